@@ -1,0 +1,194 @@
+//! Distant illumination: a constant colour or an equirectangular (lat-long) map.
+//!
+//! Orientation of maps: +y is up. Row 0 of the image is the zenith (+y), the last row the nadir.
+//! The centre column looks along -z (where the default camera looks) and `u` increases towards
+//! +x, so `u = 0.5 + atan2(d.x, -d.z) / 2π`, `v = acos(d.y) / π`.
+
+use crate::{color::luminance, distribution::Distribution2D, Rgb};
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+/// Radiance arriving from infinitely far away.
+#[derive(Clone, Debug)]
+pub enum Environment {
+    /// The same radiance from every direction.
+    Constant(Rgb),
+    /// An equirectangular map, importance sampled by luminance.
+    Map(EnvMap),
+}
+
+/// An equirectangular environment map with its sampling distribution.
+#[derive(Clone, Debug)]
+pub struct EnvMap {
+    width: u32,
+    height: u32,
+    texels: Vec<Rgb>,
+    dist: Distribution2D,
+}
+
+impl EnvMap {
+    /// Builds from row-major linear radiance (already multiplied by any strength). Non-finite and
+    /// negative texels must have been rejected by the caller.
+    pub fn new(width: u32, height: u32, texels: Vec<Rgb>) -> Self {
+        let (w, h) = (width as usize, height as usize);
+        // Weight by sinθ: rows near the poles cover less solid angle.
+        let weights: Vec<f32> = (0..h)
+            .flat_map(|y| {
+                let sin_t = (PI * (y as f32 + 0.5) / h as f32).sin();
+                let texels = &texels;
+                (0..w).map(move |x| luminance(texels[y * w + x]).max(0.0) * sin_t)
+            })
+            .collect();
+        let dist = Distribution2D::new(&weights, w, h);
+        Self {
+            width,
+            height,
+            texels,
+            dist,
+        }
+    }
+
+    fn texel(&self, uv: Vec2) -> Rgb {
+        let x = ((uv.x * self.width as f32) as u32).min(self.width - 1);
+        let y = ((uv.y * self.height as f32) as u32).min(self.height - 1);
+        self.texels[(y * self.width + x) as usize]
+    }
+}
+
+/// Direction to map coordinates.
+#[inline]
+pub fn dir_to_uv(d: Vec3) -> Vec2 {
+    let d = d.normalize();
+    let u = 0.5 + d.x.atan2(-d.z) / (2.0 * PI);
+    let v = d.y.clamp(-1.0, 1.0).acos() / PI;
+    Vec2::new(u.clamp(0.0, 1.0), v.clamp(0.0, 1.0))
+}
+
+/// Map coordinates to a unit direction.
+#[inline]
+pub fn uv_to_dir(uv: Vec2) -> Vec3 {
+    let phi = (uv.x - 0.5) * 2.0 * PI;
+    let theta = uv.y * PI;
+    let s = theta.sin();
+    Vec3::new(s * phi.sin(), theta.cos(), -s * phi.cos())
+}
+
+/// A direction sampled on the environment.
+#[derive(Clone, Copy, Debug)]
+pub struct EnvSample {
+    /// Unit direction towards the environment.
+    pub dir: Vec3,
+    /// Radiance arriving from `dir`.
+    pub radiance: Rgb,
+    /// Solid-angle pdf.
+    pub pdf: f32,
+}
+
+impl Environment {
+    /// Radiance arriving along direction `-d`, i.e. seen by a ray travelling along `d`.
+    #[inline]
+    pub fn radiance(&self, d: Vec3) -> Rgb {
+        match self {
+            Environment::Constant(c) => *c,
+            Environment::Map(m) => m.texel(dir_to_uv(d)),
+        }
+    }
+
+    /// True if the environment emits nothing (so it need not be sampled).
+    pub fn is_black(&self) -> bool {
+        match self {
+            Environment::Constant(c) => c.max_element() <= 0.0,
+            Environment::Map(m) => m.dist.integral() <= 0.0,
+        }
+    }
+
+    /// Samples an incident direction: uniformly over the sphere for a constant colour, by
+    /// luminance for a map.
+    #[inline]
+    pub fn sample(&self, u: Vec2) -> Option<EnvSample> {
+        match self {
+            Environment::Constant(c) => {
+                let dir = crate::sampling::uniform_sphere(u);
+                Some(EnvSample {
+                    dir,
+                    radiance: *c,
+                    pdf: crate::sampling::UNIFORM_SPHERE_PDF,
+                })
+            }
+            Environment::Map(m) => {
+                let (uv, pdf_uv) = m.dist.sample(u);
+                let sin_t = (uv.y * PI).sin();
+                if pdf_uv <= 0.0 || sin_t <= 0.0 {
+                    return None;
+                }
+                Some(EnvSample {
+                    dir: uv_to_dir(uv),
+                    radiance: m.texel(uv),
+                    pdf: pdf_uv / (2.0 * PI * PI * sin_t),
+                })
+            }
+        }
+    }
+
+    /// Solid-angle pdf with which [`Environment::sample`] returns direction `d`.
+    #[inline]
+    pub fn pdf(&self, d: Vec3) -> f32 {
+        match self {
+            Environment::Constant(_) => crate::sampling::UNIFORM_SPHERE_PDF,
+            Environment::Map(m) => {
+                let uv = dir_to_uv(d);
+                let sin_t = (uv.y * PI).sin();
+                if sin_t <= 0.0 {
+                    return 0.0;
+                }
+                m.dist.pdf(uv) / (2.0 * PI * PI * sin_t)
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uv_mapping_round_trips_and_is_oriented_as_documented() {
+        assert!((uv_to_dir(Vec2::new(0.5, 0.5)) - Vec3::new(0.0, 0.0, -1.0)).length() < 1e-6);
+        assert!(uv_to_dir(Vec2::new(0.75, 0.5)).x > 0.99);
+        assert!(uv_to_dir(Vec2::new(0.3, 0.0)).y > 0.99);
+        for d in [Vec3::new(0.3, 0.5, -0.2), Vec3::new(-0.8, -0.1, 0.4)] {
+            let d = d.normalize();
+            assert!((uv_to_dir(dir_to_uv(d)) - d).length() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn map_sampling_pdf_is_consistent_and_integrates_to_one() {
+        let (w, h) = (16u32, 8u32);
+        let texels = (0..w * h)
+            .map(|i| Rgb::splat(1.0 + (i % 7) as f32))
+            .collect();
+        let env = Environment::Map(EnvMap::new(w, h, texels));
+        for i in 0..64 {
+            let u = Vec2::new(
+                (i as f32 * 0.618_034 + 0.05) % 1.0,
+                (i as f32 * 0.414_214 + 0.1) % 1.0,
+            );
+            let s = env.sample(u).unwrap();
+            let p = env.pdf(s.dir);
+            assert!((p - s.pdf).abs() <= 2e-3 * s.pdf, "{p} vs {}", s.pdf);
+        }
+        // ∫ pdf dω = 1 by a uniform-sphere estimate with a fixed stratified set.
+        let n = 256;
+        let mut sum = 0.0;
+        for i in 0..n {
+            for j in 0..n {
+                let u = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+                sum += env.pdf(crate::sampling::uniform_sphere(u))
+                    / crate::sampling::UNIFORM_SPHERE_PDF;
+            }
+        }
+        let mean = sum / (n * n) as f32;
+        assert!((mean - 1.0).abs() < 0.02, "{mean}");
+    }
+}

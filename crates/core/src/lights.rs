@@ -1,0 +1,147 @@
+//! Light sampling: emissive triangles chosen in proportion to their power (thesis §2.3.5), and
+//! the environment.
+
+use crate::{
+    color::luminance, distribution::Distribution1D, sampling::uniform_triangle, triangle, Rgb,
+    Scene,
+};
+use glam::{Vec2, Vec3};
+
+/// Chooses lights for next-event estimation.
+#[derive(Clone, Debug, Default)]
+pub struct LightSampler {
+    emitters: Vec<u32>,
+    dist: Option<Distribution1D>,
+    total_power: f32,
+    env_prob: f32,
+}
+
+/// A point (or direction) on a light, as seen from a shading point.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Unit direction from the shading point to the light.
+    pub wi: Vec3,
+    /// Point on the light (for triangles) — the shadow ray's target.
+    pub point: Vec3,
+    /// Unit front normal of the light triangle (zero for the environment).
+    pub normal: Vec3,
+    /// Distance to the light point (`f32::INFINITY` for the environment).
+    pub dist: f32,
+    /// Radiance arriving from the light along `-wi`.
+    pub le: Rgb,
+    /// Solid-angle pdf of `wi`, including the probability of choosing this light.
+    pub pdf: f32,
+}
+
+fn triangle_power(scene: &Scene, prim: u32) -> f32 {
+    let m = scene.material_of(prim);
+    triangle::area(&scene.triangles[prim as usize]) * luminance(m.emission) * m.emitting_faces()
+}
+
+impl LightSampler {
+    /// Collects the emissive triangles of `scene` and weighs them by power.
+    pub fn build(scene: &Scene) -> Self {
+        let emitters: Vec<u32> = (0..scene.triangles.len() as u32)
+            .filter(|&i| scene.material_of(i).is_emissive() && triangle_power(scene, i) > 0.0)
+            .collect();
+        let powers: Vec<f32> = emitters.iter().map(|&i| triangle_power(scene, i)).collect();
+        let total_power: f32 = powers.iter().map(|&p| p as f64).sum::<f64>() as f32;
+        let has_tris = total_power > 0.0;
+        let has_env = !scene.environment.is_black();
+        // Without a cheap estimate of how much of the environment a point sees, split evenly.
+        let env_prob = match (has_tris, has_env) {
+            (true, true) => 0.5,
+            (false, true) => 1.0,
+            _ => 0.0,
+        };
+        Self {
+            dist: has_tris.then(|| Distribution1D::new(&powers)),
+            emitters,
+            total_power,
+            env_prob,
+        }
+    }
+
+    /// True if there is anything to sample.
+    pub fn is_empty(&self) -> bool {
+        self.dist.is_none() && self.env_prob == 0.0
+    }
+
+    /// Number of emissive triangles.
+    pub fn emitter_count(&self) -> usize {
+        self.emitters.len()
+    }
+
+    /// Samples a light as seen from `x`. `None` if the chosen point cannot contribute (back face
+    /// of a one-sided emitter, grazing angle, zero pdf).
+    pub fn sample(&self, scene: &Scene, x: Vec3, u_sel: f32, u: Vec2) -> Option<LightSample> {
+        if u_sel < self.env_prob {
+            let s = scene.environment.sample(u)?;
+            return Some(LightSample {
+                wi: s.dir,
+                point: Vec3::ZERO,
+                normal: Vec3::ZERO,
+                dist: f32::INFINITY,
+                le: s.radiance,
+                pdf: s.pdf * self.env_prob,
+            });
+        }
+        let dist = self.dist.as_ref()?;
+        let u_tri = ((u_sel - self.env_prob) / (1.0 - self.env_prob)).clamp(0.0, 0.999_999_94);
+        let (k, pmf, _) = dist.sample_discrete(u_tri);
+        let prim = self.emitters[k];
+        let v = &scene.triangles[prim as usize];
+        let (b1, b2) = uniform_triangle(u);
+        let p = triangle::point_at(v, b1, b2);
+        let n_raw = triangle::geometric_normal(v);
+        let area = 0.5 * n_raw.length();
+        let n = n_raw / (2.0 * area);
+        let d = p - x;
+        let dist2 = d.length_squared();
+        if dist2 <= 0.0 || !dist2.is_finite() {
+            return None;
+        }
+        let r = dist2.sqrt();
+        let wi = d / r;
+        let le = scene.material_of(prim).emitted(n, -wi);
+        let cos_l = n.dot(wi).abs();
+        if cos_l <= 0.0 || le.max_element() <= 0.0 {
+            return None;
+        }
+        let pdf = pmf * (1.0 - self.env_prob) * dist2 / (area * cos_l);
+        Some(LightSample {
+            wi,
+            point: p,
+            normal: n,
+            dist: r,
+            le,
+            pdf,
+        })
+    }
+
+    /// Solid-angle pdf with which [`LightSampler::sample`] picks point `p` on emissive triangle
+    /// `prim` from `x`; `ng` is the triangle's unit normal.
+    pub fn pdf_triangle(&self, scene: &Scene, prim: u32, x: Vec3, p: Vec3, ng: Vec3) -> f32 {
+        if self.total_power <= 0.0 {
+            return 0.0;
+        }
+        let v = &scene.triangles[prim as usize];
+        let area = triangle::area(v);
+        let d = p - x;
+        let dist2 = d.length_squared();
+        let cos_l = ng.dot(d).abs() / dist2.sqrt();
+        if area <= 0.0 || cos_l <= 0.0 {
+            return 0.0;
+        }
+        let pmf = triangle_power(scene, prim) / self.total_power;
+        pmf * (1.0 - self.env_prob) * dist2 / (area * cos_l)
+    }
+
+    /// Solid-angle pdf of sampling environment direction `d`.
+    pub fn pdf_env(&self, scene: &Scene, d: Vec3) -> f32 {
+        if self.env_prob == 0.0 {
+            return 0.0;
+        }
+        self.env_prob * scene.environment.pdf(d)
+    }
+}

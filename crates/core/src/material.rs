@@ -1,0 +1,647 @@
+//! The layered material model of Dammertz (2011, §2.3.4) and its BSDF.
+//!
+//! A material is a weighted stack of layers. Each layer has a colour at normal incidence `C0`, a
+//! colour at grazing incidence `C90` (interpolated with Schlick's weight `(1 - cos)^5`), a
+//! hardness `κ ∈ [0, 1]` and optionally transmission with an index of refraction. One random
+//! number picks the layer and, for a transmitting layer, reflection or refraction by the
+//! dielectric Fresnel term.
+//!
+//! Lobes, by hardness:
+//! - `κ = 0`: Lambertian.
+//! - `0 < κ < 1`: normalised Blinn–Phong with exponent `k = 1024κ + 1`. The thesis' Eq. 2.1 divides
+//!   by `⟨n,ωo⟩` only and normalises with `(k+2)/2`, which reflects more energy than it receives
+//!   at grazing angles. We use the reciprocal Ashikhmin–Shirley form
+//!   `f = (k+1)/(8π) · cos^k θh / (⟨h,ωo⟩ · max(cos θi, cos θo))`, whose sampling weight is
+//!   `cos θi / max(cos θi, cos θo) ≤ 1`: energy conserving at every angle, and converging to the
+//!   mirror as κ → 1.
+//! - `κ = 1`: a perfect mirror (or, with transmission, smooth glass): a delta lobe.
+//! - Transmission with `κ < 1` is rough glass: a microfacet normal is drawn from the Blinn–Phong
+//!   distribution, and the exact dielectric Fresnel term at that microfacet chooses reflection or
+//!   refraction (Snell's law). Its BSDF is defined by that sampling procedure
+//!   (`f·|cos θi| = C · pdf`), which makes every sample's weight exactly the layer colour: no
+//!   energy is created, and only directions that the microfacet sends to the wrong side are lost.
+//!
+//! Layer weights: the layers form a mixture `f = Σ ωᵢ fᵢ` with `Σ ωᵢ ≤ 1`; what is missing to 1
+//! is absorbed. A layer marked `coat` (a clear coat, as in the `plastic` preset) takes the
+//! Schlick-Fresnel share `F(θo)` of its weight for its ior and passes `1 - F(θo)` of the energy
+//! to the layers below it. Like the thesis' Fresnel colour interpolation this is not reciprocal;
+//! a path tracer does not need reciprocity.
+//!
+//! Radiance crossing into a medium of relative index η is scaled by `1/η²` (radiance, not
+//! importance, is transported by the camera paths here).
+
+use crate::{
+    frame::Frame,
+    sampling::{blinn_phong_half, blinn_phong_half_pdf, cosine_hemisphere},
+    Rgb,
+};
+use glam::{Vec2, Vec3};
+use std::f32::consts::{FRAC_1_PI, PI};
+
+/// Most layers a material may have: the BSDF keeps per-layer weights in a fixed array so that
+/// shading never allocates.
+pub const MAX_LAYERS: usize = 8;
+
+/// Hardness below which a layer counts as diffuse for path-space partitioning (thesis §2.3.4;
+/// the Fig. 6.23 caption's "2" is a misprint).
+pub const DIFFUSE_HARDNESS_THRESHOLD: f32 = 0.2;
+
+/// One layer of a material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Layer {
+    /// Mixture weight in [0, 1].
+    pub weight: f32,
+    /// Colour at normal incidence, C0.
+    pub color: Rgb,
+    /// Colour at grazing incidence, C90.
+    pub color90: Rgb,
+    /// Hardness κ in [0, 1]: 0 Lambertian, 1 perfect mirror or smooth glass.
+    pub hardness: f32,
+    /// Refracts through the surface instead of only reflecting.
+    pub transmission: bool,
+    /// Index of refraction inside the surface (the side opposite the front face), for
+    /// transmission and for coats.
+    pub ior: f32,
+    /// A Fresnel-weighted clear coat over the layers after it.
+    pub coat: bool,
+}
+
+impl Layer {
+    /// A layer with colour `c` at all angles.
+    pub fn new(weight: f32, c: Rgb, hardness: f32) -> Self {
+        Self {
+            weight,
+            color: c,
+            color90: c,
+            hardness,
+            transmission: false,
+            ior: 1.5,
+            coat: false,
+        }
+    }
+
+    /// True for the delta lobes (mirror, smooth glass).
+    #[inline]
+    pub fn is_delta(&self) -> bool {
+        self.hardness >= 1.0
+    }
+
+    /// True if this layer counts as diffuse (κ < 0.2).
+    #[inline]
+    pub fn is_diffuse(&self) -> bool {
+        self.hardness < DIFFUSE_HARDNESS_THRESHOLD
+    }
+
+    #[inline]
+    fn exponent(&self) -> f32 {
+        1024.0 * self.hardness + 1.0
+    }
+
+    #[inline]
+    fn color_at(&self, cos: f32, tint: Rgb) -> Rgb {
+        let w = (1.0 - cos.clamp(0.0, 1.0)).powi(5);
+        let c = self.color + (self.color90 - self.color) * w;
+        if self.coat {
+            c
+        } else {
+            c * tint
+        }
+    }
+}
+
+/// A material: a layer stack plus emission.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Name from the scene.
+    pub name: String,
+    /// Layers, top first.
+    pub layers: Vec<Layer>,
+    /// Emitted radiance (zero for non-emitters).
+    pub emission: Rgb,
+    /// Emit from both faces instead of the front (counter-clockwise) face only.
+    pub two_sided: bool,
+    /// Texture (index into `Scene::textures`) that modulates every non-coat layer's colours.
+    pub texture: Option<u32>,
+}
+
+/// A material parameter outside its valid range.
+#[derive(Debug, thiserror::Error, PartialEq)]
+#[non_exhaustive]
+pub enum MaterialError {
+    /// More layers than [`MAX_LAYERS`].
+    #[error("has {0} layers; at most {MAX_LAYERS} are supported")]
+    TooManyLayers(usize),
+    /// A value outside its range.
+    #[error("layer {layer}: {what}")]
+    Layer {
+        /// Index of the layer.
+        layer: usize,
+        /// What is wrong.
+        what: String,
+    },
+    /// Non-coat weights sum to more than one.
+    #[error(
+        "layer weights (excluding coats) sum to {0}, more than 1: the material would create energy"
+    )]
+    WeightSum(f32),
+    /// Bad emission.
+    #[error("emission must be finite and non-negative, got {0:?}")]
+    Emission([f32; 3]),
+}
+
+fn check_color(c: Rgb, what: &str, layer: usize) -> Result<(), MaterialError> {
+    if !c.is_finite() || c.min_element() < 0.0 || c.max_element() > 1.0 {
+        return Err(MaterialError::Layer {
+            layer,
+            what: format!(
+                "{what} must be in [0, 1] (a reflectance), got {:?}",
+                c.to_array()
+            ),
+        });
+    }
+    Ok(())
+}
+
+impl Material {
+    fn with_layers(name: &str, layers: Vec<Layer>) -> Self {
+        Self {
+            name: name.to_string(),
+            layers,
+            emission: Rgb::ZERO,
+            two_sided: false,
+            texture: None,
+        }
+    }
+
+    /// Lambertian reflector.
+    pub fn diffuse(name: &str, color: Rgb) -> Self {
+        Self::with_layers(name, vec![Layer::new(1.0, color, 0.0)])
+    }
+
+    /// Perfect mirror.
+    pub fn mirror(name: &str, color: Rgb) -> Self {
+        Self::with_layers(name, vec![Layer::new(1.0, color, 1.0)])
+    }
+
+    /// Glass: smooth for `hardness = 1`, frosted below.
+    pub fn glass(name: &str, color: Rgb, ior: f32, hardness: f32) -> Self {
+        let mut l = Layer::new(1.0, color, hardness);
+        l.transmission = true;
+        l.ior = ior;
+        Self::with_layers(name, vec![l])
+    }
+
+    /// A single glossy Blinn–Phong layer.
+    pub fn glossy(name: &str, color: Rgb, hardness: f32) -> Self {
+        Self::with_layers(name, vec![Layer::new(1.0, color, hardness)])
+    }
+
+    /// Metal: glossy layer whose colour goes to white at grazing angles (Schlick's approximation
+    /// of conductor Fresnel with `C0 = color`).
+    pub fn metal(name: &str, color: Rgb, hardness: f32) -> Self {
+        let mut l = Layer::new(1.0, color, hardness);
+        l.color90 = Rgb::ONE;
+        Self::with_layers(name, vec![l])
+    }
+
+    /// Plastic: a white Fresnel clear coat of the given hardness and ior over a Lambertian base.
+    pub fn plastic(name: &str, color: Rgb, hardness: f32, ior: f32) -> Self {
+        let mut coat = Layer::new(1.0, Rgb::ONE, hardness);
+        coat.coat = true;
+        coat.ior = ior;
+        Self::with_layers(name, vec![coat, Layer::new(1.0, color, 0.0)])
+    }
+
+    /// Checks every parameter's range.
+    pub fn validate(&self) -> Result<(), MaterialError> {
+        if self.layers.len() > MAX_LAYERS {
+            return Err(MaterialError::TooManyLayers(self.layers.len()));
+        }
+        let e = self.emission;
+        if !e.is_finite() || e.min_element() < 0.0 {
+            return Err(MaterialError::Emission(e.to_array()));
+        }
+        let mut sum = 0.0;
+        for (i, l) in self.layers.iter().enumerate() {
+            let bad = |what: String| Err(MaterialError::Layer { layer: i, what });
+            if !(0.0..=1.0).contains(&l.weight) {
+                return bad(format!("weight must be in [0, 1], got {}", l.weight));
+            }
+            if !(0.0..=1.0).contains(&l.hardness) {
+                return bad(format!("hardness must be in [0, 1], got {}", l.hardness));
+            }
+            if !(l.ior.is_finite() && l.ior > 0.0) {
+                return bad(format!("ior must be a positive number, got {}", l.ior));
+            }
+            if l.coat && l.transmission {
+                return bad("a layer cannot be both a coat and transmissive".into());
+            }
+            check_color(l.color, "color", i)?;
+            check_color(l.color90, "color90", i)?;
+            if !l.coat {
+                sum += l.weight;
+            }
+        }
+        if sum > 1.0 + 1e-4 {
+            return Err(MaterialError::WeightSum(sum));
+        }
+        Ok(())
+    }
+
+    /// True if the material emits.
+    pub fn is_emissive(&self) -> bool {
+        self.emission.max_element() > 0.0
+    }
+
+    /// Radiance emitted towards `wo` from a surface with front-facing geometric normal `ng`.
+    #[inline]
+    pub fn emitted(&self, ng: Vec3, wo: Vec3) -> Rgb {
+        if self.two_sided || ng.dot(wo) > 0.0 {
+            self.emission
+        } else {
+            Rgb::ZERO
+        }
+    }
+
+    /// Number of faces that emit (for light power).
+    pub fn emitting_faces(&self) -> f32 {
+        if self.two_sided {
+            2.0
+        } else {
+            1.0
+        }
+    }
+}
+
+/// Result of sampling a BSDF.
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    /// Sampled incident direction (world space, unit).
+    pub wi: Vec3,
+    /// `f · |cos θi| / pdf`: what the path throughput is multiplied by.
+    pub weight: Rgb,
+    /// Solid-angle pdf of `wi` for non-delta samples (for MIS); for delta samples, the
+    /// discrete probability of the chosen lobe.
+    pub pdf: f32,
+    /// The sample came from a delta lobe (mirror, smooth glass).
+    pub delta: bool,
+    /// The direction crossed the surface.
+    pub transmitted: bool,
+}
+
+/// A material evaluated at one surface point for one outgoing direction.
+///
+/// Built per path vertex; holds the per-layer weights for `wo` in a fixed array, so building
+/// and using it never allocates.
+pub struct Bsdf<'a> {
+    layers: &'a [Layer],
+    tint: Rgb,
+    frame: Frame,
+    ng: Vec3,
+    wo: Vec3,
+    wo_local: Vec3,
+    weights: [f32; MAX_LAYERS],
+    total: f32,
+    has_non_delta: bool,
+}
+
+impl<'a> Bsdf<'a> {
+    /// Builds the BSDF of `material` with texture `tint` at a point with unit shading normal `ns`
+    /// and unit geometric normal `ng` (both on the front side), for outgoing direction `wo` (unit,
+    /// pointing away from the surface).
+    pub fn new(material: &'a Material, tint: Rgb, ns: Vec3, ng: Vec3, wo: Vec3) -> Self {
+        let frame = Frame::from_normal(ns);
+        let wo_local = frame.to_local(wo);
+        let mut weights = [0.0f32; MAX_LAYERS];
+        let mut passed = 1.0f32;
+        let cos_o = wo_local.z.abs();
+        let mut has_non_delta = false;
+        for (w, l) in weights.iter_mut().zip(&material.layers) {
+            if l.coat {
+                let f0 = ((l.ior - 1.0) / (l.ior + 1.0)).powi(2);
+                let f = f0 + (1.0 - f0) * (1.0 - cos_o).powi(5);
+                *w = passed * l.weight * f;
+                passed *= 1.0 - f;
+            } else {
+                *w = passed * l.weight;
+            }
+            has_non_delta |= *w > 0.0 && !l.is_delta();
+        }
+        let total = weights.iter().sum();
+        Self {
+            layers: &material.layers,
+            tint,
+            frame,
+            ng,
+            wo,
+            wo_local,
+            weights,
+            total,
+            has_non_delta,
+        }
+    }
+
+    /// True if some non-delta lobe has weight, i.e. light sampling can contribute.
+    #[inline]
+    pub fn has_non_delta(&self) -> bool {
+        self.has_non_delta
+    }
+
+    /// Reflectance at normal incidence summed over layers: the albedo AOV.
+    pub fn albedo(&self) -> Rgb {
+        self.layers
+            .iter()
+            .zip(&self.weights)
+            .map(|(l, &w)| l.color_at(1.0, self.tint) * w)
+            .sum()
+    }
+
+    /// True if `wi` is geometrically consistent with `wo` for reflection (same side of both the
+    /// geometric and the shading surface) or transmission (opposite sides). Checking both normals
+    /// stops interpolated normals from leaking light through the surface.
+    #[inline]
+    fn sides(&self, wi: Vec3, wi_local: Vec3) -> Option<bool> {
+        let geo_same = (wi.dot(self.ng) > 0.0) == (self.wo.dot(self.ng) > 0.0);
+        let sh_same = (wi_local.z > 0.0) == (self.wo_local.z > 0.0);
+        if wi_local.z == 0.0 || geo_same != sh_same {
+            return None;
+        }
+        Some(geo_same)
+    }
+
+    /// BSDF value `f(wo, wi)` summed over the non-delta layers (world-space unit `wi`).
+    pub fn eval(&self, wi: Vec3) -> Rgb {
+        self.eval_pdf(wi).0
+    }
+
+    /// Solid-angle pdf with which [`Bsdf::sample`] produces `wi` (non-delta lobes only).
+    pub fn pdf(&self, wi: Vec3) -> f32 {
+        self.eval_pdf(wi).1
+    }
+
+    /// `(f, pdf)` in one pass.
+    pub fn eval_pdf(&self, wi: Vec3) -> (Rgb, f32) {
+        if self.total <= 0.0 {
+            return (Rgb::ZERO, 0.0);
+        }
+        let wi_local = self.frame.to_local(wi);
+        let Some(reflect) = self.sides(wi, wi_local) else {
+            return (Rgb::ZERO, 0.0);
+        };
+        let mut f = Rgb::ZERO;
+        let mut pdf = 0.0;
+        for (l, &w) in self.layers.iter().zip(&self.weights) {
+            if w <= 0.0 || l.is_delta() {
+                continue;
+            }
+            let (fl, pl) = eval_layer(l, self.tint, self.wo_local, wi_local, reflect);
+            f += fl * w;
+            pdf += pl * (w / self.total);
+        }
+        (f, pdf)
+    }
+
+    /// Samples an incident direction. `u_layer` picks the layer and (reused after rescaling) the
+    /// reflection/refraction branch; `u` samples the lobe.
+    pub fn sample(&self, u_layer: f32, u: Vec2) -> Option<BsdfSample> {
+        if self.total <= 0.0 {
+            return None;
+        }
+        // Pick a layer in proportion to its weight; rounding past the end lands on the last
+        // layer with weight.
+        let mut target = u_layer * self.total;
+        let mut chosen = None;
+        for (i, &w) in self.weights.iter().enumerate().take(self.layers.len()) {
+            if w <= 0.0 {
+                continue;
+            }
+            chosen = Some((i, (target / w).clamp(0.0, 0.999_999_94)));
+            if target < w {
+                break;
+            }
+            target -= w;
+        }
+        let (i, u_rest) = chosen?;
+        let l = &self.layers[i];
+        let wo = self.wo_local;
+        let (wi_local, delta_weight) = if l.is_delta() {
+            let (wi, scale) = sample_delta(l, wo, u_rest)?;
+            (
+                wi,
+                Some(l.color_at(wo.z.abs(), self.tint) * (self.total * scale)),
+            )
+        } else {
+            (sample_lobe(l, wo, u_rest, u)?, None)
+        };
+        let wi = self.frame.to_world(wi_local).normalize();
+        let reflect = self.sides(wi, wi_local)?;
+        if let Some(weight) = delta_weight {
+            return Some(BsdfSample {
+                wi,
+                weight,
+                pdf: self.weights[i] / self.total,
+                delta: true,
+                transmitted: !reflect,
+            });
+        }
+        let (f, pdf) = self.eval_pdf(wi);
+        if pdf <= 0.0 || !pdf.is_finite() {
+            return None;
+        }
+        Some(BsdfSample {
+            wi,
+            weight: f * (wi_local.z.abs() / pdf),
+            pdf,
+            delta: false,
+            transmitted: !reflect,
+        })
+    }
+}
+
+/// Dielectric Fresnel reflectance for cosine `cos_i ≥ 0` on the incident side and relative index
+/// `eta = η_transmitted / η_incident`.
+#[inline]
+pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
+    let cos_i = cos_i.clamp(0.0, 1.0);
+    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    0.5 * (r_par * r_par + r_perp * r_perp)
+}
+
+/// Refracts `wo` (pointing away from the surface, on the side of unit normal `n`, `wo·n > 0`)
+/// with relative index `eta`; `None` on total internal reflection.
+#[inline]
+pub fn refract(wo: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
+    let cos_i = wo.dot(n);
+    let sin2_t = (1.0 - cos_i * cos_i).max(0.0) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    Some(-wo / eta + n * (cos_i / eta - cos_t))
+}
+
+/// Relative index `η_transmitted / η_incident` for light leaving towards `wo_local`.
+#[inline]
+fn relative_eta(l: &Layer, wo_local: Vec3) -> f32 {
+    if wo_local.z > 0.0 {
+        l.ior
+    } else {
+        1.0 / l.ior
+    }
+}
+
+/// Samples a delta lobe; returns the local direction and the weight factor besides the colour
+/// (Fresnel branch probabilities cancel; refraction carries `1/η²`).
+fn sample_delta(l: &Layer, wo: Vec3, u: f32) -> Option<(Vec3, f32)> {
+    let mirror = Vec3::new(-wo.x, -wo.y, wo.z);
+    if !l.transmission {
+        return Some((mirror, 1.0));
+    }
+    let eta = relative_eta(l, wo);
+    let f = fresnel_dielectric(wo.z.abs(), eta);
+    if u < f {
+        return Some((mirror, 1.0));
+    }
+    let n = Vec3::new(0.0, 0.0, wo.z.signum());
+    let wi = refract(wo, n, eta)?;
+    Some((wi.normalize(), 1.0 / (eta * eta)))
+}
+
+/// Samples a non-delta lobe (local space).
+fn sample_lobe(l: &Layer, wo: Vec3, u_branch: f32, u: Vec2) -> Option<Vec3> {
+    let side = if wo.z >= 0.0 { 1.0 } else { -1.0 };
+    if l.hardness <= 0.0 && !l.transmission {
+        let d = cosine_hemisphere(u);
+        return Some(Vec3::new(d.x, d.y, d.z * side));
+    }
+    let h = blinn_phong_half(u, l.exponent());
+    let h = Vec3::new(h.x, h.y, h.z * side);
+    let cos_oh = wo.dot(h);
+    if cos_oh <= 0.0 {
+        return None;
+    }
+    let reflected = 2.0 * cos_oh * h - wo;
+    if !l.transmission {
+        return (reflected.z * side > 0.0).then_some(reflected);
+    }
+    let eta = relative_eta(l, wo);
+    if u_branch < fresnel_dielectric(cos_oh, eta) {
+        return (reflected.z * side > 0.0).then_some(reflected);
+    }
+    let wi = refract(wo, h, eta)?;
+    (wi.z * side < 0.0).then(|| wi.normalize())
+}
+
+/// `(f, pdf)` of one non-delta layer for local directions, given whether they are on the same
+/// side (`reflect`).
+fn eval_layer(l: &Layer, tint: Rgb, wo: Vec3, wi: Vec3, reflect: bool) -> (Rgb, f32) {
+    let (co, ci) = (wo.z.abs(), wi.z.abs());
+    if l.hardness <= 0.0 && !l.transmission {
+        if !reflect {
+            return (Rgb::ZERO, 0.0);
+        }
+        return (l.color_at(co, tint) * FRAC_1_PI, ci * FRAC_1_PI);
+    }
+    let k = l.exponent();
+    let side = if wo.z >= 0.0 { 1.0 } else { -1.0 };
+    if reflect {
+        let h = (wo + wi).normalize();
+        let h = if h.z * side < 0.0 { -h } else { h };
+        let cos_oh = wo.dot(h);
+        if cos_oh <= 0.0 {
+            return (Rgb::ZERO, 0.0);
+        }
+        let pdf_h = blinn_phong_half_pdf(h.z.abs(), k);
+        let pdf = pdf_h / (4.0 * cos_oh);
+        let c = l.color_at(cos_oh, tint);
+        if !l.transmission {
+            let f = (k + 1.0) / (8.0 * PI) * h.z.abs().powf(k) / (cos_oh * co.max(ci));
+            return (c * f, pdf);
+        }
+        let fr = fresnel_dielectric(cos_oh, relative_eta(l, wo));
+        return (c * (fr * pdf / ci), fr * pdf);
+    }
+    if !l.transmission {
+        return (Rgb::ZERO, 0.0);
+    }
+    let eta = relative_eta(l, wo);
+    let h = (wo + wi * eta).normalize();
+    let h = if h.z * side < 0.0 { -h } else { h };
+    let (cos_oh, cos_ih) = (wo.dot(h), wi.dot(h));
+    if cos_oh <= 0.0 || cos_ih >= 0.0 {
+        return (Rgb::ZERO, 0.0);
+    }
+    let denom = cos_oh + eta * cos_ih;
+    if denom == 0.0 {
+        return (Rgb::ZERO, 0.0);
+    }
+    let jacobian = eta * eta * cos_ih.abs() / (denom * denom);
+    let ft = 1.0 - fresnel_dielectric(cos_oh, eta);
+    let pdf = ft * blinn_phong_half_pdf(h.z.abs(), k) * jacobian;
+    let c = l.color_at(cos_oh, tint);
+    (c * (pdf / (ci * eta * eta)), pdf)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn presets_validate_and_bad_values_are_rejected() {
+        for m in [
+            Material::diffuse("d", Rgb::splat(0.5)),
+            Material::mirror("m", Rgb::ONE),
+            Material::glass("g", Rgb::ONE, 1.5, 1.0),
+            Material::glossy("y", Rgb::ONE, 0.6),
+            Material::metal("t", Rgb::splat(0.9), 0.8),
+            Material::plastic("p", Rgb::splat(0.5), 0.9, 1.5),
+        ] {
+            assert_eq!(m.validate(), Ok(()), "{}", m.name);
+        }
+        let mut m = Material::diffuse("d", Rgb::splat(0.5));
+        m.layers[0].hardness = 1.5;
+        assert!(m.validate().is_err());
+        let mut m = Material::diffuse("d", Rgb::new(f32::NAN, 0.0, 0.0));
+        assert!(m.validate().is_err());
+        m.layers = vec![
+            Layer::new(0.7, Rgb::ONE, 0.0),
+            Layer::new(0.7, Rgb::ONE, 0.5),
+        ];
+        assert!(matches!(m.validate(), Err(MaterialError::WeightSum(_))));
+    }
+
+    #[test]
+    fn fresnel_limits() {
+        assert!((fresnel_dielectric(1.0, 1.5) - 0.04).abs() < 1e-6);
+        assert!((fresnel_dielectric(0.0, 1.5) - 1.0).abs() < 1e-6);
+        assert_eq!(fresnel_dielectric(0.1, 1.0 / 1.5), 1.0);
+    }
+
+    #[test]
+    fn lambertian_sample_weight_is_the_colour() {
+        let m = Material::diffuse("d", Rgb::new(0.2, 0.5, 0.8));
+        let wo = Vec3::new(0.3, 0.1, 0.9).normalize();
+        let b = Bsdf::new(&m, Rgb::ONE, Vec3::Z, Vec3::Z, wo);
+        let s = b.sample(0.3, Vec2::new(0.4, 0.7)).unwrap();
+        assert!((s.weight - Rgb::new(0.2, 0.5, 0.8)).length() < 1e-5);
+        assert!(!s.delta && s.wi.z > 0.0);
+    }
+
+    #[test]
+    fn smooth_glass_refracts_by_snell() {
+        let m = Material::glass("g", Rgb::ONE, 1.5, 1.0);
+        let wo = Vec3::new(0.6, 0.0, 0.8);
+        let b = Bsdf::new(&m, Rgb::ONE, Vec3::Z, Vec3::Z, wo);
+        let s = b.sample(0.99, Vec2::ZERO).unwrap();
+        assert!(s.transmitted && s.delta);
+        // sin θt = sin θi / 1.5
+        assert!((s.wi.x.abs() - 0.6 / 1.5).abs() < 1e-5 && s.wi.z < 0.0);
+        assert!((s.weight.x - 1.0 / 2.25).abs() < 1e-5);
+    }
+}

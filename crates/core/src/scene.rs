@@ -1,0 +1,150 @@
+//! The runtime scene: triangles with their attributes, materials, lights, environment, cameras.
+//!
+//! This is plain data filled in by `rt-scene` (from TOML and mesh files) or by tests. Triangles
+//! are stored flat, in file order, so a triangle index is the same everywhere: in `Hit::prim`,
+//! in material associations and in the light sampler.
+
+use crate::{
+    environment::Environment, lights::LightSampler, texture::Texture, triangle, Camera, Hit,
+    Material, Rgb,
+};
+use glam::{Vec2, Vec3};
+
+/// A named group of consecutive triangles (one `[[geometry]]` entry).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Object {
+    /// Name from the scene file.
+    pub name: String,
+    /// Index of the first triangle.
+    pub first: u32,
+    /// Number of triangles.
+    pub count: u32,
+}
+
+/// Everything needed to render.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// World-space vertex positions, three per triangle.
+    pub triangles: Vec<[Vec3; 3]>,
+    /// Optional per-vertex shading normals (world space, unit), per triangle.
+    pub normals: Vec<Option<[Vec3; 3]>>,
+    /// Optional per-vertex texture coordinates, per triangle.
+    pub uvs: Vec<Option<[Vec2; 3]>>,
+    /// Material index of every triangle.
+    pub material_ids: Vec<u32>,
+    /// Materials.
+    pub materials: Vec<Material>,
+    /// Textures referenced by materials.
+    pub textures: Vec<Texture>,
+    /// Distant illumination.
+    pub environment: Environment,
+    /// Cameras; the first is the default.
+    pub cameras: Vec<Camera>,
+    /// Named triangle ranges.
+    pub objects: Vec<Object>,
+    /// Emitter sampling structure; rebuild with [`Scene::build_lights`] after changing geometry
+    /// or materials.
+    pub lights: LightSampler,
+}
+
+/// Shading information at a ray hit.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceHit {
+    /// Position, reconstructed from barycentrics.
+    pub p: Vec3,
+    /// Unit geometric normal of the front (counter-clockwise) face.
+    pub ng: Vec3,
+    /// Unit shading normal, on the same side as `ng`.
+    pub ns: Vec3,
+    /// Texture coordinates (barycentrics when the mesh has none).
+    pub uv: Vec2,
+    /// Material index.
+    pub material: u32,
+    /// Triangle index.
+    pub prim: u32,
+}
+
+impl Scene {
+    /// An empty scene with a black environment.
+    pub fn empty() -> Self {
+        Self {
+            triangles: Vec::new(),
+            normals: Vec::new(),
+            uvs: Vec::new(),
+            material_ids: Vec::new(),
+            materials: Vec::new(),
+            textures: Vec::new(),
+            environment: Environment::Constant(Rgb::ZERO),
+            cameras: Vec::new(),
+            objects: Vec::new(),
+            lights: LightSampler::default(),
+        }
+    }
+
+    /// Appends a triangle with material `material` and no shading normals or uvs.
+    pub fn push_triangle(&mut self, v: [Vec3; 3], material: u32) {
+        self.triangles.push(v);
+        self.normals.push(None);
+        self.uvs.push(None);
+        self.material_ids.push(material);
+    }
+
+    /// Rebuilds the light sampler from the emissive triangles and the environment.
+    pub fn build_lights(&mut self) {
+        self.lights = LightSampler::build(self);
+    }
+
+    /// Number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Material of triangle `prim`.
+    #[inline]
+    pub fn material_of(&self, prim: u32) -> &Material {
+        &self.materials[self.material_ids[prim as usize] as usize]
+    }
+
+    /// Shading information for a hit.
+    #[inline]
+    pub fn surface(&self, hit: &Hit) -> SurfaceHit {
+        let i = hit.prim as usize;
+        let v = &self.triangles[i];
+        let (b1, b2) = (hit.b1, hit.b2);
+        let b0 = 1.0 - b1 - b2;
+        let p = triangle::point_at(v, b1, b2);
+        let ng = triangle::geometric_normal(v).normalize_or(Vec3::Z);
+        let ns = match &self.normals[i] {
+            Some(n) => {
+                let n = (n[0] * b0 + n[1] * b1 + n[2] * b2).normalize_or(ng);
+                if n.dot(ng) < 0.0 {
+                    -n
+                } else {
+                    n
+                }
+            }
+            None => ng,
+        };
+        let uv = match &self.uvs[i] {
+            Some(t) => t[0] * b0 + t[1] * b1 + t[2] * b2,
+            None => Vec2::new(b1, b2),
+        };
+        SurfaceHit {
+            p,
+            ng,
+            ns,
+            uv,
+            material: self.material_ids[i],
+            prim: hit.prim,
+        }
+    }
+
+    /// Texture tint of material `m` at `uv` (white without a texture).
+    #[inline]
+    pub fn tint(&self, m: &Material, uv: Vec2) -> Rgb {
+        match m.texture {
+            Some(t) => self.textures[t as usize].lookup(uv),
+            None => Rgb::ONE,
+        }
+    }
+}

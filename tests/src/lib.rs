@@ -1,0 +1,1 @@
+//! Cross-crate end-to-end checks (statistical image tests). See `tests/tests/`.
