@@ -1,1 +1,78 @@
-//! placeholder
+//! `rt-integrators`: light transport estimators and the loop that drives them over the film.
+//!
+//! An [`Integrator`] estimates the radiance arriving along one camera ray; the [`driver`] owns
+//! the image loop (bands of rows in parallel with rayon, a deterministic sample stream per pixel
+//! and sample index) and writes into an `rt_film::Film`. Integrators see geometry only through
+//! `&dyn rt_core::Accel`, so they do not care which acceleration structure was built.
+//!
+//! Provided: [`PathIntegrator`] (unidirectional path tracing with next-event estimation and
+//! multiple importance sampling, Russian roulette and a bounce limit; also usable with BSDF
+//! sampling only), direct lighting (the same estimator stopped after one bounce) and
+//! [`AoIntegrator`] (ambient occlusion).
+//!
+//! Depends on `rt-core` and `rt-film`.
+#![forbid(unsafe_code)]
+
+mod ao;
+pub mod driver;
+mod path;
+
+pub use ao::AoIntegrator;
+pub use driver::{render, RenderOptions, RenderStats};
+pub use path::PathIntegrator;
+
+use rt_core::{Accel, Camera, Rgb, Sampler, Scene};
+use rt_film::FirstHit;
+
+/// What an integrator needs to trace rays: the scene, a structure to query it, the camera.
+#[derive(Clone, Copy)]
+pub struct Ctx<'a> {
+    /// Scene data.
+    pub scene: &'a Scene,
+    /// Ray queries.
+    pub accel: &'a dyn Accel,
+    /// The camera rays come from.
+    pub camera: &'a Camera,
+}
+
+/// Rays traced, for the rays-per-second report.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RayCounters {
+    /// Closest-hit queries.
+    pub rays: u64,
+    /// Occlusion queries.
+    pub shadow_rays: u64,
+}
+
+impl std::ops::AddAssign for RayCounters {
+    fn add_assign(&mut self, o: Self) {
+        self.rays += o.rays;
+        self.shadow_rays += o.shadow_rays;
+    }
+}
+
+/// Per-sample outputs besides radiance.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SampleAux {
+    /// Fill `first_hit` (only when some first-hit AOV is wanted: it costs a BSDF setup).
+    pub want_first_hit: bool,
+    /// The first visible surface, if any and if wanted.
+    pub first_hit: Option<FirstHit>,
+}
+
+/// A radiance estimator for camera rays.
+pub trait Integrator: Send + Sync {
+    /// Short name for reports.
+    fn name(&self) -> &str;
+
+    /// Estimates the radiance arriving at the camera along `ray`, drawing random numbers from
+    /// `sampler`. Must not allocate: it runs once per sample.
+    fn li(
+        &self,
+        ctx: &Ctx<'_>,
+        ray: rt_core::Ray,
+        sampler: &mut Sampler,
+        aux: &mut SampleAux,
+        counters: &mut RayCounters,
+    ) -> Rgb;
+}

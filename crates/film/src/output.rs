@@ -1,0 +1,324 @@
+//! Writing images: EXR for data, PNG for looking at. Both atomic.
+//!
+//! EXR: linear float32. The beauty image is in channels `R`, `G`, `B`; AOVs are channel groups
+//! `albedo.{R,G,B}`, `normal.{X,Y,Z}`, `depth.Z`, `position.{X,Y,Z}`, `variance.{R,G,B}`
+//! (variance of the pixel mean). Pixels that saw no surface have zero AOVs.
+//!
+//! PNG: 8-bit sRGB. The tone map is deliberately simple and documented: multiply by
+//! `2^exposure`, clamp each channel to [0, 1], apply the sRGB transfer curve.
+
+use crate::Film;
+use exr::prelude::{
+    AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec,
+    WritableImage,
+};
+use rt_core::{color::linear_to_srgb, Rgb};
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// Errors from writing or reading images.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum FilmError {
+    /// The extension is neither `.exr` nor `.png`.
+    #[error("{0}: unsupported output format (use .exr or .png)")]
+    Format(PathBuf),
+    /// File-system trouble.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// The encoder or decoder failed.
+    #[error("{path}: {message}")]
+    Codec {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+/// How to write the film.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct OutputOptions {
+    /// PNG exposure in stops.
+    pub exposure: f32,
+}
+
+/// Writes the film to `path`, choosing the format by extension (`.exr` or `.png`).
+pub fn write_image(path: &Path, film: &Film, opts: &OutputOptions) -> Result<(), FilmError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("exr") => write_atomic(path, |w| write_exr(w, film)),
+        Some("png") => write_atomic(path, |w| write_png(w, film, opts)),
+        _ => Err(FilmError::Format(path.to_path_buf())),
+    }
+}
+
+/// Writes through a temporary file in the same directory, then renames it over `path`, so
+/// readers never see a half-written image and an interrupted run leaves the old file (or none).
+fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&mut BufWriter<File>) -> Result<(), String>,
+) -> Result<(), FilmError> {
+    let io = |source| FilmError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    let result = (|| {
+        let file = File::create(&tmp).map_err(io)?;
+        let mut w = BufWriter::new(file);
+        write(&mut w).map_err(|message| FilmError::Codec {
+            path: path.to_path_buf(),
+            message,
+        })?;
+        let file = w.into_inner().map_err(|e| io(e.into_error()))?;
+        file.sync_all().map_err(io)?;
+        std::fs::rename(&tmp, path).map_err(io)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+fn channel(name: &str, values: Vec<f32>) -> AnyChannel<FlatSamples> {
+    // No NaN or Inf may reach a file: the film rejects them on entry, this is the last guard.
+    let values = values
+        .into_iter()
+        .map(|v| if v.is_finite() { v } else { 0.0 })
+        .collect();
+    AnyChannel::new(name, FlatSamples::F32(values))
+}
+
+fn rgb_channels(
+    out: &mut Vec<AnyChannel<FlatSamples>>,
+    prefix: &str,
+    names: [&str; 3],
+    img: &[Rgb],
+) {
+    for (c, n) in names.iter().enumerate() {
+        out.push(channel(
+            &format!("{prefix}{n}"),
+            img.iter().map(|p| p[c]).collect(),
+        ));
+    }
+}
+
+fn write_exr(w: &mut BufWriter<File>, film: &Film) -> Result<(), String> {
+    let mut chans = Vec::new();
+    rgb_channels(&mut chans, "", ["R", "G", "B"], &film.mean_image());
+    let aovs = film.aovs();
+    if aovs.any_first_hit() {
+        let first = film.aov_averages();
+        if aovs.albedo {
+            let v: Vec<Rgb> = first.iter().map(|h| h.albedo).collect();
+            rgb_channels(&mut chans, "albedo.", ["R", "G", "B"], &v);
+        }
+        if aovs.normal {
+            let v: Vec<Rgb> = first.iter().map(|h| h.normal).collect();
+            rgb_channels(&mut chans, "normal.", ["X", "Y", "Z"], &v);
+        }
+        if aovs.depth {
+            chans.push(channel("depth.Z", first.iter().map(|h| h.depth).collect()));
+        }
+        if aovs.position {
+            let v: Vec<Rgb> = first.iter().map(|h| h.position).collect();
+            rgb_channels(&mut chans, "position.", ["X", "Y", "Z"], &v);
+        }
+    }
+    if aovs.variance {
+        rgb_channels(
+            &mut chans,
+            "variance.",
+            ["R", "G", "B"],
+            &film.variance_image(),
+        );
+    }
+    let size = (film.width() as usize, film.height() as usize);
+    let layer = Layer::new(
+        size,
+        LayerAttributes::default(),
+        Encoding::FAST_LOSSLESS,
+        AnyChannels::sort(SmallVec::from_vec(chans)),
+    );
+    Image::from_layer(layer)
+        .write()
+        .to_buffered(w)
+        .map_err(|e| e.to_string())
+}
+
+fn write_png(w: &mut BufWriter<File>, film: &Film, opts: &OutputOptions) -> Result<(), String> {
+    let scale = 2f32.powf(opts.exposure);
+    let bytes: Vec<u8> = film
+        .mean_image()
+        .iter()
+        .flat_map(|p| p.to_array())
+        .map(|v| {
+            let v = if v.is_finite() {
+                (v * scale).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (linear_to_srgb(v) * 255.0 + 0.5) as u8
+        })
+        .collect();
+    let img = image::RgbImage::from_raw(film.width(), film.height(), bytes)
+        .ok_or("image size mismatch")?;
+    img.write_to(w, image::ImageFormat::Png)
+        .map_err(|e| e.to_string())?;
+    w.flush().map_err(|e| e.to_string())
+}
+
+/// An image read back from an EXR: named float channels of equal size.
+#[derive(Clone, Debug)]
+pub struct ExrImage {
+    /// Width.
+    pub width: usize,
+    /// Height.
+    pub height: usize,
+    /// Channels by full name (e.g. `R`, `albedo.G`), row-major.
+    pub channels: Vec<(String, Vec<f32>)>,
+}
+
+impl ExrImage {
+    /// A channel by name.
+    pub fn channel(&self, name: &str) -> Option<&[f32]> {
+        self.channels
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| v.as_slice())
+    }
+
+    /// The `R`, `G`, `B` channels (with optional `prefix`, e.g. `"variance."`) as pixels.
+    pub fn rgb(&self, prefix: &str) -> Option<Vec<Rgb>> {
+        let r = self.channel(&format!("{prefix}R"))?;
+        let g = self.channel(&format!("{prefix}G"))?;
+        let b = self.channel(&format!("{prefix}B"))?;
+        Some((0..r.len()).map(|i| Rgb::new(r[i], g[i], b[i])).collect())
+    }
+}
+
+/// Reads every channel of the first layer of an EXR file as f32.
+pub fn read_exr(path: &Path) -> Result<ExrImage, FilmError> {
+    use exr::prelude::{read, ReadChannels, ReadLayers};
+    let err = |e: exr::error::Error| FilmError::Codec {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    let img = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_file(path)
+        .map_err(err)?;
+    let layer = img.layer_data;
+    let channels = layer
+        .channel_data
+        .list
+        .into_iter()
+        .map(|c| {
+            let v: Vec<f32> = c.sample_data.values_as_f32().collect();
+            (c.name.to_string(), v)
+        })
+        .collect();
+    Ok(ExrImage {
+        width: layer.size.0,
+        height: layer.size.1,
+        channels,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{AovSet, FirstHit};
+
+    fn small_film() -> Film {
+        let mut film = Film::new(
+            4,
+            3,
+            AovSet {
+                albedo: true,
+                depth: true,
+                variance: true,
+                ..Default::default()
+            },
+        );
+        for mut s in film.stripes_mut(1) {
+            for x in 0..4 {
+                let y = s.y0;
+                let hit = FirstHit {
+                    albedo: Rgb::splat(0.5),
+                    depth: 3.0,
+                    ..Default::default()
+                };
+                s.add_sample(x, y, 0, Rgb::new(x as f32, y as f32, 1.0), Some(&hit));
+                s.add_sample(x, y, 1, Rgb::new(x as f32, y as f32, 3.0), Some(&hit));
+            }
+        }
+        film
+    }
+
+    #[test]
+    fn exr_round_trips_beauty_and_aovs() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("a.exr");
+        write_image(&p, &small_film(), &OutputOptions::default()).unwrap();
+        let img = read_exr(&p).unwrap();
+        assert_eq!((img.width, img.height), (4, 3));
+        let rgb = img.rgb("").unwrap();
+        assert_eq!(rgb[4 + 2], Rgb::new(2.0, 1.0, 2.0));
+        assert_eq!(img.channel("depth.Z").unwrap()[5], 3.0);
+        assert_eq!(img.rgb("albedo.").unwrap()[0], Rgb::splat(0.5));
+        assert_eq!(img.rgb("variance.").unwrap()[0].z, 1.0);
+        assert!(img.channel("normal.X").is_none());
+        // No temporary file is left behind.
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn png_is_written_and_bad_extension_or_directory_fail_cleanly() {
+        let dir = tempfile::tempdir().unwrap();
+        write_image(
+            &dir.path().join("a.png"),
+            &small_film(),
+            &OutputOptions::default(),
+        )
+        .unwrap();
+        let img = image::open(dir.path().join("a.png")).unwrap().to_rgb8();
+        assert_eq!(img.get_pixel(1, 0).0, [255, 0, 255]);
+        assert!(matches!(
+            write_image(
+                &dir.path().join("a.jpg"),
+                &small_film(),
+                &OutputOptions::default()
+            ),
+            Err(FilmError::Format(_))
+        ));
+        let e = write_image(
+            &dir.path().join("nope/a.exr"),
+            &small_film(),
+            &OutputOptions::default(),
+        );
+        assert!(e.unwrap_err().to_string().contains("nope/a.exr"));
+    }
+}

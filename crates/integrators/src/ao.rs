@@ -1,0 +1,60 @@
+//! Ambient occlusion: the fraction of the cosine-weighted hemisphere above the first visible
+//! surface that is open up to a distance. Equivalently, the image of a white Lambertian scene
+//! under a uniform white sky with one bounce and no emitters; camera rays that miss see the sky
+//! (value 1).
+
+use crate::{Ctx, Integrator, RayCounters, SampleAux};
+use rt_core::{
+    frame::Frame, ray::offset_ray_origin, sampling::cosine_hemisphere, Ray, Rgb, Sampler,
+};
+use rt_film::FirstHit;
+
+/// Ambient-occlusion estimator.
+#[derive(Clone, Debug)]
+pub struct AoIntegrator {
+    /// Occluders farther than this do not count (`f32::INFINITY` for all).
+    pub max_distance: f32,
+}
+
+impl Integrator for AoIntegrator {
+    fn name(&self) -> &str {
+        "ao"
+    }
+
+    fn li(
+        &self,
+        ctx: &Ctx<'_>,
+        ray: Ray,
+        sampler: &mut Sampler,
+        aux: &mut SampleAux,
+        counters: &mut RayCounters,
+    ) -> Rgb {
+        counters.rays += 1;
+        let Some(hit) = ctx.accel.intersect(&ray, f32::INFINITY) else {
+            return Rgb::ONE;
+        };
+        let si = ctx.scene.surface(&hit);
+        let wo = -ray.dir;
+        let flip = if si.ng.dot(wo) < 0.0 { -1.0 } else { 1.0 };
+        let (ng, ns) = (si.ng * flip, si.ns * flip);
+        if aux.want_first_hit {
+            aux.first_hit = Some(FirstHit {
+                albedo: Rgb::ONE,
+                normal: ns,
+                depth: hit.t * ray.dir.length(),
+                position: si.p,
+            });
+        }
+        let d = Frame::from_normal(ns).to_world(cosine_hemisphere(sampler.next_2d()));
+        if d.dot(ng) <= 0.0 {
+            return Rgb::ZERO;
+        }
+        counters.shadow_rays += 1;
+        let r = Ray::new(offset_ray_origin(si.p, ng), d);
+        if ctx.accel.occluded(&r, self.max_distance) {
+            Rgb::ZERO
+        } else {
+            Rgb::ONE
+        }
+    }
+}

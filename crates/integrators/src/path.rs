@@ -1,0 +1,194 @@
+//! Unidirectional path tracing with next-event estimation and MIS (Veach's power heuristic).
+//!
+//! Bounce accounting: `max_depth = D` allows at most `D` scattering events. Light reaching the
+//! camera after `D` bounces is included, whether it arrives through a light-sampled
+//! (next-event) connection from the `D`-th vertex or through a BSDF-sampled ray that hits an
+//! emitter; Mitsuba's `max_depth` is `D + 1` for the same set of paths. `D = 0` shows emitters
+//! seen directly; `D = 1` is direct lighting.
+//!
+//! Emission found by BSDF sampling after a delta bounce is always counted fully (light sampling
+//! cannot produce such paths), which keeps caustics through mirrors and glass (the "PTDL cannot
+//! do caustics" pitfall of the thesis, §6.1.1).
+
+use crate::{Ctx, Integrator, RayCounters, SampleAux};
+use rt_core::{
+    material::Bsdf,
+    ray::{offset_ray_origin, shadow_segment},
+    sampling::power_heuristic,
+    Ray, Rgb, Sampler,
+};
+use rt_film::FirstHit;
+
+/// Path tracer configuration.
+#[derive(Clone, Debug)]
+pub struct PathIntegrator {
+    /// Maximum number of bounces.
+    pub max_depth: u32,
+    /// Sample lights at every vertex and combine with BSDF sampling by MIS. When false, only
+    /// BSDF sampling finds light (a reference for testing the MIS weights).
+    pub next_event: bool,
+    /// Bounce after which Russian roulette may end paths.
+    pub rr_depth: u32,
+    name: &'static str,
+}
+
+impl PathIntegrator {
+    /// Path tracing with NEE and MIS.
+    pub fn new(max_depth: u32) -> Self {
+        Self {
+            max_depth,
+            next_event: true,
+            rr_depth: 3,
+            name: "path",
+        }
+    }
+
+    /// Path tracing by BSDF sampling only.
+    pub fn bsdf_only(max_depth: u32) -> Self {
+        Self {
+            max_depth,
+            next_event: false,
+            rr_depth: 3,
+            name: "path-bsdf",
+        }
+    }
+
+    /// Direct lighting: one bounce, NEE and MIS.
+    pub fn direct() -> Self {
+        Self {
+            max_depth: 1,
+            next_event: true,
+            rr_depth: u32::MAX,
+            name: "direct",
+        }
+    }
+}
+
+impl Integrator for PathIntegrator {
+    fn name(&self) -> &str {
+        self.name
+    }
+
+    fn li(
+        &self,
+        ctx: &Ctx<'_>,
+        mut ray: Ray,
+        sampler: &mut Sampler,
+        aux: &mut SampleAux,
+        counters: &mut RayCounters,
+    ) -> Rgb {
+        let scene = ctx.scene;
+        let lights = &scene.lights;
+        let use_nee = self.next_event && !lights.is_empty();
+        let mut l = Rgb::ZERO;
+        let mut beta = Rgb::ONE;
+        // MIS state of the previous vertex: was the bounce a delta lobe, its pdf, its position.
+        let mut prev_delta = true;
+        let mut prev_pdf = 0.0f32;
+        let mut prev_p = ray.origin;
+        let mut depth = 0u32;
+        loop {
+            counters.rays += 1;
+            let Some(hit) = ctx.accel.intersect(&ray, f32::INFINITY) else {
+                let le = scene.environment.radiance(ray.dir);
+                if le.max_element() > 0.0 {
+                    let w = if prev_delta || !use_nee {
+                        1.0
+                    } else {
+                        power_heuristic(prev_pdf, lights.pdf_env(scene, ray.dir))
+                    };
+                    l += beta * le * w;
+                }
+                break;
+            };
+            let si = scene.surface(&hit);
+            let material = &scene.materials[si.material as usize];
+            let wo = -ray.dir;
+            let le = material.emitted(si.ng, wo);
+            if le.max_element() > 0.0 {
+                let w = if prev_delta || !use_nee {
+                    1.0
+                } else {
+                    let pdf_light = lights.pdf_triangle(scene, si.prim, prev_p, si.p, si.ng);
+                    power_heuristic(prev_pdf, pdf_light)
+                };
+                l += beta * le * w;
+            }
+            let tint = scene.tint(material, si.uv);
+            let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo);
+            if depth == 0 && aux.want_first_hit {
+                let n = if si.ns.dot(wo) < 0.0 { -si.ns } else { si.ns };
+                aux.first_hit = Some(FirstHit {
+                    albedo: bsdf.albedo(),
+                    normal: n,
+                    depth: hit.t * ray.dir.length(),
+                    position: si.p,
+                });
+            }
+            if depth >= self.max_depth {
+                break;
+            }
+            // Draw the vertex's random numbers in a fixed order, used or not, so the dimension
+            // index of a bounce does not depend on which branches earlier bounces took.
+            let u_light_sel = sampler.next_1d();
+            let u_light = sampler.next_2d();
+            let u_layer = sampler.next_1d();
+            let u_bsdf = sampler.next_2d();
+            let u_rr = sampler.next_1d();
+
+            if use_nee && bsdf.has_non_delta() {
+                if let Some(ls) = lights.sample(scene, si.p, u_light_sel, u_light) {
+                    let (f, bsdf_pdf) = bsdf.eval_pdf(ls.wi);
+                    let cos = ls.wi.dot(si.ns).abs();
+                    if f.max_element() > 0.0 && cos > 0.0 {
+                        counters.shadow_rays += 1;
+                        let occluded = if ls.dist.is_infinite() {
+                            let n = if ls.wi.dot(si.ng) >= 0.0 {
+                                si.ng
+                            } else {
+                                -si.ng
+                            };
+                            let r = Ray::new(offset_ray_origin(si.p, n), ls.wi);
+                            ctx.accel.occluded(&r, f32::INFINITY)
+                        } else {
+                            let (r, t_max) = shadow_segment(si.p, si.ng, ls.point, ls.normal);
+                            ctx.accel.occluded(&r, t_max)
+                        };
+                        if !occluded {
+                            let w = power_heuristic(ls.pdf, bsdf_pdf);
+                            l += beta * f * ls.le * (cos * w / ls.pdf);
+                        }
+                    }
+                }
+            }
+
+            let Some(s) = bsdf.sample(u_layer, u_bsdf) else {
+                break;
+            };
+            beta *= s.weight;
+            if beta.max_element() <= 0.0 || !beta.is_finite() {
+                break;
+            }
+            prev_delta = s.delta;
+            prev_pdf = s.pdf;
+            prev_p = si.p;
+            let n = if s.wi.dot(si.ng) >= 0.0 {
+                si.ng
+            } else {
+                -si.ng
+            };
+            ray = Ray::new(offset_ray_origin(si.p, n), s.wi);
+            depth += 1;
+            if depth > self.rr_depth {
+                // Continue with probability tied to the throughput, so that surviving paths
+                // carry comparable weights; capped so bright paths still terminate eventually.
+                let q = beta.max_element().min(0.95);
+                if u_rr >= q {
+                    break;
+                }
+                beta /= q;
+            }
+        }
+        l
+    }
+}
