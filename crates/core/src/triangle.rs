@@ -6,7 +6,8 @@
 //! function depends only on the two vertices of its edge (not on the triangle), two triangles
 //! sharing an edge compute bit-identical values for it, so a ray through the edge hits at least
 //! one of them. When an edge function rounds to exactly zero it is recomputed in double
-//! precision, which decides the sign consistently. This is what makes closed meshes crack-free;
+//! precision, which decides the sign consistently. Valid for coordinates of magnitude up to about
+//! 1e12 relative to the ray origin (beyond, the scaled distance `t·det` overflows f32). This is what makes closed meshes crack-free;
 //! Möller–Trumbore, which the thesis used, is not.
 
 use crate::Ray;
@@ -104,18 +105,20 @@ pub fn intersect_triangle(pre: &RayPrecomp, v: &[Vec3; 3], t_max: f32) -> Option
     let bz = pre.sz * b[kz];
     let cz = pre.sz * c[kz];
     let t_scaled = u * az + v_ * bz + w * cz;
-    // Compare t = t_scaled / det against (0, t_max] without dividing.
-    let (ts, d) = if det < 0.0 {
-        (-t_scaled, -det)
-    } else {
-        (t_scaled, det)
-    };
-    if ts <= 0.0 || ts > t_max * d {
+    // Sign test before dividing (cheap rejection of hits behind the origin), then the range test
+    // on t itself: comparing `t_scaled` with `t_max·det` instead would overflow or underflow at
+    // extreme coordinate scales. Written so that NaN fails both tests.
+    let ts = if det < 0.0 { -t_scaled } else { t_scaled };
+    if ts.is_nan() || ts <= 0.0 {
         return None;
     }
     let inv = 1.0 / det;
+    let t = t_scaled * inv;
+    if t.is_nan() || t <= 0.0 || t > t_max {
+        return None;
+    }
     Some(TriHit {
-        t: t_scaled * inv,
+        t,
         b1: v_ * inv,
         b2: w * inv,
     })

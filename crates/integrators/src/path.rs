@@ -114,9 +114,13 @@ impl Integrator for PathIntegrator {
                 };
                 l += beta * le * w;
             }
+            let first_hit_wanted = depth == 0 && aux.want_first_hit;
+            if depth >= self.max_depth && !first_hit_wanted {
+                break;
+            }
             let tint = scene.tint(material, si.uv);
             let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo);
-            if depth == 0 && aux.want_first_hit {
+            if first_hit_wanted {
                 let n = if si.ns.dot(wo) < 0.0 { -si.ns } else { si.ns };
                 aux.first_hit = Some(FirstHit {
                     albedo: bsdf.albedo(),

@@ -1,0 +1,413 @@
+//! Top-down binned-SAH construction (Wald, "On fast Construction of SAH-based Bounding Volume
+//! Hierarchies", 2007), evaluated on all three axes.
+
+use super::node::Node;
+use super::BuildParams;
+use glam::Vec3;
+use rt_core::Aabb;
+
+/// Size of the traversal stack. The build keeps every leaf at depth `MAX_DEPTH - 1` or less, and
+/// ordered traversal pushes at most one entry per inner ancestor, so the stack cannot overflow.
+pub(crate) const MAX_DEPTH: usize = 64;
+
+/// Upper bound on [`BuildParams::bins`], so the bins live in a fixed array on the stack.
+pub const MAX_BINS: usize = 64;
+
+/// Below this many triangles a subtree is built on the current thread: splitting off a rayon
+/// task costs more than building a few thousand triangles.
+const PARALLEL_MIN_PRIMS: usize = 4096;
+
+/// Build parameters after clamping to what the builder supports.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Config {
+    pub max_leaf: usize,
+    pub bins: usize,
+    pub traversal_cost: f64,
+    pub intersection_cost: f64,
+    pub parallel: bool,
+}
+
+impl From<&BuildParams> for Config {
+    fn from(p: &BuildParams) -> Self {
+        let cost = |c: f32, default: f64| {
+            if c.is_finite() && c >= 0.0 {
+                c as f64
+            } else {
+                default
+            }
+        };
+        Self {
+            max_leaf: p.max_leaf_size.clamp(1, u32::MAX as usize),
+            bins: p.bins.clamp(2, MAX_BINS),
+            traversal_cost: cost(p.traversal_cost, 1.0),
+            intersection_cost: cost(p.intersection_cost, 1.0),
+            parallel: p.parallel,
+        }
+    }
+}
+
+/// A triangle as the builder sees it: its bounds and its index in the caller's order.
+#[derive(Clone, Copy, Debug)]
+struct PrimRef {
+    bounds: Aabb,
+    index: u32,
+}
+
+impl PrimRef {
+    /// Halving before adding keeps the centroid finite for coordinates near `f32::MAX`.
+    #[inline]
+    fn centroid(&self) -> Vec3 {
+        self.bounds.min * 0.5 + self.bounds.max * 0.5
+    }
+}
+
+/// Nodes (root first, children of each inner node adjacent) and the caller's triangle index of
+/// every leaf slot.
+pub(crate) struct Built {
+    pub nodes: Vec<Node>,
+    pub order: Vec<u32>,
+}
+
+/// Builds the hierarchy over `triangles`. An empty input gives no nodes at all.
+pub(crate) fn build(triangles: &[[Vec3; 3]], cfg: &Config) -> Built {
+    // Node indices are u32 and there are up to 2n - 1 nodes.
+    assert!(
+        triangles.len() <= (u32::MAX / 2) as usize,
+        "Bvh2 supports at most 2^31 - 1 triangles, got {}",
+        triangles.len()
+    );
+    if triangles.is_empty() {
+        return Built {
+            nodes: Vec::new(),
+            order: Vec::new(),
+        };
+    }
+    let mut refs: Vec<PrimRef> = triangles
+        .iter()
+        .enumerate()
+        .map(|(i, t)| PrimRef {
+            bounds: Aabb::from_points(t),
+            index: i as u32,
+        })
+        .collect();
+    let mut nodes = Vec::with_capacity(2 * triangles.len());
+    nodes.push(PLACEHOLDER);
+    let root = build_node(&mut refs, 0, 0, cfg, &mut nodes);
+    nodes[0] = root;
+    nodes.shrink_to_fit();
+    Built {
+        nodes,
+        order: refs.iter().map(|r| r.index).collect(),
+    }
+}
+
+const PLACEHOLDER: Node = Node {
+    bounds: [0.0; 6],
+    index: 0,
+    count: 0,
+};
+
+/// `ceil(log2(n))` for `n >= 1`: the depth a median-split subtree over `n` triangles needs.
+fn ceil_log2(n: usize) -> usize {
+    if n <= 1 {
+        0
+    } else {
+        (usize::BITS - (n - 1).leading_zeros()) as usize
+    }
+}
+
+/// Builds the subtree over `refs` (which start at leaf slot `first`), appends its descendants to
+/// `out` and returns its root, which the caller stores.
+///
+/// Invariant, true at the root because `n < 2^31`: `depth + ceil_log2(n) <= MAX_DEPTH - 1`.
+/// SAH splits may be as lopsided as 1 : n-1, so they are allowed only while the invariant would
+/// hold for a child of n - 1 triangles; beyond that, median splits lower `ceil_log2` by one per
+/// level and the invariant survives, which bounds the depth without ever refusing to split.
+fn build_node(
+    refs: &mut [PrimRef],
+    first: u32,
+    depth: usize,
+    cfg: &Config,
+    out: &mut Vec<Node>,
+) -> Node {
+    let n = refs.len();
+    debug_assert!(n > 0 && depth + ceil_log2(n) < MAX_DEPTH);
+    let (bounds, centroids) = refs.iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), r| {
+        (b.union(r.bounds), c.grown(r.centroid()))
+    });
+    if n == 1 {
+        return Node::leaf(bounds, first, 1);
+    }
+
+    let sah_allowed = depth + 1 + ceil_log2(n) < MAX_DEPTH;
+    let split = if sah_allowed {
+        find_sah_split(refs, &centroids, cfg)
+    } else {
+        None
+    };
+    if n <= cfg.max_leaf {
+        let leaf_cost = cfg.intersection_cost * n as f64;
+        let split_cost = split
+            .map(|s| cfg.traversal_cost + cfg.intersection_cost * s.cost / surface_area(&bounds));
+        // A NaN or infinite cost (flat or point-sized parent, overflowing coordinates) gives no
+        // reason to split, so the small node stays a leaf.
+        if !split_cost.is_some_and(|c| c < leaf_cost) {
+            return Node::leaf(bounds, first, n as u32);
+        }
+    }
+
+    let mid = match split {
+        Some(s) => partition(refs, |r| {
+            s.binner.bin(r.centroid(), s.axis) <= s.last_left_bin
+        }),
+        None => median_split(refs, &centroids),
+    };
+    debug_assert!(0 < mid && mid < n);
+
+    let (left_refs, right_refs) = refs.split_at_mut(mid);
+    let right_first = first + mid as u32;
+    let pair = out.len();
+    out.push(PLACEHOLDER);
+    out.push(PLACEHOLDER);
+    let (left, right) = if cfg.parallel && n >= PARALLEL_MIN_PRIMS {
+        let (left, (mut right, mut right_nodes)) = rayon::join(
+            || build_node(left_refs, first, depth + 1, cfg, out),
+            || {
+                let mut v = Vec::new();
+                let r = build_node(right_refs, right_first, depth + 1, cfg, &mut v);
+                (r, v)
+            },
+        );
+        // The right subtree was numbered from zero in its own vector.
+        let base = out.len() as u32;
+        for node in std::iter::once(&mut right).chain(right_nodes.iter_mut()) {
+            if !node.is_leaf() {
+                node.index += base;
+            }
+        }
+        out.append(&mut right_nodes);
+        (left, right)
+    } else {
+        let left = build_node(left_refs, first, depth + 1, cfg, out);
+        let right = build_node(right_refs, right_first, depth + 1, cfg, out);
+        (left, right)
+    };
+    out[pair] = left;
+    out[pair + 1] = right;
+    Node::inner(bounds, pair as u32)
+}
+
+/// Surface area in f64, so that boxes of extent up to `f32::MAX` do not overflow.
+fn surface_area(b: &Aabb) -> f64 {
+    let e = b.extent().as_dvec3();
+    2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
+}
+
+/// Maps centroids to bins along each axis. Partitioning reuses the exact arithmetic of binning,
+/// so the sides get exactly the counts the SAH evaluated and neither can be empty.
+#[derive(Clone, Copy, Debug)]
+struct Binner {
+    min: Vec3,
+    scale: Vec3,
+    bins: usize,
+}
+
+impl Binner {
+    fn new(centroids: &Aabb, bins: usize) -> Self {
+        let e = centroids.extent();
+        // A zero extent gives an infinite scale; `bin` turns the resulting NaN into bin 0, so
+        // such an axis simply offers no split.
+        Self {
+            min: centroids.min,
+            scale: Vec3::splat(bins as f32) / e,
+            bins,
+        }
+    }
+
+    #[inline]
+    fn bin(&self, c: Vec3, axis: usize) -> usize {
+        // `as usize` saturates and maps NaN to 0, so this is total for any input.
+        (((c[axis] - self.min[axis]) * self.scale[axis]) as usize).min(self.bins - 1)
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Split {
+    axis: usize,
+    /// Bins `0..=last_left_bin` go left.
+    last_left_bin: usize,
+    /// `area(left) * n_left + area(right) * n_right`, not yet divided by the parent's area.
+    cost: f64,
+    binner: Binner,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Bin {
+    bounds: Aabb,
+    count: usize,
+}
+
+const EMPTY_BIN: Bin = Bin {
+    bounds: Aabb::EMPTY,
+    count: 0,
+};
+
+/// The cheapest binned split over all three axes, or `None` if no axis separates the centroids
+/// (all coincide) or every candidate's cost overflows.
+fn find_sah_split(refs: &[PrimRef], centroids: &Aabb, cfg: &Config) -> Option<Split> {
+    let binner = Binner::new(centroids, cfg.bins);
+    let mut bins = [[EMPTY_BIN; MAX_BINS]; 3];
+    for r in refs {
+        let c = r.centroid();
+        for (axis, axis_bins) in bins.iter_mut().enumerate() {
+            let b = &mut axis_bins[binner.bin(c, axis)];
+            b.bounds = b.bounds.union(r.bounds);
+            b.count += 1;
+        }
+    }
+
+    let mut best: Option<Split> = None;
+    for (axis, axis_bins) in bins.iter().enumerate() {
+        // A boundary between two empty bins gives the same partition as the boundary after the
+        // last non-empty bin before it, so only boundaries after non-empty bins are candidates.
+        // For the many small nodes near the leaves this skips most of the sweep.
+        let mut occupied = [0usize; MAX_BINS];
+        let mut m = 0;
+        for (i, bin) in axis_bins[..cfg.bins].iter().enumerate() {
+            if bin.count > 0 {
+                occupied[m] = i;
+                m += 1;
+            }
+        }
+        let occupied = &occupied[..m];
+        // right_cost[k]: area * count of the occupied bins k.. .
+        let mut right_cost = [0.0f64; MAX_BINS];
+        let (mut bounds, mut count) = (Aabb::EMPTY, 0);
+        for k in (1..m).rev() {
+            let bin = &axis_bins[occupied[k]];
+            bounds = bounds.union(bin.bounds);
+            count += bin.count;
+            right_cost[k] = surface_area(&bounds) * count as f64;
+        }
+        let (mut bounds, mut count) = (Aabb::EMPTY, 0);
+        for k in 0..m.saturating_sub(1) {
+            let bin = &axis_bins[occupied[k]];
+            bounds = bounds.union(bin.bounds);
+            count += bin.count;
+            let cost = surface_area(&bounds) * count as f64 + right_cost[k + 1];
+            // NaN and infinite costs never compare less, so they are never chosen.
+            if cost < best.map_or(f64::INFINITY, |b| b.cost) {
+                best = Some(Split {
+                    axis,
+                    last_left_bin: occupied[k],
+                    cost,
+                    binner,
+                });
+            }
+        }
+    }
+    best
+}
+
+/// Moves the references satisfying `goes_left` to the front; returns how many there are.
+fn partition(refs: &mut [PrimRef], goes_left: impl Fn(&PrimRef) -> bool) -> usize {
+    let mut mid = 0;
+    for i in 0..refs.len() {
+        if goes_left(&refs[i]) {
+            refs.swap(i, mid);
+            mid += 1;
+        }
+    }
+    mid
+}
+
+/// Splits at the median centroid along the widest centroid axis: the fallback when binning finds
+/// nothing (coincident centroids) and the depth limiter. Always gives halves of `floor(n/2)` and
+/// `ceil(n/2)`.
+fn median_split(refs: &mut [PrimRef], centroids: &Aabb) -> usize {
+    let axis = centroids.largest_axis();
+    let mid = refs.len() / 2;
+    refs.select_nth_unstable_by(mid, |a, b| {
+        a.centroid()[axis].total_cmp(&b.centroid()[axis])
+    });
+    mid
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cfg(max_leaf: usize) -> Config {
+        Config::from(&BuildParams {
+            max_leaf_size: max_leaf,
+            ..BuildParams::default()
+        })
+    }
+
+    #[test]
+    fn ceil_log2_matches_definition() {
+        assert_eq!(ceil_log2(1), 0);
+        assert_eq!(ceil_log2(2), 1);
+        assert_eq!(ceil_log2(3), 2);
+        assert_eq!(ceil_log2(4), 2);
+        assert_eq!(ceil_log2(5), 3);
+        assert_eq!(ceil_log2(1 << 20), 20);
+        assert_eq!(ceil_log2((1 << 20) + 1), 21);
+    }
+
+    #[test]
+    fn params_are_clamped() {
+        let c = Config::from(&BuildParams {
+            max_leaf_size: 0,
+            bins: 1000,
+            traversal_cost: f32::NAN,
+            intersection_cost: -1.0,
+            parallel: false,
+        });
+        assert_eq!(c.max_leaf, 1);
+        assert_eq!(c.bins, MAX_BINS);
+        assert_eq!(c.traversal_cost, 1.0);
+        assert_eq!(c.intersection_cost, 1.0);
+    }
+
+    #[test]
+    fn coincident_centroids_split_by_median() {
+        let tri = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        let built = build(&vec![tri; 100], &cfg(4));
+        assert!(built.nodes.iter().all(|n| n.count <= 4));
+        let mut order = built.order.clone();
+        order.sort_unstable();
+        assert!(order.iter().copied().eq(0..100));
+    }
+
+    #[test]
+    fn lopsided_input_respects_depth_limit() {
+        // Tiny triangles at exponentially growing distances: every SAH split peels off only the
+        // farthest one, which without the limiter would give a chain 300 deep.
+        let tris: Vec<[Vec3; 3]> = (0..300)
+            .map(|i| {
+                let x = 1.3f32.powi(i);
+                [
+                    Vec3::new(x, 0.0, 0.0),
+                    Vec3::new(x, 1e-3, 0.0),
+                    Vec3::new(x, 0.0, 1e-3),
+                ]
+            })
+            .collect();
+        let built = build(&tris, &cfg(1));
+        let mut stack = vec![(0usize, 0usize)];
+        let mut max_depth = 0;
+        while let Some((i, d)) = stack.pop() {
+            max_depth = max_depth.max(d);
+            if let Some([l, r]) = built.nodes[i].children() {
+                stack.push((l, d + 1));
+                stack.push((r, d + 1));
+            }
+        }
+        assert!(max_depth < MAX_DEPTH, "depth {max_depth}");
+        assert!(
+            max_depth > 20,
+            "the input should have needed the limiter: {max_depth}"
+        );
+    }
+}

@@ -1,0 +1,131 @@
+//! Binary BVH: binned-SAH build, ordered robust traversal.
+//!
+//! The tree is stored depth-first in one array of 32-byte [`Node`]s with the two children of
+//! every inner node side by side. The triangles are copied in leaf order, so a leaf's triangles
+//! are contiguous in memory, and [`Bvh2::prim_ids`] maps each copy back to the caller's index,
+//! which is what [`Hit::prim`] reports.
+
+mod build;
+mod node;
+mod stats;
+mod traverse;
+mod validate;
+
+pub use build::MAX_BINS;
+pub use node::Node;
+pub use stats::BvhStats;
+
+use build::Config;
+use glam::Vec3;
+use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
+use traverse::NoCount;
+
+/// Knobs of [`Bvh2::build`]. Out-of-range values are clamped rather than rejected.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BuildParams {
+    /// Largest number of triangles in a leaf (at least 1). Smaller leaves are made when the SAH
+    /// says splitting does not pay.
+    pub max_leaf_size: usize,
+    /// Number of SAH bins per axis, between 2 and [`MAX_BINS`].
+    pub bins: usize,
+    /// SAH cost of visiting an inner node, relative to `intersection_cost`.
+    pub traversal_cost: f32,
+    /// SAH cost of one ray–triangle test.
+    pub intersection_cost: f32,
+    /// Build large subtrees in parallel on the rayon pool. The tree is the same either way.
+    pub parallel: bool,
+}
+
+impl Default for BuildParams {
+    fn default() -> Self {
+        Self {
+            max_leaf_size: 4,
+            bins: 32,
+            traversal_cost: 1.0,
+            intersection_cost: 1.0,
+            parallel: true,
+        }
+    }
+}
+
+/// A binary bounding volume hierarchy over triangles.
+#[derive(Clone, Debug)]
+pub struct Bvh2 {
+    nodes: Vec<Node>,
+    triangles: Vec<[Vec3; 3]>,
+    prim_ids: Vec<u32>,
+    config: Config,
+}
+
+impl Bvh2 {
+    /// Builds the hierarchy over `triangles`, whose indices become [`Hit::prim`]. Any input is
+    /// accepted: empty, degenerate, duplicated or huge triangles. Infinite coordinates build
+    /// without panicking but are of course never hit sensibly.
+    ///
+    /// # Panics
+    ///
+    /// If there are 2^31 or more triangles.
+    pub fn build(triangles: &[[Vec3; 3]], params: &BuildParams) -> Self {
+        let config = Config::from(params);
+        let built = build::build(triangles, &config);
+        let triangles = built.order.iter().map(|&i| triangles[i as usize]).collect();
+        Self {
+            nodes: built.nodes,
+            triangles,
+            prim_ids: built.order,
+            config,
+        }
+    }
+
+    /// The nodes, root first; empty for an empty scene.
+    pub fn nodes(&self) -> &[Node] {
+        &self.nodes
+    }
+
+    /// The triangles in leaf order.
+    pub fn triangles(&self) -> &[[Vec3; 3]] {
+        &self.triangles
+    }
+
+    /// The caller's index of each triangle in [`Bvh2::triangles`].
+    pub fn prim_ids(&self) -> &[u32] {
+        &self.prim_ids
+    }
+}
+
+impl Accel for Bvh2 {
+    fn name(&self) -> &str {
+        "bvh"
+    }
+
+    fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        self.traverse::<false, _>(ray, t_max, &mut NoCount)
+    }
+
+    fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        self.traverse::<true, _>(ray, t_max, &mut NoCount).is_some()
+    }
+
+    fn bounds(&self) -> Aabb {
+        self.nodes.first().map_or(Aabb::EMPTY, Node::aabb)
+    }
+
+    fn memory_bytes(&self) -> usize {
+        std::mem::size_of_val(self.nodes.as_slice())
+            + std::mem::size_of_val(self.triangles.as_slice())
+            + std::mem::size_of_val(self.prim_ids.as_slice())
+    }
+
+    fn intersect_counted(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        counters: &mut TraversalCounters,
+    ) -> Option<Hit> {
+        self.traverse::<false, _>(ray, t_max, counters)
+    }
+
+    fn counts_traversal(&self) -> bool {
+        true
+    }
+}

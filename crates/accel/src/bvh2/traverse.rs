@@ -1,0 +1,239 @@
+//! Ordered, stack-based traversal with a robust slab test (Ize, "Robust BVH Ray Traversal",
+//! JCGT 2013).
+
+use super::build::MAX_DEPTH;
+use super::Bvh2;
+use rt_core::triangle::{intersect_triangle, RayPrecomp};
+use rt_core::{Hit, Ray, TraversalCounters};
+
+/// Each slab distance `(plane - origin) * (1 / dir)` carries three roundings, so it is within
+/// `gamma(3)` of the exact value; comparing a near against a far distance can therefore be off by
+/// `2 gamma(3)`, and widening the far side by that much means a box the ray really touches is
+/// never culled. `gamma(n) = n u / (1 - n u)` with unit roundoff `u = 2^-24`.
+const FAR_SCALE: f32 = {
+    let u = f32::EPSILON * 0.5;
+    let gamma3 = 3.0 * u / (1.0 - 3.0 * u);
+    1.0 + 2.0 * gamma3
+};
+const _: () = assert!(FAR_SCALE > 1.0 && FAR_SCALE < 1.0 + 1e-6);
+
+/// Where traversal work is tallied; [`NoCount`] compiles away.
+pub(crate) trait Counter {
+    fn boxes(&mut self, n: u64);
+    fn triangle(&mut self);
+}
+
+/// The counter of the uncounted queries.
+pub(crate) struct NoCount;
+
+impl Counter for NoCount {
+    #[inline(always)]
+    fn boxes(&mut self, _: u64) {}
+    #[inline(always)]
+    fn triangle(&mut self) {}
+}
+
+impl Counter for TraversalCounters {
+    #[inline(always)]
+    fn boxes(&mut self, n: u64) {
+        self.nodes_visited += n;
+    }
+    #[inline(always)]
+    fn triangle(&mut self) {
+        self.prims_tested += 1;
+    }
+}
+
+/// Per-ray constants of the slab test.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SlabRay {
+    org: [f32; 3],
+    /// `1 / dir`, so a zero component, of either sign, becomes an infinity of the same sign.
+    inv: [f32; 3],
+    /// Sign bit of `inv` per axis: picks the near plane as `bounds[axis + 3 * neg]`. The sign bit
+    /// rather than `< 0` is what matches `-0.0` to its `-inf`.
+    neg: [bool; 3],
+}
+
+impl SlabRay {
+    #[inline]
+    pub(crate) fn new(ray: &Ray) -> Self {
+        let inv = ray.dir.recip().to_array();
+        Self {
+            org: ray.origin.to_array(),
+            inv,
+            neg: inv.map(f32::is_sign_negative),
+        }
+    }
+
+    /// Entry distance into `bounds` (packed as in [`Node`](super::Node)) if the ray overlaps it
+    /// within `[0, t_max]`, conservatively.
+    #[inline(always)]
+    pub(crate) fn hit(&self, bounds: &[f32; 6], t_max: f32) -> Option<f32> {
+        let mut t0 = 0.0f32;
+        let mut t1 = t_max;
+        for axis in 0..3 {
+            let n = self.neg[axis] as usize;
+            let near = (bounds[axis + 3 * n] - self.org[axis]) * self.inv[axis];
+            let far = (bounds[axis + 3 - 3 * n] - self.org[axis]) * self.inv[axis];
+            // A NaN arises only as 0 * inf: the ray runs parallel to this axis inside the plane
+            // of the slab's face, so it is on the box's boundary and the slab must not cull.
+            // `f32::max`/`min` return the non-NaN operand, which leaves the interval alone.
+            t0 = t0.max(near);
+            t1 = t1.min(far);
+        }
+        (t0 <= t1 * FAR_SCALE).then_some(t0)
+    }
+}
+
+impl Bvh2 {
+    /// The one traversal loop behind every query. `ANY_HIT` returns the first hit found rather
+    /// than the closest.
+    ///
+    /// Triangles are tested against the caller's `t_max`, not against the closest hit so far,
+    /// and the closest is kept with an exact `<`. The result is then the minimum of exactly the
+    /// values [`intersect_triangle`] computes over the leaves entered, independent of visiting
+    /// order, and agrees bit for bit with a brute-force loop unless a triangle's computed hit lies
+    /// outside its own box by more than the culling margin. That happens only for hits at the
+    /// same exact distance whose computed distances differ by rounding (overlapping coplanar
+    /// triangles), and for the noise hits of nearly degenerate triangles.
+    #[inline(always)]
+    pub(crate) fn traverse<const ANY_HIT: bool, C: Counter>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        counter: &mut C,
+    ) -> Option<Hit> {
+        let nodes = &self.nodes[..];
+        let root = nodes.first()?;
+        let slab = SlabRay::new(ray);
+        counter.boxes(1);
+        slab.hit(&root.bounds, t_max)?;
+        let pre = RayPrecomp::new(ray);
+
+        let mut closest: Option<Hit> = None;
+        // Starting at infinity rather than t_max makes `h.t < closest_t` reject the NaN and
+        // infinite distances that overflowing (e.g. infinite) vertex coordinates produce.
+        let mut closest_t = f32::INFINITY;
+        let mut cull_t = t_max;
+        // (node index, entry distance) of far children still to visit.
+        let mut stack = [(0u32, 0.0f32); MAX_DEPTH];
+        let mut sp = 0;
+        let mut node = root;
+        loop {
+            if let Some(prims) = node.prims() {
+                for i in prims {
+                    counter.triangle();
+                    let Some(h) = intersect_triangle(&pre, &self.triangles[i], t_max) else {
+                        continue;
+                    };
+                    if h.t < closest_t {
+                        closest = Some(Hit {
+                            t: h.t,
+                            prim: self.prim_ids[i],
+                            b1: h.b1,
+                            b2: h.b2,
+                        });
+                        if ANY_HIT {
+                            return closest;
+                        }
+                        closest_t = h.t;
+                        cull_t = h.t;
+                    }
+                }
+            } else {
+                let first = node.index as usize;
+                counter.boxes(2);
+                let t_left = slab.hit(&nodes[first].bounds, cull_t);
+                let t_right = slab.hit(&nodes[first + 1].bounds, cull_t);
+                let next = match (t_left, t_right) {
+                    (Some(tl), Some(tr)) => {
+                        let (near, far, far_entry) = if tl <= tr {
+                            (first, first + 1, tr)
+                        } else {
+                            (first + 1, first, tl)
+                        };
+                        stack[sp] = (far as u32, far_entry);
+                        sp += 1;
+                        Some(near)
+                    }
+                    (Some(_), None) => Some(first),
+                    (None, Some(_)) => Some(first + 1),
+                    (None, None) => None,
+                };
+                if let Some(next) = next {
+                    node = &nodes[next];
+                    continue;
+                }
+            }
+            // Pop the nearest pending subtree that can still hold something closer.
+            loop {
+                if sp == 0 {
+                    return closest;
+                }
+                sp -= 1;
+                let (index, t_entry) = stack[sp];
+                if t_entry <= cull_t * FAR_SCALE {
+                    node = &nodes[index as usize];
+                    break;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    const UNIT: [f32; 6] = [0.0, 0.0, 0.0, 1.0, 1.0, 1.0];
+
+    fn hit(o: Vec3, d: Vec3, b: &[f32; 6]) -> Option<f32> {
+        SlabRay::new(&Ray::new(o, d)).hit(b, f32::INFINITY)
+    }
+
+    #[test]
+    fn axis_parallel_rays_in_a_face_plane_are_not_culled() {
+        // Origins exactly on the planes x = 0 and x = 1 make (plane - origin) * inf a NaN.
+        for x in [0.0, 1.0, -0.0] {
+            for dx in [0.0, -0.0] {
+                let o = Vec3::new(x, 0.5, -1.0);
+                assert_eq!(
+                    hit(o, Vec3::new(dx, 0.0, 1.0), &UNIT),
+                    Some(1.0),
+                    "x={x} dx={dx}"
+                );
+            }
+        }
+        // A flat box (all of its slab on one plane) is still hit by a ray within that plane.
+        let flat = [0.0, 0.0, 0.5, 1.0, 1.0, 0.5];
+        assert!(hit(Vec3::new(-1.0, 0.5, 0.5), Vec3::X, &flat).is_some());
+        assert!(hit(Vec3::new(-1.0, 0.5, 0.5), Vec3::new(1.0, -0.0, -0.0), &flat).is_some());
+    }
+
+    #[test]
+    fn parallel_rays_outside_a_slab_miss() {
+        assert_eq!(hit(Vec3::new(1.5, 0.5, -1.0), Vec3::Z, &UNIT), None);
+        assert_eq!(
+            hit(
+                Vec3::new(-1e-30, 0.5, -1.0),
+                Vec3::new(-0.0, 0.0, 1.0),
+                &UNIT
+            ),
+            None
+        );
+    }
+
+    #[test]
+    fn boxes_behind_or_beyond_t_max_miss() {
+        let s = SlabRay::new(&Ray::new(Vec3::new(0.5, 0.5, 2.0), Vec3::Z));
+        assert_eq!(s.hit(&UNIT, f32::INFINITY), None);
+        let s = SlabRay::new(&Ray::new(Vec3::new(0.5, 0.5, -2.0), Vec3::Z));
+        assert_eq!(s.hit(&UNIT, 1.5), None);
+        assert_eq!(s.hit(&UNIT, 2.0), Some(2.0));
+        // Origin inside: the entry distance is clamped to zero.
+        let s = SlabRay::new(&Ray::new(Vec3::splat(0.5), -Vec3::Z));
+        assert_eq!(s.hit(&UNIT, f32::INFINITY), Some(0.0));
+    }
+}

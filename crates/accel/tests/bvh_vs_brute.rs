@@ -1,0 +1,119 @@
+//! The BVH must give exactly the brute-force answer: same triangle and bit-identical distance and
+//! barycentrics, or, when several triangles are hit at the identical distance, any of them (see
+//! `common::check_ray` for the precise rule).
+
+mod common;
+
+use common::{check_ray, rays, soup, Agreement, Rng};
+use rt_accel::{BruteForce, BuildParams, Bvh2};
+use rt_core::{Accel, TraversalCounters};
+
+/// Builds both structures over a soup and checks `n_rays` rays; returns the number of hits so
+/// callers can make sure the rays were not all misses.
+fn check_soup(seed: u64, n_tris: usize, n_rays: usize, params: &BuildParams) -> usize {
+    let mut rng = Rng::new(seed);
+    let tris = soup(&mut rng, n_tris);
+    let bvh = Bvh2::build(&tris, params);
+    bvh.validate()
+        .unwrap_or_else(|e| panic!("seed {seed}, {n_tris} tris: {e}"));
+    for (slot, &id) in bvh.prim_ids().iter().enumerate() {
+        assert_eq!(bvh.triangles()[slot], tris[id as usize]);
+    }
+    let oracle = BruteForce::new(&tris);
+    let mut hits = 0;
+    let mut outside_box = 0;
+    for (i, (ray, t_max)) in rays(&mut rng, &tris, n_rays).into_iter().enumerate() {
+        match check_ray(&bvh, &oracle, &ray, t_max, &tris) {
+            Ok(Agreement::OracleOutsideBox) => outside_box += 1,
+            Ok(_) => {}
+            Err(e) => panic!("seed {seed}, {n_tris} tris, ray {i} {ray:?} t_max {t_max}: {e}"),
+        }
+        let got = bvh.intersect(&ray, t_max);
+        let mut counters = TraversalCounters::default();
+        assert_eq!(bvh.intersect_counted(&ray, t_max, &mut counters), got);
+        assert!(counters.nodes_visited >= 1);
+        hits += usize::from(got.is_some());
+    }
+    // The oracle's nearly-degenerate-triangle artefacts are rare; many would mean the soup or
+    // the comparison is broken.
+    assert!(
+        outside_box * 1000 <= n_rays,
+        "{outside_box} of {n_rays} rays"
+    );
+    hits
+}
+
+#[test]
+fn tiny_soups_match_brute_force() {
+    for seed in 0..300 {
+        for n in [1, 2, 10] {
+            check_soup(seed, n, 200, &BuildParams::default());
+        }
+    }
+}
+
+#[test]
+fn soup_of_1000_matches_brute_force() {
+    for seed in 0..4 {
+        let hits = check_soup(1000 + seed, 1000, 10_000, &BuildParams::default());
+        assert!(hits > 5_000, "only {hits} hits");
+    }
+}
+
+#[test]
+fn soup_of_20000_matches_brute_force() {
+    let hits = check_soup(20_000, 20_000, 4_000, &BuildParams::default());
+    assert!(hits > 2_000, "only {hits} hits");
+}
+
+#[test]
+fn other_build_parameters_match_brute_force() {
+    let variants = [
+        BuildParams {
+            max_leaf_size: 1,
+            bins: 2,
+            ..BuildParams::default()
+        },
+        BuildParams {
+            max_leaf_size: 8,
+            bins: 64,
+            parallel: false,
+            ..BuildParams::default()
+        },
+        BuildParams {
+            max_leaf_size: 16,
+            bins: 8,
+            traversal_cost: 0.1,
+            intersection_cost: 2.0,
+            ..BuildParams::default()
+        },
+        BuildParams {
+            max_leaf_size: 0,
+            bins: 0,
+            traversal_cost: f32::INFINITY,
+            intersection_cost: f32::NAN,
+            ..BuildParams::default()
+        },
+    ];
+    for (k, params) in variants.iter().enumerate() {
+        for seed in 0..3 {
+            check_soup(7_000 + 10 * k as u64 + seed, 3000, 3000, params);
+        }
+    }
+}
+
+#[test]
+fn parallel_and_sequential_builds_are_identical() {
+    let tris = soup(&mut Rng::new(99), 30_000);
+    let par = Bvh2::build(&tris, &BuildParams::default());
+    let seq = Bvh2::build(
+        &tris,
+        &BuildParams {
+            parallel: false,
+            ..BuildParams::default()
+        },
+    );
+    assert_eq!(par.nodes(), seq.nodes());
+    assert_eq!(par.prim_ids(), seq.prim_ids());
+    par.validate().unwrap();
+}

@@ -1,0 +1,547 @@
+//! Shared test helpers: a seeded RNG, triangle soups, ray sets, closed meshes and the hit
+//! comparison against the brute-force oracle.
+#![allow(dead_code)] // each test binary uses a different subset
+
+use glam::{Quat, Vec3};
+use rt_accel::BruteForce;
+use rt_core::triangle::{intersect_triangle, RayPrecomp};
+use rt_core::{Accel, Hit, Ray};
+
+/// PCG32 (O'Neill), so tests are reproducible without the `rand` crate.
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Self {
+        let mut r = Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xDA3E_39CB_94B9_5BDB);
+        r.u32();
+        r
+    }
+
+    pub fn u32(&mut self) -> u32 {
+        let old = self.0;
+        self.0 = old
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
+        xorshifted.rotate_right((old >> 59) as u32)
+    }
+
+    /// Uniform in [0, 1).
+    pub fn f32(&mut self) -> f32 {
+        (self.u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+    }
+
+    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
+        lo + (hi - lo) * self.f32()
+    }
+
+    pub fn below(&mut self, n: usize) -> usize {
+        ((self.u32() as u64 * n as u64) >> 32) as usize
+    }
+
+    pub fn chance(&mut self, p: f32) -> bool {
+        self.f32() < p
+    }
+
+    pub fn vec_in(&mut self, lo: f32, hi: f32) -> Vec3 {
+        Vec3::new(self.range(lo, hi), self.range(lo, hi), self.range(lo, hi))
+    }
+
+    pub fn unit_vec(&mut self) -> Vec3 {
+        loop {
+            let v = self.vec_in(-1.0, 1.0);
+            let l = v.length_squared();
+            if l > 1e-4 && l <= 1.0 {
+                return v / l.sqrt();
+            }
+        }
+    }
+
+    /// Barycentric weights (b1, b2) uniform over the triangle.
+    pub fn barycentric(&mut self) -> (f32, f32) {
+        let (u, v) = (self.f32(), self.f32());
+        if u + v > 1.0 {
+            (1.0 - u, 1.0 - v)
+        } else {
+            (u, v)
+        }
+    }
+}
+
+/// Planes that axis-aligned soup triangles lie in; rays start on them too.
+pub const PLANES: [f32; 4] = [-0.5, 0.0, 0.25, 0.5];
+
+/// A point of the 1/8 grid in [-1, 1] on which axis-aligned soup triangles have their vertices,
+/// so that they share edges and overlap exactly.
+fn grid(rng: &mut Rng) -> f32 {
+    (rng.below(17) as f32 - 8.0) / 8.0
+}
+
+/// A triangle soup in roughly [-1, 1]^3 mixing ordinary triangles of many sizes, long thin ones,
+/// degenerate ones (collinear, two equal vertices, a point), exact and vertex-rotated duplicates
+/// and axis-aligned coplanar ones sharing edges.
+pub fn soup(rng: &mut Rng, n: usize) -> Vec<[Vec3; 3]> {
+    let mut tris: Vec<[Vec3; 3]> = Vec::with_capacity(n);
+    while tris.len() < n {
+        let t = match rng.below(10) {
+            0..=2 => {
+                let c = rng.vec_in(-1.0, 1.0);
+                let size = 10f32.powf(rng.range(-3.0, 0.0));
+                [0; 3].map(|_| c + rng.vec_in(-size, size))
+            }
+            3 => {
+                let a = rng.vec_in(-1.0, 1.0);
+                let b = a + rng.unit_vec() * rng.range(0.5, 2.0);
+                let thin = rng.unit_vec() * 10f32.powf(rng.range(-6.0, -3.0));
+                [a, b, (a + b) * 0.5 + thin]
+            }
+            4 => {
+                let a = rng.vec_in(-1.0, 1.0);
+                let b = a + rng.vec_in(-0.3, 0.3);
+                match rng.below(3) {
+                    0 => [a, b, a + (b - a) * rng.f32()],
+                    1 => [a, b, b],
+                    _ => [a, a, a],
+                }
+            }
+            5 if !tris.is_empty() => {
+                let t = tris[rng.below(tris.len())];
+                match rng.below(3) {
+                    0 => t,
+                    1 => [t[1], t[2], t[0]],
+                    _ => [t[0], t[2], t[1]],
+                }
+            }
+            6 | 7 => {
+                let axis = rng.below(3);
+                let plane = PLANES[rng.below(PLANES.len())];
+                [0; 3].map(|_| {
+                    let mut v = Vec3::new(grid(rng), grid(rng), grid(rng));
+                    v[axis] = plane;
+                    v
+                })
+            }
+            _ => {
+                let c = rng.vec_in(-0.5, 0.5);
+                [0; 3].map(|_| c + rng.vec_in(-2.0, 2.0))
+            }
+        };
+        tris.push(t);
+    }
+    tris
+}
+
+/// A direction with some components replaced by `0.0` or `-0.0`, never all.
+fn direction_with_zeros(rng: &mut Rng) -> Vec3 {
+    loop {
+        let mut d = rng.unit_vec();
+        for axis in 0..3 {
+            match rng.below(3) {
+                0 => d[axis] = 0.0,
+                1 => d[axis] = -0.0,
+                _ => {}
+            }
+        }
+        if d != Vec3::ZERO {
+            return d;
+        }
+    }
+}
+
+fn axis_direction(rng: &mut Rng) -> Vec3 {
+    let mut d = Vec3::ZERO;
+    d[rng.below(3)] = if rng.chance(0.5) { 1.0 } else { -1.0 };
+    // Keep signed zeros in the other components half the time.
+    if rng.chance(0.5) {
+        d = d.map(|c| if c == 0.0 { -0.0 } else { c });
+    }
+    d
+}
+
+/// A point on a random triangle of `tris`, from barycentrics, as a renderer computes hit points.
+fn point_on(rng: &mut Rng, tris: &[[Vec3; 3]]) -> Vec3 {
+    let t = tris[rng.below(tris.len())];
+    let (b1, b2) = rng.barycentric();
+    rt_core::triangle::point_at(&t, b1, b2)
+}
+
+/// Rays for `tris`, each with its `t_max`: random rays, rays aimed at points on triangles and at
+/// their vertices, rays along the axes and with zero and negative-zero direction components,
+/// rays starting on a triangle, and rays lying in the planes of the axis-aligned triangles.
+pub fn rays(rng: &mut Rng, tris: &[[Vec3; 3]], n: usize) -> Vec<(Ray, f32)> {
+    (0..n)
+        .map(|_| {
+            let ray = match rng.below(9) {
+                0 => Ray::new(rng.vec_in(-2.0, 2.0), rng.unit_vec()),
+                1 => {
+                    let o = rng.vec_in(-2.0, 2.0);
+                    Ray::new(o, point_on(rng, tris) - o)
+                }
+                2 => {
+                    let o = rng.vec_in(-2.0, 2.0);
+                    Ray::new(o, tris[rng.below(tris.len())][rng.below(3)] - o)
+                }
+                3 => {
+                    // Aim along an axis at a point of a triangle, so axis rays do hit things.
+                    let d = axis_direction(rng);
+                    let p = point_on(rng, tris);
+                    Ray::new(p - d * rng.range(0.5, 2.0), d)
+                }
+                4 => Ray::new(rng.vec_in(-2.0, 2.0), direction_with_zeros(rng)),
+                5 => {
+                    // Through a point of a triangle with zero components: the origin shares
+                    // that point's coordinates on those axes exactly.
+                    let p = point_on(rng, tris);
+                    let d = direction_with_zeros(rng);
+                    Ray::new(p - d * rng.range(0.5, 2.0), d)
+                }
+                6 | 7 => {
+                    let o = point_on(rng, tris);
+                    let d = if rng.chance(0.5) {
+                        rng.unit_vec()
+                    } else {
+                        direction_with_zeros(rng)
+                    };
+                    Ray::new(o, d)
+                }
+                _ => {
+                    // In the plane of the axis-aligned triangles, moving parallel to it, often
+                    // from a grid point: slab distances become 0 * inf there.
+                    let axis = rng.below(3);
+                    let mut o = if rng.chance(0.5) {
+                        Vec3::new(grid(rng), grid(rng), grid(rng)) * 1.5
+                    } else {
+                        rng.vec_in(-1.5, 1.5)
+                    };
+                    o[axis] = PLANES[rng.below(PLANES.len())];
+                    let mut d = if rng.chance(0.5) {
+                        axis_direction(rng)
+                    } else {
+                        rng.unit_vec()
+                    };
+                    d[axis] = if rng.chance(0.5) { 0.0 } else { -0.0 };
+                    if d == Vec3::ZERO {
+                        d[(axis + 1) % 3] = 1.0;
+                    }
+                    Ray::new(o, d)
+                }
+            };
+            let t_max = match rng.below(4) {
+                0 => rng.range(0.1, 3.0),
+                _ => f32::INFINITY,
+            };
+            (ray, t_max)
+        })
+        .collect()
+}
+
+/// The watertight test against one triangle, as the structures run it.
+pub fn hit_one(ray: &Ray, tri: &[Vec3; 3], t_max: f32) -> Option<(f32, f32, f32)> {
+    intersect_triangle(&RayPrecomp::new(ray), tri, t_max).map(|h| (h.t, h.b1, h.b2))
+}
+
+/// How a structure's answer related to the oracle's.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Agreement {
+    /// Same triangle, bit-identical values (or both missed).
+    Exact,
+    /// A different triangle at the same distance up to rounding.
+    Tie,
+    /// The oracle's closest hit was one that lies outside its own triangle's bounding box, which
+    /// box culling may legitimately skip; see [`check_ray`].
+    OracleOutsideBox,
+}
+
+/// Checks `accel`'s closest hit and occlusion for one ray against the brute-force `oracle` over
+/// the same `tris`.
+///
+/// The same triangle must come with bit-identical values. A different triangle is accepted only
+/// if its hit is genuine (exactly what the triangle test reports for it) and
+///
+/// - it is a tie: no closer than the oracle's (the minimum over all triangles) and farther by
+///   less than the triangle test's own rounding. Coplanar overlapping triangles are hit at the
+///   same exact distance, but each computes it from different vertices, so the computed
+///   distances differ in the last bits and culling may settle on either; the hit points then
+///   agree to within [`TIE_ULPS`] ulps of the coordinates involved. Or
+/// - the oracle's hit is not inside its triangle's bounding box. `rt-core`'s triangle test
+///   computes the distance of a nearly degenerate triangle (three almost collinear vertices,
+///   e.g. a collinear triple after rounding) from a determinant that is mostly rounding noise,
+///   and can report a point far from the triangle. A bounding volume hierarchy rightly skips
+///   such a hit when its box lies beyond a real one, so there the answer must instead be no
+///   closer than the oracle's and no farther than the closest hit that does lie in its box.
+pub fn check_ray(
+    accel: &dyn Accel,
+    oracle: &BruteForce,
+    ray: &Ray,
+    t_max: f32,
+    tris: &[[Vec3; 3]],
+) -> Result<Agreement, String> {
+    let got = accel.intersect(ray, t_max);
+    let want = oracle.intersect(ray, t_max);
+    let occluded = accel.occluded(ray, t_max);
+    let agreement = compare_hits(got, want, ray, t_max, tris)?;
+    let must_occlude = match agreement {
+        Agreement::OracleOutsideBox => closest_inside_box(ray, t_max, tris).is_some(),
+        _ => want.is_some(),
+    };
+    if occluded != must_occlude && !(occluded && want.is_some()) {
+        return Err(format!("occluded {occluded}, oracle {want:?}"));
+    }
+    Ok(agreement)
+}
+
+fn compare_hits(
+    got: Option<Hit>,
+    want: Option<Hit>,
+    ray: &Ray,
+    t_max: f32,
+    tris: &[[Vec3; 3]],
+) -> Result<Agreement, String> {
+    let genuine = |h: Hit| hit_one(ray, &tris[h.prim as usize], t_max) == Some((h.t, h.b1, h.b2));
+    match (got, want) {
+        (None, None) => return Ok(Agreement::Exact),
+        (Some(g), Some(w)) if g.prim == w.prim => {
+            let bits = |h: Hit| (h.t.to_bits(), h.b1.to_bits(), h.b2.to_bits());
+            return if bits(g) == bits(w) {
+                Ok(Agreement::Exact)
+            } else {
+                Err(format!("same prim, different values: {got:?} vs {want:?}"))
+            };
+        }
+        (Some(g), Some(w)) if genuine(g) && is_tie(g, w, ray, tris) => return Ok(Agreement::Tie),
+        _ => {}
+    }
+    // Not exact and not a tie: acceptable only if the oracle's hit is one culling may skip.
+    let Some(w) = want else {
+        return Err(format!("{got:?} vs no hit"));
+    };
+    if inside_box(ray, w.t, &tris[w.prim as usize]) {
+        return Err(format!("{got:?} vs {want:?}"));
+    }
+    let got_ok = got.map_or(true, |g| genuine(g) && g.t >= w.t);
+    let far_enough = match (got, closest_inside_box(ray, t_max, tris)) {
+        (_, None) => true,
+        (None, Some(_)) => false,
+        (Some(g), Some(c)) => g.t <= c.t || is_tie(g, c, ray, tris),
+    };
+    if got_ok && far_enough {
+        Ok(Agreement::OracleOutsideBox)
+    } else {
+        Err(format!(
+            "{got:?} vs {want:?} (whose hit lies outside its triangle's box)"
+        ))
+    }
+}
+
+/// `g` is no closer than `w` and farther by less than the rounding of the triangle test.
+fn is_tie(g: Hit, w: Hit, ray: &Ray, tris: &[[Vec3; 3]]) -> bool {
+    let scale = tris[g.prim as usize]
+        .iter()
+        .chain(&tris[w.prim as usize])
+        .chain([&ray.origin])
+        .fold(0.0f32, |m, v| m.max(v.abs().max_element()));
+    let gap = (g.t - w.t) * ray.dir.length();
+    g.t >= w.t && gap <= TIE_ULPS * f32::EPSILON * scale
+}
+
+/// Whether the point at distance `t` along `ray` lies in the bounding box of `tri`, evaluated
+/// in double precision so that the check itself does not round.
+pub fn inside_box(ray: &Ray, t: f32, tri: &[Vec3; 3]) -> bool {
+    let p = ray.origin.as_dvec3() + ray.dir.as_dvec3() * t as f64;
+    let lo = tri[0].min(tri[1]).min(tri[2]).as_dvec3();
+    let hi = tri[0].max(tri[1]).max(tri[2]).as_dvec3();
+    p.cmpge(lo).all() && p.cmple(hi).all()
+}
+
+/// The closest hit among those inside their triangle's bounding box.
+fn closest_inside_box(ray: &Ray, t_max: f32, tris: &[[Vec3; 3]]) -> Option<Hit> {
+    let mut best: Option<Hit> = None;
+    for (i, tri) in tris.iter().enumerate() {
+        if let Some((t, b1, b2)) = hit_one(ray, tri, t_max) {
+            if inside_box(ray, t, tri) && best.map_or(true, |b| t < b.t) {
+                best = Some(Hit {
+                    t,
+                    prim: i as u32,
+                    b1,
+                    b2,
+                });
+            }
+        }
+    }
+    best
+}
+
+/// How far apart, in ulps of the largest coordinate involved, two tied hit points may be.
+pub const TIE_ULPS: f32 = 4.0;
+
+/// An indexed triangle mesh whose triangles share vertices exactly.
+pub struct Mesh {
+    pub positions: Vec<Vec3>,
+    pub faces: Vec<[u32; 3]>,
+}
+
+impl Mesh {
+    pub fn triangles(&self) -> Vec<[Vec3; 3]> {
+        self.faces
+            .iter()
+            .map(|f| f.map(|i| self.positions[i as usize]))
+            .collect()
+    }
+
+    /// Panics unless every directed edge appears once and its reverse once: closed, manifold and
+    /// consistently oriented.
+    pub fn assert_closed(&self) {
+        let mut edges = std::collections::HashMap::new();
+        for f in &self.faces {
+            for k in 0..3 {
+                *edges.entry((f[k], f[(k + 1) % 3])).or_insert(0u32) += 1;
+            }
+        }
+        for (&(a, b), &n) in &edges {
+            assert_eq!(n, 1, "edge {a}-{b} used {n} times");
+            assert_eq!(edges.get(&(b, a)), Some(&1), "edge {a}-{b} has no twin");
+        }
+    }
+
+    pub fn transformed(mut self, mut f: impl FnMut(Vec3) -> Vec3) -> Self {
+        for p in &mut self.positions {
+            *p = f(*p);
+        }
+        self
+    }
+}
+
+/// Subdivided icosahedron on the unit sphere, outward-facing.
+pub fn icosphere(subdivisions: u32) -> Mesh {
+    let t = (1.0 + 5f32.sqrt()) / 2.0;
+    let mut positions: Vec<Vec3> = [
+        (-1.0, t, 0.0),
+        (1.0, t, 0.0),
+        (-1.0, -t, 0.0),
+        (1.0, -t, 0.0),
+        (0.0, -1.0, t),
+        (0.0, 1.0, t),
+        (0.0, -1.0, -t),
+        (0.0, 1.0, -t),
+        (t, 0.0, -1.0),
+        (t, 0.0, 1.0),
+        (-t, 0.0, -1.0),
+        (-t, 0.0, 1.0),
+    ]
+    .iter()
+    .map(|&(x, y, z)| Vec3::new(x, y, z).normalize())
+    .collect();
+    let mut faces: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..subdivisions {
+        let mut midpoints = std::collections::HashMap::new();
+        let mut mid = |a: u32, b: u32, positions: &mut Vec<Vec3>| -> u32 {
+            *midpoints.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                let p = (positions[a as usize] + positions[b as usize]).normalize();
+                positions.push(p);
+                positions.len() as u32 - 1
+            })
+        };
+        let mut next = Vec::with_capacity(faces.len() * 4);
+        for [a, b, c] in faces {
+            let ab = mid(a, b, &mut positions);
+            let bc = mid(b, c, &mut positions);
+            let ca = mid(c, a, &mut positions);
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        faces = next;
+    }
+    Mesh { positions, faces }
+}
+
+/// The cube [-1, 1]^3 with every face split into an `n` x `n` grid of quads, two triangles each,
+/// vertices shared along face borders; outward-facing.
+pub fn grid_cube(n: u32) -> Mesh {
+    let mut index = std::collections::HashMap::new();
+    let mut positions = Vec::new();
+    let mut vertex = |p: [i32; 3]| -> u32 {
+        *index.entry(p).or_insert_with(|| {
+            positions
+                .push(Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32) * (2.0 / n as f32) - 1.0);
+            positions.len() as u32 - 1
+        })
+    };
+    let n = n as i32;
+    let mut faces = Vec::new();
+    for axis in 0..3 {
+        for side in [0, n] {
+            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+            for i in 0..n {
+                for j in 0..n {
+                    let corner = |di: i32, dj: i32| {
+                        let mut p = [0; 3];
+                        p[axis] = side;
+                        p[u] = i + di;
+                        p[v] = j + dj;
+                        p
+                    };
+                    let q =
+                        [corner(0, 0), corner(1, 0), corner(1, 1), corner(0, 1)].map(&mut vertex);
+                    // (u, v, axis) is right-handed, so counter-clockwise in (u, v) faces +axis.
+                    let tris = [[q[0], q[1], q[2]], [q[0], q[2], q[3]]];
+                    for t in tris {
+                        faces.push(if side == n { t } else { [t[0], t[2], t[1]] });
+                    }
+                }
+            }
+        }
+    }
+    Mesh { positions, faces }
+}
+
+/// A torus around the z axis, `n` x `m` quads, outward-facing, seam vertices shared.
+pub fn torus(n: u32, m: u32, big_r: f32, small_r: f32) -> Mesh {
+    let mut positions = Vec::new();
+    for i in 0..n {
+        let phi = i as f32 / n as f32 * std::f32::consts::TAU;
+        for j in 0..m {
+            let theta = j as f32 / m as f32 * std::f32::consts::TAU;
+            let r = big_r + small_r * theta.cos();
+            positions.push(Vec3::new(
+                r * phi.cos(),
+                r * phi.sin(),
+                small_r * theta.sin(),
+            ));
+        }
+    }
+    let id = |i: u32, j: u32| (i % n) * m + (j % m);
+    let mut faces = Vec::new();
+    for i in 0..n {
+        for j in 0..m {
+            let q = [id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)];
+            faces.push([q[0], q[1], q[2]]);
+            faces.push([q[0], q[2], q[3]]);
+        }
+    }
+    Mesh { positions, faces }
+}
+
+/// A random rotation.
+pub fn rotation(rng: &mut Rng) -> Quat {
+    Quat::from_axis_angle(rng.unit_vec(), rng.range(0.0, std::f32::consts::TAU))
+}
