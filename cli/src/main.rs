@@ -1,1 +1,30 @@
-fn main() {}
+//! `render`: the command-line front end. It parses arguments (clap), loads the scene
+//! (`rt-scene`), builds the acceleration structure (`rt-accel`), runs the integrator over the
+//! film (`rt-integrators`, `rt-film`) and writes the image. All error reporting to the user
+//! happens here: libraries return typed errors, this turns them into one line on stderr and a
+//! non-zero exit code (2 for usage errors, 1 for everything else).
+
+mod args;
+mod job;
+
+use clap::Parser;
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    let args = match args::Args::try_parse() {
+        Ok(a) => a,
+        Err(e) => {
+            // --help and --version are "errors" that print to stdout and succeed.
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            return ExitCode::from(code);
+        }
+    };
+    match job::run(&args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(1)
+        }
+    }
+}

@@ -116,19 +116,51 @@ fn sobol_dim0(i: u32) -> u32 {
     i.reverse_bits()
 }
 
-/// Second Sobol' dimension (primitive polynomial x + 1).
-#[inline]
-fn sobol_dim1(mut i: u32) -> u32 {
-    let mut v = 1u32 << 31;
-    let mut r = 0u32;
-    while i != 0 {
-        if i & 1 != 0 {
-            r ^= v;
-        }
-        i >>= 1;
-        v ^= v >> 1;
+/// Direction numbers of the second Sobol' dimension (primitive polynomial x + 1):
+/// `v[k] = v[k-1] ^ (v[k-1] >> 1)`, starting from the top bit.
+const SOBOL1_DIRECTIONS: [u32; 32] = {
+    let mut v = [0u32; 32];
+    v[0] = 1 << 31;
+    let mut k = 1;
+    while k < 32 {
+        v[k] = v[k - 1] ^ (v[k - 1] >> 1);
+        k += 1;
     }
-    r
+    v
+};
+
+/// The generator matrix applied a byte at a time: `SOBOL1_BYTES[b][x]` is the XOR of the
+/// direction numbers selected by the bits of byte value `x` at byte position `b`. The shuffled
+/// index is a random 32-bit value, so a bit-serial loop would always run 32 iterations.
+const SOBOL1_BYTES: [[u32; 256]; 4] = {
+    let mut t = [[0u32; 256]; 4];
+    let mut b = 0;
+    while b < 4 {
+        let mut x = 0;
+        while x < 256 {
+            let mut r = 0u32;
+            let mut bit = 0;
+            while bit < 8 {
+                if x & (1 << bit) != 0 {
+                    r ^= SOBOL1_DIRECTIONS[8 * b + bit];
+                }
+                bit += 1;
+            }
+            t[b][x] = r;
+            x += 1;
+        }
+        b += 1;
+    }
+    t
+};
+
+/// Second Sobol' dimension.
+#[inline]
+fn sobol_dim1(i: u32) -> u32 {
+    SOBOL1_BYTES[0][(i & 0xff) as usize]
+        ^ SOBOL1_BYTES[1][((i >> 8) & 0xff) as usize]
+        ^ SOBOL1_BYTES[2][((i >> 16) & 0xff) as usize]
+        ^ SOBOL1_BYTES[3][(i >> 24) as usize]
 }
 
 #[cfg(test)]
@@ -163,6 +195,21 @@ mod tests {
             grid[(p.y * 16.0) as usize * 16 + (p.x * 16.0) as usize] += 1;
         }
         assert!(grid.iter().all(|&c| c == 1), "{grid:?}");
+    }
+
+    #[test]
+    fn table_driven_sobol_matches_the_bit_serial_definition() {
+        for i in [0u32, 1, 2, 3, 255, 256, 12345, 0xdead_beef, u32::MAX] {
+            let mut r = 0;
+            for (k, v) in SOBOL1_DIRECTIONS.iter().enumerate() {
+                if i >> k & 1 != 0 {
+                    r ^= v;
+                }
+            }
+            assert_eq!(sobol_dim1(i), r);
+        }
+        // The first points of the second dimension: 0, 1/2, 3/4, 1/4.
+        assert_eq!([1, 2, 3].map(sobol_dim1), [1 << 31, 3 << 30, 1 << 30]);
     }
 
     #[test]

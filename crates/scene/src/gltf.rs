@@ -1,0 +1,387 @@
+//! glTF 2.0 meshes (`.gltf` with external or embedded buffers, and binary `.glb`).
+//!
+//! The default scene (or the first scene) is walked depth first, children in the order the file
+//! lists them, composing node matrices and TRS transforms; every triangle primitive
+//! (`TRIANGLES`, `TRIANGLE_STRIP`, `TRIANGLE_FAN`) of every mesh instance is added, so a mesh
+//! used by two nodes appears twice. Indices may be u8, u16, u32 or absent; sparse accessors are
+//! resolved by `gltf`'s reader. glTF's uv origin is the top-left corner of the image; uvs are
+//! flipped to our bottom-up convention (`v' = 1 − v`). Point and line primitives are skipped
+//! with a warning.
+//!
+//! Material mapping onto the layered model (documented in `docs/scene-format.md`), with
+//! `C = baseColorFactor.rgb` (times `baseColorTexture`, which becomes the texture) and
+//! `κ = 1 − roughnessFactor`:
+//! - `KHR_materials_transmission` factor > 0.5: glass, colour C, hardness κ, ior from
+//!   `KHR_materials_ior` (default 1.5);
+//! - else `metallicFactor` > 0.5: metal, colour C, hardness κ;
+//! - else roughness 1: diffuse C; otherwise plastic, base C under a clear coat of hardness κ
+//!   and ior 1.5 (or `KHR_materials_ior`).
+//! - Emission: `emissiveFactor × KHR_materials_emissive_strength` (default 1); `doubleSided`
+//!   makes emission two-sided. Metallic-roughness, normal, occlusion and emissive textures
+//!   are ignored.
+
+use crate::error::{Result, SceneError};
+use crate::geometry::Mesh;
+use crate::image_io::{texture_from_image, Textures};
+use ::gltf::mesh::Mode;
+use glam::{Mat4, Vec2, Vec3};
+use rt_core::transform::Transform;
+use rt_core::{Material, Rgb};
+use std::collections::HashMap;
+use std::path::Path;
+
+/// Deepest node hierarchy followed (guards against cyclic files).
+const MAX_DEPTH: usize = 256;
+
+/// State of one file's load.
+struct Loader<'a> {
+    path: &'a Path,
+    dir: &'a Path,
+    buffers: Vec<::gltf::buffer::Data>,
+    want_materials: bool,
+    textures: &'a mut Textures,
+    /// glTF material index → index in `mesh.materials`.
+    material_slots: HashMap<usize, u32>,
+    /// glTF image index → texture index.
+    images: HashMap<usize, u32>,
+    mesh: Mesh,
+    skipped: usize,
+    dropped_attributes: usize,
+}
+
+/// Loads a `.gltf` or `.glb` file.
+pub(crate) fn load(
+    path: &Path,
+    want_materials: bool,
+    textures: &mut Textures,
+    warnings: &mut Vec<String>,
+) -> Result<Mesh> {
+    let bytes =
+        std::fs::read(path).map_err(|e| SceneError::file(path, format!("cannot open: {e}")))?;
+    let ::gltf::Gltf { document, blob } = ::gltf::Gltf::from_slice(&bytes)
+        .map_err(|e| SceneError::file(path, format!("malformed glTF: {e}")))?;
+    let dir = path.parent().unwrap_or(Path::new(""));
+    let buffers = ::gltf::import_buffers(&document, Some(dir), blob)
+        .map_err(|e| SceneError::file(path, format!("cannot load buffer data: {e}")))?;
+    let mut l = Loader {
+        path,
+        dir,
+        buffers,
+        want_materials,
+        textures,
+        material_slots: HashMap::new(),
+        images: HashMap::new(),
+        mesh: Mesh::default(),
+        skipped: 0,
+        dropped_attributes: 0,
+    };
+    match document
+        .default_scene()
+        .or_else(|| document.scenes().next())
+    {
+        Some(scene) => {
+            for node in scene.nodes() {
+                l.node(&node, Mat4::IDENTITY, 0)?;
+            }
+        }
+        None => {
+            warnings.push(format!(
+                "{}: has no scene; every mesh is placed once, untransformed",
+                path.display()
+            ));
+            for m in document.meshes() {
+                l.mesh(&m, &Mat4::IDENTITY)?;
+            }
+        }
+    }
+    if l.skipped > 0 {
+        warnings.push(format!(
+            "{}: skipped {} point or line primitives",
+            path.display(),
+            l.skipped
+        ));
+    }
+    if l.dropped_attributes > 0 {
+        warnings.push(format!(
+            "{}: ignored normals or uvs of {} primitives whose counts differ from their \
+             positions",
+            path.display(),
+            l.dropped_attributes
+        ));
+    }
+    Ok(l.mesh)
+}
+
+impl Loader<'_> {
+    fn error(&self, msg: String) -> SceneError {
+        SceneError::file(self.path, msg)
+    }
+
+    fn node(&mut self, node: &::gltf::Node, parent: Mat4, depth: usize) -> Result<()> {
+        if depth > MAX_DEPTH {
+            return Err(self.error(format!(
+                "node hierarchy deeper than {MAX_DEPTH} (cyclic?) at node {}",
+                node.index()
+            )));
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if let Some(m) = node.mesh() {
+            self.mesh(&m, &world)?;
+        }
+        for child in node.children() {
+            self.node(&child, world, depth + 1)?;
+        }
+        Ok(())
+    }
+
+    fn mesh(&mut self, m: &::gltf::Mesh, world: &Mat4) -> Result<()> {
+        let t = Transform::from_mat4(*world);
+        for prim in m.primitives() {
+            self.primitive(m, &prim, &t)?;
+        }
+        Ok(())
+    }
+
+    fn primitive(
+        &mut self,
+        m: &::gltf::Mesh,
+        prim: &::gltf::Primitive,
+        t: &Transform,
+    ) -> Result<()> {
+        let mode = prim.mode();
+        if !matches!(
+            mode,
+            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+        ) {
+            self.skipped += 1;
+            return Ok(());
+        }
+        let what = format!(
+            "mesh {} (\"{}\") primitive {}",
+            m.index(),
+            m.name().unwrap_or(""),
+            prim.index()
+        );
+        let buffers = &self.buffers;
+        let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+        let positions: Vec<Vec3> = reader
+            .read_positions()
+            .ok_or_else(|| self.error(format!("{what} has no readable POSITION data")))?
+            .map(Vec3::from)
+            .collect();
+        let n = positions.len();
+        let mut normals: Option<Vec<Vec3>> =
+            reader.read_normals().map(|it| it.map(Vec3::from).collect());
+        let mut uvs: Option<Vec<Vec2>> = reader
+            .read_tex_coords(0)
+            .map(|it| it.into_f32().map(|[u, v]| Vec2::new(u, 1.0 - v)).collect());
+        if normals.as_ref().is_some_and(|v| v.len() != n) {
+            normals = None;
+            self.dropped_attributes += 1;
+        }
+        if uvs.as_ref().is_some_and(|v| v.len() != n) {
+            uvs = None;
+            self.dropped_attributes += 1;
+        }
+        let indices: Vec<u32> = match reader.read_indices() {
+            Some(ix) => ix.into_u32().collect(),
+            None => (0..n as u32).collect(),
+        };
+        if let Some(&bad) = indices.iter().find(|&&i| i as usize >= n) {
+            return Err(self.error(format!(
+                "{what}: index {bad} is out of range (the primitive has {n} vertices)"
+            )));
+        }
+        let tris: Vec<[u32; 3]> = match mode {
+            Mode::Triangles => indices
+                .chunks_exact(3)
+                .map(|c| [c[0], c[1], c[2]])
+                .collect(),
+            // Every other strip triangle is reversed to keep a consistent winding.
+            Mode::TriangleStrip => (0..indices.len().saturating_sub(2))
+                .map(|i| {
+                    let (a, b, c) = (indices[i], indices[i + 1], indices[i + 2]);
+                    if i % 2 == 0 {
+                        [a, b, c]
+                    } else {
+                        [b, a, c]
+                    }
+                })
+                .collect(),
+            _ => (1..indices.len().saturating_sub(1))
+                .map(|i| [indices[i], indices[i + 1], indices[0]])
+                .collect(),
+        };
+        let mat = match (self.want_materials, prim.material().index()) {
+            (true, Some(i)) => Some(self.material_slot(&prim.material(), i)?),
+            _ => None,
+        };
+        let flip = t.flips_handedness();
+        for ix in tris {
+            let mut ix = ix.map(|i| i as usize);
+            if flip {
+                ix.swap(1, 2);
+            }
+            let v = ix.map(|i| t.point(positions[i]));
+            let nm = normals.as_ref().map(|ns| ix.map(|i| t.normal(ns[i])));
+            let uv = uvs.as_ref().map(|u| ix.map(|i| u[i]));
+            self.mesh.push(v, nm, uv, mat);
+        }
+        Ok(())
+    }
+
+    /// Index in `mesh.materials` of glTF material `index`, converting it on first use.
+    fn material_slot(&mut self, m: &::gltf::Material, index: usize) -> Result<u32> {
+        if let Some(&s) = self.material_slots.get(&index) {
+            return Ok(s);
+        }
+        let name = m
+            .name()
+            .map_or_else(|| format!("material{index}"), str::to_string);
+        let mat = self.convert(m, &name)?;
+        self.mesh.materials.push(mat);
+        let slot = (self.mesh.materials.len() - 1) as u32;
+        self.material_slots.insert(index, slot);
+        Ok(slot)
+    }
+
+    /// Maps a glTF material onto the layered model (see the module docs).
+    fn convert(&mut self, m: &::gltf::Material, name: &str) -> Result<Material> {
+        let pbr = m.pbr_metallic_roughness();
+        let [r, g, b, _] = pbr.base_color_factor();
+        let fix = |c: Rgb| if c.is_finite() { c } else { Rgb::ZERO };
+        let color = fix(Rgb::new(r, g, b)).clamp(Rgb::ZERO, Rgb::ONE);
+        let roughness = pbr.roughness_factor();
+        let roughness = if roughness.is_finite() {
+            roughness.clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        let hardness = 1.0 - roughness;
+        let ior = m
+            .ior()
+            .filter(|i| i.is_finite() && *i >= 1.0)
+            .unwrap_or(1.5);
+        let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
+        let mut out = if transmission > 0.5 {
+            Material::glass(name, color, ior, hardness)
+        } else if pbr.metallic_factor() > 0.5 {
+            Material::metal(name, color, hardness)
+        } else if roughness >= 1.0 {
+            Material::diffuse(name, color)
+        } else {
+            Material::plastic(name, color, hardness, ior)
+        };
+        let strength = m.emissive_strength().unwrap_or(1.0);
+        out.emission = fix(Rgb::from(m.emissive_factor()) * strength).max(Rgb::ZERO);
+        out.two_sided = m.double_sided();
+        if let Some(info) = pbr.base_color_texture() {
+            let image = info.texture().source();
+            out.texture = Some(self.image(&image)?);
+        }
+        Ok(out)
+    }
+
+    /// Texture index of a glTF image, decoding it on first use.
+    fn image(&mut self, image: &::gltf::Image) -> Result<u32> {
+        let index = image.index();
+        if let Some(&t) = self.images.get(&index) {
+            return Ok(t);
+        }
+        let bytes: Vec<u8> = match image.source() {
+            ::gltf::image::Source::View { view, .. } => {
+                let data = &self.buffers[view.buffer().index()].0;
+                data.get(view.offset()..view.offset() + view.length())
+                    .ok_or_else(|| self.error(format!("image {index}: buffer view out of range")))?
+                    .to_vec()
+            }
+            ::gltf::image::Source::Uri { uri, .. } => {
+                if let Some(rest) = uri.strip_prefix("data:") {
+                    let (_, data) = rest.split_once(";base64,").ok_or_else(|| {
+                        self.error(format!("image {index}: unsupported data URI"))
+                    })?;
+                    base64_decode(data)
+                        .ok_or_else(|| self.error(format!("image {index}: invalid base64 data")))?
+                } else {
+                    let p = self.dir.join(percent_decode(uri));
+                    std::fs::read(&p).map_err(|e| {
+                        SceneError::file(
+                            &p,
+                            format!(
+                                "cannot open (image {index} of {}): {e}",
+                                self.path.display()
+                            ),
+                        )
+                    })?
+                }
+            }
+        };
+        let img = image::load_from_memory(&bytes)
+            .map_err(|e| self.error(format!("image {index}: cannot decode: {e}")))?;
+        let t = self.textures.add(texture_from_image(img));
+        self.images.insert(index, t);
+        Ok(t)
+    }
+}
+
+/// Decodes `%XX` escapes of a relative URI.
+fn percent_decode(s: &str) -> String {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        let hex = |c: u8| (c as char).to_digit(16);
+        if b[i] == b'%' && i + 2 < b.len() {
+            if let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2])) {
+                out.push((h * 16 + l) as u8);
+                i += 3;
+                continue;
+            }
+        }
+        out.push(b[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// Standard base64 (with or without padding); `None` on invalid input.
+pub(crate) fn base64_decode(s: &str) -> Option<Vec<u8>> {
+    let val = |c: u8| -> Option<u32> {
+        Some(match c {
+            b'A'..=b'Z' => c - b'A',
+            b'a'..=b'z' => c - b'a' + 26,
+            b'0'..=b'9' => c - b'0' + 52,
+            b'+' | b'-' => 62,
+            b'/' | b'_' => 63,
+            _ => return None,
+        } as u32)
+    };
+    let s = s.trim_end_matches('=');
+    let mut out = Vec::with_capacity(s.len() * 3 / 4);
+    let (mut acc, mut bits) = (0u32, 0);
+    for c in s.bytes() {
+        acc = (acc << 6) | val(c)?;
+        bits += 6;
+        if bits >= 8 {
+            bits -= 8;
+            out.push((acc >> bits) as u8);
+            acc &= (1 << bits) - 1;
+        }
+    }
+    Some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn base64_and_percent_decoding() {
+        assert_eq!(base64_decode("TWFu").unwrap(), b"Man");
+        assert_eq!(base64_decode("TWE=").unwrap(), b"Ma");
+        assert_eq!(base64_decode("TQ==").unwrap(), b"M");
+        assert!(base64_decode("T*==").is_none());
+        assert_eq!(percent_decode("a%20b.png"), "a b.png");
+        assert_eq!(percent_decode("100%"), "100%");
+    }
+}

@@ -1,0 +1,192 @@
+//! Image files: textures (PNG, JPEG; sRGB decoded to linear) and EXR environment maps.
+
+use crate::error::{Result, SceneError};
+use rt_core::{color::srgb_to_linear, texture::Texture, Rgb};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// The scene's textures, loaded once per file.
+#[derive(Default)]
+pub(crate) struct Textures {
+    list: Vec<Texture>,
+    by_path: HashMap<PathBuf, u32>,
+}
+
+impl Textures {
+    /// Index of the texture in `path`, loading it on first use.
+    pub fn load_file(&mut self, path: &Path) -> Result<u32> {
+        let key = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+        if let Some(&i) = self.by_path.get(&key) {
+            return Ok(i);
+        }
+        let t = read_texture(path)?;
+        let i = self.add(t);
+        self.by_path.insert(key, i);
+        Ok(i)
+    }
+
+    /// Adds a texture that has no file of its own (an image inside a glTF file).
+    pub fn add(&mut self, t: Texture) -> u32 {
+        self.list.push(t);
+        (self.list.len() - 1) as u32
+    }
+
+    /// The textures, in index order.
+    pub fn into_vec(self) -> Vec<Texture> {
+        self.list
+    }
+}
+
+/// Reads a PNG or JPEG texture. Colour values are sRGB-encoded in the file and decoded to
+/// linear RGB; alpha is ignored.
+pub(crate) fn read_texture(path: &Path) -> Result<Texture> {
+    let bytes =
+        std::fs::read(path).map_err(|e| SceneError::file(path, format!("cannot open: {e}")))?;
+    let img = image::load_from_memory(&bytes)
+        .map_err(|e| SceneError::file(path, format!("cannot decode image: {e}")))?;
+    Ok(texture_from_image(img))
+}
+
+/// Converts a decoded image (sRGB-encoded) to a linear texture.
+pub(crate) fn texture_from_image(img: image::DynamicImage) -> Texture {
+    let (width, height) = (img.width(), img.height());
+    let texels = match img {
+        // 8-bit images: decode through a table (exact and fast).
+        image::DynamicImage::ImageLuma8(_)
+        | image::DynamicImage::ImageLumaA8(_)
+        | image::DynamicImage::ImageRgb8(_)
+        | image::DynamicImage::ImageRgba8(_) => {
+            let lut: Vec<f32> = (0..256).map(|i| srgb_to_linear(i as f32 / 255.0)).collect();
+            img.to_rgb8()
+                .pixels()
+                .map(|p| Rgb::new(lut[p[0] as usize], lut[p[1] as usize], lut[p[2] as usize]))
+                .collect()
+        }
+        _ => img
+            .to_rgb32f()
+            .pixels()
+            .map(|p| {
+                Rgb::new(
+                    srgb_to_linear(p[0].clamp(0.0, 1.0)),
+                    srgb_to_linear(p[1].clamp(0.0, 1.0)),
+                    srgb_to_linear(p[2].clamp(0.0, 1.0)),
+                )
+            })
+            .collect(),
+    };
+    Texture {
+        width,
+        height,
+        texels,
+    }
+}
+
+/// Reads the first RGB(A) layer of an EXR file as row-major linear radiance (row 0 at the
+/// top). Rejects empty images and NaN, infinite or negative texels, naming the first bad one.
+pub(crate) fn read_env_map(path: &Path) -> Result<(u32, u32, Vec<Rgb>)> {
+    if let Err(e) = std::fs::File::open(path) {
+        return Err(SceneError::file(path, format!("cannot open: {e}")));
+    }
+    struct Pixels {
+        width: usize,
+        texels: Vec<Rgb>,
+    }
+    let img = exr::prelude::read_first_rgba_layer_from_file(
+        path,
+        |size, _| Pixels {
+            width: size.width(),
+            texels: vec![Rgb::ZERO; size.width() * size.height()],
+        },
+        |px: &mut Pixels, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            px.texels[pos.y() * px.width + pos.x()] = Rgb::new(r, g, b);
+        },
+    )
+    .map_err(|e| SceneError::file(path, format!("cannot read as an RGB EXR image: {e}")))?;
+    let size = img.layer_data.size;
+    let (w, h) = (size.width(), size.height());
+    if w == 0 || h == 0 {
+        return Err(SceneError::file(path, "the image is empty"));
+    }
+    let texels = img.layer_data.channel_data.pixels.texels;
+    if let Some(i) = texels
+        .iter()
+        .position(|t| !t.is_finite() || t.min_element() < 0.0)
+    {
+        return Err(SceneError::file(
+            path,
+            format!(
+                "texel ({}, {}) is {:?}: environment radiance must be finite and non-negative",
+                i % w,
+                i / w,
+                texels[i].to_array()
+            ),
+        ));
+    }
+    Ok((w as u32, h as u32, texels))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn png_texture_is_srgb_decoded_and_row_zero_is_the_top() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("t.png");
+        let mut img = image::RgbImage::new(2, 2);
+        img.put_pixel(0, 0, image::Rgb([255, 0, 0]));
+        img.put_pixel(1, 0, image::Rgb([188, 188, 188]));
+        img.save(&p).unwrap();
+        let t = read_texture(&p).unwrap();
+        assert_eq!((t.width, t.height), (2, 2));
+        assert_eq!(t.texels[0], Rgb::new(1.0, 0.0, 0.0));
+        // sRGB 188 is about 0.5 linear.
+        assert!((t.texels[1].x - 0.5029).abs() < 1e-3, "{}", t.texels[1]);
+        assert_eq!(t.texels[3], Rgb::ZERO);
+
+        let mut tex = Textures::default();
+        let a = tex.load_file(&p).unwrap();
+        let b = tex.load_file(&dir.path().join(".").join("t.png")).unwrap();
+        assert_eq!(a, b, "the same file is loaded once");
+        assert_eq!(tex.into_vec().len(), 1);
+    }
+
+    #[test]
+    fn bad_texture_files_name_the_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("missing.png");
+        let e = read_texture(&p).unwrap_err().to_string();
+        assert!(e.contains("missing.png: cannot open"), "{e}");
+        let p = dir.path().join("junk.png");
+        std::fs::write(&p, b"not a png").unwrap();
+        let e = read_texture(&p).unwrap_err().to_string();
+        assert!(e.contains("junk.png: cannot decode image"), "{e}");
+    }
+
+    #[test]
+    fn exr_maps_are_read_and_bad_texels_rejected() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("env.exr");
+        exr::prelude::write_rgb_file(&p, 4, 2, |x, y| (x as f32, y as f32, 0.5f32)).unwrap();
+        let (w, h, t) = read_env_map(&p).unwrap();
+        assert_eq!((w, h), (4, 2));
+        assert_eq!(t[4 + 3], Rgb::new(3.0, 1.0, 0.5));
+
+        for (bad, what) in [(f32::NAN, "NaN"), (f32::INFINITY, "inf"), (-1.0, "-1.0")] {
+            exr::prelude::write_rgb_file(&p, 4, 2, |x, y| {
+                (if (x, y) == (2, 1) { bad } else { 1.0f32 }, 1.0f32, 1.0f32)
+            })
+            .unwrap();
+            let e = read_env_map(&p).unwrap_err().to_string();
+            assert!(e.contains("env.exr: texel (2, 1)"), "{e}");
+            assert!(e.contains(what), "{e}");
+        }
+        let e = read_env_map(&dir.path().join("none.exr"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("none.exr: cannot open"), "{e}");
+        std::fs::write(&p, b"garbage").unwrap();
+        let e = read_env_map(&p).unwrap_err().to_string();
+        assert!(e.contains("env.exr: cannot read"), "{e}");
+    }
+}

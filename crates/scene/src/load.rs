@@ -1,0 +1,699 @@
+//! Turns a parsed scene description into an `rt_core::Scene`, section by section:
+//! environment, cameras, materials, geometry, material assignments, lights.
+
+use crate::desc::{self, AssignDesc, CameraDesc, EnvironmentDesc, RenderTableDesc, SceneDesc, V3};
+use crate::error::{Result, Source};
+use crate::geometry;
+use crate::image_io::{self, Textures};
+use crate::material::{self, MaterialTable};
+use crate::{LoadedScene, RenderDesc};
+use glam::Vec3;
+use rt_core::environment::{EnvMap, Environment};
+use rt_core::{Camera, Rgb, Scene};
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+/// Largest image side in pixels.
+pub(crate) const MAX_RESOLUTION: u32 = 16384;
+/// Largest pixel count (2^26, e.g. 8192×8192).
+pub(crate) const MAX_PIXELS: u64 = 1 << 26;
+
+/// State shared by the sections while a scene loads.
+pub(crate) struct Ctx<'a> {
+    /// The TOML text and its name, for errors.
+    pub src: Source<'a>,
+    /// Directory that relative paths in the file are resolved against.
+    pub base: &'a Path,
+    /// Textures loaded so far.
+    pub textures: Textures,
+    /// Non-fatal remarks.
+    pub warnings: Vec<String>,
+}
+
+impl Ctx<'_> {
+    /// A path from the scene file, resolved against the file's directory.
+    pub fn resolve(&self, rel: &str) -> PathBuf {
+        self.base.join(rel)
+    }
+}
+
+/// Loads a scene from TOML text (see [`crate::load_str`]).
+pub(crate) fn load(text: &str, base: &Path, name: &Path) -> Result<LoadedScene> {
+    let src = Source { name, text };
+    let d: SceneDesc = desc::parse(text).map_err(|e| src.toml_error(&e))?;
+    let mut ctx = Ctx {
+        src,
+        base,
+        textures: Textures::default(),
+        warnings: Vec::new(),
+    };
+    let mut scene = Scene::empty();
+    if let Some(env) = &d.environment {
+        scene.environment = environment(&ctx, env)?;
+    }
+    scene.cameras = cameras(&ctx, &d.camera)?;
+    let mut mats = MaterialTable::default();
+    for m in &d.material {
+        let built = material::build(&mut ctx, m)?;
+        if mats.insert(built).is_none() {
+            return Err(ctx.src.error_at(
+                m.get_ref().name.span(),
+                format!(
+                    "material \"{}\" is defined twice",
+                    m.get_ref().name.get_ref()
+                ),
+            ));
+        }
+    }
+    geometry::build_all(&mut ctx, &d.geometry, &mut mats, &mut scene)?;
+    for a in &d.assign {
+        assign(&ctx, a.get_ref(), &mut mats, &mut scene)?;
+    }
+    let render = render(&ctx, d.render)?;
+
+    for name in mats.unused() {
+        ctx.warnings
+            .push(format!("material \"{name}\" is defined but never used"));
+    }
+    scene.materials = mats.into_vec();
+    scene.textures = std::mem::take(&mut ctx.textures).into_vec();
+    scene.build_lights();
+    if scene.lights.is_empty() {
+        ctx.warnings.push(
+            "the scene has no light: no emissive material is used and the environment is black, \
+             so the image will be black"
+                .into(),
+        );
+    }
+    Ok(LoadedScene {
+        scene,
+        render,
+        warnings: ctx.warnings,
+    })
+}
+
+/// Checks that every component of `v` is finite; `what` names the key.
+pub(crate) fn finite3(ctx: &Ctx, v: &Spanned<V3>, what: &str) -> Result<Vec3> {
+    let a = v.get_ref().0;
+    if a.iter().all(|x| x.is_finite()) {
+        Ok(Vec3::from(a))
+    } else {
+        Err(ctx
+            .src
+            .error_at(v.span(), format!("{what} must be finite, got {a:?}")))
+    }
+}
+
+/// `[environment]`.
+fn environment(ctx: &Ctx, env: &Spanned<EnvironmentDesc>) -> Result<Environment> {
+    let e = env.get_ref();
+    let strength = match &e.strength {
+        Some(s) => {
+            let v = *s.get_ref();
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(ctx.src.error_at(
+                    s.span(),
+                    format!("environment strength must be finite and >= 0, got {v}"),
+                ));
+            }
+            v
+        }
+        None => 1.0,
+    };
+    let color = match &e.color {
+        Some(c) => {
+            let v = finite3(ctx, c, "environment color")?;
+            if v.min_element() < 0.0 {
+                return Err(ctx.src.error_at(
+                    c.span(),
+                    format!("environment color must be >= 0, got {:?}", c.get_ref().0),
+                ));
+            }
+            v
+        }
+        None => Rgb::ZERO,
+    };
+    let Some(map) = &e.map else {
+        return Ok(Environment::Constant(color * strength));
+    };
+    if color != Rgb::ZERO {
+        return Err(ctx.src.error_at(
+            e.color.as_ref().map_or(map.span(), |c| c.span()),
+            "environment has both a non-black `color` and a `map`; give one of them",
+        ));
+    }
+    let path = ctx.resolve(map.get_ref());
+    let (w, h, mut texels) = image_io::read_env_map(&path)?;
+    for t in &mut texels {
+        *t *= strength;
+    }
+    Ok(Environment::Map(EnvMap::new(w, h, texels)))
+}
+
+/// `[[camera]]`: at least one, unique names, every value in range.
+fn cameras(ctx: &Ctx, descs: &[Spanned<CameraDesc>]) -> Result<Vec<Camera>> {
+    if descs.is_empty() {
+        return Err(ctx
+            .src
+            .error("the scene has no [[camera]]; at least one is required"));
+    }
+    let mut names = HashSet::new();
+    descs
+        .iter()
+        .map(|d| {
+            let d = d.get_ref();
+            if !names.insert(d.name.get_ref().as_str()) {
+                return Err(ctx.src.error_at(
+                    d.name.span(),
+                    format!("camera \"{}\" is defined twice", d.name.get_ref()),
+                ));
+            }
+            camera(ctx, d)
+        })
+        .collect()
+}
+
+fn camera(ctx: &Ctx, d: &CameraDesc) -> Result<Camera> {
+    let name = d.name.get_ref();
+    let at = |span: std::ops::Range<usize>, msg: String| {
+        Err(ctx.src.error_at(span, format!("camera \"{name}\": {msg}")))
+    };
+    let position = finite3(ctx, &d.position, "position")?;
+    let look_at = finite3(ctx, &d.look_at, "look_at")?;
+    let up = match &d.up {
+        Some(u) => finite3(ctx, u, "up")?,
+        None => Vec3::Y,
+    };
+    let view = look_at - position;
+    if view.length_squared() == 0.0 || !view.length_squared().is_finite() {
+        return at(
+            d.look_at.span(),
+            "look_at must differ from position (and be a finite distance away)".into(),
+        );
+    }
+    let sin = view.normalize().cross(up.normalize_or_zero()).length();
+    if sin.is_nan() || sin <= 1e-6 {
+        let s = d.up.as_ref().unwrap_or(&d.look_at);
+        return at(
+            s.span(),
+            format!("up {up} is zero or parallel to the view direction {view}"),
+        );
+    }
+    let mut fov = 40.0;
+    if let Some(f) = &d.fov {
+        fov = *f.get_ref();
+        if !(fov > 0.0 && fov < 180.0) {
+            return at(
+                f.span(),
+                format!("fov must be in (0, 180) degrees (vertical), got {fov}"),
+            );
+        }
+    }
+    let (mut w, mut h) = (512, 512);
+    if let Some(r) = &d.resolution {
+        [w, h] = r.get_ref().0;
+        if w == 0
+            || h == 0
+            || w > MAX_RESOLUTION
+            || h > MAX_RESOLUTION
+            || w as u64 * h as u64 > MAX_PIXELS
+        {
+            return at(
+                r.span(),
+                format!(
+                    "absurd resolution {w}x{h}: width and height must be in [1, {MAX_RESOLUTION}] \
+                     and width*height at most {MAX_PIXELS}"
+                ),
+            );
+        }
+    }
+    let mut aperture = 0.0;
+    if let Some(a) = &d.aperture {
+        aperture = *a.get_ref();
+        if !(aperture.is_finite() && aperture >= 0.0) {
+            return at(
+                a.span(),
+                format!("aperture must be finite and >= 0, got {aperture}"),
+            );
+        }
+    }
+    let mut focus = view.length();
+    if let Some(f) = &d.focus_distance {
+        focus = *f.get_ref();
+        if !(focus.is_finite() && focus > 0.0) {
+            return at(
+                f.span(),
+                format!("focus_distance must be finite and > 0, got {focus}"),
+            );
+        }
+    }
+    Ok(Camera::look_at(
+        name.clone(),
+        position,
+        look_at,
+        up,
+        fov,
+        w,
+        h,
+        aperture,
+        focus,
+    ))
+}
+
+/// `[[assign]]`: sets the material of a half-open triangle range of one geometry.
+fn assign(ctx: &Ctx, a: &AssignDesc, mats: &mut MaterialTable, scene: &mut Scene) -> Result<()> {
+    let g = a.geometry.get_ref();
+    let Some(obj) = scene.objects.iter().find(|o| &o.name == g) else {
+        return Err(ctx.src.error_at(
+            a.geometry.span(),
+            format!("geometry \"{g}\" used by [[assign]] is not defined"),
+        ));
+    };
+    let [start, end] = a.triangles.get_ref().0;
+    if start >= end || end > obj.count {
+        return Err(ctx.src.error_at(
+            a.triangles.span(),
+            format!(
+                "triangle range [{start}, {end}) is out of bounds: it must be non-empty and \
+                 within geometry \"{g}\"'s {} triangles ([0, {}))",
+                obj.count, obj.count
+            ),
+        ));
+    }
+    let m = a.material.get_ref();
+    let Some(id) = mats.lookup(m) else {
+        return Err(ctx.src.error_at(
+            a.material.span(),
+            format!("material \"{m}\" used by [[assign]] of geometry \"{g}\" is not defined"),
+        ));
+    };
+    let first = obj.first as usize;
+    scene.material_ids[first + start as usize..first + end as usize].fill(id);
+    Ok(())
+}
+
+/// `[render]`.
+fn render(ctx: &Ctx, r: Option<RenderTableDesc>) -> Result<RenderDesc> {
+    let Some(r) = r else {
+        return Ok(RenderDesc::default());
+    };
+    if let Some(s) = &r.spp {
+        if *s.get_ref() == 0 {
+            return Err(ctx.src.error_at(s.span(), "spp must be at least 1"));
+        }
+    }
+    if let Some(t) = &r.threads {
+        if *t.get_ref() == 0 {
+            return Err(ctx.src.error_at(t.span(), "threads must be at least 1"));
+        }
+    }
+    Ok(RenderDesc {
+        spp: r.spp.map(Spanned::into_inner),
+        integrator: r.integrator,
+        accel: r.accel,
+        max_depth: r.max_depth,
+        seed: r.seed,
+        threads: r.threads.map(Spanned::into_inner),
+        aov: r.aov,
+        output: r.output,
+    })
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+    use crate::LoadedScene;
+
+    /// A camera and an emitting quad: the smallest valid scene.
+    pub(crate) const BASE: &str = r#"
+[[camera]]
+name = "main"
+position = [0, 1, 4]
+look_at = [0, 1, 0]
+
+[[material]]
+name = "light"
+emission = [1, 1, 1]
+
+[[geometry]]
+name = "lamp"
+shape = "quad"
+vertices = [[-1, 2, -1], [1, 2, -1], [1, 2, 1], [-1, 2, 1]]
+material = "light"
+"#;
+
+    /// Loads `BASE` followed by `extra`, resolving paths against `dir`.
+    pub(crate) fn load_in(dir: &Path, extra: &str) -> std::result::Result<LoadedScene, String> {
+        crate::load_str(&format!("{BASE}{extra}"), dir, Path::new("t.toml"))
+            .map_err(|e| e.to_string())
+    }
+
+    pub(crate) fn ok(extra: &str) -> LoadedScene {
+        load_in(Path::new("."), extra).unwrap()
+    }
+
+    pub(crate) fn err(extra: &str) -> String {
+        let e = load_in(Path::new("."), extra).unwrap_err();
+        assert!(e.starts_with("t.toml:"), "{e}");
+        assert!(!e.contains('\n'), "{e}");
+        e
+    }
+
+    /// Line of `needle` in `BASE + extra`, 1-based, for position assertions.
+    pub(crate) fn line_of(extra: &str, needle: &str) -> usize {
+        let text = format!("{BASE}{extra}");
+        text[..text.find(needle).unwrap()].matches('\n').count() + 1
+    }
+
+    fn env(s: &LoadedScene) -> Rgb {
+        match &s.scene.environment {
+            Environment::Constant(c) => *c,
+            Environment::Map(_) => panic!("map"),
+        }
+    }
+
+    #[test]
+    fn environment_color_and_strength() {
+        assert_eq!(env(&ok("")), Rgb::ZERO);
+        assert_eq!(env(&ok("[environment]\n")), Rgb::ZERO);
+        assert_eq!(
+            env(&ok("[environment]\ncolor = [0.5, 1, 2]")),
+            Rgb::new(0.5, 1.0, 2.0)
+        );
+        assert_eq!(
+            env(&ok("[environment]\ncolor = [0.5, 1, 2]\nstrength = 2")),
+            Rgb::new(1.0, 2.0, 4.0)
+        );
+        for bad in ["-1", "nan", "inf"] {
+            let e = err(&format!("[environment]\nstrength = {bad}"));
+            assert!(e.contains("strength must be finite and >= 0"), "{e}");
+        }
+        let e = err("[environment]\ncolor = [0, -1, 0]");
+        assert!(e.contains("environment color must be >= 0"), "{e}");
+        let e = err("[environment]\ncolor = [0, nan, 0]");
+        assert!(e.contains("environment color must be finite"), "{e}");
+    }
+
+    #[test]
+    fn environment_map_is_read_relative_to_the_scene_and_scaled() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir(dir.path().join("env")).unwrap();
+        exr::prelude::write_rgb_file(dir.path().join("env/sky.exr"), 8, 4, |x, _| {
+            (x as f32, 1.0f32, 0.0f32)
+        })
+        .unwrap();
+        let s = load_in(
+            dir.path(),
+            "[environment]\nmap = \"env/sky.exr\"\nstrength = 0.5",
+        )
+        .unwrap();
+        let Environment::Map(_) = &s.scene.environment else {
+            panic!("expected a map")
+        };
+        // Column x = 7 is the last; u = 0.5 + atan2(dx, -dz)/2π: +x is u = 0.75, column 6.
+        let r = s.scene.environment.radiance(Vec3::X);
+        assert_eq!(r, Rgb::new(3.0, 0.5, 0.0));
+        // A black colour next to a map is fine; a non-black one is not.
+        load_in(
+            dir.path(),
+            "[environment]\nmap = \"env/sky.exr\"\ncolor = [0, 0, 0]",
+        )
+        .unwrap();
+        let e = load_in(
+            dir.path(),
+            "[environment]\nmap = \"env/sky.exr\"\ncolor = [1, 0, 0]",
+        )
+        .unwrap_err();
+        assert!(e.contains("both a non-black `color` and a `map`"), "{e}");
+        let e = load_in(dir.path(), "[environment]\nmap = \"env/none.exr\"").unwrap_err();
+        assert!(e.contains("none.exr: cannot open"), "{e}");
+    }
+
+    fn cam(extra: &str) -> std::result::Result<Camera, String> {
+        let text = format!(
+            "[[camera]]\nname = \"c\"\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\n{extra}\n{}",
+            &BASE[BASE.find("[[material]]").unwrap()..]
+        );
+        crate::load_str(&text, Path::new("."), Path::new("c.toml"))
+            .map(|s| s.scene.cameras[0].clone())
+            .map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn camera_keys_and_defaults() {
+        let c = cam("").unwrap();
+        assert_eq!(c.name, "c");
+        assert_eq!(c.position, Vec3::new(0.0, 0.0, 5.0));
+        assert_eq!(c.forward, -Vec3::Z);
+        assert_eq!(c.up, Vec3::Y);
+        assert_eq!(c.right, Vec3::X);
+        assert_eq!((c.fov_y_deg, c.width, c.height), (40.0, 512, 512));
+        assert_eq!((c.aperture, c.focus_distance), (0.0, 5.0));
+        let c = cam("up = [1, 0, 0]\nfov = 39.3\nresolution = [640, 360]\naperture = 0.1\nfocus_distance = 3")
+            .unwrap();
+        assert_eq!(c.up, Vec3::X);
+        assert_eq!((c.fov_y_deg, c.width, c.height), (39.3, 640, 360));
+        assert_eq!((c.aperture, c.focus_distance), (0.1, 3.0));
+        assert_eq!(cam("resolution = [16384, 4096]").unwrap().width, 16384);
+    }
+
+    #[test]
+    fn camera_errors_point_at_the_value() {
+        for (extra, want) in [
+            (
+                "fov = 0",
+                "c.toml:5:7: camera \"c\": fov must be in (0, 180)",
+            ),
+            ("fov = 180", "fov must be in (0, 180)"),
+            ("fov = nan", "fov must be in (0, 180)"),
+            (
+                "resolution = [0, 100]",
+                "c.toml:5:14: camera \"c\": absurd resolution 0x100",
+            ),
+            ("resolution = [100, 0]", "absurd resolution 100x0"),
+            ("resolution = [16385, 10]", "absurd resolution 16385x10"),
+            (
+                "resolution = [16384, 16384]",
+                "absurd resolution 16384x16384",
+            ),
+            ("aperture = -0.1", "aperture must be finite and >= 0"),
+            ("aperture = inf", "aperture must be finite and >= 0"),
+            (
+                "focus_distance = 0",
+                "focus_distance must be finite and > 0",
+            ),
+            (
+                "focus_distance = -2",
+                "focus_distance must be finite and > 0",
+            ),
+            (
+                "up = [0, 0, 2]",
+                "c.toml:5:6: camera \"c\": up [0, 0, 2] is zero or parallel",
+            ),
+            ("up = [0, 0, 0]", "is zero or parallel"),
+            ("up = [0, nan, 0]", "up must be finite"),
+        ] {
+            let e = cam(extra).unwrap_err();
+            assert!(e.contains(want), "{extra}: {e}");
+        }
+        let e = cam("position = [0, 0, 0]").unwrap_err();
+        assert!(e.contains("duplicate key") || e.contains("position"), "{e}");
+        let text = "[[camera]]\nname = \"c\"\nposition = [1, 2, 3]\nlook_at = [1, 2, 3]\n";
+        let e = crate::load_str(text, Path::new("."), Path::new("c.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("c.toml:4:11: camera \"c\": look_at must differ from position"),
+            "{e}"
+        );
+        let text = "[[camera]]\nname = \"c\"\nposition = [inf, 2, 3]\nlook_at = [1, 2, 3]\n";
+        let e = crate::load_str(text, Path::new("."), Path::new("c.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("c.toml:3:12: position must be finite"), "{e}");
+    }
+
+    #[test]
+    fn cameras_need_unique_names_and_at_least_one_exists() {
+        let extra = "[[camera]]\nname = \"main\"\nposition = [0, 0, 1]\nlook_at = [0, 0, 0]\n";
+        let e = err(extra);
+        assert!(e.contains("camera \"main\" is defined twice"), "{e}");
+        assert!(
+            e.starts_with(&format!(
+                "t.toml:{}:",
+                line_of(extra, "name = \"main\"\nposition = [0, 0, 1]")
+            )),
+            "{e}"
+        );
+        let s = ok(&extra.replace("main", "second"));
+        assert_eq!(s.scene.cameras.len(), 2);
+        assert_eq!(s.scene.cameras[1].name, "second");
+        let no_cam = &BASE[BASE.find("[[material]]").unwrap()..];
+        let e = crate::load_str(no_cam, Path::new("."), Path::new("n.toml")).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "n.toml: the scene has no [[camera]]; at least one is required"
+        );
+    }
+
+    const BOX: &str = "\n[[material]]\nname = \"red\"\ncolor = [1, 0, 0]\n\
+        [[geometry]]\nname = \"box\"\nshape = \"box\"\nmin = [0, 0, 0]\nmax = [1, 1, 1]\nmaterial = \"light\"\n";
+
+    #[test]
+    fn assign_sets_a_half_open_triangle_range() {
+        let s = ok(&format!(
+            "{BOX}[[assign]]\ngeometry = \"box\"\ntriangles = [2, 5]\nmaterial = \"red\"\n"
+        ));
+        let red = s
+            .scene
+            .materials
+            .iter()
+            .position(|m| m.name == "red")
+            .unwrap() as u32;
+        let light = 0;
+        let ids: Vec<u32> = s.scene.material_ids[2..].to_vec();
+        let mut want = vec![light; 12];
+        want[2..5].fill(red);
+        assert_eq!(ids, want);
+        // The whole range is fine too.
+        ok(&format!(
+            "{BOX}[[assign]]\ngeometry = \"box\"\ntriangles = [0, 12]\nmaterial = \"red\"\n"
+        ));
+    }
+
+    #[test]
+    fn assign_errors() {
+        for (tail, want) in [
+            (
+                "geometry = \"boxx\"\ntriangles = [0, 1]\nmaterial = \"red\"",
+                "geometry \"boxx\" used by [[assign]] is not defined",
+            ),
+            (
+                "geometry = \"box\"\ntriangles = [0, 13]\nmaterial = \"red\"",
+                "triangle range [0, 13) is out of bounds",
+            ),
+            (
+                "geometry = \"box\"\ntriangles = [3, 3]\nmaterial = \"red\"",
+                "triangle range [3, 3) is out of bounds",
+            ),
+            (
+                "geometry = \"box\"\ntriangles = [4, 2]\nmaterial = \"red\"",
+                "triangle range [4, 2)",
+            ),
+            (
+                "geometry = \"box\"\ntriangles = [0, 1]\nmaterial = \"blue\"",
+                "material \"blue\" used by [[assign]] of geometry \"box\" is not defined",
+            ),
+            (
+                "geometry = \"box\"\ntriangles = [-1, 1]\nmaterial = \"red\"",
+                "-1",
+            ),
+            (
+                "geometry = \"box\"\ntriangles = [0, 1, 2]\nmaterial = \"red\"",
+                "length",
+            ),
+        ] {
+            let extra = format!("{BOX}[[assign]]\n{tail}\n");
+            let e = err(&extra);
+            assert!(e.contains(want), "{tail}: {e}");
+            let assign_line = line_of(&extra, "[[assign]]");
+            let at: usize = e.split(':').nth(1).unwrap().parse().unwrap();
+            assert!(at > assign_line && at <= assign_line + 3, "{e}");
+        }
+        assert!(err(&format!(
+            "{BOX}[[assign]]\ngeometry = \"box\"\nmaterial = \"red\"\n"
+        ))
+        .contains("missing field `triangles`"));
+    }
+
+    #[test]
+    fn render_table_keys() {
+        let s = ok("[render]\nspp = 64\nintegrator = \"path\"\naccel = \"bvh\"\nmax_depth = 16\nseed = 7\nthreads = 2\naov = [\"albedo\", \"normal\"]\noutput = \"out.exr\"");
+        let r = s.render;
+        assert_eq!(r.spp, Some(64));
+        assert_eq!(r.integrator.as_deref(), Some("path"));
+        assert_eq!(r.accel.as_deref(), Some("bvh"));
+        assert_eq!(r.max_depth, Some(16));
+        assert_eq!(r.seed, Some(7));
+        assert_eq!(r.threads, Some(2));
+        assert_eq!(
+            r.aov,
+            Some(vec!["albedo".to_string(), "normal".to_string()])
+        );
+        assert_eq!(r.output.as_deref(), Some("out.exr"));
+        let r = ok("").render;
+        assert!(r.spp.is_none() && r.integrator.is_none() && r.aov.is_none());
+        assert!(err("[render]\nspp = 0").contains("spp must be at least 1"));
+        assert!(err("[render]\nthreads = 0").contains("threads must be at least 1"));
+        assert!(err("[render]\nspp = -4").contains("-4"));
+        assert!(err("[render]\naov = \"albedo\"").contains("expected a sequence"));
+        let e = err("[render]\nsamples = 4");
+        assert!(e.contains("unknown field `samples`"), "{e}");
+    }
+
+    #[test]
+    fn malformed_toml_names_file_line_and_column() {
+        let e = err("[[material]\nname = \"x\"");
+        assert!(
+            e.starts_with(&format!(
+                "t.toml:{}:",
+                line_of("[[material]\n", "[[material]\n")
+            )),
+            "{e}"
+        );
+        let e = err("[[material]]\nname = \"x\"\ncolor = [0.5, 0.5, 0.5");
+        assert!(e.contains("t.toml:"), "{e}");
+        let extra = "[[material]]\nname = \"x\"\n  glossiness = 0.5\n";
+        let e = err(extra);
+        assert!(
+            e.starts_with(&format!(
+                "t.toml:{}:3: unknown field `glossiness`",
+                line_of(extra, "glossiness")
+            )),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn warnings_for_unused_materials_and_missing_lights() {
+        let s = ok("[[material]]\nname = \"spare\"\n");
+        assert!(
+            s.warnings
+                .iter()
+                .any(|w| w == "material \"spare\" is defined but never used"),
+            "{:?}",
+            s.warnings
+        );
+        let dark = BASE.replace("emission = [1, 1, 1]", "color = [0.5, 0.5, 0.5]");
+        let s = crate::load_str(&dark, Path::new("."), Path::new("d.toml")).unwrap();
+        assert!(
+            s.warnings
+                .iter()
+                .any(|w| w.contains("the scene has no light")),
+            "{:?}",
+            s.warnings
+        );
+        assert!(ok("").warnings.is_empty(), "{:?}", ok("").warnings);
+        assert_eq!(
+            ok("").scene.lights.emitter_count(),
+            2,
+            "build_lights() was called"
+        );
+    }
+
+    #[test]
+    fn materials_need_unique_names() {
+        let extra = "[[material]]\nname = \"light\"\n";
+        let e = err(extra);
+        let text = format!("{BASE}{extra}");
+        let line = text[..text.rfind("name = \"light\"").unwrap()]
+            .matches('\n')
+            .count()
+            + 1;
+        assert_eq!(
+            e,
+            format!("t.toml:{line}:8: material \"light\" is defined twice")
+        );
+    }
+}

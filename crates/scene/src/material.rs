@@ -1,0 +1,453 @@
+//! `[[material]]`: presets and layer stacks of the layered model (`rt_core::material`), and the
+//! table of named materials that geometry and `[[assign]]` refer to.
+
+use crate::desc::{LayerDesc, MaterialDesc};
+use crate::error::Result;
+use crate::load::{finite3, Ctx};
+use rt_core::material::MaterialError;
+use rt_core::{Layer, Material, Rgb};
+use std::collections::HashMap;
+use std::ops::Range;
+use toml::Spanned;
+
+/// The material types a `type` key may name.
+pub(crate) const TYPES: [&str; 7] = [
+    "diffuse", "mirror", "glass", "glossy", "plastic", "metal", "layered",
+];
+
+/// Colour when `color` is not given.
+pub(crate) const DEFAULT_COLOR: Rgb = Rgb::splat(0.8);
+/// Index of refraction when `ior` is not given.
+pub(crate) const DEFAULT_IOR: f32 = 1.5;
+
+/// Default hardness of the presets that take one.
+pub(crate) fn default_hardness(kind: &str) -> Option<f32> {
+    match kind {
+        "glossy" => Some(0.6),
+        "metal" => Some(0.85),
+        "plastic" => Some(0.9),
+        "glass" => Some(1.0),
+        _ => None,
+    }
+}
+
+/// Named materials in index order, with which of them something uses.
+#[derive(Default)]
+pub(crate) struct MaterialTable {
+    list: Vec<Material>,
+    by_name: HashMap<String, u32>,
+    used: Vec<bool>,
+}
+
+impl MaterialTable {
+    /// Adds `m` under its name; `None` if the name is taken.
+    pub fn insert(&mut self, m: Material) -> Option<u32> {
+        if self.by_name.contains_key(&m.name) {
+            return None;
+        }
+        let id = self.list.len() as u32;
+        self.by_name.insert(m.name.clone(), id);
+        self.list.push(m);
+        self.used.push(false);
+        Some(id)
+    }
+
+    /// Index of the material called `name`, marking it used.
+    pub fn lookup(&mut self, name: &str) -> Option<u32> {
+        let id = *self.by_name.get(name)?;
+        self.used[id as usize] = true;
+        Some(id)
+    }
+
+    /// Names of the materials nothing refers to.
+    pub fn unused(&self) -> impl Iterator<Item = &str> {
+        self.list
+            .iter()
+            .zip(&self.used)
+            .filter(|(_, &u)| !u)
+            .map(|(m, _)| m.name.as_str())
+    }
+
+    /// The materials, in index order.
+    pub fn into_vec(self) -> Vec<Material> {
+        self.list
+    }
+}
+
+/// Builds the material of one `[[material]]` table and checks it with `Material::validate`.
+pub(crate) fn build(ctx: &mut Ctx, d: &Spanned<MaterialDesc>) -> Result<Material> {
+    let d = d.get_ref();
+    let name = d.name.get_ref();
+    let err = |span: Range<usize>, msg: String| {
+        ctx.src
+            .error_at(span, format!("material \"{name}\": {msg}"))
+    };
+    if name.is_empty() || name.contains('/') {
+        return Err(ctx.src.error_at(
+            d.name.span(),
+            format!(
+                "material name \"{name}\" is invalid: it must be non-empty and must not contain \
+                 '/' (reserved for materials loaded from mesh files)"
+            ),
+        ));
+    }
+    let kind = match (&d.kind, &d.layers) {
+        (Some(k), _) => {
+            if !TYPES.contains(&k.get_ref().as_str()) {
+                return Err(err(
+                    k.span(),
+                    format!(
+                        "unknown material type \"{}\"; valid types are {}",
+                        k.get_ref(),
+                        TYPES.join(", ")
+                    ),
+                ));
+            }
+            k.get_ref().as_str()
+        }
+        (None, Some(_)) => "layered",
+        (None, None) => "diffuse",
+    };
+    if let (Some(l), true) = (&d.layers, kind != "layered") {
+        return Err(err(
+            l.span(),
+            format!("`layers` cannot be combined with type \"{kind}\"; omit `type` or set it to \"layered\""),
+        ));
+    }
+    if kind == "layered" && d.layers.is_none() {
+        let span = d.kind.as_ref().map_or(d.name.span(), |k| k.span());
+        return Err(err(span, "type \"layered\" needs `layers`".into()));
+    }
+    // Keys that the chosen type does not use are errors, like unknown keys: they would be
+    // silently ignored otherwise.
+    let takes_hardness = default_hardness(kind).is_some();
+    let takes_ior = matches!(kind, "glass" | "plastic");
+    if let (Some(h), false) = (&d.hardness, takes_hardness) {
+        return Err(err(
+            h.span(),
+            format!("`hardness` does not apply to type \"{kind}\" (it applies to glossy, metal, plastic and glass{})",
+                if kind == "layered" { "; give it per layer" } else { "" }),
+        ));
+    }
+    if let (Some(i), false) = (&d.ior, takes_ior) {
+        return Err(err(
+            i.span(),
+            format!(
+                "`ior` does not apply to type \"{kind}\" (it applies to glass and plastic{})",
+                if kind == "layered" {
+                    "; give it per layer"
+                } else {
+                    ""
+                }
+            ),
+        ));
+    }
+    let color = match &d.color {
+        Some(c) => finite3(ctx, c, "color")?,
+        None => DEFAULT_COLOR,
+    };
+    let hardness = d
+        .hardness
+        .as_ref()
+        .map(|h| *h.get_ref())
+        .or(default_hardness(kind))
+        .unwrap_or(0.0);
+    let ior = d.ior.as_ref().map_or(DEFAULT_IOR, |i| *i.get_ref());
+    let mut m = match kind {
+        "diffuse" => Material::diffuse(name, color),
+        "mirror" => Material::mirror(name, color),
+        "glass" => Material::glass(name, color, ior, hardness),
+        "glossy" => Material::glossy(name, color, hardness),
+        "plastic" => Material::plastic(name, color, hardness, ior),
+        "metal" => Material::metal(name, color, hardness),
+        _ => {
+            let layers = d.layers.as_ref().expect("layered has layers");
+            if layers.get_ref().is_empty() {
+                return Err(err(
+                    layers.span(),
+                    "`layers` is empty; give at least one layer (a black diffuse material is \
+                     color = [0, 0, 0])"
+                        .into(),
+                ));
+            }
+            let mut m = Material::diffuse(name, color);
+            m.layers = layers
+                .get_ref()
+                .iter()
+                .map(|l| layer(l.get_ref(), color))
+                .collect();
+            m
+        }
+    };
+    if let Some(e) = &d.emission {
+        m.emission = finite3(ctx, e, "emission")?;
+    }
+    m.two_sided = d.two_sided.unwrap_or(false);
+    if let Some(t) = &d.texture {
+        m.texture = Some(ctx.textures.load_file(&ctx.resolve(t.get_ref()))?);
+    }
+    if let Err(e) = m.validate() {
+        // Point at the value that is wrong.
+        let span = match (&e, &d.layers) {
+            (MaterialError::Emission(_), _) => d.emission.as_ref().map(|e| e.span()),
+            (MaterialError::Layer { layer, .. }, Some(ls)) => {
+                ls.get_ref().get(*layer).map(|l| l.span())
+            }
+            (MaterialError::Layer { what, .. }, None) => {
+                if what.starts_with("color") {
+                    d.color.as_ref().map(|c| c.span())
+                } else if what.starts_with("hardness") {
+                    d.hardness.as_ref().map(|c| c.span())
+                } else if what.starts_with("ior") {
+                    d.ior.as_ref().map(|c| c.span())
+                } else {
+                    None
+                }
+            }
+            (_, Some(ls)) => Some(ls.span()),
+            _ => None,
+        };
+        return Err(err(span.unwrap_or(d.name.span()), e.to_string()));
+    }
+    Ok(m)
+}
+
+/// One entry of `layers`; `color` is the material's `color` (the default layer colour).
+fn layer(l: &LayerDesc, color: Rgb) -> Layer {
+    let c = l.color.map_or(color, Rgb::from);
+    Layer {
+        weight: l.weight.unwrap_or(1.0),
+        color: c,
+        color90: l.color90.map_or(c, Rgb::from),
+        hardness: l.hardness.unwrap_or(0.0),
+        transmission: l.transmission.unwrap_or(false),
+        ior: l.ior.unwrap_or(DEFAULT_IOR),
+        coat: l.coat.unwrap_or(false),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::desc::SceneDesc;
+    use crate::error::Source;
+    use crate::image_io::Textures;
+    use std::path::Path;
+
+    /// Builds the first material of `text`, or returns the error message.
+    fn mat(text: &str) -> std::result::Result<(Material, usize), String> {
+        let d: SceneDesc = toml::from_str(text).map_err(|e| e.to_string())?;
+        let mut ctx = Ctx {
+            src: Source {
+                name: Path::new("m.toml"),
+                text,
+            },
+            base: Path::new("."),
+            textures: Textures::default(),
+            warnings: vec![],
+        };
+        let m = build(&mut ctx, &d.material[0]).map_err(|e| e.to_string())?;
+        Ok((m, ctx.textures.into_vec().len()))
+    }
+
+    fn ok(body: &str) -> Material {
+        mat(&format!("[[material]]\nname = \"m\"\n{body}"))
+            .unwrap()
+            .0
+    }
+
+    fn bad(body: &str) -> String {
+        mat(&format!("[[material]]\nname = \"m\"\n{body}")).unwrap_err()
+    }
+
+    #[test]
+    fn type_selects_the_preset_with_its_default_hardness() {
+        let c = Rgb::new(0.2, 0.4, 0.6);
+        let col = "color = [0.2, 0.4, 0.6]";
+        assert_eq!(ok(""), Material::diffuse("m", DEFAULT_COLOR));
+        assert_eq!(
+            ok(&format!("type = \"diffuse\"\n{col}")),
+            Material::diffuse("m", c)
+        );
+        assert_eq!(
+            ok(&format!("type = \"mirror\"\n{col}")),
+            Material::mirror("m", c)
+        );
+        assert_eq!(
+            ok(&format!("type = \"glass\"\n{col}")),
+            Material::glass("m", c, 1.5, 1.0)
+        );
+        assert_eq!(
+            ok(&format!("type = \"glossy\"\n{col}")),
+            Material::glossy("m", c, 0.6)
+        );
+        assert_eq!(
+            ok(&format!("type = \"metal\"\n{col}")),
+            Material::metal("m", c, 0.85)
+        );
+        assert_eq!(
+            ok(&format!("type = \"plastic\"\n{col}")),
+            Material::plastic("m", c, 0.9, 1.5)
+        );
+    }
+
+    #[test]
+    fn hardness_and_ior_apply_where_they_mean_something() {
+        assert_eq!(
+            ok("type = \"glass\"\nhardness = 0.7\nior = 1.33"),
+            Material::glass("m", DEFAULT_COLOR, 1.33, 0.7)
+        );
+        assert_eq!(
+            ok("type = \"plastic\"\nhardness = 0.5\nior = 1.4"),
+            Material::plastic("m", DEFAULT_COLOR, 0.5, 1.4)
+        );
+        assert_eq!(
+            ok("type = \"glossy\"\nhardness = 0.3").layers[0].hardness,
+            0.3
+        );
+        assert_eq!(
+            ok("type = \"metal\"\nhardness = 0.3").layers[0].hardness,
+            0.3
+        );
+        let e = bad("type = \"diffuse\"\nhardness = 0.5");
+        assert!(
+            e.contains(
+                "m.toml:4:12: material \"m\": `hardness` does not apply to type \"diffuse\""
+            ),
+            "{e}"
+        );
+        let e = bad("type = \"metal\"\nior = 1.5");
+        assert!(e.contains("`ior` does not apply to type \"metal\""), "{e}");
+        let e = bad("type = \"glossy\"\nhardness = 1.5");
+        assert!(
+            e.contains("m.toml:4:12: material \"m\": layer 0: hardness must be in [0, 1]"),
+            "{e}"
+        );
+        let e = bad("type = \"glass\"\nior = -1");
+        assert!(
+            e.contains("m.toml:4:7:") && e.contains("ior must be a positive number"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn unknown_type_lists_the_valid_ones() {
+        let e = bad("type = \"velvet\"");
+        assert!(
+            e.starts_with("m.toml:3:8: material \"m\": unknown material type \"velvet\""),
+            "{e}"
+        );
+        assert!(
+            e.contains("diffuse, mirror, glass, glossy, plastic, metal, layered"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn color_emission_and_two_sided() {
+        let m = ok("color = [0.1, 0.2, 0.3]\nemission = [17, 12, 4]\ntwo_sided = true");
+        assert_eq!(m.layers[0].color, Rgb::new(0.1, 0.2, 0.3));
+        assert_eq!(m.emission, Rgb::new(17.0, 12.0, 4.0));
+        assert!(m.two_sided && m.is_emissive());
+        assert!(!ok("").two_sided);
+        assert_eq!(ok("").emission, Rgb::ZERO);
+        let e = bad("color = [1.5, 0, 0]");
+        assert!(
+            e.contains("m.toml:3:9:") && e.contains("color must be in [0, 1]"),
+            "{e}"
+        );
+        let e = bad("color = [nan, 0, 0]");
+        assert!(
+            e.contains("m.toml:3:9:") && e.contains("color must be finite"),
+            "{e}"
+        );
+        let e = bad("emission = [1, -1, 0]");
+        assert!(
+            e.contains("m.toml:3:12:") && e.contains("emission must be finite and non-negative"),
+            "{e}"
+        );
+        let e = bad("emission = [inf, 1, 0]");
+        assert!(
+            e.contains("m.toml:3:12:") && e.contains("emission must be finite"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn layers_build_a_custom_stack_with_defaults() {
+        let m = ok("color = [0.5, 0.5, 0.5]\nlayers = [\n  { weight = 0.3, color = [1, 1, 1], hardness = 0.8, coat = true, ior = 1.6 },\n  { weight = 0.7 },\n  { weight = 0.3, color = [0.9, 0.9, 0.9], color90 = [1, 1, 1], transmission = true, hardness = 1 },\n]");
+        assert_eq!(m.layers.len(), 3);
+        assert_eq!(
+            m.layers[0],
+            Layer {
+                weight: 0.3,
+                color: Rgb::ONE,
+                color90: Rgb::ONE,
+                hardness: 0.8,
+                transmission: false,
+                ior: 1.6,
+                coat: true
+            }
+        );
+        assert_eq!(m.layers[1], Layer::new(0.7, Rgb::splat(0.5), 0.0));
+        assert_eq!(m.layers[2].color90, Rgb::ONE);
+        assert!(m.layers[2].transmission && m.layers[2].ior == 1.5);
+        // Explicit "layered" type is the same thing.
+        let m2 = ok("type = \"layered\"\nlayers = [{ weight = 1 }]");
+        assert_eq!(m2.layers, vec![Layer::new(1.0, DEFAULT_COLOR, 0.0)]);
+        let e = bad("layers = [{ weight = 0.7 }, { weight = 0.7, hardness = 0.5 }]");
+        assert!(
+            e.contains("m.toml:3:10:") && e.contains("sum to 1.4"),
+            "{e}"
+        );
+        let e = bad("layers = [{ weight = 0.5 }, { hardness = 2 }]");
+        assert!(
+            e.contains("m.toml:3:29:") && e.contains("layer 1: hardness"),
+            "{e}"
+        );
+        let e = bad("type = \"glossy\"\nlayers = [{ weight = 1 }]");
+        assert!(e.contains("cannot be combined with type \"glossy\""), "{e}");
+        let e = bad("layers = []");
+        assert!(e.contains("`layers` is empty"), "{e}");
+        let e = bad("type = \"layered\"");
+        assert!(e.contains("needs `layers`") || e.contains("layers"), "{e}");
+        let e = bad("layers = [{ weight = 1 }]\nhardness = 0.5");
+        assert!(e.contains("give it per layer"), "{e}");
+    }
+
+    #[test]
+    fn names_are_checked() {
+        let e = mat("[[material]]\nname = \"a/b\"").unwrap_err();
+        assert!(e.contains("must not contain '/'"), "{e}");
+        let e = mat("[[material]]\nname = \"\"").unwrap_err();
+        assert!(e.contains("must be non-empty"), "{e}");
+    }
+
+    #[test]
+    fn texture_is_loaded_relative_to_the_scene_and_missing_ones_are_errors() {
+        let dir = tempfile::tempdir().unwrap();
+        image::RgbImage::from_pixel(2, 2, image::Rgb([255, 128, 0]))
+            .save(dir.path().join("t.png"))
+            .unwrap();
+        let text = "[[material]]\nname = \"m\"\ntexture = \"t.png\"";
+        let d: SceneDesc = toml::from_str(text).unwrap();
+        let mut ctx = Ctx {
+            src: Source {
+                name: Path::new("m.toml"),
+                text,
+            },
+            base: dir.path(),
+            textures: Textures::default(),
+            warnings: vec![],
+        };
+        let m = build(&mut ctx, &d.material[0]).unwrap();
+        assert_eq!(m.texture, Some(0));
+        let t = ctx.textures.into_vec();
+        assert_eq!(
+            t[0].texels[0],
+            Rgb::new(1.0, rt_core::color::srgb_to_linear(128.0 / 255.0), 0.0)
+        );
+        let e = bad("texture = \"nope.png\"");
+        assert!(e.contains("nope.png: cannot open"), "{e}");
+    }
+}

@@ -1,0 +1,236 @@
+//! Inline shapes, tessellated on load: quad, box, icosphere, disk.
+//!
+//! The functions here take already-validated parameters (finite, positive radius, ordered box
+//! corners; `geometry.rs` checks them against the TOML) and produce triangles whose front
+//! (counter-clockwise) faces point out of the solid, or towards the given normal.
+
+use crate::geometry::Mesh;
+use glam::{Vec2, Vec3};
+use std::collections::HashMap;
+
+/// Texture coordinates of the four corners of a quad.
+const QUAD_UV: [Vec2; 4] = [
+    Vec2::new(0.0, 0.0),
+    Vec2::new(1.0, 0.0),
+    Vec2::new(1.0, 1.0),
+    Vec2::new(0.0, 1.0),
+];
+
+/// A quad from four corners in counter-clockwise order seen from the front, as the triangles
+/// (0,1,2) and (0,2,3). The corners get uvs (0,0), (1,0), (1,1), (0,1).
+pub(crate) fn quad(v: [Vec3; 4]) -> Mesh {
+    let mut m = Mesh::default();
+    push_quad(&mut m, v);
+    m
+}
+
+fn push_quad(m: &mut Mesh, v: [Vec3; 4]) {
+    let uv = QUAD_UV;
+    m.push([v[0], v[1], v[2]], None, Some([uv[0], uv[1], uv[2]]), None);
+    m.push([v[0], v[2], v[3]], None, Some([uv[0], uv[2], uv[3]]), None);
+}
+
+/// An axis-aligned box from `min` to `max` (each component of `max` greater): 12 triangles,
+/// faces outward, each face with uvs over [0,1]².
+pub(crate) fn cuboid(min: Vec3, max: Vec3) -> Mesh {
+    let mut m = Mesh::default();
+    let center = (min + max) * 0.5;
+    for axis in 0..3 {
+        for side in [0.0f32, 1.0] {
+            let (b, c) = ((axis + 1) % 3, (axis + 2) % 3);
+            let corner = |sb: f32, sc: f32| {
+                let mut p = Vec3::ZERO;
+                let pick = |s: f32, i: usize| if s > 0.5 { max[i] } else { min[i] };
+                p[axis] = pick(side, axis);
+                p[b] = pick(sb, b);
+                p[c] = pick(sc, c);
+                p
+            };
+            let mut v = [
+                corner(0.0, 0.0),
+                corner(1.0, 0.0),
+                corner(1.0, 1.0),
+                corner(0.0, 1.0),
+            ];
+            // Orient the face outward: its normal must point away from the centre.
+            let n = (v[1] - v[0]).cross(v[2] - v[0]);
+            let face_center = (v[0] + v[2]) * 0.5;
+            if n.dot(face_center - center) < 0.0 {
+                v.swap(1, 3);
+            }
+            push_quad(&mut m, v);
+        }
+    }
+    m
+}
+
+/// An icosphere: the icosahedron subdivided `subdivisions` times (20·4^s triangles), outward,
+/// with smooth normals.
+pub(crate) fn sphere(center: Vec3, radius: f32, subdivisions: u32) -> Mesh {
+    let t = (1.0 + 5.0f32.sqrt()) / 2.0;
+    let mut verts: Vec<Vec3> = [
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ]
+    .iter()
+    .map(|&p| Vec3::from(p).normalize())
+    .collect();
+    let mut faces: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..subdivisions {
+        let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut midpoint = |a: u32, b: u32, verts: &mut Vec<Vec3>| {
+            let key = (a.min(b), a.max(b));
+            *mid.entry(key).or_insert_with(|| {
+                verts.push(((verts[a as usize] + verts[b as usize]) * 0.5).normalize());
+                (verts.len() - 1) as u32
+            })
+        };
+        let mut next = Vec::with_capacity(faces.len() * 4);
+        for [a, b, c] in faces {
+            let ab = midpoint(a, b, &mut verts);
+            let bc = midpoint(b, c, &mut verts);
+            let ca = midpoint(c, a, &mut verts);
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        faces = next;
+    }
+    let mut m = Mesh::default();
+    for [a, b, c] in faces {
+        let mut n = [verts[a as usize], verts[b as usize], verts[c as usize]];
+        // The table above is outward already; keep the guarantee explicit.
+        if (n[1] - n[0]).cross(n[2] - n[0]).dot(n[0] + n[1] + n[2]) < 0.0 {
+            n.swap(1, 2);
+        }
+        m.push(n.map(|d| center + d * radius), Some(n), None, None);
+    }
+    m
+}
+
+/// A disk of `segments` triangles around `center`, front face towards `normal` (unit), with
+/// planar uvs (centre at (0.5, 0.5)).
+pub(crate) fn disk(center: Vec3, normal: Vec3, radius: f32, segments: u32) -> Mesh {
+    // Tangents with t × b = normal, so increasing angle runs counter-clockwise seen from the
+    // normal side.
+    let (t, b) = normal.any_orthonormal_pair();
+    let (t, b) = if t.cross(b).dot(normal) > 0.0 {
+        (t, b)
+    } else {
+        (b, t)
+    };
+    let at = |i: u32| {
+        let a = std::f32::consts::TAU * (i % segments) as f32 / segments as f32;
+        let (s, c) = a.sin_cos();
+        (
+            center + (t * c + b * s) * radius,
+            Vec2::new(0.5 + 0.5 * c, 0.5 + 0.5 * s),
+        )
+    };
+    let mut m = Mesh::default();
+    let uc = Vec2::splat(0.5);
+    for i in 0..segments {
+        let (p0, u0) = at(i);
+        let (p1, u1) = at(i + 1);
+        m.push([center, p0, p1], None, Some([uc, u0, u1]), None);
+    }
+    m
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn normal(v: &[Vec3; 3]) -> Vec3 {
+        (v[1] - v[0]).cross(v[2] - v[0])
+    }
+
+    #[test]
+    fn quad_is_split_as_0_1_2_and_0_2_3() {
+        let v = [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y];
+        let m = quad(v);
+        assert_eq!(m.tris, vec![[v[0], v[1], v[2]], [v[0], v[2], v[3]]]);
+        assert!(normal(&m.tris[0]).z > 0.0 && normal(&m.tris[1]).z > 0.0);
+        assert_eq!(m.uvs[1], Some([QUAD_UV[0], QUAD_UV[2], QUAD_UV[3]]));
+    }
+
+    #[test]
+    fn box_faces_point_outward_and_cover_the_surface() {
+        let (lo, hi) = (Vec3::new(-1.0, 0.0, 2.0), Vec3::new(1.0, 3.0, 2.5));
+        let m = cuboid(lo, hi);
+        assert_eq!(m.tris.len(), 12);
+        let c = (lo + hi) * 0.5;
+        let mut area = 0.0;
+        for t in &m.tris {
+            let n = normal(t);
+            assert!(n.dot((t[0] + t[1] + t[2]) / 3.0 - c) > 0.0, "{t:?}");
+            area += n.length() * 0.5;
+        }
+        let d = hi - lo;
+        assert!((area - 2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)).abs() < 1e-4);
+    }
+
+    #[test]
+    fn icosphere_is_outward_with_unit_normals_on_the_sphere() {
+        let c = Vec3::new(1.0, 2.0, 3.0);
+        for s in 0..4 {
+            let m = sphere(c, 0.5, s);
+            assert_eq!(m.tris.len(), 20 * 4usize.pow(s));
+            for (t, n) in m.tris.iter().zip(&m.normals) {
+                assert!(normal(t).dot((t[0] + t[1] + t[2]) / 3.0 - c) > 0.0);
+                for (p, n) in t.iter().zip(n.unwrap()) {
+                    assert!(((*p - c).length() - 0.5).abs() < 1e-5);
+                    assert!((n - (*p - c) * 2.0).length() < 1e-5);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn disk_faces_its_normal_and_has_the_right_area() {
+        let n = Vec3::new(1.0, 1.0, 0.0).normalize();
+        let m = disk(Vec3::ONE, n, 2.0, 64);
+        assert_eq!(m.tris.len(), 64);
+        let mut area = 0.0;
+        for t in &m.tris {
+            let g = normal(t);
+            assert!(g.normalize().dot(n) > 0.9999);
+            area += g.length() * 0.5;
+        }
+        let exact = 0.5 * 64.0 * 4.0 * (std::f32::consts::TAU / 64.0).sin();
+        assert!((area - exact).abs() < 1e-3, "{area} {exact}");
+        for axis in [Vec3::X, Vec3::Y, Vec3::Z, -Vec3::Y] {
+            let m = disk(Vec3::ZERO, axis, 1.0, 3);
+            assert!(m.tris.iter().all(|t| normal(t).dot(axis) > 0.0), "{axis}");
+        }
+    }
+}

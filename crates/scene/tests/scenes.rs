@@ -1,0 +1,304 @@
+//! The shipped scenes (`scenes/*.toml`) and the shared test meshes (`../shared/data`, skipped
+//! with a message when absent).
+
+mod common;
+
+use glam::Vec3;
+use rt_core::{Material, Rgb};
+use std::path::{Path, PathBuf};
+
+fn scenes_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
+}
+
+fn load_scene(name: &str) -> rt_scene::LoadedScene {
+    let p = scenes_dir().join(name);
+    rt_scene::load(&p).unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn every_shipped_scene_loads_without_warnings() {
+    let mut names: Vec<PathBuf> = std::fs::read_dir(scenes_dir())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    names.sort();
+    let expected = [
+        "cornell-box.toml",
+        "depth-of-field.toml",
+        "environment.toml",
+        "meshes.toml",
+        "showcase.toml",
+    ];
+    for e in expected {
+        assert!(
+            names.iter().any(|p| p.ends_with(e)),
+            "scenes/{e} is missing"
+        );
+    }
+    for p in &names {
+        let s = rt_scene::load(p).unwrap_or_else(|e| panic!("{e}"));
+        assert!(s.warnings.is_empty(), "{}: {:?}", p.display(), s.warnings);
+        assert!(!s.scene.cameras.is_empty() && s.scene.triangle_count() > 0);
+        assert!(!s.scene.lights.is_empty(), "{} has no light", p.display());
+        for c in &s.scene.cameras {
+            assert!(
+                c.width <= 512 && c.height <= 512,
+                "{}: keep shipped scenes cheap",
+                p.display()
+            );
+        }
+        for m in &s.scene.materials {
+            assert_eq!(m.validate(), Ok(()), "{}: {}", p.display(), m.name);
+        }
+    }
+}
+
+/// Unit normal of a triangle's front (counter-clockwise) face.
+fn normal(t: &[Vec3; 3]) -> Vec3 {
+    (t[1] - t[0]).cross(t[2] - t[0]).normalize()
+}
+
+#[test]
+fn cornell_box_matches_the_published_data() {
+    let s = load_scene("cornell-box.toml");
+    let sc = &s.scene;
+    // Camera: (278, 273, -800) along +z, up +y, 35 mm lens on 25 mm film, 512².
+    let c = &sc.cameras[0];
+    assert_eq!(c.position, Vec3::new(278.0, 273.0, -800.0));
+    assert_eq!(c.forward, Vec3::Z);
+    assert_eq!(c.up, Vec3::Y);
+    assert!((c.fov_y_deg - 2.0 * (12.5f32 / 35.0).atan().to_degrees()).abs() < 1e-3);
+    assert_eq!((c.width, c.height, c.aperture), (512, 512, 0.0));
+    assert_eq!(c.right, -Vec3::X, "the green wall at x = 0 is on the right");
+    // Inline geometry only: 16 quads.
+    assert_eq!(sc.triangle_count(), 32);
+    assert_eq!(sc.objects.len(), 16);
+    assert!(sc.textures.is_empty());
+    let mat = |name: &str| sc.materials.iter().find(|m| m.name == name).unwrap();
+    assert_eq!(
+        mat("white"),
+        &Material::diffuse("white", Rgb::new(0.725, 0.71, 0.68))
+    );
+    assert_eq!(
+        mat("red"),
+        &Material::diffuse("red", Rgb::new(0.63, 0.065, 0.05))
+    );
+    assert_eq!(
+        mat("green"),
+        &Material::diffuse("green", Rgb::new(0.14, 0.45, 0.091))
+    );
+    let light = mat("light");
+    assert_eq!(light.emission, Rgb::new(17.0, 12.0, 4.0));
+    assert_eq!(light.layers[0].color, Rgb::splat(0.78));
+    assert!(!light.two_sided);
+    assert!(
+        matches!(sc.environment, rt_core::environment::Environment::Constant(c) if c == Rgb::ZERO)
+    );
+    // Every front face faces into the room, or out of its block; the light faces down,
+    // 0.1 mm below the ceiling.
+    let room = Vec3::new(278.0, 274.4, 279.6);
+    let short = Vec3::new(185.5, 82.5, 169.0);
+    let tall = Vec3::new(368.5, 165.0, 351.25);
+    for o in &sc.objects {
+        for t in &sc.triangles[o.first as usize..(o.first + o.count) as usize] {
+            let n = normal(t);
+            let centroid = (t[0] + t[1] + t[2]) / 3.0;
+            let ok = if o.name == "light" {
+                assert!(t.iter().all(|p| p.y == 548.7));
+                n.dot(-Vec3::Y) > 0.999
+            } else if o.name.starts_with("short-block") {
+                n.dot(centroid - short) > 0.0
+            } else if o.name.starts_with("tall-block") {
+                n.dot(centroid - tall) > 0.0
+            } else {
+                n.dot(room - centroid) > 0.0
+            };
+            assert!(ok, "{} faces the wrong way: {t:?}", o.name);
+        }
+    }
+    assert_eq!(sc.lights.emitter_count(), 2);
+    assert_eq!(s.render.spp, Some(256));
+    assert_eq!(s.render.max_depth, Some(16));
+    assert_eq!(s.render.integrator.as_deref(), Some("path"));
+}
+
+#[test]
+fn showcase_has_every_preset_and_a_texture() {
+    let s = load_scene("showcase.toml");
+    let sc = &s.scene;
+    let mat = |name: &str| sc.materials.iter().find(|m| m.name == name).unwrap();
+    assert_eq!(mat("frosted-glass").layers[0].hardness, 0.7);
+    assert!(mat("frosted-glass").layers[0].transmission);
+    assert_eq!(mat("glass").layers[0].hardness, 1.0);
+    assert_eq!(mat("two-layer").layers.len(), 2);
+    assert!(mat("plastic").layers[0].coat);
+    assert_eq!(mat("gold").layers[0].color90, Rgb::ONE);
+    let t = mat("checker").texture.unwrap() as usize;
+    assert_eq!((sc.textures[t].width, sc.textures[t].height), (64, 64));
+    let png = std::fs::metadata(scenes_dir().join("textures/checker.png")).unwrap();
+    assert!(png.len() < 50_000);
+}
+
+#[test]
+fn environment_scene_is_lit_by_the_generated_sky() {
+    let s = load_scene("environment.toml");
+    let env = &s.scene.environment;
+    assert!(matches!(env, rt_core::environment::Environment::Map(_)));
+    assert_eq!(
+        s.scene.lights.emitter_count(),
+        0,
+        "the map is the only light"
+    );
+    // The sun is towards +x, +z at 35° elevation, much brighter than the zenith.
+    let sun = Vec3::new(
+        35f32.to_radians().cos() * std::f32::consts::FRAC_1_SQRT_2,
+        35f32.to_radians().sin(),
+        35f32.to_radians().cos() * std::f32::consts::FRAC_1_SQRT_2,
+    );
+    assert!(env.radiance(sun).x > 100.0, "{}", env.radiance(sun));
+    assert!(
+        env.radiance(Vec3::Y).z > env.radiance(Vec3::Y).x,
+        "blue zenith"
+    );
+    assert!(env.radiance(Vec3::Y).x < 1.0);
+    let exr = std::fs::metadata(scenes_dir().join("sky.exr")).unwrap();
+    assert!(exr.len() < 400_000);
+}
+
+#[test]
+fn depth_of_field_focuses_on_the_middle_sphere() {
+    let s = load_scene("depth-of-field.toml");
+    let c = &s.scene.cameras[0];
+    assert!(c.aperture > 0.0);
+    let middle = Vec3::new(0.0, 0.4, -1.0);
+    assert!(((middle - c.position).length() - c.focus_distance).abs() < 1e-3);
+    assert_eq!(s.scene.cameras[1].aperture, 0.0);
+}
+
+#[test]
+fn meshes_scene_uses_file_materials_and_assignments() {
+    let s = load_scene("meshes.toml");
+    let sc = &s.scene;
+    let names: Vec<&str> = sc.materials.iter().map(|m| m.name.as_str()).collect();
+    for n in [
+        "tetra-ico/copper",
+        "tetra-ico/jade",
+        "tetra-ico/slate",
+        "prism/amber",
+        "prism/steel",
+    ] {
+        assert!(names.contains(&n), "{n} missing from {names:?}");
+    }
+    let obj = |name: &str| sc.objects.iter().find(|o| o.name == name).unwrap().clone();
+    // OBJ: 4 + 20 triangles + one quad split in two.
+    assert_eq!(obj("tetra-ico").count, 26);
+    assert_eq!(obj("prism").count, 8);
+    let small = obj("small-copy");
+    let id = |n: &str| names.iter().position(|&m| m == n).unwrap() as u32;
+    let ids = &sc.material_ids[small.first as usize..(small.first + small.count) as usize];
+    assert!(ids[..4].iter().all(|&i| i == id("red")));
+    assert!(ids[4..].iter().all(|&i| i == id("porcelain")));
+    let ico = obj("tetra-ico");
+    assert!(
+        sc.normals[ico.first as usize + 4].is_some(),
+        "the icosahedron has vertex normals"
+    );
+    assert!(
+        sc.normals[ico.first as usize].is_none(),
+        "the tetrahedron is flat"
+    );
+    // The prism faces outward after its node transforms and the scene transform.
+    let p = obj("prism");
+    let tris = &sc.triangles[p.first as usize..(p.first + p.count) as usize];
+    let center = tris.iter().flatten().sum::<Vec3>() / (3 * tris.len()) as f32;
+    for t in tris {
+        assert!(
+            normal(t).dot((t[0] + t[1] + t[2]) / 3.0 - center) > 0.0,
+            "{t:?}"
+        );
+    }
+}
+
+// --- Meshes made by others (../shared/data), skipped when absent ---------------------------
+
+fn load_file(file: &Path, material: Option<&str>) -> rt_scene::LoadedScene {
+    let m = material.map_or(String::new(), |m| format!("material = \"{m}\"\n"));
+    let text = format!(
+        "{}[[geometry]]\nname = \"m\"\nfile = \"{}\"\n{m}",
+        common::BASE,
+        file.display()
+    );
+    rt_scene::load_str(&text, Path::new("."), Path::new("data.toml"))
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn count(s: &rt_scene::LoadedScene) -> u32 {
+    s.scene
+        .objects
+        .iter()
+        .find(|o| o.name == "m")
+        .unwrap()
+        .count
+}
+
+#[test]
+fn stanford_bunny_obj() {
+    let Some(data) = common::shared_data() else {
+        return;
+    };
+    let t = std::time::Instant::now();
+    let s = load_file(&data.join("models/stanford-bunny.obj"), Some("white"));
+    assert_eq!(count(&s), 69_451);
+    println!("bunny loaded in {:?}", t.elapsed());
+}
+
+#[test]
+fn beast_obj_with_quads_and_pentagons() {
+    let Some(data) = common::shared_data() else {
+        return;
+    };
+    // Mostly quads, 10 pentagons and 2 hexagons: 64,618 triangles after fan triangulation.
+    let s = load_file(&data.join("models/beast.obj"), Some("white"));
+    assert_eq!(count(&s), 64_618);
+}
+
+#[test]
+fn gltf_sample_models() {
+    let Some(data) = common::shared_data() else {
+        return;
+    };
+    let gltf = data.join("gltf");
+    // Duck: GLB with an embedded PNG and a node matrix; its own material.
+    let s = load_file(&gltf.join("Duck/Duck.glb"), None);
+    assert_eq!(count(&s), 4_212);
+    assert_eq!(s.scene.textures.len(), 1);
+    assert!(s
+        .scene
+        .materials
+        .iter()
+        .any(|m| m.name.starts_with("m/") && m.texture.is_some()));
+    // CesiumMilkTruck: external .bin and .png, hierarchy with matrix and TRS, wheels instanced
+    // twice.
+    let s = load_file(&gltf.join("CesiumMilkTruck/CesiumMilkTruck.gltf"), None);
+    assert_eq!(count(&s), 3_624);
+    // SimpleSparseAccessor: no materials of its own.
+    let dir = gltf.join("SimpleSparseAccessor");
+    let file = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "gltf"))
+        .unwrap();
+    let s = load_file(&file, Some("white"));
+    assert_eq!(count(&s), 12);
+    // The sparse accessor lifts some vertices to y = 4 (the base grid is flat at y = 0..2).
+    let top = s
+        .scene
+        .triangles
+        .iter()
+        .flatten()
+        .map(|p| p.y)
+        .fold(f32::MIN, f32::max);
+    assert!(top > 3.9, "sparse values not applied: max y = {top}");
+}
