@@ -34,6 +34,7 @@ pub mod ray;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
+pub mod shapes;
 pub mod texture;
 pub mod transform;
 pub mod triangle;

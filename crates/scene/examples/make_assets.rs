@@ -86,24 +86,8 @@ fn tetra_ico(dir: &Path) {
 
     // Icosahedron of radius 0.45, smooth normals, its lowest vertex (0.45·0.8507 below the
     // centre) 1 mm above the plate.
-    let t = (1.0 + 5.0f32.sqrt()) / 2.0;
-    let unit: Vec<Vec3> = [
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ]
-    .iter()
-    .map(|&v| Vec3::from(v).normalize())
-    .collect();
+    let ico = rt_core::shapes::icosphere(0);
+    let unit = ico.positions;
     let ic = Vec3::new(0.7, 0.05 + 0.45 * 0.850_651 + 0.001, 0.0);
     let ip: Vec<Vec3> = unit.iter().map(|&u| ic + u * 0.45).collect();
     obj.push_str("o icosahedron\n");
@@ -114,30 +98,9 @@ fn tetra_ico(dir: &Path) {
         writeln!(obj, "vn {:.6} {:.6} {:.6}", n.x, n.y, n.z).unwrap();
     }
     obj.push_str("usemtl jade\n");
-    let faces = [
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
+    let faces = ico.faces;
     for f in faces {
-        let f = outward(f, &ip, ic);
+        let f = outward(f.map(|i| i as usize), &ip, ic);
         // Vertex i uses normal i: position and normal indices coincide (normals are numbered
         // from 1 in this file).
         let v = |k: usize| format!("{}//{}", f[k] + base, f[k] + 1);

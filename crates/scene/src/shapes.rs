@@ -6,7 +6,6 @@
 
 use crate::geometry::Mesh;
 use glam::{Vec2, Vec3};
-use std::collections::HashMap;
 
 /// Texture coordinates of the four corners of a quad.
 const QUAD_UV: [Vec2; 4] = [
@@ -67,64 +66,10 @@ pub(crate) fn cuboid(min: Vec3, max: Vec3) -> Mesh {
 /// An icosphere: the icosahedron subdivided `subdivisions` times (20·4^s triangles), outward,
 /// with smooth normals.
 pub(crate) fn sphere(center: Vec3, radius: f32, subdivisions: u32) -> Mesh {
-    let t = (1.0 + 5.0f32.sqrt()) / 2.0;
-    let mut verts: Vec<Vec3> = [
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ]
-    .iter()
-    .map(|&p| Vec3::from(p).normalize())
-    .collect();
-    let mut faces: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..subdivisions {
-        let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut midpoint = |a: u32, b: u32, verts: &mut Vec<Vec3>| {
-            let key = (a.min(b), a.max(b));
-            *mid.entry(key).or_insert_with(|| {
-                verts.push(((verts[a as usize] + verts[b as usize]) * 0.5).normalize());
-                (verts.len() - 1) as u32
-            })
-        };
-        let mut next = Vec::with_capacity(faces.len() * 4);
-        for [a, b, c] in faces {
-            let ab = midpoint(a, b, &mut verts);
-            let bc = midpoint(b, c, &mut verts);
-            let ca = midpoint(c, a, &mut verts);
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        faces = next;
-    }
+    let rt_core::shapes::IndexedMesh {
+        positions: verts,
+        faces,
+    } = rt_core::shapes::icosphere(subdivisions);
     let mut m = Mesh::default();
     for [a, b, c] in faces {
         let mut n = [verts[a as usize], verts[b as usize], verts[c as usize]];
