@@ -360,6 +360,10 @@ def build_scene_dict(scene: dict, base_dir: str, args) -> dict:
     }
 
     # --- environment ----------------------------------------------------
+    # We look texels up without interpolation (the radiance is then exactly the piecewise-
+    # constant function our sampling pdf is built from); Mitsuba's envmap always interpolates
+    # bilinearly. Replicating every texel ENV_UPSAMPLE x ENV_UPSAMPLE times confines the
+    # difference to thin seams between texels.
     env = scene.get("environment", {}) or {}
     strength = float(env.get("strength", 1.0))
     color = vec3(env.get("color", [0.0, 0.0, 0.0]), "environment.color")
@@ -367,6 +371,7 @@ def build_scene_dict(scene: dict, base_dir: str, args) -> dict:
         if any(color):
             die("environment: 'map' and a non-black 'color' are mutually exclusive")
         path = env["map"] if os.path.isabs(env["map"]) else os.path.join(base_dir, env["map"])
+        path = nearest_upsampled(path, ENV_UPSAMPLE)
         d["environment"] = {
             "type": "envmap",
             "filename": path,
@@ -474,6 +479,21 @@ def write_exr(path: str, rgb_img: np.ndarray):
     bmp = mi.Bitmap(np.ascontiguousarray(rgb_img, dtype=np.float32),
                     mi.Bitmap.PixelFormat.RGB)
     bmp.write(path)
+
+
+ENV_UPSAMPLE = 8
+
+
+def nearest_upsampled(path, k):
+    """Writes a copy of an EXR with every texel repeated k x k times; returns its path."""
+    import numpy as np
+    import tempfile
+    bmp = mi.Bitmap(path).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, srgb_gamma=False)
+    a = np.array(bmp)
+    a = np.repeat(np.repeat(a, k, axis=0), k, axis=1)
+    out = os.path.join(tempfile.mkdtemp(prefix="toml2mi-"), "env.exr")
+    mi.Bitmap(a).write(out)
+    return out
 
 
 def main(argv=None):
