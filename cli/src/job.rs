@@ -127,7 +127,7 @@ impl Job {
             threads,
             // Fold the 64-bit seed into the 32-bit stream key without discarding the high half.
             seed: (seed ^ (seed >> 32)) as u32,
-            camera: args.camera.clone().or(None),
+            camera: args.camera.clone(),
             aovs,
             exposure: args.exposure,
             ao_distance,

@@ -31,12 +31,6 @@ pub fn srgb_to_linear(x: f32) -> f32 {
     }
 }
 
-/// True if all components are finite.
-#[inline]
-pub fn is_finite(c: Rgb) -> bool {
-    c.is_finite()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
