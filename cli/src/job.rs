@@ -62,18 +62,29 @@ impl Job {
             (None, Some(s)) => enum_from_table(scene, "accel", s)?,
             (None, None) => AccelKind::Bvh,
         };
+        // Names where a value came from, so that a bad `[render]` default points at the file.
+        let origin = |flag: &str, key: &str, from_cli: bool| {
+            if from_cli {
+                format!("--{flag}")
+            } else {
+                format!("{}: [render] {key}", scene.display())
+            }
+        };
         let spp = args.spp.or(desc.spp).unwrap_or(64);
         if spp == 0 || spp > MAX_SPP {
-            bail!("samples per pixel must be between 1 and {MAX_SPP}, got {spp}");
+            let at = origin("spp", "spp", args.spp.is_some());
+            bail!("{at}: samples per pixel must be between 1 and {MAX_SPP}, got {spp}");
         }
         let max_depth = args.max_depth.or(desc.max_depth).unwrap_or(16);
         if max_depth > MAX_DEPTH {
-            bail!("max depth must be at most {MAX_DEPTH}, got {max_depth}");
+            let at = origin("max-depth", "max_depth", args.max_depth.is_some());
+            bail!("{at}: max depth must be at most {MAX_DEPTH}, got {max_depth}");
         }
         let threads = args.threads.or(desc.threads);
         if let Some(t) = threads {
             if t == 0 || t > MAX_THREADS {
-                bail!("thread count must be between 1 and {MAX_THREADS}, got {t}");
+                let at = origin("threads", "threads", args.threads.is_some());
+                bail!("{at}: thread count must be between 1 and {MAX_THREADS}, got {t}");
             }
         }
         let seed = args.seed.or(desc.seed).unwrap_or(0);
@@ -83,7 +94,7 @@ impl Job {
             .or_else(|| desc.aov.clone())
             .unwrap_or_default();
         let aovs = AovSet::parse_list(aov_names.iter().map(String::as_str))
-            .map_err(|e| anyhow::anyhow!("--aov: {e}"))?;
+            .map_err(|e| anyhow::anyhow!("{}: {e}", origin("aov", "aov", args.aov.is_some())))?;
         let output = match (&args.output, &desc.output) {
             (Some(o), _) => o.clone(),
             (None, Some(o)) => PathBuf::from(o),

@@ -279,6 +279,19 @@ fn bad_command_line_values() {
     expect_error(GOOD, &["--camera", "side"], &["scene.toml", "side"]);
     expect_error(GOOD, &["--threads", "0"], &["thread"]);
     expect_error(GOOD, &["--aov", "albedo,gloss"], &["gloss"]);
+    // A bad default from the scene's [render] table names the file and the key.
+    let table = format!("{GOOD}\n[render]\nspp = 0\n");
+    let r = Run::new();
+    r.write("scene.toml", &table);
+    let out = r.render(&["scene.toml", "-q"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(err.contains("scene.toml") && err.contains("spp"), "{err}");
+    expect_error(
+        &format!("{GOOD}\n[render]\nintegrator = \"bdpt\"\n"),
+        &[],
+        &["scene.toml", "bdpt"],
+    );
     let r = Run::new();
     r.write("scene.toml", GOOD);
     let out = r.render(&["scene.toml", "-o", "x.jpg"]);
