@@ -44,8 +44,8 @@ impl Sampler {
     pub fn next_1d(&mut self) -> f32 {
         let h = self.dim_hash();
         let i = nested_uniform_scramble(self.index, h);
-        let x = nested_uniform_scramble(sobol_dim0(i), hash2(h, 0x68bc_21eb));
-        to_unit_float(x)
+        // nested_uniform_scramble(sobol_dim0(i)) with the two bit reversals that cancel removed.
+        to_unit_float(laine_karras_permutation(i, hash_u32(h ^ 0x68bc_21eb)).reverse_bits())
     }
 
     /// The next 2D value in [0, 1)².
@@ -53,8 +53,8 @@ impl Sampler {
     pub fn next_2d(&mut self) -> Vec2 {
         let h = self.dim_hash();
         let i = nested_uniform_scramble(self.index, h);
-        let x = nested_uniform_scramble(sobol_dim0(i), hash2(h, 0x68bc_21eb));
-        let y = nested_uniform_scramble(sobol_dim1(i), hash2(h, 0x02e5_be93));
+        let x = laine_karras_permutation(i, hash_u32(h ^ 0x68bc_21eb)).reverse_bits();
+        let y = nested_uniform_scramble(sobol_dim1(i), hash_u32(h ^ 0x02e5_be93));
         Vec2::new(to_unit_float(x), to_unit_float(y))
     }
 
@@ -110,8 +110,9 @@ fn nested_uniform_scramble(x: u32, seed: u32) -> u32 {
     laine_karras_permutation(x.reverse_bits(), seed).reverse_bits()
 }
 
-/// First Sobol' dimension: the van der Corput sequence.
-#[inline]
+/// First Sobol' dimension: the van der Corput sequence. (Only the tests call it: the sampler
+/// folds its bit reversal into the scramble.)
+#[cfg(test)]
 fn sobol_dim0(i: u32) -> u32 {
     i.reverse_bits()
 }
@@ -210,6 +211,14 @@ mod tests {
         }
         // The first points of the second dimension: 0, 1/2, 3/4, 1/4.
         assert_eq!([1, 2, 3].map(sobol_dim1), [1 << 31, 3 << 30, 1 << 30]);
+    }
+
+    #[test]
+    fn folded_first_dimension_equals_the_scrambled_van_der_corput_point() {
+        for (i, seed) in [(0u32, 1u32), (7, 99), (12345, 0xdead_beef), (u32::MAX, 3)] {
+            let folded = laine_karras_permutation(i, seed).reverse_bits();
+            assert_eq!(folded, nested_uniform_scramble(sobol_dim0(i), seed));
+        }
     }
 
     #[test]
