@@ -170,7 +170,7 @@ fn prism(path: &Path) {
         let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
         let b = pos.len() as u16;
         pos.extend(&p);
-        nrm.extend(std::iter::repeat(n).take(p.len()));
+        nrm.extend(std::iter::repeat_n(n, p.len()));
         out.extend([b, b + 1, b + 2]);
         if p.len() == 4 {
             out.extend([b, b + 2, b + 3]);
@@ -194,7 +194,7 @@ fn prism(path: &Path) {
     let mut bin: Vec<u8> = Vec::new();
     let mut views = Vec::new();
     let mut push = |bytes: Vec<u8>, bin: &mut Vec<u8>| {
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         views.push(json!({ "buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len() }));

@@ -318,7 +318,7 @@ fn compare_hits(
     if inside_box(ray, w.t, &tris[w.prim as usize]) {
         return Err(format!("{got:?} vs {want:?}"));
     }
-    let got_ok = got.map_or(true, |g| genuine(g) && g.t >= w.t);
+    let got_ok = got.is_none_or(|g| genuine(g) && g.t >= w.t);
     let far_enough = match (got, closest_inside_box(ray, t_max, tris)) {
         (_, None) => true,
         (None, Some(_)) => false,
@@ -358,7 +358,7 @@ fn closest_inside_box(ray: &Ray, t_max: f32, tris: &[[Vec3; 3]]) -> Option<Hit> 
     let mut best: Option<Hit> = None;
     for (i, tri) in tris.iter().enumerate() {
         if let Some((t, b1, b2)) = hit_one(ray, tri, t_max) {
-            if inside_box(ray, t, tri) && best.map_or(true, |b| t < b.t) {
+            if inside_box(ray, t, tri) && best.is_none_or(|b| t < b.t) {
                 best = Some(Hit {
                     t,
                     prim: i as u32,
