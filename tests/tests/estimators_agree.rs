@@ -147,3 +147,38 @@ fn direct_lighting_agrees_with_one_bounce_bsdf_sampling() {
     let bsdf = render(&scene, &PathIntegrator::bsdf_only(1), 1024, 4, 2);
     compare(&direct, &bsdf);
 }
+
+/// The same agreement under an environment map (a smooth sky with a broad bright patch), which
+/// exercises the map's luminance importance sampling and its MIS weights.
+#[test]
+fn nee_and_bsdf_sampling_agree_under_an_environment_map() {
+    use rt_core::environment::{EnvMap, Environment};
+    use rt_core::Rgb;
+    let open = ROOM
+        .replace("[environment]\ncolor = [0.3, 0.4, 0.6]", "")
+        .replace("name = \"back\"", "name = \"back-wall\"");
+    // Remove the ceiling light and the back wall so the sky lights the scene.
+    let open: String = open
+        .split("[[geometry]]")
+        .filter(|g| !g.contains("\"light\"\nshape") && !g.contains("back-wall"))
+        .collect::<Vec<_>>()
+        .join("[[geometry]]");
+    let mut scene = scene_from_toml(&open);
+    let (w, h) = (64u32, 32u32);
+    let texels = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f32 / w as f32, (i / w) as f32 / h as f32);
+            let patch = (-((x - 0.5).powi(2) + (y - 0.3).powi(2)) / 0.01).exp() * 8.0;
+            Rgb::new(
+                0.4 + patch,
+                0.5 + 0.8 * patch,
+                0.7 * (1.0 - y) + 0.5 * patch,
+            )
+        })
+        .collect();
+    scene.environment = Environment::Map(EnvMap::new(w, h, texels));
+    scene.build_lights();
+    let nee = render(&scene, &PathIntegrator::new(4), 256, 21, 2);
+    let bsdf = render(&scene, &PathIntegrator::bsdf_only(4), 1024, 22, 2);
+    compare(&nee, &bsdf);
+}
