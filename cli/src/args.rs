@@ -51,7 +51,7 @@ pub struct Args {
     #[arg(long)]
     pub seed: Option<u64>,
 
-    /// Camera by name. [default: the first [[camera]] in the scene]
+    /// Camera by name. [default: the first `[[camera]]` in the scene]
     #[arg(long)]
     pub camera: Option<String>,
 
