@@ -1,0 +1,352 @@
+//! Ordered stack traversal with a four-wide robust slab test.
+
+use super::node::{leaf_range, QNode, EMPTY, LEAF_BIT};
+use super::Qbvh;
+use rt_core::triangle::{intersect_triangle, RayPrecomp};
+use rt_core::{Aabb, Hit, Ray, TraversalCounters};
+
+/// Far-distance widening of the slab test, as in [`Bvh2`](crate::Bvh2): each slab distance is
+/// within `gamma(3)` of the exact one, so widening the far side by `2 gamma(3)` never culls a box
+/// the ray really touches.
+pub(crate) const FAR_SCALE: f32 = {
+    let u = f32::EPSILON * 0.5;
+    let gamma3 = 3.0 * u / (1.0 - 3.0 * u);
+    1.0 + 2.0 * gamma3
+};
+
+/// Deepest node the traversal stack supports: the binary tree's depth bound (64) plus the
+/// levels that split over-long leaves (at most 12 for 2^27 triangles).
+pub(crate) const MAX_DEPTH: usize = 80;
+/// Ordered traversal pushes at most three entries per inner node on the current path.
+const STACK_SIZE: usize = 3 * MAX_DEPTH + 1;
+
+/// Key of a missed or empty slot; sorts after every hit.
+const MISS: u64 = u64::MAX;
+
+/// Where traversal work is tallied; [`NoCount`] compiles away.
+pub(crate) trait Counter {
+    fn boxes(&mut self, n: u64);
+    fn triangle(&mut self);
+}
+
+/// The counter of the uncounted queries.
+pub(crate) struct NoCount;
+
+impl Counter for NoCount {
+    #[inline(always)]
+    fn boxes(&mut self, _: u64) {}
+    #[inline(always)]
+    fn triangle(&mut self) {}
+}
+
+impl Counter for TraversalCounters {
+    #[inline(always)]
+    fn boxes(&mut self, n: u64) {
+        self.nodes_visited += n;
+    }
+    #[inline(always)]
+    fn triangle(&mut self) {
+        self.prims_tested += 1;
+    }
+}
+
+/// Per-ray constants of the slab test.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Slab4 {
+    org: [f32; 3],
+    /// `1 / dir`; a zero component of either sign becomes an infinity of that sign.
+    inv: [f32; 3],
+    /// Plane index (into [`QNode`]'s `bounds`) of the near and far plane per axis, chosen by the
+    /// sign bit of `inv` so that `-0.0` goes with `-inf`.
+    near: [usize; 3],
+    far: [usize; 3],
+}
+
+impl Slab4 {
+    #[inline]
+    pub(crate) fn new(ray: &Ray) -> Self {
+        let inv = ray.dir.recip().to_array();
+        let neg = inv.map(|x| x.is_sign_negative() as usize);
+        Self {
+            org: ray.origin.to_array(),
+            inv,
+            near: [0, 1, 2].map(|a| a + 3 * neg[a]),
+            far: [0, 1, 2].map(|a| a + 3 - 3 * neg[a]),
+        }
+    }
+
+    /// Entry distance into `b` within `[0, t_max]`, conservatively, exactly as `Bvh2` tests.
+    #[inline(always)]
+    pub(crate) fn hit_box(&self, b: &Aabb, t_max: f32) -> Option<f32> {
+        let planes = [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z];
+        let mut t0 = 0.0f32;
+        let mut t1 = t_max;
+        for axis in 0..3 {
+            let near = (planes[self.near[axis]] - self.org[axis]) * self.inv[axis];
+            let far = (planes[self.far[axis]] - self.org[axis]) * self.inv[axis];
+            t0 = t0.max(near);
+            t1 = t1.min(far);
+        }
+        (t0 <= t1 * FAR_SCALE).then_some(t0)
+    }
+
+    /// Entry distances into the four boxes of `node` and the mask of boxes hit, one lane at a
+    /// time. A NaN slab distance (0 * inf: the ray lies in a face plane) leaves the interval
+    /// alone, because `f32::max`/`min` return the non-NaN operand.
+    #[cfg_attr(
+        all(target_arch = "x86_64", target_feature = "sse2"),
+        allow(dead_code) // used by the tests only
+    )]
+    #[inline(always)]
+    pub(crate) fn hit4_scalar(&self, node: &QNode, t_max: f32) -> (u32, [f32; 4]) {
+        let mut mask = 0;
+        let mut t = [0.0f32; 4];
+        for (lane, t_lane) in t.iter_mut().enumerate() {
+            let mut t0 = 0.0f32;
+            let mut t1 = t_max;
+            for axis in 0..3 {
+                let o = self.org[axis];
+                let near = (node.bounds[self.near[axis]][lane] - o) * self.inv[axis];
+                let far = (node.bounds[self.far[axis]][lane] - o) * self.inv[axis];
+                t0 = t0.max(near);
+                t1 = t1.min(far);
+            }
+            *t_lane = t0;
+            mask |= u32::from(t0 <= t1 * FAR_SCALE) << lane;
+        }
+        (mask, t)
+    }
+
+    /// [`Slab4::hit4_scalar`] with SSE2. `maxps`/`minps` return their second operand when the
+    /// comparison is unordered, so the slab distance goes first and a NaN leaves the running
+    /// interval alone, exactly like the scalar code.
+    #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
+    #[allow(unsafe_code)]
+    #[inline(always)]
+    pub(crate) fn hit4_sse(&self, node: &QNode, t_max: f32) -> (u32, [f32; 4]) {
+        use std::arch::x86_64::*;
+        let mut t = [0.0f32; 4];
+        // SAFETY: the `cfg` guarantees SSE and SSE2 are enabled for the whole build, which is
+        // all these intrinsics require. `_mm_load_ps` reads 16 bytes from a `[f32; 4]` of
+        // `node.bounds`, which starts at a multiple of 16 bytes from the 64-byte-aligned node,
+        // so the pointer is valid and 16-byte aligned; `_mm_storeu_ps` writes 16 bytes to the
+        // local `[f32; 4]` `t`, which needs no alignment.
+        let mask = unsafe {
+            let mut t0 = _mm_setzero_ps();
+            let mut t1 = _mm_set1_ps(t_max);
+            for axis in 0..3 {
+                let o = _mm_set1_ps(self.org[axis]);
+                let inv = _mm_set1_ps(self.inv[axis]);
+                let lo = _mm_load_ps(node.bounds[self.near[axis]].as_ptr());
+                let hi = _mm_load_ps(node.bounds[self.far[axis]].as_ptr());
+                let near = _mm_mul_ps(_mm_sub_ps(lo, o), inv);
+                let far = _mm_mul_ps(_mm_sub_ps(hi, o), inv);
+                t0 = _mm_max_ps(near, t0);
+                t1 = _mm_min_ps(far, t1);
+            }
+            let hit = _mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(FAR_SCALE)));
+            _mm_storeu_ps(t.as_mut_ptr(), t0);
+            _mm_movemask_ps(hit) as u32
+        };
+        (mask, t)
+    }
+
+    /// The four-wide test used by traversal: SSE2 on x86_64 (part of its baseline, so no runtime
+    /// detection), the scalar loop elsewhere.
+    #[inline(always)]
+    pub(crate) fn hit4(&self, node: &QNode, t_max: f32) -> (u32, [f32; 4]) {
+        #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
+        {
+            self.hit4_sse(node, t_max)
+        }
+        #[cfg(not(all(target_arch = "x86_64", target_feature = "sse2")))]
+        {
+            self.hit4_scalar(node, t_max)
+        }
+    }
+}
+
+/// Sort key of a hit slot: entry distance in the high word, child code in the low one. Entry
+/// distances are never NaN and at least zero (possibly `-0.0`, hence clearing the sign bit), so
+/// their bits order like the values.
+#[inline(always)]
+fn key(t: f32, code: u32) -> u64 {
+    (u64::from(t.to_bits() & 0x7FFF_FFFF) << 32) | u64::from(code)
+}
+
+#[inline(always)]
+fn key_t(k: u64) -> f32 {
+    f32::from_bits((k >> 32) as u32)
+}
+
+/// Sorting network for four keys, ascending.
+#[inline(always)]
+fn sort4(k: &mut [u64; 4]) {
+    #[inline(always)]
+    fn cswap(k: &mut [u64; 4], i: usize, j: usize) {
+        let (a, b) = (k[i], k[j]);
+        k[i] = a.min(b);
+        k[j] = a.max(b);
+    }
+    cswap(k, 0, 1);
+    cswap(k, 2, 3);
+    cswap(k, 0, 2);
+    cswap(k, 1, 3);
+    cswap(k, 1, 2);
+}
+
+impl Qbvh {
+    /// The one traversal loop behind every query; `ANY_HIT` returns the first hit found.
+    ///
+    /// As in `Bvh2`, triangles are tested against the caller's `t_max` and the closest is kept
+    /// with an exact `<`, so the answer is the minimum over the leaves entered, independent of
+    /// visiting order; boxes are culled against the closest hit so far.
+    #[inline(always)]
+    pub(crate) fn traverse<const ANY_HIT: bool, C: Counter>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        counter: &mut C,
+    ) -> Option<Hit> {
+        let nodes = &self.nodes[..];
+        if nodes.is_empty() {
+            return None;
+        }
+        let slab = Slab4::new(ray);
+        counter.boxes(1);
+        slab.hit_box(&self.bounds, t_max)?;
+        let pre = RayPrecomp::new(ray);
+
+        let mut closest: Option<Hit> = None;
+        let mut closest_t = f32::INFINITY;
+        let mut cull_t = t_max;
+        // Keys (see `key`) of slots still to visit, farthest deepest.
+        let mut stack = [0u64; STACK_SIZE];
+        let mut sp = 0;
+        let mut cur: u32 = 0;
+        loop {
+            if cur & LEAF_BIT != 0 {
+                for i in leaf_range(cur) {
+                    counter.triangle();
+                    let Some(h) = intersect_triangle(&pre, &self.triangles[i], t_max) else {
+                        continue;
+                    };
+                    if h.t < closest_t {
+                        closest = Some(Hit {
+                            t: h.t,
+                            prim: self.prim_ids[i],
+                            b1: h.b1,
+                            b2: h.b2,
+                        });
+                        if ANY_HIT {
+                            return closest;
+                        }
+                        closest_t = h.t;
+                        cull_t = h.t;
+                    }
+                }
+            } else {
+                let node = &nodes[cur as usize];
+                counter.boxes(node.occupied() as u64);
+                let (mask, t) = slab.hit4(node, cull_t);
+                let mut keys = [MISS; 4];
+                for lane in 0..4 {
+                    let code = node.children[lane];
+                    if mask & (1 << lane) != 0 && code != EMPTY {
+                        keys[lane] = key(t[lane], code);
+                    }
+                }
+                sort4(&mut keys);
+                if keys[0] != MISS {
+                    for &k in [keys[3], keys[2], keys[1]].iter() {
+                        if k != MISS {
+                            stack[sp] = k;
+                            sp += 1;
+                        }
+                    }
+                    cur = keys[0] as u32;
+                    continue;
+                }
+            }
+            // Pop the nearest pending slot that can still hold something closer.
+            loop {
+                if sp == 0 {
+                    return closest;
+                }
+                sp -= 1;
+                let k = stack[sp];
+                if key_t(k) <= cull_t * FAR_SCALE {
+                    cur = k as u32;
+                    break;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::qbvh::node::{leaf_code, NO_AXES, NO_PARENT};
+    use glam::Vec3;
+
+    #[test]
+    fn sort4_sorts() {
+        let mut k = [5, MISS, 1, 3];
+        sort4(&mut k);
+        assert_eq!(k, [1, 3, 5, MISS]);
+    }
+
+    #[test]
+    #[allow(clippy::needless_range_loop)] // slots index several arrays
+    fn sse_and_scalar_agree() {
+        let mut s = 0x1234_5678u32;
+        let mut rnd = || {
+            s ^= s << 13;
+            s ^= s >> 17;
+            s ^= s << 5;
+            // Few distinct values so that rays often lie in face planes.
+            (s % 9) as f32 * 0.25 - 1.0
+        };
+        for _ in 0..20_000 {
+            let mut node = QNode::new(NO_PARENT, NO_AXES);
+            for slot in 0..3 {
+                let a = Vec3::new(rnd(), rnd(), rnd());
+                let b = Vec3::new(rnd(), rnd(), rnd());
+                node.set(slot, Aabb::new(a.min(b), a.max(b)), leaf_code(slot, 1));
+            }
+            let mut d = Vec3::new(rnd(), rnd(), rnd());
+            for c in 0..3 {
+                if d[c] == 0.0 && rnd() < 0.0 {
+                    d[c] = -0.0;
+                }
+            }
+            if d == Vec3::ZERO {
+                d = Vec3::X;
+            }
+            let ray = Ray::new(Vec3::new(rnd(), rnd(), rnd()) * 2.0, d);
+            let slab = Slab4::new(&ray);
+            for t_max in [f32::INFINITY, 1.0] {
+                let (m, t) = slab.hit4_scalar(&node, t_max);
+                assert_eq!(m & 8, 0, "empty slot hit");
+                for slot in 0..3 {
+                    let want = slab.hit_box(&node.child_aabb(slot), t_max);
+                    assert_eq!(want.is_some(), m & (1 << slot) != 0);
+                    if let Some(w) = want {
+                        assert_eq!(w, t[slot]);
+                    }
+                }
+                #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
+                {
+                    let (ms, ts) = slab.hit4_sse(&node, t_max);
+                    assert_eq!(ms, m);
+                    for slot in 0..4 {
+                        if m & (1 << slot) != 0 {
+                            assert_eq!(ts[slot], t[slot]);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
