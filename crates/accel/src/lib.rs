@@ -39,6 +39,7 @@
 pub mod brute_force;
 pub mod bvh2;
 pub mod qbvh;
+mod traversal;
 
 pub use brute_force::BruteForce;
 pub use bvh2::{BuildParams, Bvh2, BvhStats, Node};

@@ -15,10 +15,10 @@ pub use build::MAX_BINS;
 pub use node::Node;
 pub use stats::BvhStats;
 
+use crate::traversal::NoCount;
 use build::Config;
 use glam::Vec3;
 use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
-use traverse::NoCount;
 
 /// Knobs of [`Bvh2::build`]. Out-of-range values are clamped rather than rejected.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -3,46 +3,9 @@
 
 use super::build::MAX_DEPTH;
 use super::Bvh2;
+use crate::traversal::{Counter, FAR_SCALE};
 use rt_core::triangle::{intersect_triangle, RayPrecomp};
-use rt_core::{Hit, Ray, TraversalCounters};
-
-/// Each slab distance `(plane - origin) * (1 / dir)` carries three roundings, so it is within
-/// `gamma(3)` of the exact value; comparing a near against a far distance can therefore be off by
-/// `2 gamma(3)`, and widening the far side by that much means a box the ray really touches is
-/// never culled. `gamma(n) = n u / (1 - n u)` with unit roundoff `u = 2^-24`.
-const FAR_SCALE: f32 = {
-    let u = f32::EPSILON * 0.5;
-    let gamma3 = 3.0 * u / (1.0 - 3.0 * u);
-    1.0 + 2.0 * gamma3
-};
-const _: () = assert!(FAR_SCALE > 1.0 && FAR_SCALE < 1.0 + 1e-6);
-
-/// Where traversal work is tallied; [`NoCount`] compiles away.
-pub(crate) trait Counter {
-    fn boxes(&mut self, n: u64);
-    fn triangle(&mut self);
-}
-
-/// The counter of the uncounted queries.
-pub(crate) struct NoCount;
-
-impl Counter for NoCount {
-    #[inline(always)]
-    fn boxes(&mut self, _: u64) {}
-    #[inline(always)]
-    fn triangle(&mut self) {}
-}
-
-impl Counter for TraversalCounters {
-    #[inline(always)]
-    fn boxes(&mut self, n: u64) {
-        self.nodes_visited += n;
-    }
-    #[inline(always)]
-    fn triangle(&mut self) {
-        self.prims_tested += 1;
-    }
-}
+use rt_core::{Hit, Ray};
 
 /// Per-ray constants of the slab test.
 #[derive(Clone, Copy, Debug)]

@@ -2,6 +2,7 @@
 
 use super::build::MAX_DEPTH;
 use super::Bvh2;
+use crate::traversal::inside;
 use rt_core::Aabb;
 
 impl Bvh2 {
@@ -91,8 +92,4 @@ impl Bvh2 {
         }
         Ok(())
     }
-}
-
-fn inside(inner: &Aabb, outer: &Aabb) -> bool {
-    inner.min.cmpge(outer.min).all() && inner.max.cmple(outer.max).all()
 }

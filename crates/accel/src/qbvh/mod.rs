@@ -13,10 +13,10 @@ mod validate;
 
 pub use node::{QChild, QNode, EMPTY, LEAF_BIT, MAX_LEAF_TRIANGLES, MAX_TRIANGLES, NO_AXIS};
 
+use crate::traversal::NoCount;
 use crate::{BuildParams, Bvh2};
 use glam::Vec3;
 use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
-use traverse::NoCount;
 
 /// A four-wide bounding volume hierarchy over triangles.
 #[derive(Clone, Debug)]

@@ -2,17 +2,9 @@
 
 use super::node::{leaf_range, QNode, EMPTY, LEAF_BIT};
 use super::Qbvh;
+use crate::traversal::{Counter, FAR_SCALE};
 use rt_core::triangle::{intersect_triangle, RayPrecomp};
-use rt_core::{Aabb, Hit, Ray, TraversalCounters};
-
-/// Far-distance widening of the slab test, as in [`Bvh2`](crate::Bvh2): each slab distance is
-/// within `gamma(3)` of the exact one, so widening the far side by `2 gamma(3)` never culls a box
-/// the ray really touches.
-pub(crate) const FAR_SCALE: f32 = {
-    let u = f32::EPSILON * 0.5;
-    let gamma3 = 3.0 * u / (1.0 - 3.0 * u);
-    1.0 + 2.0 * gamma3
-};
+use rt_core::{Aabb, Hit, Ray};
 
 /// Deepest node the traversal stack supports: the binary tree's depth bound (64) plus the
 /// levels that split over-long leaves (at most 12 for 2^27 triangles).
@@ -22,33 +14,6 @@ const STACK_SIZE: usize = 3 * MAX_DEPTH + 1;
 
 /// Key of a missed or empty slot; sorts after every hit.
 const MISS: u64 = u64::MAX;
-
-/// Where traversal work is tallied; [`NoCount`] compiles away.
-pub(crate) trait Counter {
-    fn boxes(&mut self, n: u64);
-    fn triangle(&mut self);
-}
-
-/// The counter of the uncounted queries.
-pub(crate) struct NoCount;
-
-impl Counter for NoCount {
-    #[inline(always)]
-    fn boxes(&mut self, _: u64) {}
-    #[inline(always)]
-    fn triangle(&mut self) {}
-}
-
-impl Counter for TraversalCounters {
-    #[inline(always)]
-    fn boxes(&mut self, n: u64) {
-        self.nodes_visited += n;
-    }
-    #[inline(always)]
-    fn triangle(&mut self) {
-        self.prims_tested += 1;
-    }
-}
 
 /// Per-ray constants of the slab test.
 #[derive(Clone, Copy, Debug)]

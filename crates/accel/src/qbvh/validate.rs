@@ -3,6 +3,7 @@
 use super::node::{QChild, EMPTY, NO_PARENT};
 use super::traverse::MAX_DEPTH;
 use super::Qbvh;
+use crate::traversal::inside;
 use rt_core::Aabb;
 
 impl Qbvh {
@@ -105,8 +106,4 @@ impl Qbvh {
         }
         Ok(())
     }
-}
-
-fn inside(inner: &Aabb, outer: &Aabb) -> bool {
-    inner.min.cmpge(outer.min).all() && inner.max.cmple(outer.max).all()
 }
