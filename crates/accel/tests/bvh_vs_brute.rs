@@ -1,44 +1,18 @@
-//! The BVH must give exactly the brute-force answer: same triangle and bit-identical distance and
+//! The BVHs (binary and four-wide) must give exactly the brute-force answer: same triangle and bit-identical distance and
 //! barycentrics, or, when several triangles are hit at the identical distance, any of them (see
 //! `common::check_ray` for the precise rule).
 
 mod common;
 
-use common::{check_ray, rays, soup, Agreement, Rng};
-use rt_accel::{BruteForce, BuildParams, Bvh2};
-use rt_core::{Accel, TraversalCounters};
+use common::{soup, Rng};
+use rt_accel::{BuildParams, Bvh2, Qbvh};
 
-/// Builds both structures over a soup and checks `n_rays` rays; returns the number of hits so
-/// callers can make sure the rays were not all misses.
+/// The soup check for both structures.
 fn check_soup(seed: u64, n_tris: usize, n_rays: usize, params: &BuildParams) -> usize {
-    let mut rng = Rng::new(seed);
-    let tris = soup(&mut rng, n_tris);
-    let bvh = Bvh2::build(&tris, params);
-    bvh.validate()
-        .unwrap_or_else(|e| panic!("seed {seed}, {n_tris} tris: {e}"));
-    for (slot, &id) in bvh.prim_ids().iter().enumerate() {
-        assert_eq!(bvh.triangles()[slot], tris[id as usize]);
-    }
-    let oracle = BruteForce::new(&tris);
-    let mut hits = 0;
-    let mut outside_box = 0;
-    for (i, (ray, t_max)) in rays(&mut rng, &tris, n_rays).into_iter().enumerate() {
-        match check_ray(&bvh, &oracle, &ray, t_max, &tris) {
-            Ok(Agreement::OracleOutsideBox) => outside_box += 1,
-            Ok(_) => {}
-            Err(e) => panic!("seed {seed}, {n_tris} tris, ray {i} {ray:?} t_max {t_max}: {e}"),
-        }
-        let got = bvh.intersect(&ray, t_max);
-        let mut counters = TraversalCounters::default();
-        assert_eq!(bvh.intersect_counted(&ray, t_max, &mut counters), got);
-        assert!(counters.nodes_visited >= 1);
-        hits += usize::from(got.is_some());
-    }
-    // The oracle's nearly-degenerate-triangle artefacts are rare; many would mean the soup or
-    // the comparison is broken.
-    assert!(
-        outside_box * 1000 <= n_rays,
-        "{outside_box} of {n_rays} rays"
+    let hits = common::check_soup::<Bvh2>(seed, n_tris, n_rays, params);
+    assert_eq!(
+        common::check_soup::<Qbvh>(seed, n_tris, n_rays, params),
+        hits
     );
     hits
 }

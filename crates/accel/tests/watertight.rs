@@ -13,7 +13,7 @@ mod common;
 
 use common::{grid_cube, icosphere, rotation, torus, Mesh, Rng};
 use glam::Vec3;
-use rt_accel::{BuildParams, Bvh2};
+use rt_accel::{BuildParams, Bvh2, Qbvh};
 use rt_core::{triangle::geometric_normal, Accel, Ray};
 use std::collections::HashMap;
 
@@ -59,6 +59,9 @@ fn fire(mesh: &Mesh, seed: u64, aim: Aim) {
 
     let bvh = Bvh2::build(&tris, &BuildParams::default());
     bvh.validate().unwrap();
+    let qbvh = Qbvh::from_bvh2(&bvh);
+    qbvh.validate().unwrap();
+    let accels: [&dyn Accel; 2] = [&bvh, &qbvh];
     let radius = bvh.bounds().bounding_radius();
     let mut rng = Rng::new(seed);
     let mut fired = 0;
@@ -87,18 +90,22 @@ fn fire(mesh: &Mesh, seed: u64, aim: Aim) {
         let origin = target.point + out * radius * rng.range(2.0, 6.0);
         let ray = Ray::new(origin, target.point - origin);
         fired += 1;
-        let hit = bvh.intersect(&ray, f32::INFINITY);
-        let ok = hit.is_some_and(|h| h.t <= 1.0 + 1e-3);
-        assert!(
-            ok,
-            "ray {fired} {ray:?} at {:?} found {hit:?}",
-            target.point
-        );
-        if fired % 8 == 0 {
+        for accel in accels {
+            let hit = accel.intersect(&ray, f32::INFINITY);
+            let ok = hit.is_some_and(|h| h.t <= 1.0 + 1e-3);
             assert!(
-                bvh.occluded(&ray, 1.0 + 1e-3),
-                "ray {fired} {ray:?} not occluded"
+                ok,
+                "{}: ray {fired} {ray:?} at {:?} found {hit:?}",
+                accel.name(),
+                target.point
             );
+            if fired % 8 == 0 {
+                assert!(
+                    accel.occluded(&ray, 1.0 + 1e-3),
+                    "{}: ray {fired} {ray:?} not occluded",
+                    accel.name()
+                );
+            }
         }
     }
 }

@@ -3,9 +3,9 @@
 #![allow(dead_code)] // each test binary uses a different subset
 
 use glam::{Quat, Vec3};
-use rt_accel::BruteForce;
+use rt_accel::{BruteForce, BuildParams, Bvh2, Qbvh};
 use rt_core::triangle::{intersect_triangle, RayPrecomp};
-use rt_core::{Accel, Hit, Ray};
+use rt_core::{Accel, Hit, Ray, TraversalCounters};
 
 /// PCG32 (O'Neill), so tests are reproducible without the `rand` crate.
 pub struct Rng(u64);
@@ -490,4 +490,89 @@ pub fn torus(n: u32, m: u32, big_r: f32, small_r: f32) -> Mesh {
 /// A random rotation.
 pub fn rotation(rng: &mut Rng) -> Quat {
     Quat::from_axis_angle(rng.unit_vec(), rng.range(0.0, std::f32::consts::TAU))
+}
+
+/// What the soup checks need of a built structure besides `Accel`.
+pub trait Built: Accel {
+    fn build(tris: &[[Vec3; 3]], params: &BuildParams) -> Self;
+    fn validate(&self) -> Result<(), String>;
+    fn prim_ids(&self) -> &[u32];
+    fn triangles(&self) -> &[[Vec3; 3]];
+}
+
+impl Built for Bvh2 {
+    fn build(tris: &[[Vec3; 3]], params: &BuildParams) -> Self {
+        Bvh2::build(tris, params)
+    }
+    fn validate(&self) -> Result<(), String> {
+        Bvh2::validate(self)
+    }
+    fn prim_ids(&self) -> &[u32] {
+        Bvh2::prim_ids(self)
+    }
+    fn triangles(&self) -> &[[Vec3; 3]] {
+        Bvh2::triangles(self)
+    }
+}
+
+impl Built for Qbvh {
+    fn build(tris: &[[Vec3; 3]], params: &BuildParams) -> Self {
+        Qbvh::build(tris, params)
+    }
+    fn validate(&self) -> Result<(), String> {
+        Qbvh::validate(self)
+    }
+    fn prim_ids(&self) -> &[u32] {
+        Qbvh::prim_ids(self)
+    }
+    fn triangles(&self) -> &[[Vec3; 3]] {
+        Qbvh::triangles(self)
+    }
+}
+
+/// Builds structure `A` over a random soup and checks `n_rays` rays against brute force;
+/// returns the number of hits so callers can make sure the rays were not all misses.
+pub fn check_soup<A: Built>(
+    seed: u64,
+    n_tris: usize,
+    n_rays: usize,
+    params: &BuildParams,
+) -> usize {
+    let mut rng = Rng::new(seed);
+    let tris = soup(&mut rng, n_tris);
+    let accel = A::build(&tris, params);
+    accel
+        .validate()
+        .unwrap_or_else(|e| panic!("{} seed {seed}, {n_tris} tris: {e}", accel.name()));
+    for (slot, &id) in accel.prim_ids().iter().enumerate() {
+        assert_eq!(accel.triangles()[slot], tris[id as usize]);
+    }
+    let oracle = BruteForce::new(&tris);
+    let mut hits = 0;
+    let mut outside_box = 0;
+    for (i, (ray, t_max)) in rays(&mut rng, &tris, n_rays).into_iter().enumerate() {
+        match check_ray(&accel, &oracle, &ray, t_max, &tris) {
+            Ok(Agreement::OracleOutsideBox) => outside_box += 1,
+            Ok(_) => {}
+            Err(e) => panic!(
+                "{} seed {seed}, {n_tris} tris, ray {i} {ray:?} t_max {t_max}: {e}",
+                accel.name()
+            ),
+        }
+        let got = accel.intersect(&ray, t_max);
+        let mut counters = TraversalCounters::default();
+        assert_eq!(accel.intersect_counted(&ray, t_max, &mut counters), got);
+        assert!(counters.nodes_visited >= 1);
+        if got.is_some() {
+            assert!(counters.prims_tested >= 1);
+        }
+        hits += usize::from(got.is_some());
+    }
+    // The oracle's nearly-degenerate-triangle artefacts are rare; many would mean the soup or
+    // the comparison is broken.
+    assert!(
+        outside_box * 1000 <= n_rays,
+        "{outside_box} of {n_rays} rays"
+    );
+    hits
 }
