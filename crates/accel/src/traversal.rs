@@ -1,6 +1,9 @@
 //! Pieces every traversal and validator in this crate shares.
 
-use rt_core::{Aabb, TraversalCounters};
+use glam::Vec3;
+use rt_core::triangle::{intersect_triangle, RayPrecomp};
+use rt_core::{Aabb, Hit, TraversalCounters};
+use std::ops::Range;
 
 /// Each slab distance `(plane - origin) * (1 / dir)` carries three roundings, so it is within
 /// `gamma(3)` of the exact value; comparing a near against a far distance can therefore be off by
@@ -38,6 +41,69 @@ impl Counter for TraversalCounters {
     #[inline(always)]
     fn triangle(&mut self) {
         self.prims_tested += 1;
+    }
+}
+
+/// The closest hit of one query so far, and the leaf test that improves it.
+///
+/// Triangles are tested against the caller's `t_max`, not against the closest hit so far, and
+/// the closest is kept with an exact `<`. The result is then the minimum of exactly the values
+/// [`intersect_triangle`] computes over the leaves entered, independent of visiting order, and
+/// agrees bit for bit with a brute-force loop unless a triangle's computed hit lies outside its
+/// own box by more than the culling margin (overlapping coplanar triangles, nearly degenerate
+/// ones). Starting at infinity rather than `t_max` makes `<` reject the NaN and infinite
+/// distances that overflowing vertex coordinates produce.
+pub(crate) struct Closest {
+    /// The hit, if any.
+    pub hit: Option<Hit>,
+    t: f32,
+    /// Distance beyond which boxes are culled: `t_max` until something is hit.
+    pub cull_t: f32,
+}
+
+impl Closest {
+    #[inline(always)]
+    pub(crate) fn new(t_max: f32) -> Self {
+        Self {
+            hit: None,
+            t: f32::INFINITY,
+            cull_t: t_max,
+        }
+    }
+
+    /// Tests the leaf-ordered triangles `range` (caller ids in `ids`); returns true when an
+    /// any-hit query has its answer.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn test_leaf<const ANY_HIT: bool, C: Counter>(
+        &mut self,
+        pre: &RayPrecomp,
+        triangles: &[[Vec3; 3]],
+        ids: &[u32],
+        range: Range<usize>,
+        t_max: f32,
+        counter: &mut C,
+    ) -> bool {
+        for i in range {
+            counter.triangle();
+            let Some(h) = intersect_triangle(pre, &triangles[i], t_max) else {
+                continue;
+            };
+            if h.t < self.t {
+                self.hit = Some(Hit {
+                    t: h.t,
+                    prim: ids[i],
+                    b1: h.b1,
+                    b2: h.b2,
+                });
+                if ANY_HIT {
+                    return true;
+                }
+                self.t = h.t;
+                self.cull_t = h.t;
+            }
+        }
+        false
     }
 }
 

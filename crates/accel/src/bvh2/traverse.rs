@@ -3,8 +3,8 @@
 
 use super::build::MAX_DEPTH;
 use super::Bvh2;
-use crate::traversal::{Counter, FAR_SCALE};
-use rt_core::triangle::{intersect_triangle, RayPrecomp};
+use crate::traversal::{Closest, Counter, FAR_SCALE};
+use rt_core::triangle::RayPrecomp;
 use rt_core::{Hit, Ray};
 
 /// Per-ray constants of the slab test.
@@ -53,13 +53,7 @@ impl Bvh2 {
     /// The one traversal loop behind every query. `ANY_HIT` returns the first hit found rather
     /// than the closest.
     ///
-    /// Triangles are tested against the caller's `t_max`, not against the closest hit so far,
-    /// and the closest is kept with an exact `<`. The result is then the minimum of exactly the
-    /// values [`intersect_triangle`] computes over the leaves entered, independent of visiting
-    /// order, and agrees bit for bit with a brute-force loop unless a triangle's computed hit lies
-    /// outside its own box by more than the culling margin. That happens only for hits at the
-    /// same exact distance whose computed distances differ by rounding (overlapping coplanar
-    /// triangles), and for the noise hits of nearly degenerate triangles.
+    /// The result agrees with brute force as explained at [`Closest`].
     #[inline(always)]
     pub(crate) fn traverse<const ANY_HIT: bool, C: Counter>(
         &self,
@@ -74,41 +68,22 @@ impl Bvh2 {
         slab.hit(&root.bounds, t_max)?;
         let pre = RayPrecomp::new(ray);
 
-        let mut closest: Option<Hit> = None;
-        // Starting at infinity rather than t_max makes `h.t < closest_t` reject the NaN and
-        // infinite distances that overflowing (e.g. infinite) vertex coordinates produce.
-        let mut closest_t = f32::INFINITY;
-        let mut cull_t = t_max;
+        let mut closest = Closest::new(t_max);
         // (node index, entry distance) of far children still to visit.
         let mut stack = [(0u32, 0.0f32); MAX_DEPTH];
         let mut sp = 0;
         let mut node = root;
         loop {
             if let Some(prims) = node.prims() {
-                for i in prims {
-                    counter.triangle();
-                    let Some(h) = intersect_triangle(&pre, &self.triangles[i], t_max) else {
-                        continue;
-                    };
-                    if h.t < closest_t {
-                        closest = Some(Hit {
-                            t: h.t,
-                            prim: self.prim_ids[i],
-                            b1: h.b1,
-                            b2: h.b2,
-                        });
-                        if ANY_HIT {
-                            return closest;
-                        }
-                        closest_t = h.t;
-                        cull_t = h.t;
-                    }
+                let (tris, ids) = (&self.triangles[..], &self.prim_ids[..]);
+                if closest.test_leaf::<ANY_HIT, C>(&pre, tris, ids, prims, t_max, counter) {
+                    return closest.hit;
                 }
             } else {
                 let first = node.index as usize;
                 counter.boxes(2);
-                let t_left = slab.hit(&nodes[first].bounds, cull_t);
-                let t_right = slab.hit(&nodes[first + 1].bounds, cull_t);
+                let t_left = slab.hit(&nodes[first].bounds, closest.cull_t);
+                let t_right = slab.hit(&nodes[first + 1].bounds, closest.cull_t);
                 let next = match (t_left, t_right) {
                     (Some(tl), Some(tr)) => {
                         let (near, far, far_entry) = if tl <= tr {
@@ -132,11 +107,11 @@ impl Bvh2 {
             // Pop the nearest pending subtree that can still hold something closer.
             loop {
                 if sp == 0 {
-                    return closest;
+                    return closest.hit;
                 }
                 sp -= 1;
                 let (index, t_entry) = stack[sp];
-                if t_entry <= cull_t * FAR_SCALE {
+                if t_entry <= closest.cull_t * FAR_SCALE {
                     node = &nodes[index as usize];
                     break;
                 }

@@ -2,8 +2,8 @@
 
 use super::node::{leaf_range, QNode, EMPTY, LEAF_BIT};
 use super::Qbvh;
-use crate::traversal::{Counter, FAR_SCALE};
-use rt_core::triangle::{intersect_triangle, RayPrecomp};
+use crate::traversal::{Closest, Counter, FAR_SCALE};
+use rt_core::triangle::RayPrecomp;
 use rt_core::{Aabb, Hit, Ray};
 
 /// Deepest node the traversal stack supports: the binary tree's depth bound (64) plus the
@@ -163,9 +163,8 @@ fn sort4(k: &mut [u64; 4]) {
 impl Qbvh {
     /// The one traversal loop behind every query; `ANY_HIT` returns the first hit found.
     ///
-    /// As in `Bvh2`, triangles are tested against the caller's `t_max` and the closest is kept
-    /// with an exact `<`, so the answer is the minimum over the leaves entered, independent of
-    /// visiting order; boxes are culled against the closest hit so far.
+    /// The leaf test is shared with `Bvh2` ([`Closest`]), so both agree with brute force under
+    /// the same rule; boxes are culled against the closest hit so far.
     #[inline(always)]
     pub(crate) fn traverse<const ANY_HIT: bool, C: Counter>(
         &self,
@@ -182,38 +181,22 @@ impl Qbvh {
         slab.hit_box(&self.bounds, t_max)?;
         let pre = RayPrecomp::new(ray);
 
-        let mut closest: Option<Hit> = None;
-        let mut closest_t = f32::INFINITY;
-        let mut cull_t = t_max;
+        let mut closest = Closest::new(t_max);
         // Keys (see `key`) of slots still to visit, farthest deepest.
         let mut stack = [0u64; STACK_SIZE];
         let mut sp = 0;
         let mut cur: u32 = 0;
         loop {
             if cur & LEAF_BIT != 0 {
-                for i in leaf_range(cur) {
-                    counter.triangle();
-                    let Some(h) = intersect_triangle(&pre, &self.triangles[i], t_max) else {
-                        continue;
-                    };
-                    if h.t < closest_t {
-                        closest = Some(Hit {
-                            t: h.t,
-                            prim: self.prim_ids[i],
-                            b1: h.b1,
-                            b2: h.b2,
-                        });
-                        if ANY_HIT {
-                            return closest;
-                        }
-                        closest_t = h.t;
-                        cull_t = h.t;
-                    }
+                let (tris, ids) = (&self.triangles[..], &self.prim_ids[..]);
+                let range = leaf_range(cur);
+                if closest.test_leaf::<ANY_HIT, C>(&pre, tris, ids, range, t_max, counter) {
+                    return closest.hit;
                 }
             } else {
                 let node = &nodes[cur as usize];
                 counter.boxes(node.occupied() as u64);
-                let (mask, t) = slab.hit4(node, cull_t);
+                let (mask, t) = slab.hit4(node, closest.cull_t);
                 let mut keys = [MISS; 4];
                 for lane in 0..4 {
                     let code = node.children[lane];
@@ -236,11 +219,11 @@ impl Qbvh {
             // Pop the nearest pending slot that can still hold something closer.
             loop {
                 if sp == 0 {
-                    return closest;
+                    return closest.hit;
                 }
                 sp -= 1;
                 let k = stack[sp];
-                if key_t(k) <= cull_t * FAR_SCALE {
+                if key_t(k) <= closest.cull_t * FAR_SCALE {
                     cur = k as u32;
                     break;
                 }
