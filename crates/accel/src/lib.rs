@@ -38,9 +38,13 @@
 
 pub mod brute_force;
 pub mod bvh2;
+pub mod on_demand;
 pub mod qbvh;
+pub mod spec;
 mod traversal;
 
 pub use brute_force::BruteForce;
-pub use bvh2::{BuildParams, Bvh2, BvhStats, Node};
-pub use qbvh::{QNode, Qbvh};
+pub use bvh2::{BuildParams, Bvh2, BvhStats, Node, Split, MAX_BINS};
+pub use on_demand::OnDemandQbvh;
+pub use qbvh::{Order, QNode, Qbvh, QbvhOptions, TriangleTest};
+pub use spec::{AccelKind, AccelSpec, SpecError};

@@ -20,6 +20,7 @@ const _: () = assert!(FAR_SCALE > 1.0 && FAR_SCALE < 1.0 + 1e-6);
 /// Where traversal work is tallied; [`NoCount`] compiles away.
 pub(crate) trait Counter {
     fn boxes(&mut self, n: u64);
+    fn leaf(&mut self);
     fn triangle(&mut self);
 }
 
@@ -30,6 +31,8 @@ impl Counter for NoCount {
     #[inline(always)]
     fn boxes(&mut self, _: u64) {}
     #[inline(always)]
+    fn leaf(&mut self) {}
+    #[inline(always)]
     fn triangle(&mut self) {}
 }
 
@@ -37,6 +40,10 @@ impl Counter for TraversalCounters {
     #[inline(always)]
     fn boxes(&mut self, n: u64) {
         self.nodes_visited += n;
+    }
+    #[inline(always)]
+    fn leaf(&mut self) {
+        self.leaves_visited += 1;
     }
     #[inline(always)]
     fn triangle(&mut self) {
@@ -84,6 +91,7 @@ impl Closest {
         t_max: f32,
         counter: &mut C,
     ) -> bool {
+        counter.leaf();
         for i in range {
             counter.triangle();
             let Some(h) = intersect_triangle(pre, &triangles[i], t_max) else {

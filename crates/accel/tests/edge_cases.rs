@@ -70,6 +70,7 @@ fn single_triangle() {
         c,
         TraversalCounters {
             nodes_visited: 1,
+            leaves_visited: 1,
             prims_tested: 1
         }
     );
@@ -114,6 +115,7 @@ fn counters_count_boxes_and_triangles() {
         c,
         TraversalCounters {
             nodes_visited: 3,
+            leaves_visited: 1,
             prims_tested: 1
         }
     );

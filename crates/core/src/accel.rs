@@ -24,8 +24,11 @@ pub struct Hit {
 /// that override [`Accel::intersect_counted`] fill them in.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct TraversalCounters {
-    /// Inner and leaf nodes whose bounds were tested.
+    /// Boxes tested: every child box of every inner node visited (a four-wide node counts its
+    /// occupied slots), plus the root's bounds.
     pub nodes_visited: u64,
+    /// Leaves entered (their triangles then tested).
+    pub leaves_visited: u64,
     /// Ray–triangle tests performed.
     pub prims_tested: u64,
 }
@@ -33,6 +36,7 @@ pub struct TraversalCounters {
 impl std::ops::AddAssign for TraversalCounters {
     fn add_assign(&mut self, o: Self) {
         self.nodes_visited += o.nodes_visited;
+        self.leaves_visited += o.leaves_visited;
         self.prims_tested += o.prims_tested;
     }
 }

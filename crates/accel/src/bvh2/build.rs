@@ -363,6 +363,7 @@ mod tests {
             traversal_cost: f32::NAN,
             intersection_cost: -1.0,
             parallel: false,
+            ..BuildParams::default()
         });
         assert_eq!(c.max_leaf, 1);
         assert_eq!(c.bins, MAX_BINS);

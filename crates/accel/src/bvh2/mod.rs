@@ -34,6 +34,33 @@ pub struct BuildParams {
     pub intersection_cost: f32,
     /// Build large subtrees in parallel on the rayon pool. The tree is the same either way.
     pub parallel: bool,
+    /// Triangle splitting before the build (Dammertz §4.3): extra references with tighter
+    /// boxes, never new triangles; leaves still intersect the original triangles.
+    pub split: Split,
+    /// Remove duplicate references of one triangle within a leaf after the build (only
+    /// matters with [`BuildParams::split`]).
+    pub compact_leaves: bool,
+}
+
+/// Triangle splitting heuristics of Dammertz §4.3. Both split a triangle at the midpoint of an
+/// edge, recursively, and hand the builder one reference (box, original index) per piece.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Split {
+    /// One reference per triangle.
+    #[default]
+    None,
+    /// Edge Volume Heuristic: split at the midpoint of the edge whose edge box has the largest
+    /// volume while that volume exceeds `V_scene / 2^t` (t = 14 in the thesis). Shared edges
+    /// split identically, so closed meshes stay closed.
+    Evh {
+        /// Threshold exponent.
+        t: u32,
+    },
+    /// Bounding Box Area Heuristic: split while the piece's box area exceeds `A_scene / 2^t`.
+    Bbah {
+        /// Threshold exponent.
+        t: u32,
+    },
 }
 
 impl Default for BuildParams {
@@ -44,6 +71,8 @@ impl Default for BuildParams {
             traversal_cost: 1.0,
             intersection_cost: 1.0,
             parallel: true,
+            split: Split::None,
+            compact_leaves: false,
         }
     }
 }

@@ -8,10 +8,12 @@
 
 mod collapse;
 mod node;
+mod options;
 mod traverse;
 mod validate;
 
 pub use node::{QChild, QNode, EMPTY, LEAF_BIT, MAX_LEAF_TRIANGLES, MAX_TRIANGLES, NO_AXIS};
+pub use options::{Order, QbvhOptions, TriangleTest, DEFAULT_LEAF_SIZE};
 
 use crate::traversal::NoCount;
 use crate::{BuildParams, Bvh2};
@@ -25,6 +27,7 @@ pub struct Qbvh {
     triangles: Vec<[Vec3; 3]>,
     prim_ids: Vec<u32>,
     bounds: Aabb,
+    options: QbvhOptions,
 }
 
 impl Qbvh {
@@ -35,6 +38,26 @@ impl Qbvh {
     /// If there are [`MAX_TRIANGLES`] (2^27) or more triangles.
     pub fn build(triangles: &[[Vec3; 3]], params: &BuildParams) -> Self {
         Self::from_bvh2(&Bvh2::build(triangles, params))
+    }
+
+    /// Builds with `params` and traverses with `options`.
+    ///
+    /// # Panics
+    ///
+    /// If there are [`MAX_TRIANGLES`] (2^27) or more triangles.
+    pub fn build_with(
+        triangles: &[[Vec3; 3]],
+        params: &BuildParams,
+        options: &QbvhOptions,
+    ) -> Self {
+        let mut q = Self::build(triangles, params);
+        q.options = *options;
+        q
+    }
+
+    /// The traversal options.
+    pub fn options(&self) -> &QbvhOptions {
+        &self.options
     }
 
     /// Collapses `bvh`: every node takes the two children of its binary node and then
@@ -55,6 +78,7 @@ impl Qbvh {
             triangles: bvh.triangles().to_vec(),
             prim_ids: bvh.prim_ids().to_vec(),
             bounds: bvh.bounds(),
+            options: QbvhOptions::default(),
         }
     }
 

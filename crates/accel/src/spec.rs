@@ -1,0 +1,344 @@
+//! Naming a structure and its options in one string, and building it.
+//!
+//! The CLI's `--accel`, the scene's `[render] accel` and `render bench-accel --accel` all take
+//! the same text: a kind followed by `:`-separated options, e.g. `qbvh`, `bvh`,
+//! `qbvh:order=distance:tstack`, `qbvh:evh=14:compact`, `qbvh:isect=hybrid`, `qbvh:lazy`.
+//! [`AccelSpec`] parses it ([`std::str::FromStr`]), prints it back in a canonical form
+//! ([`std::fmt::Display`]) and [`AccelSpec::build`] makes the structure, so a program that
+//! depends only on this crate can offer the same choice.
+//!
+//! | option | kinds | meaning |
+//! |---|---|---|
+//! | `leaf=N` | bvh, qbvh | largest leaf (default 4 for bvh, 16 for qbvh) |
+//! | `bins=N` | bvh, qbvh | SAH bins per axis |
+//! | `evh=T` / `bbah=T` | bvh, qbvh | triangle splitting with threshold exponent T |
+//! | `compact` | bvh, qbvh | remove duplicate references per leaf |
+//! | `order=unsorted\|distance\|split` | qbvh | child order (default `split`) |
+//! | `tstack` | qbvh | keep entry distances on the stack and skip stale entries |
+//! | `shadow-cache` | qbvh | start occlusion queries at the last occluder's node |
+//! | `tri-cache` | qbvh | per-thread cache of four-wide leaf triangles |
+//! | `isect=watertight\|subdivision\|hybrid` | qbvh | triangle test (default watertight) |
+//! | `lazy` | qbvh | build subtrees the first time a ray reaches them |
+
+use crate::qbvh::{Order, QbvhOptions, TriangleTest};
+use crate::{BruteForce, BuildParams, Bvh2, Qbvh, Split};
+use glam::Vec3;
+use rt_core::Accel;
+use std::fmt;
+use std::str::FromStr;
+
+/// The structures this crate builds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AccelKind {
+    /// [`Bvh2`].
+    Bvh,
+    /// [`Qbvh`].
+    Qbvh,
+    /// [`BruteForce`].
+    BruteForce,
+}
+
+impl AccelKind {
+    /// Every kind, in the order reports list them.
+    pub const ALL: [AccelKind; 3] = [AccelKind::Qbvh, AccelKind::Bvh, AccelKind::BruteForce];
+
+    /// The name used in specs and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            AccelKind::Bvh => "bvh",
+            AccelKind::Qbvh => "qbvh",
+            AccelKind::BruteForce => "brute-force",
+        }
+    }
+}
+
+/// A structure and all its build and traversal options.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AccelSpec {
+    /// Which structure.
+    pub kind: AccelKind,
+    /// Build parameters of the binary BVH (the QBVH is collapsed from one).
+    pub build: BuildParams,
+    /// Traversal options of the QBVH.
+    pub qbvh: QbvhOptions,
+    /// Build subtrees on demand (QBVH only).
+    pub lazy: bool,
+}
+
+/// Why an accel spec was rejected.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum SpecError {
+    /// The text before the first `:` is not a structure.
+    #[error("unknown acceleration structure `{0}` (expected qbvh, bvh or brute-force)")]
+    UnknownKind(String),
+    /// An option this crate does not know.
+    #[error("unknown option `{option}` of `{kind}` (see the options table in rt_accel::spec)")]
+    UnknownOption {
+        /// The structure.
+        kind: &'static str,
+        /// The option as written.
+        option: String,
+    },
+    /// An option that does not apply to the structure.
+    #[error("option `{option}` does not apply to `{kind}`")]
+    NotApplicable {
+        /// The structure.
+        kind: &'static str,
+        /// The option as written.
+        option: String,
+    },
+    /// An option value that does not parse or is out of range.
+    #[error("bad value in `{option}`: {reason}")]
+    BadValue {
+        /// The option as written.
+        option: String,
+        /// What is wrong with it.
+        reason: &'static str,
+    },
+}
+
+impl AccelSpec {
+    /// The default spec of `kind`.
+    pub fn new(kind: AccelKind) -> Self {
+        let mut build = BuildParams::default();
+        if kind == AccelKind::Qbvh {
+            build.max_leaf_size = crate::qbvh::DEFAULT_LEAF_SIZE;
+        }
+        Self {
+            kind,
+            build,
+            qbvh: QbvhOptions::default(),
+            lazy: false,
+        }
+    }
+
+    /// Builds the structure over `triangles` (whose indices become [`rt_core::Hit::prim`]).
+    pub fn build(&self, triangles: &[[Vec3; 3]]) -> Box<dyn Accel> {
+        match self.kind {
+            AccelKind::Bvh => Box::new(Bvh2::build(triangles, &self.build)),
+            AccelKind::Qbvh if self.lazy => {
+                Box::new(crate::OnDemandQbvh::new(triangles, &self.build, &self.qbvh))
+            }
+            AccelKind::Qbvh => Box::new(Qbvh::build_with(triangles, &self.build, &self.qbvh)),
+            AccelKind::BruteForce => Box::new(BruteForce::new(triangles)),
+        }
+    }
+
+    fn apply(&mut self, option: &str) -> Result<(), SpecError> {
+        let kind = self.kind.name();
+        let (key, value) = match option.split_once('=') {
+            Some((k, v)) => (k, Some(v)),
+            None => (option, None),
+        };
+        let bad = |reason| SpecError::BadValue {
+            option: option.to_string(),
+            reason,
+        };
+        let number = |lo: u32, hi: u32, reason| {
+            value
+                .and_then(|v| v.parse::<u32>().ok())
+                .filter(|n| (lo..=hi).contains(n))
+                .ok_or_else(|| bad(reason))
+        };
+        let flag = || match value {
+            None => Ok(()),
+            Some(_) => Err(bad("this option takes no value")),
+        };
+        let tree = matches!(self.kind, AccelKind::Bvh | AccelKind::Qbvh);
+        let qbvh = self.kind == AccelKind::Qbvh;
+        let applies = match key {
+            "leaf" | "bins" | "evh" | "bbah" | "compact" => tree,
+            "order" | "tstack" | "shadow-cache" | "tri-cache" | "isect" | "lazy" => qbvh,
+            _ => {
+                return Err(SpecError::UnknownOption {
+                    kind,
+                    option: option.to_string(),
+                })
+            }
+        };
+        if !applies {
+            return Err(SpecError::NotApplicable {
+                kind,
+                option: option.to_string(),
+            });
+        }
+        match key {
+            "leaf" => {
+                let hi = if qbvh {
+                    crate::qbvh::MAX_LEAF_TRIANGLES as u32
+                } else {
+                    1 << 16
+                };
+                self.build.max_leaf_size =
+                    number(1, hi, "leaf size must be 1 to 16 (qbvh) or 65536 (bvh)")? as usize;
+            }
+            "bins" => {
+                self.build.bins =
+                    number(2, crate::MAX_BINS as u32, "bins must be 2 to 64")? as usize
+            }
+            "evh" => {
+                self.build.split = Split::Evh {
+                    t: number(0, 40, "the exponent must be 0 to 40")?,
+                }
+            }
+            "bbah" => {
+                self.build.split = Split::Bbah {
+                    t: number(0, 40, "the exponent must be 0 to 40")?,
+                }
+            }
+            "compact" => {
+                flag()?;
+                self.build.compact_leaves = true;
+            }
+            "order" => {
+                self.qbvh.order = match value {
+                    Some("unsorted") => Order::Unsorted,
+                    Some("distance") => Order::Distance,
+                    Some("split") => Order::SplitPlane,
+                    _ => return Err(bad("expected unsorted, distance or split")),
+                }
+            }
+            "tstack" => {
+                flag()?;
+                self.qbvh.t_stack = true;
+            }
+            "shadow-cache" => {
+                flag()?;
+                self.qbvh.shadow_cache = true;
+            }
+            "tri-cache" => {
+                flag()?;
+                self.qbvh.triangle_cache = true;
+            }
+            "isect" => {
+                self.qbvh.intersection = match value {
+                    Some("watertight") => TriangleTest::Watertight,
+                    Some("subdivision") => TriangleTest::Subdivision,
+                    Some("hybrid") => TriangleTest::Hybrid,
+                    _ => return Err(bad("expected watertight, subdivision or hybrid")),
+                }
+            }
+            "lazy" => {
+                flag()?;
+                self.lazy = true;
+            }
+            _ => unreachable!("keys were checked above"),
+        }
+        Ok(())
+    }
+}
+
+impl FromStr for AccelSpec {
+    type Err = SpecError;
+
+    fn from_str(s: &str) -> Result<Self, SpecError> {
+        let mut parts = s.trim().split(':');
+        let name = parts.next().unwrap_or_default();
+        let kind = AccelKind::ALL
+            .into_iter()
+            .find(|k| k.name() == name)
+            .ok_or_else(|| SpecError::UnknownKind(name.to_string()))?;
+        let mut spec = AccelSpec::new(kind);
+        for option in parts {
+            spec.apply(option)?;
+        }
+        Ok(spec)
+    }
+}
+
+impl fmt::Display for AccelSpec {
+    /// The canonical text: the kind, then every option that differs from the kind's default.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let default = AccelSpec::new(self.kind);
+        f.write_str(self.kind.name())?;
+        let (b, d) = (&self.build, &default.build);
+        if b.max_leaf_size != d.max_leaf_size {
+            write!(f, ":leaf={}", b.max_leaf_size)?;
+        }
+        if b.bins != d.bins {
+            write!(f, ":bins={}", b.bins)?;
+        }
+        match b.split {
+            Split::None => {}
+            Split::Evh { t } => write!(f, ":evh={t}")?,
+            Split::Bbah { t } => write!(f, ":bbah={t}")?,
+        }
+        if b.compact_leaves {
+            f.write_str(":compact")?;
+        }
+        let (q, dq) = (&self.qbvh, &default.qbvh);
+        if q.order != dq.order {
+            let o = match q.order {
+                Order::Unsorted => "unsorted",
+                Order::Distance => "distance",
+                Order::SplitPlane => "split",
+            };
+            write!(f, ":order={o}")?;
+        }
+        if q.t_stack {
+            f.write_str(":tstack")?;
+        }
+        if q.shadow_cache {
+            f.write_str(":shadow-cache")?;
+        }
+        if q.triangle_cache {
+            f.write_str(":tri-cache")?;
+        }
+        if q.intersection != dq.intersection {
+            let i = match q.intersection {
+                TriangleTest::Watertight => "watertight",
+                TriangleTest::Subdivision => "subdivision",
+                TriangleTest::Hybrid => "hybrid",
+            };
+            write!(f, ":isect={i}")?;
+        }
+        if self.lazy {
+            f.write_str(":lazy")?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_and_prints_back() {
+        for s in [
+            "qbvh",
+            "bvh",
+            "brute-force",
+            "qbvh:order=distance:tstack",
+            "qbvh:evh=14:compact",
+            "bvh:leaf=8:bbah=12",
+            "qbvh:leaf=8:order=unsorted:shadow-cache:tri-cache:isect=hybrid:lazy",
+        ] {
+            let spec: AccelSpec = s.parse().unwrap();
+            assert_eq!(spec.to_string(), s);
+        }
+        let spec: AccelSpec = "qbvh:order=split:isect=watertight".parse().unwrap();
+        assert_eq!(spec, AccelSpec::new(AccelKind::Qbvh));
+    }
+
+    #[test]
+    fn rejects_bad_specs() {
+        let err = |s: &str| s.parse::<AccelSpec>().unwrap_err();
+        assert!(matches!(err("kd"), SpecError::UnknownKind(_)));
+        assert!(matches!(err("qbvh:fast"), SpecError::UnknownOption { .. }));
+        assert!(matches!(err("bvh:tstack"), SpecError::NotApplicable { .. }));
+        assert!(matches!(
+            err("brute-force:leaf=2"),
+            SpecError::NotApplicable { .. }
+        ));
+        assert!(matches!(err("qbvh:leaf=17"), SpecError::BadValue { .. }));
+        assert!(matches!(err("qbvh:leaf=x"), SpecError::BadValue { .. }));
+        assert!(matches!(
+            err("qbvh:order=random"),
+            SpecError::BadValue { .. }
+        ));
+        assert!(matches!(err("qbvh:tstack=1"), SpecError::BadValue { .. }));
+        assert!(matches!(err("qbvh:evh"), SpecError::BadValue { .. }));
+        assert!(err("qbvh:leaf=0").to_string().contains("leaf=0"));
+    }
+}
