@@ -11,6 +11,7 @@
 //! |---|---|---|
 //! | `leaf=N` | bvh, qbvh | largest leaf (default 4 for bvh, 16 for qbvh) |
 //! | `bins=N` | bvh, qbvh | SAH bins per axis |
+//! | `icost=F` | bvh, qbvh | SAH cost of a triangle test relative to a node visit |
 //! | `evh=T` / `bbah=T` | bvh, qbvh | triangle splitting with threshold exponent T |
 //! | `compact` | bvh, qbvh | remove duplicate references per leaf |
 //! | `order=unsorted\|distance\|split` | qbvh | child order (default `split`) |
@@ -147,7 +148,7 @@ impl AccelSpec {
         let tree = matches!(self.kind, AccelKind::Bvh | AccelKind::Qbvh);
         let qbvh = self.kind == AccelKind::Qbvh;
         let applies = match key {
-            "leaf" | "bins" | "evh" | "bbah" | "compact" => tree,
+            "leaf" | "bins" | "icost" | "evh" | "bbah" | "compact" => tree,
             "order" | "tstack" | "shadow-cache" | "tri-cache" | "isect" | "lazy" => qbvh,
             _ => {
                 return Err(SpecError::UnknownOption {
@@ -175,6 +176,12 @@ impl AccelSpec {
             "bins" => {
                 self.build.bins =
                     number(2, crate::MAX_BINS as u32, "bins must be 2 to 64")? as usize
+            }
+            "icost" => {
+                self.build.intersection_cost = value
+                    .and_then(|v| v.parse::<f32>().ok())
+                    .filter(|c| c.is_finite() && *c > 0.0 && *c <= 1e3)
+                    .ok_or_else(|| bad("the cost must be a number in (0, 1000]"))?
             }
             "evh" => {
                 self.build.split = Split::Evh {
@@ -258,6 +265,9 @@ impl fmt::Display for AccelSpec {
         if b.bins != d.bins {
             write!(f, ":bins={}", b.bins)?;
         }
+        if b.intersection_cost != d.intersection_cost {
+            write!(f, ":icost={}", b.intersection_cost)?;
+        }
         match b.split {
             Split::None => {}
             Split::Evh { t } => write!(f, ":evh={t}")?,
@@ -312,6 +322,7 @@ mod tests {
             "qbvh:order=distance:tstack",
             "qbvh:evh=14:compact",
             "bvh:leaf=8:bbah=12",
+            "qbvh:icost=0.5",
             "qbvh:leaf=8:order=unsorted:shadow-cache:tri-cache:isect=hybrid:lazy",
         ] {
             let spec: AccelSpec = s.parse().unwrap();

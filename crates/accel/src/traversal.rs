@@ -21,7 +21,10 @@ const _: () = assert!(FAR_SCALE > 1.0 && FAR_SCALE < 1.0 + 1e-6);
 pub(crate) trait Counter {
     fn boxes(&mut self, n: u64);
     fn leaf(&mut self);
-    fn triangle(&mut self);
+    fn triangle(&mut self) {
+        self.triangles(1);
+    }
+    fn triangles(&mut self, n: u64);
 }
 
 /// The counter of the uncounted queries.
@@ -33,7 +36,7 @@ impl Counter for NoCount {
     #[inline(always)]
     fn leaf(&mut self) {}
     #[inline(always)]
-    fn triangle(&mut self) {}
+    fn triangles(&mut self, _: u64) {}
 }
 
 impl Counter for TraversalCounters {
@@ -46,8 +49,8 @@ impl Counter for TraversalCounters {
         self.leaves_visited += 1;
     }
     #[inline(always)]
-    fn triangle(&mut self) {
-        self.prims_tested += 1;
+    fn triangles(&mut self, n: u64) {
+        self.prims_tested += n;
     }
 }
 
@@ -97,19 +100,29 @@ impl Closest {
             let Some(h) = intersect_triangle(pre, &triangles[i], t_max) else {
                 continue;
             };
-            if h.t < self.t {
-                self.hit = Some(Hit {
-                    t: h.t,
-                    prim: ids[i],
-                    b1: h.b1,
-                    b2: h.b2,
-                });
-                if ANY_HIT {
-                    return true;
-                }
-                self.t = h.t;
-                self.cull_t = h.t;
+            if self.offer::<ANY_HIT>(h.t, ids[i], h.b1, h.b2) {
+                return true;
             }
+        }
+        false
+    }
+
+    /// Offers a hit with `t <= t_max`; returns true when an any-hit query has its answer.
+    #[inline(always)]
+    pub(crate) fn offer<const ANY_HIT: bool>(
+        &mut self,
+        t: f32,
+        prim: u32,
+        b1: f32,
+        b2: f32,
+    ) -> bool {
+        if t < self.t {
+            self.hit = Some(Hit { t, prim, b1, b2 });
+            if ANY_HIT {
+                return true;
+            }
+            self.t = t;
+            self.cull_t = t;
         }
         false
     }

@@ -1,59 +1,144 @@
-//! Rough single-thread timing of Bvh2 against Qbvh, closest hit, primary-like rays at an
-//! icosphere(6). Run with `cargo test -p rt-accel --release --test qbvh_timing -- --ignored
-//! --nocapture`.
+//! Rough single-thread timing of the structures and QBVH options, closest hit, on primary-like
+//! rays at an icosphere(6) and on incoherent rays from points on it (or on `RT_TIMING_OBJ`, an
+//! OBJ file, when set). Run with `cargo test -p rt-accel --release --test qbvh_timing --
+//! --ignored --nocapture`; `render bench-accel` is the real benchmark.
 
 mod common;
 
+use common::Rng;
 use glam::Vec3;
-use rt_accel::{BuildParams, Bvh2, Qbvh};
-use rt_core::{Accel, Ray, TraversalCounters};
+use rt_accel::AccelSpec;
+use rt_core::{Ray, TraversalCounters};
 use std::time::Instant;
+
+/// Triangles of an OBJ file (`v` and `f` lines only, fans for polygons).
+fn read_obj(path: &str) -> Vec<[Vec3; 3]> {
+    let text = std::fs::read_to_string(path).expect("RT_TIMING_OBJ readable");
+    let mut v = Vec::new();
+    let mut tris = Vec::new();
+    for line in text.lines() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => {
+                let c: Vec<f32> = it.take(3).map(|x| x.parse().unwrap()).collect();
+                v.push(Vec3::new(c[0], c[1], c[2]));
+            }
+            Some("f") => {
+                let idx: Vec<usize> = it
+                    .map(|f| {
+                        let i: i64 = f.split('/').next().unwrap().parse().unwrap();
+                        if i < 0 {
+                            (v.len() as i64 + i) as usize
+                        } else {
+                            i as usize - 1
+                        }
+                    })
+                    .collect();
+                for k in 1..idx.len() - 1 {
+                    tris.push([v[idx[0]], v[idx[k]], v[idx[k + 1]]]);
+                }
+            }
+            _ => {}
+        }
+    }
+    tris
+}
+
+/// Seconds this thread has run on a CPU (Linux), so that other processes sharing the machine
+/// inflate the numbers less than wall-clock time would; wall-clock time elsewhere.
+fn thread_seconds() -> f64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
+        .map_or_else(
+            || {
+                static START: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
+                START.get_or_init(Instant::now).elapsed().as_secs_f64()
+            },
+            |ns| ns * 1e-9,
+        )
+}
 
 #[test]
 #[ignore = "timing, not a check"]
-fn bvh2_vs_qbvh_closest_hit() {
-    let tris = common::icosphere(6).triangles();
-    let bvh = Bvh2::build(&tris, &BuildParams::default());
-    let q = Qbvh::from_bvh2(&bvh);
-    // A 512 x 512 pinhole camera at z = 3 looking down -z with a 45 degree field of view.
+fn structures_and_options() {
+    let tris = match std::env::var("RT_TIMING_OBJ") {
+        Ok(path) => read_obj(&path),
+        Err(_) => common::icosphere(6).triangles(),
+    };
+    let bounds = tris.iter().fold(rt_core::Aabb::EMPTY, |b, t| {
+        b.union(rt_core::Aabb::from_points(t))
+    });
+    let (c, r) = (bounds.center(), (bounds.max - bounds.min).length() * 0.5);
+    // A 512 x 512 pinhole camera looking at the centre from 2.5 radii away.
     let n = 512;
-    let rays: Vec<Ray> = (0..n * n)
+    let eye = c + Vec3::new(0.3, 0.4, 2.5) * r;
+    let fwd = (c - eye).normalize();
+    let right = fwd.cross(Vec3::Y).normalize();
+    let up = right.cross(fwd);
+    let primary: Vec<Ray> = (0..n * n)
         .map(|i| {
             let (x, y) = ((i % n) as f32, (i / n) as f32);
             let s = (22.5f32).to_radians().tan();
-            let d = Vec3::new(
-                (2.0 * (x + 0.5) / n as f32 - 1.0) * s,
-                (1.0 - 2.0 * (y + 0.5) / n as f32) * s,
-                -1.0,
-            );
-            Ray::new(Vec3::new(0.1, 0.2, 3.0), d)
+            let d = fwd
+                + right * (2.0 * (x + 0.5) / n as f32 - 1.0) * s
+                + up * (1.0 - 2.0 * (y + 0.5) / n as f32) * s;
+            Ray::new(eye, d)
         })
         .collect();
-    let run = |a: &dyn Accel| {
-        let mut best = f64::INFINITY;
-        let mut hits = 0;
-        for _ in 0..5 {
-            let start = Instant::now();
-            hits = rays
-                .iter()
-                .filter(|r| a.intersect(r, f32::INFINITY).is_some())
-                .count();
-            best = best.min(start.elapsed().as_secs_f64());
+    // Incoherent: from the primary hits, uniformly random directions.
+    let reference = "bvh".parse::<AccelSpec>().unwrap().build(&tris);
+    let mut rng = Rng::new(3);
+    let incoherent: Vec<Ray> = primary
+        .iter()
+        .filter_map(|ray| {
+            let h = reference.intersect(ray, f32::INFINITY)?;
+            let p = ray.origin + ray.dir * h.t;
+            let d = rng.unit_vec();
+            Some(Ray::new(p - ray.dir.normalize() * 1e-4 * r, d))
+        })
+        .collect();
+    println!(
+        "{} triangles, {} primary, {} incoherent rays",
+        tris.len(),
+        primary.len(),
+        incoherent.len()
+    );
+    let specs = std::env::var("RT_TIMING_SPECS").unwrap_or_else(|_| {
+        "bvh,qbvh,qbvh:order=distance,qbvh:order=unsorted,qbvh:tstack,qbvh:leaf=8".into()
+    });
+    for spec in specs.split(',') {
+        let spec: AccelSpec = spec.parse().unwrap();
+        let start = Instant::now();
+        let a = spec.build(&tris);
+        let build = start.elapsed().as_secs_f64();
+        for (name, rays) in [("primary", &primary), ("incoherent", &incoherent)] {
+            let mut best = f64::INFINITY;
+            let mut hits = 0;
+            for _ in 0..3 {
+                let start = thread_seconds();
+                hits = rays
+                    .iter()
+                    .filter(|r| a.intersect(r, f32::INFINITY).is_some())
+                    .count();
+                best = best.min(thread_seconds() - start);
+            }
+            let mut c = TraversalCounters::default();
+            for r in rays.iter() {
+                a.intersect_counted(r, f32::INFINITY, &mut c);
+            }
+            let per = |x: u64| x as f64 / rays.len() as f64;
+            println!(
+                "{:<28} {:<10} {:7.2} Mrays/s  {hits:>7} hits  {:5.1} boxes {:4.1} leaves {:5.1} tris/ray  build {:6.0} ms  {:6.1} MB",
+                spec.to_string(),
+                name,
+                rays.len() as f64 / best / 1e6,
+                per(c.nodes_visited),
+                per(c.leaves_visited),
+                per(c.prims_tested),
+                build * 1e3,
+                a.memory_bytes() as f64 / 1e6
+            );
         }
-        let mut c = TraversalCounters::default();
-        for r in &rays {
-            a.intersect_counted(r, f32::INFINITY, &mut c);
-        }
-        println!(
-            "{:>5}: {:7.2} Mrays/s, {hits} hits, {:.1} boxes/ray, {:.1} tris/ray, {:.1} MB",
-            a.name(),
-            rays.len() as f64 / best / 1e6,
-            c.nodes_visited as f64 / rays.len() as f64,
-            c.prims_tested as f64 / rays.len() as f64,
-            a.memory_bytes() as f64 / 1e6
-        );
-    };
-    println!("icosphere(6): {} triangles", tris.len());
-    run(&bvh);
-    run(&q);
+    }
 }

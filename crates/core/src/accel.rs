@@ -5,6 +5,7 @@
 //! the integrators independent of which structure the user picked.
 
 use crate::{Aabb, Ray};
+use glam::Vec3;
 
 /// A closest-hit result: primitive index (in the scene's triangle order) and the hit's
 /// parametric distance and barycentrics.
@@ -52,6 +53,28 @@ pub trait Accel: Send + Sync {
     /// True if anything is hit with `t ∈ (0, t_max]`. Implementations should stop at the first hit.
     fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         self.intersect(ray, t_max).is_some()
+    }
+
+    /// Occlusion of a shadow ray whose light-side endpoint is `target` (the light sample the
+    /// ray goes toward). Always the same answer as [`Accel::occluded`]; structures with a
+    /// shadow cache use `target` to start where the last occluder toward the same light region
+    /// was found.
+    fn occluded_toward(&self, ray: &Ray, t_max: f32, target: Vec3) -> bool {
+        let _ = target;
+        self.occluded(ray, t_max)
+    }
+
+    /// Like [`Accel::occluded_toward`], also counting work into `counters` if the structure
+    /// supports it.
+    fn occluded_toward_counted(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        target: Vec3,
+        counters: &mut TraversalCounters,
+    ) -> bool {
+        let _ = counters;
+        self.occluded_toward(ray, t_max, target)
     }
 
     /// Bounds of all geometry.

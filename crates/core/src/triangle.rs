@@ -67,6 +67,19 @@ impl RayPrecomp {
             sz: 1.0 / d[kz],
         }
     }
+
+    /// The axis permutation `[kx, ky, kz]`: `kz` is the dominant axis of the direction.
+    #[inline]
+    pub fn axes(&self) -> [usize; 3] {
+        [self.kx, self.ky, self.kz]
+    }
+
+    /// The shear `[sx, sy, sz]` (`sz = 1 / d[kz]`), for SIMD versions of the test that must
+    /// compute exactly what [`intersect_triangle`] does.
+    #[inline]
+    pub fn shear(&self) -> [f32; 3] {
+        [self.sx, self.sy, self.sz]
+    }
 }
 
 /// Intersects a ray with triangle `v` for `t ∈ (0, t_max]`. Both faces are hit (culling is a

@@ -9,24 +9,31 @@
 mod collapse;
 mod node;
 mod options;
+mod shadow_cache;
 mod traverse;
+mod tri4;
 mod validate;
 
 pub use node::{QChild, QNode, EMPTY, LEAF_BIT, MAX_LEAF_TRIANGLES, MAX_TRIANGLES, NO_AXIS};
 pub use options::{Order, QbvhOptions, TriangleTest, DEFAULT_LEAF_SIZE};
+pub use tri4::Tri4;
 
-use crate::traversal::NoCount;
+use crate::traversal::{Counter, NoCount};
 use crate::{BuildParams, Bvh2};
 use glam::Vec3;
 use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
+use traverse::{DISTANCE, SPLIT_PLANE, UNSORTED};
 
 /// A four-wide bounding volume hierarchy over triangles.
 #[derive(Clone, Debug)]
 pub struct Qbvh {
     nodes: Vec<QNode>,
-    triangles: Vec<[Vec3; 3]>,
-    prim_ids: Vec<u32>,
+    packets: Vec<Tri4>,
+    packet_ids: Vec<[u32; 4]>,
+    references: usize,
     bounds: Aabb,
+    /// Tags this structure's entries in the per-thread shadow-cache tables.
+    id: u64,
     options: QbvhOptions,
 }
 
@@ -73,11 +80,14 @@ impl Qbvh {
             "Qbvh supports fewer than 2^27 triangles, got {}",
             bvh.triangles().len()
         );
+        let c = collapse::collapse(bvh.nodes(), bvh.triangles(), bvh.prim_ids());
         Self {
-            nodes: collapse::collapse(bvh.nodes(), bvh.triangles()),
-            triangles: bvh.triangles().to_vec(),
-            prim_ids: bvh.prim_ids().to_vec(),
+            nodes: c.nodes,
+            packets: c.packets,
+            packet_ids: c.packet_ids,
+            references: bvh.triangles().len(),
             bounds: bvh.bounds(),
+            id: shadow_cache::new_id(),
             options: QbvhOptions::default(),
         }
     }
@@ -88,14 +98,44 @@ impl Qbvh {
         &self.nodes
     }
 
-    /// The triangles in leaf order.
-    pub fn triangles(&self) -> &[[Vec3; 3]] {
-        &self.triangles
+    /// The leaf triangles, four to a packet, in leaf order.
+    pub fn packets(&self) -> &[Tri4] {
+        &self.packets
     }
 
-    /// The caller's index of each triangle in [`Qbvh::triangles`].
-    pub fn prim_ids(&self) -> &[u32] {
-        &self.prim_ids
+    /// The triangle and caller's index in lane slot `slot` (`4 * packet + lane`, as in
+    /// [`QChild::Leaf`]).
+    pub fn reference(&self, slot: usize) -> ([Vec3; 3], u32) {
+        let (p, lane) = (slot / 4, slot % 4);
+        (self.packets[p].triangle(lane), self.packet_ids[p][lane])
+    }
+
+    /// Number of triangle references in the leaves (the triangle count, unless the build split
+    /// triangles).
+    pub fn reference_count(&self) -> usize {
+        self.references
+    }
+
+    /// Runs the traversal variant the options select.
+    #[inline]
+    fn query<const ANY_HIT: bool, C: Counter>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        c: &mut C,
+    ) -> Option<Hit> {
+        match (self.options.order, self.options.t_stack) {
+            (Order::SplitPlane, false) => {
+                self.traverse::<ANY_HIT, SPLIT_PLANE, false, C>(ray, t_max, c)
+            }
+            (Order::SplitPlane, true) => {
+                self.traverse::<ANY_HIT, SPLIT_PLANE, true, C>(ray, t_max, c)
+            }
+            (Order::Distance, false) => self.traverse::<ANY_HIT, DISTANCE, false, C>(ray, t_max, c),
+            (Order::Distance, true) => self.traverse::<ANY_HIT, DISTANCE, true, C>(ray, t_max, c),
+            (Order::Unsorted, false) => self.traverse::<ANY_HIT, UNSORTED, false, C>(ray, t_max, c),
+            (Order::Unsorted, true) => self.traverse::<ANY_HIT, UNSORTED, true, C>(ray, t_max, c),
+        }
     }
 }
 
@@ -105,11 +145,33 @@ impl Accel for Qbvh {
     }
 
     fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        self.traverse::<false, _>(ray, t_max, &mut NoCount)
+        self.query::<false, _>(ray, t_max, &mut NoCount)
     }
 
     fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        self.traverse::<true, _>(ray, t_max, &mut NoCount).is_some()
+        self.query::<true, _>(ray, t_max, &mut NoCount).is_some()
+    }
+
+    fn occluded_toward(&self, ray: &Ray, t_max: f32, target: Vec3) -> bool {
+        if self.options.shadow_cache {
+            self.occluded_cached(ray, t_max, target, &mut NoCount)
+        } else {
+            self.occluded(ray, t_max)
+        }
+    }
+
+    fn occluded_toward_counted(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        target: Vec3,
+        counters: &mut TraversalCounters,
+    ) -> bool {
+        if self.options.shadow_cache {
+            self.occluded_cached(ray, t_max, target, counters)
+        } else {
+            self.query::<true, _>(ray, t_max, counters).is_some()
+        }
     }
 
     fn bounds(&self) -> Aabb {
@@ -118,8 +180,8 @@ impl Accel for Qbvh {
 
     fn memory_bytes(&self) -> usize {
         std::mem::size_of_val(self.nodes.as_slice())
-            + std::mem::size_of_val(self.triangles.as_slice())
-            + std::mem::size_of_val(self.prim_ids.as_slice())
+            + std::mem::size_of_val(self.packets.as_slice())
+            + std::mem::size_of_val(self.packet_ids.as_slice())
     }
 
     fn intersect_counted(
@@ -128,7 +190,7 @@ impl Accel for Qbvh {
         t_max: f32,
         counters: &mut TraversalCounters,
     ) -> Option<Hit> {
-        self.traverse::<false, _>(ray, t_max, counters)
+        self.query::<false, _>(ray, t_max, counters)
     }
 
     fn counts_traversal(&self) -> bool {

@@ -14,7 +14,7 @@ const COUNT_SHIFT: u32 = 27;
 const FIRST_MASK: u32 = (1 << COUNT_SHIFT) - 1;
 /// Most triangles one leaf code can hold.
 pub const MAX_LEAF_TRIANGLES: usize = 16;
-/// Triangle slots a [`Qbvh`](super::Qbvh) can address: 27 bits of first slot.
+/// Packets a [`Qbvh`](super::Qbvh) can address: 27 bits of first packet.
 pub const MAX_TRIANGLES: usize = 1 << COUNT_SHIFT;
 /// Value of an unset split axis in [`QNode::axes`].
 pub const NO_AXIS: u32 = 3;
@@ -36,22 +36,29 @@ pub const NO_PARENT: u32 = u32::MAX;
 /// | 96..112  | `children` | one `u32` child code per slot                                   |
 /// | 112..116 | `axes`     | bits 0-1 `axis0`, 2-3 `axis1`, 4-5 `axis2`; 3 = not recorded     |
 /// | 116..120 | `parent`   | index of the parent node, `u32::MAX` for the root               |
-/// | 120..128 | reserved   | zero                                                           |
+/// | 120..128 | `orders`   | per direction octant, the slots in split-plane order (2 bits each) |
 ///
 /// A plane is picked as `bounds[axis + 3 * max_side]`, so traversal chooses near and far planes
 /// per ray without branching. Child codes:
 ///
 /// - [`EMPTY`] (0): no child; the slot's box is inverted (`min = +inf`, `max = -inf`).
 /// - bit 31 clear, nonzero: index of an inner node (always greater than the parent's index).
-/// - bit 31 set ([`LEAF_BIT`]): a leaf of `((code >> 27) & 15) + 1` triangles (1 to 16) starting
-///   at slot `code & (2^27 - 1)` of [`Qbvh::triangles`](super::Qbvh::triangles).
+/// - bit 31 set ([`LEAF_BIT`]): a leaf of `((code >> 27) & 15) + 1` triangles (1 to 16) packed
+///   four to a [`Tri4`](super::Tri4) from packet `code & (2^27 - 1)` on.
 ///
 /// Split axes: `axis0` is the axis of the binary split the node was collapsed from (it separates
 /// the slots that came from the binary left child from those of the right). When both binary
 /// children were expanded, so the slots are `[LL, LR, RL, RR]`, `axis1` separates slots 0 and 1
 /// and `axis2` slots 2 and 3, as in Dammertz's layout; otherwise they are 3. The binary BVH does
 /// not store its split axes, so each is inferred as the axis along which the two child boxes'
-/// centres lie farthest apart. Traversal does not use them (it sorts by entry distance).
+/// centres lie farthest apart.
+///
+/// Split-plane ordered traversal (Dammertz §3.3.3) visits the slots as the binary splits they
+/// came from would: at every split, the side the ray direction points away from first. A node
+/// collapsed by largest-area expansion need not have the `[LL, LR, RL, RR]` shape the three
+/// axes describe, so the order is precomputed for each of the eight direction octants (octant
+/// bit `a` set when the direction is negative along axis `a`) into the spare bytes:
+/// `orders[octant]` holds the nearest slot in bits 0-1, the next in 2-3, and so on.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
 pub struct QNode {
@@ -59,8 +66,11 @@ pub struct QNode {
     pub(crate) children: [u32; 4],
     pub(crate) axes: u32,
     pub(crate) parent: u32,
-    pub(crate) reserved: [u32; 2],
+    pub(crate) orders: [u8; 8],
 }
+
+/// `orders` byte of slot order 0, 1, 2, 3.
+pub(crate) const IDENTITY_ORDER: u8 = 0b11_10_01_00;
 
 const _: () = assert!(std::mem::size_of::<QNode>() == 128);
 const _: () = assert!(std::mem::align_of::<QNode>() == 64);
@@ -72,11 +82,11 @@ pub enum QChild {
     Empty,
     /// An inner node, by index into [`Qbvh::nodes`](super::Qbvh::nodes).
     Inner(usize),
-    /// A leaf: its range of [`Qbvh::triangles`](super::Qbvh::triangles).
+    /// A leaf: its lane slots (`4 * packet + lane`, see [`Qbvh::reference`](super::Qbvh::reference)).
     Leaf(Range<usize>),
 }
 
-/// The child code of a leaf of `count` (1 to 16) triangles from slot `first`.
+/// The child code of a leaf of `count` (1 to 16) triangles packed from packet `first`.
 #[inline]
 pub(crate) fn leaf_code(first: usize, count: usize) -> u32 {
     debug_assert!((1..=MAX_LEAF_TRIANGLES).contains(&count));
@@ -84,12 +94,19 @@ pub(crate) fn leaf_code(first: usize, count: usize) -> u32 {
     LEAF_BIT | (((count - 1) as u32) << COUNT_SHIFT) | first as u32
 }
 
-/// Decodes a leaf code (bit 31 set) into its triangle range.
+/// Decodes a leaf code (bit 31 set) into its first packet and its triangle count.
 #[inline(always)]
-pub(crate) fn leaf_range(code: u32) -> Range<usize> {
+pub(crate) fn leaf_parts(code: u32) -> (usize, usize) {
     let first = (code & FIRST_MASK) as usize;
     let count = ((code >> COUNT_SHIFT) & 15) as usize + 1;
-    first..first + count
+    (first, count)
+}
+
+/// A leaf's triangles as lane slots (`4 * packet + lane`).
+#[inline]
+pub(crate) fn leaf_range(code: u32) -> Range<usize> {
+    let (first, count) = leaf_parts(code);
+    4 * first..4 * first + count
 }
 
 impl QNode {
@@ -106,7 +123,7 @@ impl QNode {
             children: [EMPTY; 4],
             axes,
             parent,
-            reserved: [0; 2],
+            orders: [IDENTITY_ORDER; 8],
         }
     }
 
@@ -156,6 +173,14 @@ impl QNode {
         [self.axes & 3, (self.axes >> 2) & 3, (self.axes >> 4) & 3]
     }
 
+    /// The slots in split-plane order, nearest first, for a direction in `octant` (bit `a` set
+    /// when the direction is negative along axis `a`).
+    #[inline]
+    pub fn slot_order(&self, octant: usize) -> [usize; 4] {
+        let o = self.orders[octant];
+        [0, 2, 4, 6].map(|s| usize::from((o >> s) & 3))
+    }
+
     /// Index of the parent node, `None` for the root.
     #[inline]
     pub fn parent(&self) -> Option<usize> {
@@ -172,14 +197,15 @@ mod tests {
         for (first, count) in [(0, 1), (5, 16), (MAX_TRIANGLES - 16, 16), (123_456, 7)] {
             let c = leaf_code(first, count);
             assert_ne!(c, EMPTY);
-            assert_eq!(leaf_range(c), first..first + count);
+            assert_eq!(leaf_parts(c), (first, count));
+            assert_eq!(leaf_range(c), 4 * first..4 * first + count);
         }
         let mut n = QNode::new(NO_PARENT, 1 | (2 << 2) | (NO_AXIS << 4));
         let b = Aabb::new(Vec3::new(-1.0, -2.0, -3.0), Vec3::new(1.0, 2.0, 3.0));
         n.set(2, b, leaf_code(9, 3));
         n.set(0, b, 17);
         assert_eq!(n.child_aabb(2), b);
-        assert_eq!(n.child(2), QChild::Leaf(9..12));
+        assert_eq!(n.child(2), QChild::Leaf(36..39));
         assert_eq!(n.child(0), QChild::Inner(17));
         assert_eq!(n.child(1), QChild::Empty);
         assert!(n.child_aabb(1).is_empty());

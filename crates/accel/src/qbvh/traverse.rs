@@ -1,16 +1,17 @@
-//! Ordered stack traversal with a four-wide robust slab test.
+//! Stack traversal with a four-wide robust slab test, in three child orders, with or without
+//! entry distances on the stack.
 
-use super::node::{leaf_range, QNode, EMPTY, LEAF_BIT};
+use super::node::{leaf_parts, QNode, EMPTY, IDENTITY_ORDER, LEAF_BIT};
+use super::tri4::{intersect4, RayPrecomp4};
 use super::Qbvh;
 use crate::traversal::{Closest, Counter, FAR_SCALE};
-use rt_core::triangle::RayPrecomp;
 use rt_core::{Aabb, Hit, Ray};
 
 /// Deepest node the traversal stack supports: the binary tree's depth bound (64) plus the
 /// levels that split over-long leaves (at most 12 for 2^27 triangles).
 pub(crate) const MAX_DEPTH: usize = 80;
-/// Ordered traversal pushes at most three entries per inner node on the current path.
-const STACK_SIZE: usize = 3 * MAX_DEPTH + 1;
+/// Traversal pushes at most three entries per inner node on the current path.
+pub(crate) const STACK_SIZE: usize = 3 * MAX_DEPTH + 1;
 
 /// Key of a missed or empty slot; sorts after every hit.
 const MISS: u64 = u64::MAX;
@@ -160,13 +161,68 @@ fn sort4(k: &mut [u64; 4]) {
     cswap(k, 1, 2);
 }
 
-impl Qbvh {
-    /// The one traversal loop behind every query; `ANY_HIT` returns the first hit found.
-    ///
-    /// The leaf test is shared with `Bvh2` ([`Closest`]), so both agree with brute force under
-    /// the same rule; boxes are culled against the closest hit so far.
+/// [`Order`](super::Order) as a const generic parameter.
+pub(crate) const UNSORTED: u8 = 0;
+pub(crate) const DISTANCE: u8 = 1;
+pub(crate) const SPLIT_PLANE: u8 = 2;
+
+/// Direction octant: bit `a` set when the direction is negative along axis `a` (`-0.0` counts
+/// as negative, matching the slab test's choice of planes).
+#[inline(always)]
+pub(crate) fn octant(ray: &Ray) -> usize {
+    usize::from(ray.dir.x.is_sign_negative())
+        | usize::from(ray.dir.y.is_sign_negative()) << 1
+        | usize::from(ray.dir.z.is_sign_negative()) << 2
+}
+
+/// Slots still to visit: child codes and, with the t-stack, their entry distances.
+struct Stack<const TSTACK: bool> {
+    codes: [u32; STACK_SIZE],
+    ts: [f32; STACK_SIZE],
+    len: usize,
+}
+
+impl<const TSTACK: bool> Stack<TSTACK> {
     #[inline(always)]
-    pub(crate) fn traverse<const ANY_HIT: bool, C: Counter>(
+    fn new() -> Self {
+        Self {
+            codes: [0; STACK_SIZE],
+            ts: [0.0; STACK_SIZE],
+            len: 0,
+        }
+    }
+
+    #[inline(always)]
+    fn push(&mut self, code: u32, t: f32) {
+        self.codes[self.len] = code;
+        if TSTACK {
+            self.ts[self.len] = t;
+        }
+        self.len += 1;
+    }
+
+    /// The most recently pushed slot that may still hold something within `cull_t`.
+    #[inline(always)]
+    fn pop(&mut self, cull_t: f32) -> Option<u32> {
+        while self.len > 0 {
+            self.len -= 1;
+            if !TSTACK || self.ts[self.len] <= cull_t * FAR_SCALE {
+                return Some(self.codes[self.len]);
+            }
+        }
+        None
+    }
+}
+
+impl Qbvh {
+    /// The one traversal loop behind every query; `ANY_HIT` returns the first hit found,
+    /// `ORDER` is one of [`UNSORTED`], [`DISTANCE`], [`SPLIT_PLANE`].
+    ///
+    /// Leaves are tested with [`Qbvh::test_leaf`], which keeps the rule of [`Closest`]: hits are
+    /// tested against the caller's `t_max` and the closest kept with an exact `<`, so the
+    /// answer does not depend on the order; boxes are culled against the closest hit so far.
+    #[inline(always)]
+    pub(crate) fn traverse<const ANY_HIT: bool, const ORDER: u8, const TSTACK: bool, C: Counter>(
         &self,
         ray: &Ray,
         t_max: f32,
@@ -179,56 +235,99 @@ impl Qbvh {
         let slab = Slab4::new(ray);
         counter.boxes(1);
         slab.hit_box(&self.bounds, t_max)?;
-        let pre = RayPrecomp::new(ray);
+        let pre = RayPrecomp4::new(ray);
+        let oct = octant(ray);
 
         let mut closest = Closest::new(t_max);
-        // Keys (see `key`) of slots still to visit, farthest deepest.
-        let mut stack = [0u64; STACK_SIZE];
-        let mut sp = 0;
+        let mut stack = Stack::<TSTACK>::new();
         let mut cur: u32 = 0;
         loop {
             if cur & LEAF_BIT != 0 {
-                let (tris, ids) = (&self.triangles[..], &self.prim_ids[..]);
-                let range = leaf_range(cur);
-                if closest.test_leaf::<ANY_HIT, C>(&pre, tris, ids, range, t_max, counter) {
+                if self.test_leaf::<ANY_HIT, C>(&pre, cur, t_max, &mut closest, counter) {
                     return closest.hit;
                 }
             } else {
                 let node = &nodes[cur as usize];
                 counter.boxes(node.occupied() as u64);
                 let (mask, t) = slab.hit4(node, closest.cull_t);
-                let mut keys = [MISS; 4];
-                for lane in 0..4 {
-                    let code = node.children[lane];
-                    if mask & (1 << lane) != 0 && code != EMPTY {
-                        keys[lane] = key(t[lane], code);
-                    }
-                }
-                sort4(&mut keys);
-                if keys[0] != MISS {
-                    for &k in [keys[3], keys[2], keys[1]].iter() {
-                        if k != MISS {
-                            stack[sp] = k;
-                            sp += 1;
+                if mask != 0 {
+                    if ORDER == DISTANCE {
+                        let mut keys = [MISS; 4];
+                        for lane in 0..4 {
+                            if mask & (1 << lane) != 0 {
+                                keys[lane] = key(t[lane], node.children[lane]);
+                            }
                         }
+                        sort4(&mut keys);
+                        for &k in [keys[3], keys[2], keys[1]].iter() {
+                            if k != MISS {
+                                stack.push(k as u32, key_t(k));
+                            }
+                        }
+                        cur = keys[0] as u32;
+                    } else {
+                        let order = if ORDER == SPLIT_PLANE {
+                            node.orders[oct]
+                        } else {
+                            IDENTITY_ORDER
+                        };
+                        // Push the hit slots far to near; the nearest is visited next.
+                        let mut next = None;
+                        for rank in (0..4).rev() {
+                            let slot = usize::from((order >> (2 * rank)) & 3);
+                            if mask & (1 << slot) != 0 {
+                                if let Some((code, t)) = next {
+                                    stack.push(code, t);
+                                }
+                                next = Some((node.children[slot], t[slot]));
+                            }
+                        }
+                        cur = next.map_or(0, |(code, _)| code);
                     }
-                    cur = keys[0] as u32;
+                    // Empty slots have inverted boxes and never hit, so `cur` is a real child.
+                    debug_assert_ne!(cur, EMPTY);
                     continue;
                 }
             }
-            // Pop the nearest pending slot that can still hold something closer.
-            loop {
-                if sp == 0 {
-                    return closest.hit;
-                }
-                sp -= 1;
-                let k = stack[sp];
-                if key_t(k) <= closest.cull_t * FAR_SCALE {
-                    cur = k as u32;
-                    break;
+            match stack.pop(closest.cull_t) {
+                Some(code) => cur = code,
+                None => return closest.hit,
+            }
+        }
+    }
+
+    /// Tests the triangles of leaf `code`; returns true when an any-hit query has its answer.
+    #[inline(always)]
+    pub(crate) fn test_leaf<const ANY_HIT: bool, C: Counter>(
+        &self,
+        pre: &RayPrecomp4,
+        code: u32,
+        t_max: f32,
+        closest: &mut Closest,
+        counter: &mut C,
+    ) -> bool {
+        let (first, count) = leaf_parts(code);
+        counter.leaf();
+        counter.triangles(count as u64);
+        for p in first..first + count.div_ceil(4) {
+            let h = intersect4(pre, &self.packets[p], t_max);
+            if h.mask == 0 {
+                continue;
+            }
+            for lane in 0..4 {
+                if h.mask & (1 << lane) != 0
+                    && closest.offer::<ANY_HIT>(
+                        h.t[lane],
+                        self.packet_ids[p][lane],
+                        h.b1[lane],
+                        h.b2[lane],
+                    )
+                {
+                    return true;
                 }
             }
         }
+        false
     }
 }
 

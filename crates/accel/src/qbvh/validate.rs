@@ -10,30 +10,24 @@ impl Qbvh {
     /// Checks the invariants traversal relies on: every node is reachable exactly once, inner
     /// children lie after their parent and record it as their parent, every slot box contains
     /// the boxes below it (or, for a leaf, its triangles), empty slots have inverted boxes,
-    /// leaves are non-empty and cover every triangle slot exactly once, [`Qbvh::prim_ids`] is a
-    /// permutation, the root's children lie inside [`Accel::bounds`](rt_core::Accel::bounds),
-    /// and the depth fits the traversal stack. Returns the first violation found.
+    /// every node's split-plane orders are permutations of its slots, leaves are non-empty and
+    /// cover every packet exactly once, lanes a leaf does not fill repeat its last triangle,
+    /// the leaves hold [`Qbvh::reference_count`] references, the root's children lie inside
+    /// [`Accel::bounds`](rt_core::Accel::bounds), and the depth fits the traversal stack.
+    /// Returns the first violation found.
     pub fn validate(&self) -> Result<(), String> {
-        let n_tris = self.triangles.len();
-        if self.prim_ids.len() != n_tris {
+        let n_packets = self.packets.len();
+        if self.packet_ids.len() != n_packets {
             return Err(format!(
-                "{} prim ids for {n_tris} triangles",
-                self.prim_ids.len()
+                "{} id rows for {n_packets} packets",
+                self.packet_ids.len()
             ));
         }
-        let mut seen_id = vec![false; n_tris];
-        for &id in &self.prim_ids {
-            match seen_id.get_mut(id as usize) {
-                Some(seen @ false) => *seen = true,
-                Some(true) => return Err(format!("prim id {id} appears twice")),
-                None => return Err(format!("prim id {id} out of range")),
-            }
-        }
         if self.nodes.is_empty() {
-            return if n_tris == 0 {
+            return if n_packets == 0 && self.references == 0 {
                 Ok(())
             } else {
-                Err(format!("no nodes for {n_tris} triangles"))
+                Err(format!("no nodes for {n_packets} packets"))
             };
         }
         if self.nodes[0].parent != NO_PARENT {
@@ -41,7 +35,8 @@ impl Qbvh {
         }
 
         let mut reached = vec![false; self.nodes.len()];
-        let mut covered = vec![false; n_tris];
+        let mut covered = vec![false; n_packets];
+        let mut references = 0;
         // (node, depth, box it must lie in)
         let mut stack = vec![(0usize, 0usize, self.bounds)];
         while let Some((i, depth, outer)) = stack.pop() {
@@ -52,8 +47,14 @@ impl Qbvh {
                 return Err(format!("node {i} at depth {depth} overflows the stack"));
             }
             let node = &self.nodes[i];
-            if node.reserved != [0; 2] {
-                return Err(format!("node {i} has nonzero reserved words"));
+            for octant in 0..8 {
+                let mut order = node.slot_order(octant);
+                order.sort_unstable();
+                if order != [0, 1, 2, 3] {
+                    return Err(format!(
+                        "node {i}: order of octant {octant} is no permutation"
+                    ));
+                }
             }
             if node.occupied() == 0 {
                 return Err(format!("node {i} has no children"));
@@ -82,16 +83,26 @@ impl Qbvh {
                         }
                         stack.push((c, depth + 1, b));
                     }
-                    QChild::Leaf(prims) => {
-                        if prims.end > n_tris {
-                            return Err(format!("leaf {prims:?} of node {i} out of range"));
+                    QChild::Leaf(slots) => {
+                        let packets = slots.start / 4..slots.end.div_ceil(4);
+                        if packets.end > n_packets {
+                            return Err(format!("leaf {slots:?} of node {i} out of range"));
                         }
-                        for p in prims {
+                        for p in packets {
                             if std::mem::replace(&mut covered[p], true) {
-                                return Err(format!("triangle slot {p} is in two leaves"));
+                                return Err(format!("packet {p} is in two leaves"));
                             }
-                            if !inside(&Aabb::from_points(&self.triangles[p]), &b) {
-                                return Err(format!("triangle slot {p} sticks out of its leaf"));
+                        }
+                        references += slots.len();
+                        for s in slots.clone() {
+                            if !inside(&Aabb::from_points(&self.reference(s).0), &b) {
+                                return Err(format!("triangle slot {s} sticks out of its leaf"));
+                            }
+                        }
+                        let last = self.reference(slots.end - 1);
+                        for pad in slots.end..slots.end.next_multiple_of(4) {
+                            if self.reference(pad) != last {
+                                return Err(format!("padding lane {pad} differs"));
                             }
                         }
                     }
@@ -102,7 +113,13 @@ impl Qbvh {
             return Err(format!("node {i} is unreachable"));
         }
         if let Some(p) = covered.iter().position(|c| !c) {
-            return Err(format!("triangle slot {p} is in no leaf"));
+            return Err(format!("packet {p} is in no leaf"));
+        }
+        if references != self.references {
+            return Err(format!(
+                "{references} references in leaves, {} expected",
+                self.references
+            ));
         }
         Ok(())
     }

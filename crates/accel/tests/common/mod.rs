@@ -3,6 +3,7 @@
 #![allow(dead_code)] // each test binary uses a different subset
 
 use glam::{Quat, Vec3};
+use rt_accel::qbvh::QChild;
 use rt_accel::{BruteForce, BuildParams, Bvh2, Qbvh};
 use rt_core::triangle::{intersect_triangle, RayPrecomp};
 use rt_core::{Accel, Hit, Ray, TraversalCounters};
@@ -496,8 +497,8 @@ pub fn rotation(rng: &mut Rng) -> Quat {
 pub trait Built: Accel {
     fn build(tris: &[[Vec3; 3]], params: &BuildParams) -> Self;
     fn validate(&self) -> Result<(), String>;
-    fn prim_ids(&self) -> &[u32];
-    fn triangles(&self) -> &[[Vec3; 3]];
+    /// Every (triangle, caller index) reference in the leaves.
+    fn references(&self) -> Vec<([Vec3; 3], u32)>;
 }
 
 impl Built for Bvh2 {
@@ -507,11 +508,12 @@ impl Built for Bvh2 {
     fn validate(&self) -> Result<(), String> {
         Bvh2::validate(self)
     }
-    fn prim_ids(&self) -> &[u32] {
-        Bvh2::prim_ids(self)
-    }
-    fn triangles(&self) -> &[[Vec3; 3]] {
-        Bvh2::triangles(self)
+    fn references(&self) -> Vec<([Vec3; 3], u32)> {
+        self.triangles()
+            .iter()
+            .copied()
+            .zip(self.prim_ids().iter().copied())
+            .collect()
     }
 }
 
@@ -522,11 +524,17 @@ impl Built for Qbvh {
     fn validate(&self) -> Result<(), String> {
         Qbvh::validate(self)
     }
-    fn prim_ids(&self) -> &[u32] {
-        Qbvh::prim_ids(self)
-    }
-    fn triangles(&self) -> &[[Vec3; 3]] {
-        Qbvh::triangles(self)
+    fn references(&self) -> Vec<([Vec3; 3], u32)> {
+        self.nodes()
+            .iter()
+            .flat_map(|n| (0..4).map(move |s| n.child(s)))
+            .filter_map(|c| match c {
+                QChild::Leaf(slots) => Some(slots),
+                _ => None,
+            })
+            .flatten()
+            .map(|s| self.reference(s))
+            .collect()
     }
 }
 
@@ -544,9 +552,13 @@ pub fn check_soup<A: Built>(
     accel
         .validate()
         .unwrap_or_else(|e| panic!("{} seed {seed}, {n_tris} tris: {e}", accel.name()));
-    for (slot, &id) in accel.prim_ids().iter().enumerate() {
-        assert_eq!(accel.triangles()[slot], tris[id as usize]);
+    let refs = accel.references();
+    let mut seen = vec![false; tris.len()];
+    for (tri, id) in refs {
+        assert_eq!(tri, tris[id as usize]);
+        seen[id as usize] = true;
     }
+    assert!(seen.iter().all(|&s| s), "a triangle is in no leaf");
     let oracle = BruteForce::new(&tris);
     let mut hits = 0;
     let mut outside_box = 0;

@@ -1,0 +1,158 @@
+//! The shadow cache of Dammertz §5.3: occlusion queries toward a light start at the node where
+//! the last occluder toward the same light region was found, and backtrack through parent
+//! indices.
+//!
+//! Consecutive shadow rays toward one light sample region tend to be blocked by the same or
+//! neighbouring triangles, so starting in the subtree that held the last occluder often finds
+//! an occluder after a handful of boxes. If the subtree has none, the search moves to the
+//! parent and searches its other children, and so on up to the root; the subtree plus the
+//! siblings of every ancestor are the whole tree, so the answer is always the same as a query
+//! from the root. When nothing was cached the entry is the root, so there is no special case.
+//!
+//! The table (4096 node indices keyed by a hash of the light-side endpoint, as in the thesis)
+//! is per thread: it is written on every occluded query, and sharing it would mean contention.
+//! It is tagged with the structure it belongs to, so a thread that queries several structures
+//! never uses another's node index. The thesis hashes positions on a fixed 1/16-unit grid;
+//! here the grid has 256 cells along the scene's largest extent, so it does not depend on the
+//! scene's units.
+
+use super::node::{QNode, EMPTY, LEAF_BIT, NO_PARENT};
+use super::traverse::{octant, Slab4, STACK_SIZE};
+use super::tri4::RayPrecomp4;
+use super::Qbvh;
+use crate::traversal::{Closest, Counter};
+use glam::Vec3;
+use rt_core::Ray;
+use std::cell::RefCell;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+const HASH_SIZE: usize = 4096;
+/// Grid cells along the scene's largest extent.
+const CELLS: f32 = 256.0;
+
+/// Source of [`Qbvh`] identities for tagging tables.
+static NEXT_ID: AtomicU64 = AtomicU64::new(1);
+
+pub(crate) fn new_id() -> u64 {
+    NEXT_ID.fetch_add(1, Ordering::Relaxed)
+}
+
+struct Table {
+    owner: u64,
+    entry: [u32; HASH_SIZE],
+}
+
+thread_local! {
+    static TABLE: RefCell<Table> = const {
+        RefCell::new(Table { owner: 0, entry: [0; HASH_SIZE] })
+    };
+}
+
+impl Qbvh {
+    /// Table slot of the light-side endpoint `p`.
+    fn shadow_hash(&self, p: Vec3) -> usize {
+        let extent = self.bounds.max - self.bounds.min;
+        let scale = CELLS / extent.max_element();
+        let cell = ((p - self.bounds.min) * scale).to_array().map(|c| {
+            // Saturating float-to-int casts: NaN becomes 0, anything outside the range clamps.
+            c as i32 as u32
+        });
+        let h = cell[0].wrapping_mul(73_856_093)
+            ^ cell[1].wrapping_mul(19_349_663)
+            ^ cell[2].wrapping_mul(83_492_791);
+        h as usize & (HASH_SIZE - 1)
+    }
+
+    /// Occlusion of `ray` over `(0, t_max]` through the calling thread's shadow cache, keyed by
+    /// the light-side endpoint `target`.
+    pub(crate) fn occluded_cached<C: Counter>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        target: Vec3,
+        counter: &mut C,
+    ) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let slab = Slab4::new(ray);
+        counter.boxes(1);
+        if slab.hit_box(&self.bounds, t_max).is_none() {
+            return false;
+        }
+        let pre = RayPrecomp4::new(ray);
+        let oct = octant(ray);
+        let h = self.shadow_hash(target);
+        TABLE.with(|table| {
+            let mut table = table.borrow_mut();
+            if table.owner != self.id {
+                table.owner = self.id;
+                table.entry = [0; HASH_SIZE];
+            }
+            let mut entry = table.entry[h];
+            let mut done = EMPTY;
+            loop {
+                let found = self.any_hit_below(entry, done, &slab, &pre, oct, t_max, counter);
+                if let Some(owner) = found {
+                    table.entry[h] = owner;
+                    return true;
+                }
+                let parent = self.nodes[entry as usize].parent;
+                if parent == NO_PARENT {
+                    return false;
+                }
+                done = entry;
+                entry = parent;
+            }
+        })
+    }
+
+    /// Any-hit search of the subtree of node `entry`, leaving out its child `done` (a subtree
+    /// already searched, or [`EMPTY`]). Returns the node whose child slot held the occluding
+    /// leaf.
+    #[allow(clippy::too_many_arguments)]
+    fn any_hit_below<C: Counter>(
+        &self,
+        entry: u32,
+        done: u32,
+        slab: &Slab4,
+        pre: &RayPrecomp4,
+        oct: usize,
+        t_max: f32,
+        counter: &mut C,
+    ) -> Option<u32> {
+        // (child code, node holding it)
+        let mut stack = [(0u32, 0u32); STACK_SIZE];
+        let mut sp = 0;
+        let mut closest = Closest::new(t_max);
+        let mut expand = Some(entry);
+        loop {
+            if let Some(index) = expand.take() {
+                let node: &QNode = &self.nodes[index as usize];
+                counter.boxes(node.occupied() as u64);
+                let (mask, _) = slab.hit4(node, t_max);
+                let order = node.orders[oct];
+                for rank in (0..4).rev() {
+                    let slot = usize::from((order >> (2 * rank)) & 3);
+                    let code = node.children[slot];
+                    if mask & (1 << slot) != 0 && code != done {
+                        stack[sp] = (code, index);
+                        sp += 1;
+                    }
+                }
+            }
+            if sp == 0 {
+                return None;
+            }
+            sp -= 1;
+            let (code, owner) = stack[sp];
+            if code & LEAF_BIT != 0 {
+                if self.test_leaf::<true, C>(pre, code, t_max, &mut closest, counter) {
+                    return Some(owner);
+                }
+            } else {
+                expand = Some(code);
+            }
+        }
+    }
+}
