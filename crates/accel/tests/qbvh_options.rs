@@ -1,0 +1,124 @@
+//! Every QBVH traversal option gives the brute-force answer, and the shadow cache never
+//! changes a visibility answer.
+
+mod common;
+
+use common::{check_ray, rays, soup, Rng};
+use glam::Vec3;
+use rt_accel::{AccelSpec, BruteForce};
+use rt_core::{Accel, Ray};
+
+const SPECS: [&str; 10] = [
+    "qbvh",
+    "qbvh:order=distance",
+    "qbvh:order=unsorted",
+    "qbvh:tstack",
+    "qbvh:order=distance:tstack",
+    "qbvh:order=unsorted:tstack",
+    "qbvh:shadow-cache",
+    "qbvh:leaf=4",
+    "qbvh:leaf=1",
+    "qbvh:icost=0.05",
+];
+
+#[test]
+fn every_option_matches_brute_force() {
+    for (k, spec) in SPECS.iter().enumerate() {
+        for seed in 0..3u64 {
+            let mut rng = Rng::new(9_000 + 10 * k as u64 + seed);
+            let tris = soup(&mut rng, 1500);
+            let accel = spec.parse::<AccelSpec>().unwrap().build(&tris);
+            let oracle = BruteForce::new(&tris);
+            let mut hits = 0;
+            for (i, (ray, t_max)) in rays(&mut rng, &tris, 2000).into_iter().enumerate() {
+                if let Err(e) = check_ray(accel.as_ref(), &oracle, &ray, t_max, &tris) {
+                    panic!("{spec} seed {seed} ray {i} {ray:?} t_max {t_max}: {e}");
+                }
+                // Any-hit agrees with closest-hit, with and without a light-side endpoint.
+                let closest = accel.intersect(&ray, t_max).is_some();
+                assert_eq!(accel.occluded(&ray, t_max), closest, "{spec} ray {i}");
+                let target = ray.origin + ray.dir * t_max.min(4.0);
+                assert_eq!(
+                    accel.occluded_toward(&ray, t_max, target),
+                    closest,
+                    "{spec} ray {i}"
+                );
+                hits += usize::from(closest);
+            }
+            assert!(hits > 500, "{spec}: only {hits} hits");
+        }
+    }
+}
+
+/// Shadow rays from points on the geometry toward a few light points, in coherent runs (as a
+/// renderer issues them), so the cache is really used: every answer equals brute force.
+#[test]
+fn shadow_cache_never_changes_an_answer() {
+    let mut rng = Rng::new(4242);
+    let tris = soup(&mut rng, 300);
+    let cached = "qbvh:shadow-cache"
+        .parse::<AccelSpec>()
+        .unwrap()
+        .build(&tris);
+    // A second cached structure queried on the same thread, interleaved: tables must not
+    // leak node indices between structures.
+    let other_tris = soup(&mut rng, 500);
+    let other = "qbvh:shadow-cache"
+        .parse::<AccelSpec>()
+        .unwrap()
+        .build(&other_tris);
+    let oracle = BruteForce::new(&tris);
+    let other_oracle = BruteForce::new(&other_tris);
+    let lights: Vec<Vec3> = (0..4).map(|_| rng.unit_vec() * 3.0).collect();
+    let (mut blocked, mut n) = (0, 0);
+    for _ in 0..200 {
+        let light = lights[rng.below(lights.len())];
+        let base = tris[rng.below(tris.len())][0];
+        for _ in 0..50 {
+            let p = base + rng.vec_in(-0.1, 0.1);
+            let target = light + rng.vec_in(-0.01, 0.01);
+            let ray = Ray::new(p, target - p);
+            let want = oracle.occluded(&ray, 1.0);
+            assert_eq!(cached.occluded_toward(&ray, 1.0, target), want);
+            assert_eq!(
+                other.occluded_toward(&ray, 1.0, target),
+                other_oracle.occluded(&ray, 1.0)
+            );
+            blocked += usize::from(want);
+            n += 1;
+        }
+    }
+    assert!(
+        blocked > n / 20 && blocked < n * 19 / 20,
+        "{blocked} of {n}"
+    );
+}
+
+/// Several threads share one structure, each with its own table.
+#[test]
+fn shadow_cache_is_per_thread() {
+    let mut rng = Rng::new(777);
+    let tris = soup(&mut rng, 2000);
+    let cached = "qbvh:shadow-cache"
+        .parse::<AccelSpec>()
+        .unwrap()
+        .build(&tris);
+    let oracle = BruteForce::new(&tris);
+    std::thread::scope(|s| {
+        for t in 0..4u64 {
+            let (cached, oracle, tris) = (&cached, &oracle, &tris);
+            s.spawn(move || {
+                let mut rng = Rng::new(100 + t);
+                let light = rng.vec_in(-1.5, 1.5);
+                for _ in 0..5000 {
+                    let p = tris[rng.below(tris.len())][1] + rng.vec_in(-0.05, 0.05);
+                    let ray = Ray::new(p, light - p);
+                    assert_eq!(
+                        cached.occluded_toward(&ray, 1.0, light),
+                        oracle.occluded(&ray, 1.0)
+                    );
+                }
+            });
+        }
+    });
+}
