@@ -32,7 +32,8 @@
 //! assert!(!bvh.occluded(&ray, 2.5));
 //! assert_eq!(BruteForce::new(&triangles).intersect(&ray, f32::INFINITY), Some(hit));
 //! ```
-// Unsafe code is allowed only in the QBVH's SSE2 box test, item by item.
+// Unsafe code is allowed only in the QBVH's SIMD kernels and its uninitialised traversal
+// stacks, item by item, each with its safety argument.
 #![deny(unsafe_code)]
 #![deny(missing_docs)]
 

@@ -11,7 +11,7 @@
 //! |---|---|---|
 //! | `leaf=N` | bvh, qbvh | largest leaf (default 4 for bvh, 16 for qbvh) |
 //! | `bins=N` | bvh, qbvh | SAH bins per axis |
-//! | `icost=F` | bvh, qbvh | SAH cost of a triangle test relative to a node visit |
+//! | `icost=F` | bvh, qbvh | SAH cost of a triangle test relative to a node visit (default 1 for bvh, 0.3 for qbvh) |
 //! | `evh=T` / `bbah=T` | bvh, qbvh | triangle splitting with threshold exponent T |
 //! | `compact` | bvh, qbvh | remove duplicate references per leaf |
 //! | `order=unsorted\|distance\|split` | qbvh | child order (default `split`) |
@@ -104,6 +104,7 @@ impl AccelSpec {
         let mut build = BuildParams::default();
         if kind == AccelKind::Qbvh {
             build.max_leaf_size = crate::qbvh::DEFAULT_LEAF_SIZE;
+            build.intersection_cost = crate::qbvh::DEFAULT_INTERSECTION_COST;
         }
         Self {
             kind,
@@ -323,6 +324,7 @@ mod tests {
             "qbvh:evh=14:compact",
             "bvh:leaf=8:bbah=12",
             "qbvh:icost=0.5",
+            "bvh:icost=0.3",
             "qbvh:leaf=8:order=unsorted:shadow-cache:tri-cache:isect=hybrid:lazy",
         ] {
             let spec: AccelSpec = s.parse().unwrap();

@@ -15,7 +15,7 @@ mod tri4;
 mod validate;
 
 pub use node::{QChild, QNode, EMPTY, LEAF_BIT, MAX_LEAF_TRIANGLES, MAX_TRIANGLES, NO_AXIS};
-pub use options::{Order, QbvhOptions, TriangleTest, DEFAULT_LEAF_SIZE};
+pub use options::{Order, QbvhOptions, TriangleTest, DEFAULT_INTERSECTION_COST, DEFAULT_LEAF_SIZE};
 pub use tri4::Tri4;
 
 use crate::traversal::{Counter, NoCount};

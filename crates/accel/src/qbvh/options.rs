@@ -3,6 +3,11 @@
 /// Default largest leaf of a QBVH: the thesis' 16, four SIMD groups of four triangles.
 pub const DEFAULT_LEAF_SIZE: usize = 16;
 
+/// SAH cost of one triangle test relative to one node visit for QBVH builds: four triangles
+/// are tested at once, so a leaf costs about a quarter per triangle of what a binary BVH's does
+/// (measured best of 0.1 to 1 on the bunny; `docs/benchmarks.md`).
+pub const DEFAULT_INTERSECTION_COST: f32 = 0.3;
+
 /// The order in which a node's hit children are visited (Dammertz §3.3.3, Table 3.1).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Order {

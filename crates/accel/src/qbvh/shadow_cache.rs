@@ -24,6 +24,7 @@ use crate::traversal::{Closest, Counter};
 use glam::Vec3;
 use rt_core::Ray;
 use std::cell::RefCell;
+use std::mem::MaybeUninit;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 const HASH_SIZE: usize = 4096;
@@ -122,7 +123,9 @@ impl Qbvh {
         counter: &mut C,
     ) -> Option<u32> {
         // (child code, node holding it)
-        let mut stack = [(0u32, 0u32); STACK_SIZE];
+        // Uninitialised, like the main traversal's stack, because zeroing it costs more than a
+        // short query.
+        let mut stack = [const { MaybeUninit::<(u32, u32)>::uninit() }; STACK_SIZE];
         let mut sp = 0;
         let mut closest = Closest::new(t_max);
         let mut expand = Some(entry);
@@ -136,7 +139,7 @@ impl Qbvh {
                     let slot = usize::from((order >> (2 * rank)) & 3);
                     let code = node.children[slot];
                     if mask & (1 << slot) != 0 && code != done {
-                        stack[sp] = (code, index);
+                        stack[sp].write((code, index));
                         sp += 1;
                     }
                 }
@@ -145,7 +148,9 @@ impl Qbvh {
                 return None;
             }
             sp -= 1;
-            let (code, owner) = stack[sp];
+            // SAFETY: every slot below the old `sp` was written just before `sp` passed it.
+            #[allow(unsafe_code)]
+            let (code, owner) = unsafe { stack[sp].assume_init() };
             if code & LEAF_BIT != 0 {
                 if self.test_leaf::<true, C>(pre, code, t_max, &mut closest, counter) {
                     return Some(owner);

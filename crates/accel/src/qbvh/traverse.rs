@@ -6,6 +6,7 @@ use super::tri4::{intersect4, RayPrecomp4};
 use super::Qbvh;
 use crate::traversal::{Closest, Counter, FAR_SCALE};
 use rt_core::{Aabb, Hit, Ray};
+use std::mem::MaybeUninit;
 
 /// Deepest node the traversal stack supports: the binary tree's depth bound (64) plus the
 /// levels that split over-long leaves (at most 12 for 2^27 triangles).
@@ -176,9 +177,11 @@ pub(crate) fn octant(ray: &Ray) -> usize {
 }
 
 /// Slots still to visit: child codes and, with the t-stack, their entry distances.
+///
+/// The arrays are left uninitialised: zeroing 2 KB per ray cost more than a short traversal.
 struct Stack<const TSTACK: bool> {
-    codes: [u32; STACK_SIZE],
-    ts: [f32; STACK_SIZE],
+    codes: [MaybeUninit<u32>; STACK_SIZE],
+    ts: [MaybeUninit<f32>; STACK_SIZE],
     len: usize,
 }
 
@@ -186,28 +189,37 @@ impl<const TSTACK: bool> Stack<TSTACK> {
     #[inline(always)]
     fn new() -> Self {
         Self {
-            codes: [0; STACK_SIZE],
-            ts: [0.0; STACK_SIZE],
+            codes: [const { MaybeUninit::uninit() }; STACK_SIZE],
+            ts: [const { MaybeUninit::uninit() }; STACK_SIZE],
             len: 0,
         }
     }
 
     #[inline(always)]
     fn push(&mut self, code: u32, t: f32) {
-        self.codes[self.len] = code;
+        self.codes[self.len].write(code);
         if TSTACK {
-            self.ts[self.len] = t;
+            self.ts[self.len].write(t);
         }
         self.len += 1;
     }
 
     /// The most recently pushed slot that may still hold something within `cull_t`.
     #[inline(always)]
+    #[allow(unsafe_code)]
     fn pop(&mut self, cull_t: f32) -> Option<u32> {
         while self.len > 0 {
             self.len -= 1;
-            if !TSTACK || self.ts[self.len] <= cull_t * FAR_SCALE {
-                return Some(self.codes[self.len]);
+            // SAFETY: `push` wrote `codes[i]` (and `ts[i]` when `TSTACK`) for every `i < len`
+            // before incrementing `len`, and nothing else changes `len` or the arrays.
+            let (code, keep) = unsafe {
+                (
+                    self.codes[self.len].assume_init(),
+                    !TSTACK || self.ts[self.len].assume_init() <= cull_t * FAR_SCALE,
+                )
+            };
+            if keep {
+                return Some(code);
             }
         }
         None
@@ -271,18 +283,20 @@ impl Qbvh {
                         } else {
                             IDENTITY_ORDER
                         };
-                        // Push the hit slots far to near; the nearest is visited next.
-                        let mut next = None;
-                        for rank in (0..4).rev() {
-                            let slot = usize::from((order >> (2 * rank)) & 3);
-                            if mask & (1 << slot) != 0 {
-                                if let Some((code, t)) = next {
-                                    stack.push(code, t);
-                                }
-                                next = Some((node.children[slot], t[slot]));
-                            }
+                        // Hit slots by rank (bit r: the r-th nearest slot was hit). The
+                        // nearest is visited next, the others pushed far to near.
+                        let slot = |rank: u32| usize::from((order >> (2 * rank)) & 3);
+                        let ranks =
+                            (0..4).fold(0u32, |r, rank| r | (((mask >> slot(rank)) & 1) << rank));
+                        let nearest = slot(ranks.trailing_zeros());
+                        let mut rest = ranks & (ranks - 1);
+                        while rest != 0 {
+                            let rank = 31 - rest.leading_zeros();
+                            rest &= !(1 << rank);
+                            let s = slot(rank);
+                            stack.push(node.children[s], t[s]);
                         }
-                        cur = next.map_or(0, |(code, _)| code);
+                        cur = node.children[nearest];
                     }
                     // Empty slots have inverted boxes and never hit, so `cur` is a real child.
                     debug_assert_ne!(cur, EMPTY);
