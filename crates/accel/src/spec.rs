@@ -17,7 +17,6 @@
 //! | `order=unsorted\|distance\|split` | qbvh | child order (default `split`) |
 //! | `tstack` | qbvh | keep entry distances on the stack and skip stale entries |
 //! | `shadow-cache` | qbvh | start occlusion queries at the last occluder's node |
-//! | `tri-cache` | qbvh | per-thread cache of four-wide leaf triangles |
 //! | `isect=watertight\|subdivision\|hybrid` | qbvh | triangle test (default watertight) |
 //! | `lazy` | qbvh | build subtrees the first time a ray reaches them |
 
@@ -150,7 +149,7 @@ impl AccelSpec {
         let qbvh = self.kind == AccelKind::Qbvh;
         let applies = match key {
             "leaf" | "bins" | "icost" | "evh" | "bbah" | "compact" => tree,
-            "order" | "tstack" | "shadow-cache" | "tri-cache" | "isect" | "lazy" => qbvh,
+            "order" | "tstack" | "shadow-cache" | "isect" | "lazy" => qbvh,
             _ => {
                 return Err(SpecError::UnknownOption {
                     kind,
@@ -213,10 +212,6 @@ impl AccelSpec {
             "shadow-cache" => {
                 flag()?;
                 self.qbvh.shadow_cache = true;
-            }
-            "tri-cache" => {
-                flag()?;
-                self.qbvh.triangle_cache = true;
             }
             "isect" => {
                 self.qbvh.intersection = match value {
@@ -292,9 +287,6 @@ impl fmt::Display for AccelSpec {
         if q.shadow_cache {
             f.write_str(":shadow-cache")?;
         }
-        if q.triangle_cache {
-            f.write_str(":tri-cache")?;
-        }
         if q.intersection != dq.intersection {
             let i = match q.intersection {
                 TriangleTest::Watertight => "watertight",
@@ -325,7 +317,7 @@ mod tests {
             "bvh:leaf=8:bbah=12",
             "qbvh:icost=0.5",
             "bvh:icost=0.3",
-            "qbvh:leaf=8:order=unsorted:shadow-cache:tri-cache:isect=hybrid:lazy",
+            "qbvh:leaf=8:order=unsorted:shadow-cache:isect=hybrid:lazy",
         ] {
             let spec: AccelSpec = s.parse().unwrap();
             assert_eq!(spec.to_string(), s);

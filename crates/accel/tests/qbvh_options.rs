@@ -8,7 +8,7 @@ use glam::Vec3;
 use rt_accel::{AccelSpec, BruteForce};
 use rt_core::{Accel, Ray};
 
-const SPECS: [&str; 11] = [
+const SPECS: [&str; 10] = [
     "qbvh",
     "qbvh:order=distance",
     "qbvh:order=unsorted",
@@ -19,7 +19,6 @@ const SPECS: [&str; 11] = [
     "qbvh:leaf=4",
     "qbvh:leaf=1",
     "qbvh:icost=0.05",
-    "qbvh:tri-cache",
 ];
 
 #[test]

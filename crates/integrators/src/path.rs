@@ -156,7 +156,8 @@ impl Integrator for PathIntegrator {
                             ctx.accel.occluded(&r, f32::INFINITY)
                         } else {
                             let (r, t_max) = shadow_segment(si.p, si.ng, ls.point, ls.normal);
-                            ctx.accel.occluded(&r, t_max)
+                            // The light point keys the shadow cache of structures that have one.
+                            ctx.accel.occluded_toward(&r, t_max, ls.point)
                         };
                         if !occluded {
                             let w = power_heuristic(ls.pdf, bsdf_pdf);

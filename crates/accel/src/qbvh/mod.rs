@@ -12,7 +12,6 @@ mod options;
 mod shadow_cache;
 mod traverse;
 mod tri4;
-mod tri_cache;
 mod validate;
 
 pub use node::{QChild, QNode, EMPTY, LEAF_BIT, MAX_LEAF_TRIANGLES, MAX_TRIANGLES, NO_AXIS};
@@ -33,9 +32,6 @@ pub struct Qbvh {
     packet_ids: Vec<[u32; 4]>,
     references: usize,
     bounds: Aabb,
-    /// With [`QbvhOptions::triangle_cache`]: the packets' triangles unswizzled, in lane-slot
-    /// order, which the cache gathers from; empty otherwise.
-    flat: Vec<[Vec3; 3]>,
     /// Tags this structure's entries in the per-thread shadow-cache tables.
     id: u64,
     options: QbvhOptions,
@@ -63,13 +59,6 @@ impl Qbvh {
     ) -> Self {
         let mut q = Self::build(triangles, params);
         q.options = *options;
-        if options.triangle_cache {
-            q.flat = q
-                .packets
-                .iter()
-                .flat_map(|p| (0..4).map(|lane| p.triangle(lane)))
-                .collect();
-        }
         q
     }
 
@@ -98,7 +87,6 @@ impl Qbvh {
             packet_ids: c.packet_ids,
             references: bvh.triangles().len(),
             bounds: bvh.bounds(),
-            flat: Vec::new(),
             id: shadow_cache::new_id(),
             options: QbvhOptions::default(),
         }
@@ -194,7 +182,6 @@ impl Accel for Qbvh {
         std::mem::size_of_val(self.nodes.as_slice())
             + std::mem::size_of_val(self.packets.as_slice())
             + std::mem::size_of_val(self.packet_ids.as_slice())
-            + std::mem::size_of_val(self.flat.as_slice())
     }
 
     fn intersect_counted(

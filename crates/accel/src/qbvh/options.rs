@@ -47,8 +47,6 @@ pub struct QbvhOptions {
     /// Start occlusion queries from the node of the last occluder found for the same light
     /// region, with backtracking through parent indices (Dammertz §5.3). Per thread.
     pub shadow_cache: bool,
-    /// Gather leaf triangles through a per-thread software cache (Dammertz §5.1).
-    pub triangle_cache: bool,
     /// The leaf triangle test.
     pub intersection: TriangleTest,
 }

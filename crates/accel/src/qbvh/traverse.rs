@@ -2,7 +2,7 @@
 //! entry distances on the stack.
 
 use super::node::{leaf_parts, QNode, EMPTY, IDENTITY_ORDER, LEAF_BIT};
-use super::tri4::{intersect4, RayPrecomp4, Tri4};
+use super::tri4::{intersect4, RayPrecomp4};
 use super::Qbvh;
 use crate::traversal::{Closest, Counter, FAR_SCALE};
 use rt_core::{Aabb, Hit, Ray};
@@ -323,34 +323,15 @@ impl Qbvh {
         let (first, count) = leaf_parts(code);
         counter.leaf();
         counter.triangles(count as u64);
-        let n = count.div_ceil(4);
-        if self.options.triangle_cache {
-            return self.with_cached_packets(code, |packets| {
-                self.test_packets::<ANY_HIT>(pre, packets, first, t_max, closest)
-            });
-        }
-        self.test_packets::<ANY_HIT>(pre, &self.packets[first..first + n], first, t_max, closest)
-    }
-
-    /// Tests `packets`, which are (copies of) the packets from index `first` on.
-    #[inline(always)]
-    fn test_packets<const ANY_HIT: bool>(
-        &self,
-        pre: &RayPrecomp4,
-        packets: &[Tri4],
-        first: usize,
-        t_max: f32,
-        closest: &mut Closest,
-    ) -> bool {
-        for (k, packet) in packets.iter().enumerate() {
-            let h = intersect4(pre, packet, t_max);
+        for p in first..first + count.div_ceil(4) {
+            let h = intersect4(pre, &self.packets[p], t_max);
             if h.mask == 0 {
                 continue;
             }
-            let ids = &self.packet_ids[first + k];
-            for lane in 0..4 {
+            let ids = &self.packet_ids[p];
+            for (lane, &id) in ids.iter().enumerate() {
                 if h.mask & (1 << lane) != 0
-                    && closest.offer::<ANY_HIT>(h.t[lane], ids[lane], h.b1[lane], h.b2[lane])
+                    && closest.offer::<ANY_HIT>(h.t[lane], id, h.b1[lane], h.b2[lane])
                 {
                     return true;
                 }
