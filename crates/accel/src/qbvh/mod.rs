@@ -32,6 +32,8 @@ pub struct Qbvh {
     packet_ids: Vec<[u32; 4]>,
     references: usize,
     bounds: Aabb,
+    /// The CPU has AVX2: traversal runs a copy compiled for it.
+    avx2: bool,
     /// Tags this structure's entries in the per-thread shadow-cache tables.
     id: u64,
     options: QbvhOptions,
@@ -87,6 +89,10 @@ impl Qbvh {
             packet_ids: c.packet_ids,
             references: bvh.triangles().len(),
             bounds: bvh.bounds(),
+            #[cfg(target_arch = "x86_64")]
+            avx2: std::is_x86_feature_detected!("avx2"),
+            #[cfg(not(target_arch = "x86_64"))]
+            avx2: false,
             id: shadow_cache::new_id(),
             options: QbvhOptions::default(),
         }
@@ -116,9 +122,38 @@ impl Qbvh {
         self.references
     }
 
-    /// Runs the traversal variant the options select.
+    /// Runs the traversal variant the options select, compiled for AVX2 when the CPU has it.
     #[inline]
     fn query<const ANY_HIT: bool, C: Counter>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        c: &mut C,
+    ) -> Option<Hit> {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only when `is_x86_feature_detected!("avx2")` said so.
+            #[allow(unsafe_code)]
+            return unsafe { self.query_avx2::<ANY_HIT, C>(ray, t_max, c) };
+        }
+        self.query_any::<ANY_HIT, C>(ray, t_max, c)
+    }
+
+    /// [`Qbvh::query_any`] compiled with AVX2 enabled: the same SSE2 code, VEX-encoded.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[allow(unsafe_code)]
+    unsafe fn query_avx2<const ANY_HIT: bool, C: Counter>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        c: &mut C,
+    ) -> Option<Hit> {
+        self.query_any::<ANY_HIT, C>(ray, t_max, c)
+    }
+
+    #[inline(always)]
+    fn query_any<const ANY_HIT: bool, C: Counter>(
         &self,
         ray: &Ray,
         t_max: f32,
