@@ -39,6 +39,7 @@
 
 pub mod brute_force;
 pub mod bvh2;
+pub mod crack_free;
 pub mod on_demand;
 pub mod qbvh;
 pub mod spec;

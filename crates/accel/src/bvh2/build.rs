@@ -2,7 +2,7 @@
 //! Hierarchies", 2007), evaluated on all three axes.
 
 use super::node::Node;
-use super::BuildParams;
+use super::{compact, split, BuildParams};
 use glam::Vec3;
 use rt_core::Aabb;
 
@@ -25,6 +25,8 @@ pub(crate) struct Config {
     pub traversal_cost: f64,
     pub intersection_cost: f64,
     pub parallel: bool,
+    pub split: super::Split,
+    pub compact_leaves: bool,
 }
 
 impl From<&BuildParams> for Config {
@@ -42,15 +44,18 @@ impl From<&BuildParams> for Config {
             traversal_cost: cost(p.traversal_cost, 1.0),
             intersection_cost: cost(p.intersection_cost, 1.0),
             parallel: p.parallel,
+            split: p.split,
+            compact_leaves: p.compact_leaves,
         }
     }
 }
 
-/// A triangle as the builder sees it: its bounds and its index in the caller's order.
+/// A reference as the builder sees it: the bounds of a triangle, or of a piece of it when
+/// splitting, and the triangle's index in the caller's order.
 #[derive(Clone, Copy, Debug)]
-struct PrimRef {
-    bounds: Aabb,
-    index: u32,
+pub(super) struct PrimRef {
+    pub bounds: Aabb,
+    pub index: u32,
 }
 
 impl PrimRef {
@@ -62,43 +67,37 @@ impl PrimRef {
 }
 
 /// Nodes (root first, children of each inner node adjacent) and the caller's triangle index of
-/// every leaf slot.
+/// every leaf slot. With splitting a triangle may fill several slots, in one leaf or several.
 pub(crate) struct Built {
     pub nodes: Vec<Node>,
     pub order: Vec<u32>,
 }
 
 /// Builds the hierarchy over `triangles`. An empty input gives no nodes at all.
+///
+/// # Panics
+///
+/// If there are more than `u32::MAX / 2` references (triangles, or pieces when splitting).
 pub(crate) fn build(triangles: &[[Vec3; 3]], cfg: &Config) -> Built {
-    // Node indices are u32 and there are up to 2n - 1 nodes.
-    assert!(
-        triangles.len() <= (u32::MAX / 2) as usize,
-        "Bvh2 supports at most 2^31 - 1 triangles, got {}",
-        triangles.len()
-    );
-    if triangles.is_empty() {
+    // This panics beyond u32::MAX / 2 references, the count that the u32 node and slot indices
+    // and the depth invariant of `build_node` allow.
+    let mut refs = split::references(triangles, cfg.split, cfg.parallel);
+    if refs.is_empty() {
         return Built {
             nodes: Vec::new(),
             order: Vec::new(),
         };
     }
-    let mut refs: Vec<PrimRef> = triangles
-        .iter()
-        .enumerate()
-        .map(|(i, t)| PrimRef {
-            bounds: Aabb::from_points(t),
-            index: i as u32,
-        })
-        .collect();
-    let mut nodes = Vec::with_capacity(2 * triangles.len());
+    let mut nodes = Vec::with_capacity(2 * refs.len());
     nodes.push(PLACEHOLDER);
     let root = build_node(&mut refs, 0, 0, cfg, &mut nodes);
     nodes[0] = root;
     nodes.shrink_to_fit();
-    Built {
-        nodes,
-        order: refs.iter().map(|r| r.index).collect(),
+    let mut order: Vec<u32> = refs.iter().map(|r| r.index).collect();
+    if cfg.compact_leaves {
+        compact::compact_leaves(&mut nodes, &mut order);
     }
+    Built { nodes, order }
 }
 
 const PLACEHOLDER: Node = Node {
@@ -119,7 +118,10 @@ fn ceil_log2(n: usize) -> usize {
 /// Builds the subtree over `refs` (which start at leaf slot `first`), appends its descendants to
 /// `out` and returns its root, which the caller stores.
 ///
-/// Invariant, true at the root because `n < 2^31`: `depth + ceil_log2(n) <= MAX_DEPTH - 1`.
+/// `refs` are triangle references: triangles, or pieces of them when splitting.
+///
+/// Invariant, true at the root because there are fewer than 2^31 references:
+/// `depth + ceil_log2(n) <= MAX_DEPTH - 1`.
 /// SAH splits may be as lopsided as 1 : n-1, so they are allowed only while the invariant would
 /// hold for a child of n - 1 triangles; beyond that, median splits lower `ceil_log2` by one per
 /// level and the invariant survives, which bounds the depth without ever refusing to split.

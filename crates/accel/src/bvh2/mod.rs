@@ -4,15 +4,22 @@
 //! every inner node side by side. The triangles are copied in leaf order, so a leaf's triangles
 //! are contiguous in memory, and [`Bvh2::prim_ids`] maps each copy back to the caller's index,
 //! which is what [`Hit::prim`] reports.
+//!
+//! With [`BuildParams::split`] the builder partitions pieces of triangles rather than triangles
+//! (see [`split_references`]), so a triangle can fill several leaf slots; each slot still holds
+//! the whole triangle and its caller's index.
 
 mod build;
+mod compact;
 mod node;
+mod split;
 mod stats;
 mod traverse;
 mod validate;
 
 pub use build::MAX_BINS;
 pub use node::Node;
+pub use split::{split_pieces, split_references};
 pub use stats::BvhStats;
 
 use crate::traversal::NoCount;
@@ -83,6 +90,8 @@ pub struct Bvh2 {
     nodes: Vec<Node>,
     triangles: Vec<[Vec3; 3]>,
     prim_ids: Vec<u32>,
+    /// The caller's triangle count; with splitting there are more slots.
+    n_triangles: usize,
     config: Config,
 }
 
@@ -93,15 +102,17 @@ impl Bvh2 {
     ///
     /// # Panics
     ///
-    /// If there are 2^31 or more triangles.
+    /// If there are 2^31 or more triangles, or references when splitting.
     pub fn build(triangles: &[[Vec3; 3]], params: &BuildParams) -> Self {
         let config = Config::from(params);
         let built = build::build(triangles, &config);
+        let n_triangles = triangles.len();
         let triangles = built.order.iter().map(|&i| triangles[i as usize]).collect();
         Self {
             nodes: built.nodes,
             triangles,
             prim_ids: built.order,
+            n_triangles,
             config,
         }
     }
@@ -111,9 +122,16 @@ impl Bvh2 {
         &self.nodes
     }
 
-    /// The triangles in leaf order.
+    /// The triangles in leaf order, one per leaf slot: with splitting, a triangle appears once
+    /// for every leaf that references it (or more often without leaf compaction).
     pub fn triangles(&self) -> &[[Vec3; 3]] {
         &self.triangles
+    }
+
+    /// True if the build split triangles ([`BuildParams::split`]), so leaf boxes may bound only
+    /// a piece of their triangles.
+    pub fn is_split(&self) -> bool {
+        self.config.split != Split::None
     }
 
     /// The caller's index of each triangle in [`Bvh2::triangles`].
@@ -143,6 +161,16 @@ impl Accel for Bvh2 {
         std::mem::size_of_val(self.nodes.as_slice())
             + std::mem::size_of_val(self.triangles.as_slice())
             + std::mem::size_of_val(self.prim_ids.as_slice())
+    }
+
+    fn occluded_toward_counted(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        _target: Vec3,
+        counters: &mut TraversalCounters,
+    ) -> bool {
+        self.traverse::<true, _>(ray, t_max, counters).is_some()
     }
 
     fn intersect_counted(

@@ -9,13 +9,16 @@ use std::fmt;
 pub struct BvhStats {
     /// Number of triangles.
     pub triangles: usize,
+    /// Number of leaf slots: the triangles, plus the extra references that splitting added and
+    /// leaf compaction kept.
+    pub references: usize,
     /// Inner nodes plus leaves.
     pub nodes: usize,
     /// Leaves.
     pub leaves: usize,
     /// Edges from the root to the deepest leaf (0 for a lone leaf or an empty tree).
     pub max_depth: usize,
-    /// Most triangles in any leaf.
+    /// Most references in any leaf.
     pub largest_leaf: usize,
     /// Expected cost of a random ray that hits the root under the surface area heuristic, with
     /// the build's traversal and intersection costs: the sum over nodes of their cost weighted
@@ -30,7 +33,8 @@ impl Bvh2 {
     /// Computes the statistics by walking the tree.
     pub fn stats(&self) -> BvhStats {
         let mut s = BvhStats {
-            triangles: self.triangles.len(),
+            triangles: self.n_triangles,
+            references: self.triangles.len(),
             nodes: self.nodes.len(),
             memory_bytes: self.memory_bytes(),
             ..BvhStats::default()
@@ -72,8 +76,10 @@ impl fmt::Display for BvhStats {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "{} triangles, {} nodes ({} leaves, largest {}), depth {}, SAH {:.2}, {:.1} KiB",
+            "{} triangles ({} references), {} nodes ({} leaves, largest {}), depth {}, SAH {:.2}, \
+             {:.1} KiB",
             self.triangles,
+            self.references,
             self.nodes,
             self.leaves,
             self.largest_leaf,

@@ -31,6 +31,8 @@ pub struct Qbvh {
     packets: Vec<Tri4>,
     packet_ids: Vec<[u32; 4]>,
     references: usize,
+    /// Built from split references: a leaf box may bound only a piece of a triangle.
+    split: bool,
     bounds: Aabb,
     /// The CPU has AVX2: traversal runs a copy compiled for it.
     avx2: bool,
@@ -88,6 +90,7 @@ impl Qbvh {
             packets: c.packets,
             packet_ids: c.packet_ids,
             references: bvh.triangles().len(),
+            split: bvh.is_split(),
             bounds: bvh.bounds(),
             #[cfg(target_arch = "x86_64")]
             avx2: std::is_x86_feature_detected!("avx2"),

@@ -3,7 +3,8 @@
 
 use super::node::{leaf_parts, QNode, EMPTY, IDENTITY_ORDER, LEAF_BIT};
 use super::tri4::{intersect4, RayPrecomp4};
-use super::Qbvh;
+use super::{Qbvh, TriangleTest};
+use crate::crack_free::{intersect_hybrid, intersect_subdivision, SubdivRay};
 use crate::traversal::{Closest, Counter, FAR_SCALE};
 use rt_core::{Aabb, Hit, Ray};
 use std::mem::MaybeUninit;
@@ -323,6 +324,9 @@ impl Qbvh {
         let (first, count) = leaf_parts(code);
         counter.leaf();
         counter.triangles(count as u64);
+        if self.options.intersection != TriangleTest::Watertight {
+            return self.test_leaf_crack_free::<ANY_HIT>(pre, first, count, t_max, closest);
+        }
         for p in first..first + count.div_ceil(4) {
             let h = intersect4(pre, &self.packets[p], t_max);
             if h.mask == 0 {
@@ -333,6 +337,33 @@ impl Qbvh {
                 if h.mask & (1 << lane) != 0
                     && closest.offer::<ANY_HIT>(h.t[lane], id, h.b1[lane], h.b2[lane])
                 {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
+    /// The leaf test with the thesis' crack-free triangle tests, one triangle at a time (they
+    /// exist for comparison, not speed).
+    #[inline(never)]
+    fn test_leaf_crack_free<const ANY_HIT: bool>(
+        &self,
+        pre: &RayPrecomp4,
+        first: usize,
+        count: usize,
+        t_max: f32,
+        closest: &mut Closest,
+    ) -> bool {
+        let sub = SubdivRay::new(&pre.ray);
+        for slot in 4 * first..4 * first + count {
+            let (tri, id) = self.reference(slot);
+            let hit = match self.options.intersection {
+                TriangleTest::Hybrid => intersect_hybrid(&sub, &tri, t_max),
+                _ => intersect_subdivision(&sub, &tri, t_max),
+            };
+            if let Some(h) = hit {
+                if closest.offer::<ANY_HIT>(h.t, id, h.b1, h.b2) {
                     return true;
                 }
             }

@@ -52,6 +52,7 @@ impl Tri4 {
 /// Per-ray constants of the four-wide test: the scalar test's shear, plus the permuted origin.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct RayPrecomp4 {
+    pub ray: Ray,
     pub scalar: RayPrecomp,
     k: [usize; 3],
     org: [f32; 3],
@@ -64,6 +65,7 @@ impl RayPrecomp4 {
         let scalar = RayPrecomp::new(ray);
         let k = scalar.axes();
         Self {
+            ray: *ray,
             scalar,
             k,
             org: k.map(|a| ray.origin[a]),

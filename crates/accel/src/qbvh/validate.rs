@@ -11,6 +11,7 @@ impl Qbvh {
     /// children lie after their parent and record it as their parent, every slot box contains
     /// the boxes below it (or, for a leaf, its triangles), empty slots have inverted boxes,
     /// every node's split-plane orders are permutations of its slots, leaves are non-empty and
+    /// (unless the build split triangles, when they need only overlap it) lie inside their box,
     /// cover every packet exactly once, lanes a leaf does not fill repeat its last triangle,
     /// the leaves hold [`Qbvh::reference_count`] references, the root's children lie inside
     /// [`Accel::bounds`](rt_core::Accel::bounds), and the depth fits the traversal stack.
@@ -95,7 +96,14 @@ impl Qbvh {
                         }
                         references += slots.len();
                         for s in slots.clone() {
-                            if !inside(&Aabb::from_points(&self.reference(s).0), &b) {
+                            let tri = Aabb::from_points(&self.reference(s).0);
+                            // A split reference's box bounds a piece of its triangle only.
+                            let ok = if self.split {
+                                tri.min.cmple(b.max).all() && tri.max.cmpge(b.min).all()
+                            } else {
+                                inside(&tri, &b)
+                            };
+                            if !ok {
                                 return Err(format!("triangle slot {s} sticks out of its leaf"));
                             }
                         }

@@ -588,3 +588,114 @@ pub fn check_soup<A: Built>(
     );
     hits
 }
+
+// The on-demand QBVH (`tests/on_demand.rs`): its references are its groups' triangles, and
+// `validate` checks the top tree and the groups built so far.
+impl Built for rt_accel::OnDemandQbvh {
+    fn build(tris: &[[Vec3; 3]], params: &BuildParams) -> Self {
+        rt_accel::OnDemandQbvh::new(tris, params, &rt_accel::QbvhOptions::default())
+    }
+    fn validate(&self) -> Result<(), String> {
+        rt_accel::OnDemandQbvh::validate(self)
+    }
+    fn references(&self) -> Vec<([Vec3; 3], u32)> {
+        self.group_order()
+            .iter()
+            .map(|&i| (self.triangles()[i as usize], i))
+            .collect()
+    }
+}
+
+/// Long thin triangles in random directions, none in an axis plane: the boxes of such
+/// triangles are mostly empty, which is what triangle splitting is for. A fifth of them lie
+/// along the main diagonal, rotated 45 degrees from every axis plane, and some share edges.
+pub fn thin_diagonal_soup(rng: &mut Rng, n: usize) -> Vec<[Vec3; 3]> {
+    let diagonal = Vec3::ONE.normalize();
+    let mut tris: Vec<[Vec3; 3]> = Vec::with_capacity(n);
+    while tris.len() < n {
+        let dir = if rng.chance(0.2) {
+            diagonal
+        } else {
+            rng.unit_vec()
+        };
+        let a = rng.vec_in(-1.0, 1.0);
+        let b = a + dir * rng.range(0.3, 2.5);
+        let across = dir.cross(rng.unit_vec()).normalize_or(Vec3::X);
+        let c = a.lerp(b, rng.f32()) + across * 10f32.powf(rng.range(-3.0, -1.0));
+        tris.push([a, b, c]);
+        if rng.chance(0.2) && tris.len() < n {
+            // A neighbour across the long edge.
+            tris.push([b, a, a.lerp(b, rng.f32()) - across * rng.range(0.001, 0.1)]);
+        }
+    }
+    tris
+}
+
+/// Checks `accel` against brute force over `tris` for every ray with [`check_ray`], panicking
+/// with `label` on a disagreement; returns the number of hits.
+pub fn check_rays(
+    accel: &dyn Accel,
+    tris: &[[Vec3; 3]],
+    rays: &[(Ray, f32)],
+    label: &str,
+) -> usize {
+    let oracle = BruteForce::new(tris);
+    let mut hits = 0;
+    for (i, (ray, t_max)) in rays.iter().enumerate() {
+        if let Err(e) = check_ray(accel, &oracle, ray, *t_max, tris) {
+            panic!("{label}: ray {i} {ray:?} t_max {t_max}: {e}");
+        }
+        hits += usize::from(accel.intersect(ray, *t_max).is_some());
+    }
+    hits
+}
+
+/// `n` rays from outside a closed `mesh` aimed exactly at its vertices, edge midpoints and
+/// random points on edges, from within 30 degrees of the mean normal there and crossing every
+/// triangle around the target at more than 5 degrees (see `watertight.rs`); each must hit at
+/// `t <= 1`, up to rounding.
+pub fn rays_at_edges_and_vertices(mesh: &Mesh, rng: &mut Rng, n: usize) -> Vec<Ray> {
+    let unit_normal: Vec<Vec3> = mesh
+        .triangles()
+        .iter()
+        .map(|t| rt_core::triangle::geometric_normal(t).normalize())
+        .collect();
+    let mut vertex_faces: Vec<Vec<usize>> = vec![Vec::new(); mesh.positions.len()];
+    let mut edge_faces: std::collections::BTreeMap<(u32, u32), Vec<usize>> = Default::default();
+    for (fi, f) in mesh.faces.iter().enumerate() {
+        for k in 0..3 {
+            vertex_faces[f[k] as usize].push(fi);
+            let (a, b) = (f[k], f[(k + 1) % 3]);
+            edge_faces.entry((a.min(b), a.max(b))).or_default().push(fi);
+        }
+    }
+    let edges: Vec<_> = edge_faces.into_iter().collect();
+    let radius = rt_core::Aabb::from_points(&mesh.positions).bounding_radius();
+    let min_sin = 5f32.to_radians().sin();
+    let mut out = Vec::with_capacity(n);
+    while out.len() < n {
+        let (point, faces) = match rng.below(3) {
+            0 => {
+                let v = rng.below(mesh.positions.len());
+                (mesh.positions[v], &vertex_faces[v])
+            }
+            k => {
+                let ((a, b), faces) = &edges[rng.below(edges.len())];
+                let (a, b) = (mesh.positions[*a as usize], mesh.positions[*b as usize]);
+                let s = if k == 1 { 0.5 } else { rng.f32() };
+                (a + (b - a) * s, faces)
+            }
+        };
+        let normal = faces
+            .iter()
+            .map(|&f| unit_normal[f])
+            .sum::<Vec3>()
+            .normalize();
+        let d = (normal + rng.unit_vec() * 0.5).normalize();
+        if faces.iter().all(|&f| unit_normal[f].dot(d) > min_sin) {
+            let origin = point + d * radius * rng.range(2.0, 6.0);
+            out.push(Ray::new(origin, point - origin));
+        }
+    }
+    out
+}
