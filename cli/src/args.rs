@@ -1,17 +1,42 @@
 //! Command-line arguments.
 
-use clap::{Parser, ValueEnum};
+use clap::{Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
+
+/// The acceleration structure used when neither `--accel` nor `[render] accel` names one. A
+/// macro so that the help text below can include it; use [`DEFAULT_ACCEL`] in code.
+macro_rules! default_accel {
+    () => {
+        "qbvh"
+    };
+}
+
+/// The acceleration structure used when neither `--accel` nor `[render] accel` names one.
+pub const DEFAULT_ACCEL: &str = default_accel!();
 
 /// Render a TOML scene (see docs/scene-format.md) to an EXR or PNG image.
 ///
 /// Settings come from the command line; any left out fall back to the scene's optional
-/// `[render]` table, then to the defaults shown here.
+/// `[render]` table, then to the defaults shown here. `render bench-accel` measures the
+/// acceleration structures instead (see `render bench-accel --help`).
 #[derive(Parser, Debug)]
-#[command(name = "render", version, about, long_about = None)]
+#[command(
+    name = "render",
+    version,
+    about,
+    long_about = None,
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
+)]
 pub struct Args {
-    /// Scene file (TOML).
-    pub scene: PathBuf,
+    /// Another task instead of rendering.
+    #[command(subcommand)]
+    pub command: Option<Command>,
+
+    /// Scene file (TOML), or gen:NAME for a procedural scene (worst-case, rotated, mixed,
+    /// million).
+    #[arg(required = true)]
+    pub scene: Option<PathBuf>,
 
     /// Output image; the extension picks the format: .exr (linear float, AOVs as extra
     /// channels) or .png (sRGB, exposure then clamp). [default: `[render] output`, else
@@ -29,10 +54,19 @@ pub struct Args {
     #[arg(long, value_enum)]
     pub integrator: Option<IntegratorKind>,
 
-    /// Acceleration structure: bvh (binned-SAH binary BVH) or brute-force (tests every
-    /// triangle; for checking only). [default: `[render] accel`, else bvh]
-    #[arg(long, value_enum)]
-    pub accel: Option<AccelKind>,
+    #[arg(
+        long,
+        value_name = "SPEC",
+        help = concat!(
+            "Acceleration structure and its options, KIND[:OPTION...]: bvh (binned-SAH binary ",
+            "BVH), qbvh (four-wide BVH) or brute-force (tests every triangle; for checking ",
+            "only), e.g. qbvh:evh=14:compact or qbvh:order=distance; the options are listed in ",
+            "crates/accel/src/spec.rs. [default: `[render] accel`, else ",
+            default_accel!(),
+            "]"
+        )
+    )]
+    pub accel: Option<String>,
 
     /// Maximum number of bounces (scattering events). Light arriving after the last bounce
     /// counts, whether found by a light-sampled connection from the last vertex or by a BSDF
@@ -87,13 +121,22 @@ pub enum IntegratorKind {
     Ao,
 }
 
-/// `--accel` values.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum AccelKind {
-    /// Binned-SAH binary BVH.
-    Bvh,
-    /// Every triangle for every ray.
-    BruteForce,
+/// Subcommands.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Measure acceleration structures: build time, memory, Mrays/s and traversal work for
+    /// primary, incoherent (diffuse bounce) and shadow rays, after checking their answers
+    /// against the binary BVH (docs/benchmarks.md, "Accel benchmark").
+    BenchAccel(crate::bench_accel::BenchArgs),
+    /// Write a procedural scene's triangles to a Wavefront OBJ file (one `o` per part), e.g.
+    /// to benchmark other ray tracers on the same geometry.
+    GenScene {
+        /// worst-case, rotated, mixed or million.
+        name: String,
+        /// Output file (.obj).
+        #[arg(short, long)]
+        output: PathBuf,
+    },
 }
 
 #[cfg(test)]
@@ -135,9 +178,28 @@ mod tests {
         .unwrap();
         assert_eq!(a.spp, Some(8));
         assert_eq!(a.integrator, Some(IntegratorKind::PathBsdf));
-        assert_eq!(a.accel, Some(AccelKind::BruteForce));
+        assert_eq!(a.accel.as_deref(), Some("brute-force"));
+        assert!(a.command.is_none());
         assert_eq!(a.aov.unwrap(), vec!["albedo", "normal"]);
         assert_eq!(a.exposure, -1.0);
         assert!(Args::try_parse_from(["render", "s.toml", "--integrator", "bdpt"]).is_err());
+    }
+
+    #[test]
+    fn subcommands_leave_rendering_alone() {
+        let a =
+            Args::try_parse_from(["render", "bench-accel", "gen:mixed", "--threads", "2"]).unwrap();
+        let Some(Command::BenchAccel(b)) = &a.command else {
+            panic!("{a:?}")
+        };
+        assert_eq!(b.input, "gen:mixed");
+        assert_eq!(b.threads, Some(2));
+        let a = Args::try_parse_from(["render", "gen-scene", "rotated", "-o", "r.obj"]).unwrap();
+        assert!(matches!(a.command, Some(Command::GenScene { .. })));
+        // The scene is still required without a subcommand.
+        assert!(Args::try_parse_from(["render", "--spp", "4"]).is_err());
+        let a = Args::try_parse_from(["render", "scene.toml", "-o", "out.exr"]).unwrap();
+        assert_eq!(a.scene, Some(PathBuf::from("scene.toml")));
+        assert!(a.command.is_none());
     }
 }

@@ -1,13 +1,14 @@
 //! Turning arguments and the scene's `[render]` table into a render, and running it.
 
-use crate::args::{AccelKind, Args, IntegratorKind};
+use crate::args::{Args, IntegratorKind, DEFAULT_ACCEL};
 use anyhow::{bail, Context, Result};
 use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rt_accel::AccelSpec;
 use rt_core::{Accel, Scene};
 use rt_film::{AovSet, Film, OutputOptions};
 use rt_integrators::{AoIntegrator, Ctx, Integrator, PathIntegrator, RenderOptions, RenderStats};
-use rt_scene::RenderDesc;
+use rt_scene::{LoadedScene, RenderDesc};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -23,7 +24,7 @@ pub struct Job {
     pub output: PathBuf,
     pub spp: u32,
     pub integrator: IntegratorKind,
-    pub accel: AccelKind,
+    pub accel: AccelSpec,
     pub max_depth: u32,
     pub threads: Option<usize>,
     pub seed: u32,
@@ -48,19 +49,46 @@ fn enum_from_table<T: ValueEnum>(scene: &Path, key: &str, value: &str) -> Result
     })
 }
 
+/// The scene path; clap requires it whenever there is no subcommand.
+fn scene_arg(args: &Args) -> &Path {
+    args.scene
+        .as_deref()
+        .expect("clap requires SCENE when no subcommand is given")
+}
+
+/// Loads a scene file, or generates the procedural scene `gen:NAME` (`rt_scene::procedural`).
+pub fn load_scene(path: &Path) -> Result<LoadedScene> {
+    if let Some(name) = path.to_str().and_then(|p| p.strip_prefix("gen:")) {
+        let scene = rt_scene::procedural::generate(name)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        return Ok(LoadedScene {
+            scene,
+            render: RenderDesc::default(),
+            warnings: Vec::new(),
+        });
+    }
+    rt_scene::load(path).map_err(|e| anyhow::anyhow!("{e}"))
+}
+
 impl Job {
     /// Command line first, then the scene's `[render]` table, then defaults.
     pub fn resolve(args: &Args, desc: &RenderDesc) -> Result<Job> {
-        let scene = &args.scene;
+        let scene = scene_arg(args);
         let integrator = match (args.integrator, &desc.integrator) {
             (Some(i), _) => i,
             (None, Some(s)) => enum_from_table(scene, "integrator", s)?,
             (None, None) => IntegratorKind::Path,
         };
-        let accel = match (args.accel, &desc.accel) {
-            (Some(a), _) => a,
-            (None, Some(s)) => enum_from_table(scene, "accel", s)?,
-            (None, None) => AccelKind::Bvh,
+        let accel = match (&args.accel, &desc.accel) {
+            (Some(a), _) => a
+                .parse::<AccelSpec>()
+                .map_err(|e| anyhow::anyhow!("--accel {a}: {e}"))?,
+            (None, Some(s)) => s.parse::<AccelSpec>().map_err(|e| {
+                anyhow::anyhow!("{}: [render] accel = \"{s}\": {e}", scene.display())
+            })?,
+            (None, None) => DEFAULT_ACCEL
+                .parse()
+                .expect("the default accel spec parses"),
         };
         // Names where a value came from, so that a bad `[render]` default points at the file.
         let origin = |flag: &str, key: &str, from_cli: bool| {
@@ -129,7 +157,7 @@ impl Job {
             bail!("--ao-distance must be positive, got {ao_distance}");
         }
         Ok(Job {
-            scene_path: scene.clone(),
+            scene_path: scene.to_path_buf(),
             output,
             spp,
             integrator,
@@ -147,15 +175,9 @@ impl Job {
     }
 }
 
-/// Builds the chosen acceleration structure (the one place that dispatches on it).
-pub fn build_accel(kind: AccelKind, scene: &Scene) -> Box<dyn Accel> {
-    match kind {
-        AccelKind::Bvh => Box::new(rt_accel::Bvh2::build(
-            &scene.triangles,
-            &rt_accel::BuildParams::default(),
-        )),
-        AccelKind::BruteForce => Box::new(rt_accel::BruteForce::new(&scene.triangles)),
-    }
+/// Builds the chosen acceleration structure.
+pub fn build_accel(spec: &AccelSpec, scene: &Scene) -> Box<dyn Accel> {
+    spec.build(&scene.triangles)
 }
 
 /// Builds the chosen integrator.
@@ -173,7 +195,7 @@ pub fn build_integrator(job: &Job) -> Box<dyn Integrator> {
 /// Loads, renders and writes; prints the summary line.
 pub fn run(args: &Args) -> Result<()> {
     let t_load = Instant::now();
-    let loaded = rt_scene::load(&args.scene).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let loaded = load_scene(scene_arg(args))?;
     let load_secs = t_load.elapsed().as_secs_f64();
     for w in &loaded.warnings {
         if !args.quiet {
@@ -208,7 +230,7 @@ pub fn run(args: &Args) -> Result<()> {
     let pool = pool.build().context("cannot start worker threads")?;
 
     let t_build = Instant::now();
-    let accel = pool.install(|| build_accel(job.accel, &scene));
+    let accel = pool.install(|| build_accel(&job.accel, &scene));
     let build_secs = t_build.elapsed().as_secs_f64();
     let integrator = build_integrator(&job);
     let mut film = Film::new(camera.width, camera.height, job.aovs);
@@ -291,7 +313,7 @@ fn print_summary(
         camera.height,
         job.spp,
         integrator.name(),
-        accel.name(),
+        job.accel,
         scene.triangle_count(),
         threads,
         stats.elapsed.as_secs_f64(),

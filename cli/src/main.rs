@@ -2,9 +2,11 @@
 //! (`rt-scene`), builds the acceleration structure (`rt-accel`), runs the integrator over the
 //! film (`rt-integrators`, `rt-film`) and writes the image. All error reporting to the user
 //! happens here: libraries return typed errors, this turns them into one line on stderr and a
-//! non-zero exit code (2 for usage errors, 1 for everything else).
+//! non-zero exit code (2 for usage errors, 1 for everything else). `render bench-accel` (in
+//! `bench_accel/`) measures the acceleration structures instead of rendering.
 
 mod args;
+mod bench_accel;
 mod job;
 
 use clap::Parser;
@@ -20,7 +22,14 @@ fn main() -> ExitCode {
             return ExitCode::from(code);
         }
     };
-    match job::run(&args) {
+    let result = match &args.command {
+        Some(args::Command::BenchAccel(bench)) => bench_accel::run(bench),
+        Some(args::Command::GenScene { name, output }) => {
+            bench_accel::input::write_obj(name, output)
+        }
+        None => job::run(&args),
+    };
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");

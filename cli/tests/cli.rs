@@ -322,3 +322,342 @@ fn unwritable_output_leaves_nothing() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("missing-dir/out.exr"));
     assert!(!Path::new(&r.path("missing-dir")).exists());
 }
+
+#[test]
+fn accel_specs_from_the_command_line_and_the_render_table() {
+    let r = Run::new();
+    r.write("scene.toml", GOOD);
+    for spec in ["qbvh", "qbvh:evh=14:compact", "bvh:leaf=8", "brute-force"] {
+        let out = r.render(&["scene.toml", "-o", "q.exr", "--spp", "1", "--accel", spec]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "--accel {spec}: {err}");
+        let summary = String::from_utf8_lossy(&out.stdout);
+        assert!(summary.contains(spec), "{summary}");
+    }
+    let table = format!("{GOOD}\n[render]\naccel = \"qbvh:order=distance\"\n");
+    r.write("table.toml", &table);
+    let out = r.render(&["table.toml", "-o", "t.exr", "--spp", "1"]);
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("qbvh:order=distance"));
+    // The command line wins over the table.
+    let out = r.render(&["table.toml", "-o", "t.exr", "--spp", "1", "--accel", "bvh"]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains(" bvh ("));
+
+    expect_error(
+        GOOD,
+        &["--accel", "qbvh:bogus"],
+        &["--accel", "qbvh:bogus", "bogus"],
+    );
+    expect_error(GOOD, &["--accel", "kd"], &["--accel", "kd"]);
+    expect_error(
+        &format!("{GOOD}\n[render]\naccel = \"kd\"\n"),
+        &[],
+        &["scene.toml", "accel", "\"kd\""],
+    );
+    expect_error(
+        &format!("{GOOD}\n[render]\naccel = \"qbvh:leaf=99\"\n"),
+        &[],
+        &["scene.toml", "leaf=99"],
+    );
+}
+
+#[test]
+fn procedural_scene_names() {
+    let r = Run::new();
+    let out = r.render(&["gen:nope", "-o", "x.exr", "-q"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("gen:nope") && err.contains("worst-case"),
+        "{err}"
+    );
+    // gen-scene writes the triangles as OBJ, which bench-accel (and anything else) can read.
+    let out = r.render(&["gen-scene", "worst-case", "-o", "wc.obj"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let obj = std::fs::read_to_string(r.path("wc.obj")).unwrap();
+    assert_eq!(obj.lines().filter(|l| l.starts_with("f ")).count(), 4_100);
+    assert_eq!(
+        obj.lines().filter(|l| l.starts_with("v ")).count(),
+        3 * 4_100
+    );
+}
+
+/// Runs `render bench-accel ARGS -q` and expects exit code 1 and one error line containing all
+/// of `needles`.
+fn expect_bench_error(r: &Run, args: &[&str], needles: &[&str]) {
+    let mut all = vec!["bench-accel", "-q", "--width", "8", "--repeat", "1"];
+    all.extend_from_slice(args);
+    let out = r.render(&all);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(
+        err.lines().count(),
+        1,
+        "{args:?}: expected one line, got: {err}"
+    );
+    assert!(out.stdout.is_empty(), "{args:?}: no table after an error");
+    for n in needles {
+        assert!(
+            err.contains(n),
+            "{args:?}: error should mention {n:?}: {err}"
+        );
+    }
+}
+
+#[test]
+fn bench_accel_bad_input() {
+    let r = Run::new();
+    r.write("scene.toml", GOOD);
+    r.write("empty.obj", "# nothing\nv 0 0 0\nv 1 0 0\n");
+    r.write("mesh.stl", "solid x\n");
+    r.write("odd.bin", &"x".repeat(25));
+    r.write("empty.bin", "");
+    expect_bench_error(&r, &["nope.obj"], &["nope.obj"]);
+    expect_bench_error(&r, &["nope.toml"], &["nope.toml"]);
+    expect_bench_error(&r, &["mesh.stl"], &["mesh.stl", "unknown input"]);
+    expect_bench_error(&r, &["empty.obj"], &["empty.obj"]);
+    expect_bench_error(&r, &["gen:teapot"], &["gen:teapot", "million"]);
+    expect_bench_error(
+        &r,
+        &["scene.toml", "--accel", "bvh,qbvh:bogus"],
+        &["qbvh:bogus"],
+    );
+    expect_bench_error(&r, &["scene.toml", "--accel", "kd"], &["--accel", "kd"]);
+    expect_bench_error(
+        &r,
+        &["scene.toml", "--rays", "primary,diffuse"],
+        &["--rays", "diffuse"],
+    );
+    expect_bench_error(&r, &["scene.toml", "--rays", "file"], &["--ray-file"]);
+    expect_bench_error(
+        &r,
+        &["scene.toml", "--ray-file", "odd.bin"],
+        &["odd.bin", "multiple of 24"],
+    );
+    expect_bench_error(
+        &r,
+        &["scene.toml", "--ray-file", "empty.bin"],
+        &["empty.bin", "empty"],
+    );
+    expect_bench_error(&r, &["scene.toml", "--ray-file", "none.bin"], &["none.bin"]);
+    expect_bench_error(&r, &["scene.toml", "--threads", "0"], &["thread"]);
+    expect_bench_error(
+        &r,
+        &["scene.toml", "--camera", "side"],
+        &["scene.toml", "side"],
+    );
+    expect_bench_error(
+        &r,
+        &["scene.toml", "--height", "0"],
+        &["--width/--height", "0"],
+    );
+    expect_bench_error(
+        &r,
+        &["scene.toml", "--view", "inside"],
+        &["--view", "scene.toml"],
+    );
+}
+
+fn csv_rows(path: &Path) -> Vec<Vec<String>> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    assert!(
+        header.starts_with(
+            "accel,rays,threads,build_ms,bytes,mrays_per_s,hits,boxes_per_ray,leaves_per_ray,tris_per_ray"
+        ),
+        "{header}"
+    );
+    let names: Vec<&str> = header.split(',').collect();
+    lines
+        .map(|l| {
+            let row: Vec<String> = l.split(',').map(str::to_string).collect();
+            assert_eq!(row.len(), names.len(), "{l}");
+            row
+        })
+        .collect()
+}
+
+#[test]
+fn bench_accel_on_a_procedural_scene_writes_the_csv() {
+    let r = Run::new();
+    let out = r.render(&[
+        "bench-accel",
+        "gen:worst-case",
+        "--accel",
+        "bvh,qbvh,brute-force",
+        "--width",
+        "24",
+        "--height",
+        "16",
+        "--threads",
+        "2",
+        "--repeat",
+        "1",
+        "--csv",
+        "out.csv",
+        "--dump-rays",
+        "rays",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("0 mismatches"), "{err}");
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        table.contains("Mrays/s") && table.contains("brute-force"),
+        "{table}"
+    );
+    let rows = csv_rows(&r.path("out.csv"));
+    // One row per (accel, rays, threads).
+    let mut keys: Vec<(String, String, String)> = rows
+        .iter()
+        .map(|r| (r[0].clone(), r[1].clone(), r[2].clone()))
+        .collect();
+    assert_eq!(keys.len(), 3 * 3 * 2);
+    keys.sort();
+    keys.dedup();
+    assert_eq!(keys.len(), 3 * 3 * 2);
+    for row in &rows {
+        assert!(["bvh", "qbvh", "brute-force"].contains(&row[0].as_str()));
+        assert!(["primary", "incoherent", "shadow"].contains(&row[1].as_str()));
+        assert!(["1", "2"].contains(&row[2].as_str()));
+        assert!(row[5].parse::<f64>().unwrap() > 0.0, "{row:?}");
+        assert_eq!(row[15], "0", "check mismatches: {row:?}");
+        assert_eq!(row[10], "gen:worst-case");
+        assert_eq!(row[11], "4100");
+    }
+    // Every structure finds the same number of hits on the same rays.
+    let hits = |accel: &str, rays: &str| -> String {
+        rows.iter().find(|r| r[0] == accel && r[1] == rays).unwrap()[6].clone()
+    };
+    for rays in ["primary", "incoherent", "shadow"] {
+        assert_eq!(hits("qbvh", rays), hits("bvh", rays));
+        assert_eq!(hits("brute-force", rays), hits("bvh", rays));
+    }
+    let primary: usize = rows.iter().find(|r| r[1] == "primary").unwrap()[13]
+        .parse()
+        .unwrap();
+    assert_eq!(primary, 24 * 16);
+
+    // The dumped rays, read back, give the same answers.
+    for (file, rays, extra) in [
+        ("rays/primary.bin", "primary", None),
+        ("rays/shadow.bin", "shadow", Some("--ray-file-occlusion")),
+    ] {
+        let mut args = vec![
+            "bench-accel",
+            "gen:worst-case",
+            "-q",
+            "--threads",
+            "1",
+            "--repeat",
+            "1",
+            "--ray-file",
+            file,
+            "--csv",
+            "file.csv",
+        ];
+        args.extend(extra);
+        let out = r.render(&args);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let file_rows = csv_rows(&r.path("file.csv"));
+        assert_eq!(file_rows.len(), 2, "bvh and qbvh, one thread, one set");
+        for row in &file_rows {
+            assert_eq!(row[1], "file");
+            assert_eq!(row[6], hits(&row[0], rays), "{file} {row:?}");
+        }
+    }
+}
+
+#[test]
+fn bench_accel_on_a_mesh_and_a_scene() {
+    let r = Run::new();
+    // A closed octahedron.
+    r.write(
+        "octa.obj",
+        "v 1 0 0\nv -1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nv 0 0 -1\n\
+         f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n",
+    );
+    let out = r.render(&[
+        "bench-accel",
+        "octa.obj",
+        "--width",
+        "16",
+        "--threads",
+        "1",
+        "--repeat",
+        "1",
+        "--csv",
+        "o.csv",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("point light"), "{err}");
+    let rows = csv_rows(&r.path("o.csv"));
+    assert_eq!(
+        rows.len(),
+        2 * 3,
+        "two structures, three sets, one thread count"
+    );
+    // The automatic camera sees the mesh.
+    let primary = rows.iter().find(|r| r[1] == "primary").unwrap();
+    assert!(primary[6].parse::<u32>().unwrap() > 16, "{primary:?}");
+
+    // Standing inside the closed octahedron, every primary ray hits.
+    let out = r.render(&[
+        "bench-accel",
+        "octa.obj",
+        "--view",
+        "inside",
+        "--width",
+        "16",
+        "--threads",
+        "1",
+        "--repeat",
+        "1",
+        "--rays",
+        "primary",
+        "--csv",
+        "inside.csv",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows = csv_rows(&r.path("inside.csv"));
+    assert_eq!(rows.len(), 2);
+    for row in &rows {
+        assert_eq!(row[6], row[13], "hits = rays: {row:?}");
+    }
+
+    r.write("scene.toml", GOOD);
+    let out = r.render(&[
+        "bench-accel",
+        "scene.toml",
+        "--rays",
+        "shadow",
+        "--threads",
+        "1",
+        "--repeat",
+        "1",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("2 emissive triangles"), "{err}");
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        table.contains("shadow") && !table.contains("primary"),
+        "{table}"
+    );
+}

@@ -60,6 +60,7 @@ mod image_io;
 mod load;
 mod material;
 mod obj;
+pub mod procedural;
 pub mod raw;
 mod shapes;
 

@@ -1,0 +1,247 @@
+//! The benchmark's geometry: a TOML scene, a bare mesh file, or a procedural scene.
+
+use anyhow::{bail, Context, Result};
+use rt_core::{glam::Vec3, Aabb, Accel, Camera, Ray, Scene};
+use std::io::Write;
+use std::path::Path;
+
+/// A loaded scene with the camera for the primary rays.
+pub struct Input {
+    /// The input as the user wrote it (for messages and the CSV).
+    pub name: String,
+    /// The scene.
+    pub scene: Scene,
+    /// The chosen camera.
+    pub camera: Camera,
+    /// Where shadow rays aim when the scene has no emissive triangles: above the geometry.
+    pub fallback_light: Vec3,
+    /// The loader's remarks.
+    pub warnings: Vec<String>,
+    /// True for a bare mesh (the camera is automatic).
+    pub is_mesh: bool,
+    /// Bounds of all triangles.
+    pub bounds: Aabb,
+}
+
+/// Where the automatic camera of a mesh stands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum View {
+    /// Outside the bounds, seeing every vertex (scanned objects: bunny, dragon).
+    Outside,
+    /// Inside, looking down the long horizontal axis (rooms: conference, Sibenik, kitchen).
+    Inside,
+}
+
+/// Mesh extensions the scene crate reads.
+const MESH_EXTENSIONS: [&str; 4] = ["obj", "gltf", "glb", "ra2"];
+/// Longest side of the primary ray grid by default.
+const DEFAULT_WIDTH: u32 = 512;
+/// Largest primary ray grid (the scene format's limits).
+const MAX_SIDE: u32 = 16_384;
+const MAX_PIXELS: u64 = 1 << 26;
+
+/// Loads `input`: `gen:NAME`, a `.toml` scene, or a mesh file.
+pub fn load(input: &str, camera: Option<&str>) -> Result<Input> {
+    let path = Path::new(input);
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
+    let (loaded, is_mesh) = if input.starts_with("gen:") || ext == "toml" {
+        (crate::job::load_scene(path)?, false)
+    } else if MESH_EXTENSIONS.contains(&ext.as_str()) {
+        (load_mesh(path)?, true)
+    } else {
+        bail!(
+            "{input}: unknown input type (expected a .toml scene, a .obj, .gltf, .glb or .ra2 \
+             mesh, or gen:NAME with NAME one of {})",
+            rt_scene::procedural::NAMES.join(", ")
+        );
+    };
+    let scene = loaded.scene;
+    let bounds = Aabb::from_points(scene.triangles.iter().flatten());
+    if scene.triangles.is_empty() || bounds.is_empty() {
+        bail!("{input}: the scene has no triangles");
+    }
+    let radius = 0.5 * bounds.extent().length();
+    let camera = if is_mesh {
+        if let Some(name) = camera {
+            bail!("--camera {name}: a mesh file has no cameras (an automatic one is used)");
+        }
+        auto_camera(&scene.triangles, &bounds)
+    } else {
+        match camera {
+            Some(name) => scene
+                .cameras
+                .iter()
+                .find(|c| c.name == name)
+                .cloned()
+                .with_context(|| {
+                    let names: Vec<&str> = scene.cameras.iter().map(|c| c.name.as_str()).collect();
+                    format!(
+                        "{input}: no camera named \"{name}\" (cameras: {})",
+                        names.join(", ")
+                    )
+                })?,
+            None => scene
+                .cameras
+                .first()
+                .cloned()
+                .with_context(|| format!("{input}: the scene has no camera"))?,
+        }
+    };
+    Ok(Input {
+        name: input.to_string(),
+        fallback_light: bounds.center() + Vec3::Y * (2.0 * radius),
+        scene,
+        camera,
+        warnings: loaded.warnings,
+        is_mesh,
+        bounds,
+    })
+}
+
+/// Reads a mesh through the scene loader: a generated TOML scene that references the mesh's
+/// absolute path with one grey material (the mesh's own materials do not matter here).
+fn load_mesh(path: &Path) -> Result<rt_scene::LoadedScene> {
+    std::fs::metadata(path).map_err(|e| anyhow::anyhow!("{}: cannot open: {e}", path.display()))?;
+    let abs = std::fs::canonicalize(path)
+        .map_err(|e| anyhow::anyhow!("{}: cannot open: {e}", path.display()))?;
+    let Some(abs_text) = abs.to_str() else {
+        bail!("{}: the path is not valid UTF-8", path.display());
+    };
+    let quoted = abs_text.replace('\\', "\\\\").replace('"', "\\\"");
+    let toml = format!(
+        "[environment]\ncolor = [1, 1, 1]\n\n\
+         [[camera]]\nname = \"auto\"\nposition = [0, 0, 1]\nlook_at = [0, 0, 0]\n\n\
+         [[material]]\nname = \"grey\"\n\n\
+         [[geometry]]\nname = \"mesh\"\nfile = \"{quoted}\"\nmaterial = \"grey\"\n"
+    );
+    let base = abs.parent().unwrap_or(Path::new("/"));
+    rt_scene::load_str(&toml, base, path).map_err(|e| anyhow::anyhow!("{e}"))
+}
+
+/// A camera looking at the centre of the triangles' bounding box from the fixed diagonal
+/// (1, 0.7, 1.3), just far enough for every vertex to be in its 40° field of view.
+fn auto_camera(triangles: &[[Vec3; 3]], bounds: &Aabb) -> Camera {
+    let centre = bounds.center();
+    let fov = 40.0f32;
+    let tan_half = (0.5 * fov).to_radians().tan();
+    let back = Vec3::new(1.0, 0.7, 1.3).normalize();
+    let right = (-back).cross(Vec3::Y).normalize();
+    let up = right.cross(-back);
+    let dist = triangles
+        .iter()
+        .flatten()
+        .map(|&p| {
+            let v = p - centre;
+            let lateral = v.dot(right).abs().max(v.dot(up).abs());
+            v.dot(back) + lateral / tan_half
+        })
+        .fold(f32::MIN_POSITIVE, f32::max)
+        * 1.05;
+    Camera::look_at(
+        "auto",
+        centre + back * dist,
+        centre,
+        Vec3::Y,
+        fov,
+        DEFAULT_WIDTH,
+        DEFAULT_WIDTH,
+        0.0,
+        dist,
+    )
+}
+
+/// The automatic camera and light of a room: from the middle of the bounds at 60 % of the
+/// height, backed off along the long horizontal axis by 70 % of the free distance behind
+/// (measured with `reference`), looking down that axis and a little down, 60° field of view;
+/// the light under the middle of the ceiling (90 % of the height).
+pub fn inside_view(bounds: &Aabb, reference: &dyn Accel) -> (Camera, Vec3) {
+    let (lo, centre, ext) = (bounds.min, bounds.center(), bounds.extent());
+    let axis = if ext.x >= ext.z { Vec3::X } else { Vec3::Z };
+    let mid = Vec3::new(centre.x, lo.y + 0.6 * ext.y, centre.z);
+    let behind = reference
+        .intersect(&Ray::new(mid, -axis), f32::INFINITY)
+        .map_or(0.5 * ext.dot(axis), |h| h.t);
+    let eye = mid - axis * (0.7 * behind);
+    let target = Vec3::new(centre.x, lo.y + 0.3 * ext.y, centre.z) + axis * (0.5 * behind);
+    let camera = Camera::look_at(
+        "inside",
+        eye,
+        target,
+        Vec3::Y,
+        60.0,
+        DEFAULT_WIDTH,
+        DEFAULT_WIDTH,
+        0.0,
+        (target - eye).length(),
+    );
+    (camera, Vec3::new(centre.x, lo.y + 0.9 * ext.y, centre.z))
+}
+
+/// The primary ray grid: as given, or derived from the camera's aspect ratio.
+pub fn resolution(camera: &Camera, width: Option<u32>, height: Option<u32>) -> Result<(u32, u32)> {
+    let aspect = camera.height as f64 / camera.width as f64;
+    let from = |v: u32, a: f64| ((v as f64 * a).round() as u32).max(1);
+    let (w, h) = match (width, height) {
+        (Some(w), Some(h)) => (w, h),
+        (Some(w), None) => (w, from(w, aspect)),
+        (None, Some(h)) => (from(h, 1.0 / aspect), h),
+        (None, None) => (DEFAULT_WIDTH, from(DEFAULT_WIDTH, aspect)),
+    };
+    if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE || w as u64 * h as u64 > MAX_PIXELS {
+        bail!(
+            "--width/--height: {w}x{h} primary rays: each side must be in [1, {MAX_SIDE}] and \
+             width*height at most {MAX_PIXELS}"
+        );
+    }
+    Ok((w, h))
+}
+
+/// `camera` with another image size (the field of view stays vertical).
+pub fn with_resolution(camera: &Camera, width: u32, height: u32) -> Camera {
+    Camera::look_at(
+        camera.name.clone(),
+        camera.position,
+        camera.position + camera.forward,
+        camera.up,
+        camera.fov_y_deg,
+        width,
+        height,
+        camera.aperture,
+        camera.focus_distance,
+    )
+}
+
+/// `render gen-scene NAME -o FILE.obj`: the procedural scene's triangles as OBJ, one `o` per
+/// part, vertices not shared, coordinates printed exactly (shortest round-trip decimal).
+pub fn write_obj(name: &str, output: &Path) -> Result<()> {
+    let scene =
+        rt_scene::procedural::generate(name).map_err(|e| anyhow::anyhow!("gen:{name}: {e}"))?;
+    let fail = |e: std::io::Error| anyhow::anyhow!("{}: cannot write: {e}", output.display());
+    let file = std::fs::File::create(output).map_err(fail)?;
+    let mut w = std::io::BufWriter::new(file);
+    writeln!(
+        w,
+        "# rt procedural scene gen:{name}, {} triangles",
+        scene.triangle_count()
+    )
+    .map_err(fail)?;
+    for object in &scene.objects {
+        writeln!(w, "o {}", object.name).map_err(fail)?;
+        let range = object.first as usize..(object.first + object.count) as usize;
+        for t in &scene.triangles[range.clone()] {
+            for v in t {
+                writeln!(w, "v {} {} {}", v.x, v.y, v.z).map_err(fail)?;
+            }
+        }
+        for i in range {
+            let k = 3 * i + 1;
+            writeln!(w, "f {} {} {}", k, k + 1, k + 2).map_err(fail)?;
+        }
+    }
+    w.flush().map_err(fail)?;
+    Ok(())
+}
