@@ -1,0 +1,479 @@
+//! Side-by-side benchmark of our acceleration structures (rt-accel, through `AccelSpec` and the
+//! `Accel` trait) and other Rust BVH crates (obvhs, bvh) on the same ray files. See README.md.
+
+mod bvh_peer;
+mod mesh;
+mod obvhs_peer;
+mod ours;
+mod peer;
+mod rays;
+
+use anyhow::{Context, Result};
+use clap::Parser;
+use peer::{Peer, Work};
+use rayon::prelude::*;
+use rt_core::Ray;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Benchmark rt-accel's structures against obvhs and the bvh crate on identical rays.
+#[derive(Parser, Debug)]
+#[command(name = "accel-peers")]
+struct Args {
+    /// Wavefront OBJ mesh (triangles in the order our loader reads them).
+    mesh: PathBuf,
+    /// Directory of primary.bin, incoherent.bin, shadow.bin (written there with --gen-rays).
+    #[arg(long)]
+    rays: PathBuf,
+    /// Our structures: AccelSpec strings (`qbvh`, `bvh`, `qbvh:order=distance`, ...).
+    #[arg(long, value_delimiter = ',', default_value = "qbvh,bvh")]
+    accel: Vec<String>,
+    /// Peer structures: obvhs-bvh2, obvhs-cwbvh (optionally `:fastest|fast|medium|slow`
+    /// build preset, default medium), bvh-crate, bvh-crate-flat. `none` for none.
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "obvhs-bvh2,obvhs-cwbvh,bvh-crate,bvh-crate-flat"
+    )]
+    peers: Vec<String>,
+    /// Threads of the multi-threaded runs (default: all cores). Builds and traces run once
+    /// with 1 thread and once with N.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Write the results as CSV here.
+    #[arg(long)]
+    csv: Option<PathBuf>,
+    /// Check every structure's answers against ours (`bvh`) on this many rays of each set.
+    #[arg(long, default_value_t = 10_000)]
+    check: usize,
+    /// Timed runs per measurement; the best is reported.
+    #[arg(long, default_value_t = 3)]
+    runs: usize,
+    /// Write our `bvh`'s answers for every ray to this directory: NAME.t.f32 (closest t,
+    /// +inf on a miss), NAME.prim.u32 (u32::MAX on a miss) and shadow.occluded.u8.
+    #[arg(long)]
+    dump_hits: Option<PathBuf>,
+    /// Generate the ray files into --rays instead of benchmarking (fallback until
+    /// `render bench-accel --dump-rays` exists).
+    #[arg(long)]
+    gen_rays: bool,
+    /// --gen-rays: image width.
+    #[arg(long, default_value_t = 512)]
+    width: u32,
+    /// --gen-rays: image height.
+    #[arg(long, default_value_t = 384)]
+    height: u32,
+    /// --gen-rays: camera placement.
+    #[arg(long, value_enum, default_value = "outside")]
+    view: rays::View,
+    /// --gen-rays: camera position `x,y,z` instead of the view's (needs --look-at).
+    #[arg(long, value_delimiter = ',', requires = "look_at")]
+    eye: Option<Vec<f32>>,
+    /// --gen-rays: camera target `x,y,z` (with --eye).
+    #[arg(long, value_delimiter = ',', requires = "eye")]
+    look_at: Option<Vec<f32>>,
+    /// --gen-rays: incoherent and shadow rays per primary hit.
+    #[arg(long, default_value_t = 2)]
+    per_hit: u32,
+    /// --gen-rays: random seed.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
+
+/// One ray set read from the ray directory.
+struct RaySet {
+    name: &'static str,
+    shadow: bool,
+    rays: Vec<Ray>,
+}
+
+/// One output row.
+struct Row {
+    accel: String,
+    rays: &'static str,
+    threads: usize,
+    build_ms: f64,
+    /// CPU time of the build (1-thread rows).
+    build_cpu_ms: Option<f64>,
+    bytes: Option<usize>,
+    mrays_per_s: f64,
+    /// Rays per CPU-second of the tracing thread (1-thread rows).
+    mrays_per_cpu_s: Option<f64>,
+    hits: usize,
+    work: [Option<f64>; 3],
+}
+
+/// What a query answered, for the correctness check.
+#[derive(Clone, Copy, PartialEq)]
+enum Answer {
+    Closest(Option<(f32, u32)>),
+    Occluded(bool),
+}
+
+fn answer(p: &dyn Peer, ray: &Ray, shadow: bool) -> Answer {
+    let t_max = rays::t_max(shadow);
+    if shadow {
+        Answer::Occluded(p.occluded(ray, t_max))
+    } else {
+        Answer::Closest(p.closest(ray, t_max))
+    }
+}
+
+fn main() -> Result<()> {
+    let args = Args::parse();
+    let threads = args
+        .threads
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let t0 = Instant::now();
+    let tris = mesh::load_obj(&args.mesh)?;
+    eprintln!(
+        "{}: {} triangles, loaded in {:.2} s",
+        args.mesh.display(),
+        tris.len(),
+        t0.elapsed().as_secs_f64()
+    );
+    if args.gen_rays {
+        return generate(&args, &tris);
+    }
+    let sets = read_sets(&args.rays)?;
+    let pool = |n| rayon::ThreadPoolBuilder::new().num_threads(n).build();
+    let pools = if threads > 1 {
+        vec![(1, pool(1)?), (threads, pool(threads)?)]
+    } else {
+        vec![(1, pool(1)?)]
+    };
+    let all = pools.last().map(|p| &p.1).context("no thread pool")?;
+
+    // Reference answers from our binary BVH.
+    let reference = all.install(|| peer::build("bvh", &tris))?;
+    let expected: Vec<Vec<Answer>> = all.install(|| {
+        sets.iter()
+            .map(|s| {
+                let n = args.check.min(s.rays.len());
+                s.rays[..n]
+                    .par_iter()
+                    .map(|r| answer(&*reference, r, s.shadow))
+                    .collect()
+            })
+            .collect()
+    });
+    if let Some(dir) = &args.dump_hits {
+        all.install(|| dump_hits(dir, &*reference, &sets))?;
+    }
+    drop(reference);
+
+    let mut rows = Vec::new();
+    let mut checks = String::new();
+    let names = args
+        .accel
+        .iter()
+        .chain(args.peers.iter().filter(|p| *p != "none"));
+    for name in names {
+        // Checked and counted once, on the first (1-thread) build.
+        let mut work: Option<Vec<[Option<f64>; 3]>> = None;
+        for (n, pool) in &pools {
+            let (start, cpu) = (Instant::now(), pool.install(thread_cpu_seconds));
+            let p = pool.install(|| peer::build(name, &tris))?;
+            let build_ms = start.elapsed().as_secs_f64() * 1e3;
+            // On one thread the whole build ran on the pool's one worker.
+            let build_cpu_ms = (*n == 1).then(|| (pool.install(thread_cpu_seconds) - cpu) * 1e3);
+            eprintln!("{name}: built in {build_ms:.1} ms on {n} thread(s)");
+            let work = work.get_or_insert_with(|| {
+                for (s, exp) in sets.iter().zip(&expected) {
+                    let _ = writeln!(checks, "{}", check(&*p, s, exp));
+                }
+                all.install(|| sets.iter().map(|s| mean_work(&*p, s)).collect())
+            });
+            for (s, w) in sets.iter().zip(work.iter()) {
+                let runs: Vec<Timing> = (0..args.runs.max(1))
+                    .map(|_| pool.install(|| trace(&*p, s, *n)))
+                    .collect();
+                let wall = runs.iter().map(|r| r.wall).fold(f64::INFINITY, f64::min);
+                let cpu = runs.iter().filter_map(|r| r.cpu).reduce(f64::min);
+                let mrays = |secs: f64| s.rays.len() as f64 / secs / 1e6;
+                rows.push(Row {
+                    accel: name.clone(),
+                    rays: s.name,
+                    threads: *n,
+                    build_ms,
+                    build_cpu_ms,
+                    bytes: p.bytes(),
+                    mrays_per_s: mrays(wall),
+                    mrays_per_cpu_s: cpu.map(mrays),
+                    hits: runs[0].hits,
+                    work: *w,
+                });
+            }
+        }
+    }
+
+    print!("{}", table(&args, &tris, &sets, &rows));
+    println!(
+        "\nCheck against ours (bvh), first {} rays of each set:",
+        args.check
+    );
+    print!("{checks}");
+    if let Some(path) = &args.csv {
+        std::fs::write(path, csv(&rows))
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+fn generate(args: &Args, tris: &[[rt_core::glam::Vec3; 3]]) -> Result<()> {
+    for v in [&args.eye, &args.look_at].into_iter().flatten() {
+        anyhow::ensure!(v.len() == 3, "--eye and --look-at take x,y,z");
+    }
+    let opts = rays::GenOptions {
+        width: args.width,
+        height: args.height,
+        view: args.view,
+        per_hit: args.per_hit,
+        eye: args.eye.as_ref().zip(args.look_at.as_ref()).map(|(e, t)| {
+            let v = |a: &[f32]| rt_core::glam::Vec3::new(a[0], a[1], a[2]);
+            (v(e), v(t))
+        }),
+        seed: args.seed,
+    };
+    let generated = rays::generate(tris, &opts)?;
+    std::fs::create_dir_all(&args.rays)?;
+    for ((name, _), set) in rays::SETS.iter().zip(&generated) {
+        let path = args.rays.join(format!("{name}.bin"));
+        rays::write(&path, set)?;
+        eprintln!("wrote {} ({} rays)", path.display(), set.len());
+    }
+    Ok(())
+}
+
+fn read_sets(dir: &Path) -> Result<Vec<RaySet>> {
+    let mut sets = Vec::new();
+    for (name, shadow) in rays::SETS {
+        let path = dir.join(format!("{name}.bin"));
+        if path.exists() {
+            sets.push(RaySet {
+                name,
+                shadow,
+                rays: rays::read(&path)?,
+            });
+        } else {
+            eprintln!("note: {} is missing, skipping that set", path.display());
+        }
+    }
+    anyhow::ensure!(!sets.is_empty(), "no ray files in {}", dir.display());
+    Ok(sets)
+}
+
+/// CPU time of the calling thread in seconds: on a shared machine it excludes the time the
+/// thread waited for a core, which wall time does not.
+fn thread_cpu_seconds() -> f64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec; CLOCK_THREAD_CPUTIME_ID is always supported
+    // on Linux.
+    unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}
+
+/// One timed pass over a set.
+struct Timing {
+    /// Wall-clock seconds.
+    wall: f64,
+    /// CPU seconds of the tracing thread (1-thread runs only).
+    cpu: Option<f64>,
+    /// Closest hits, or occluded rays.
+    hits: usize,
+}
+
+/// Traces a whole set on the current pool.
+fn trace(p: &dyn Peer, s: &RaySet, threads: usize) -> Timing {
+    let t_max = rays::t_max(s.shadow);
+    let one = |r: &Ray| -> usize {
+        if s.shadow {
+            p.occluded(r, t_max) as usize
+        } else {
+            p.closest(r, t_max).is_some() as usize
+        }
+    };
+    if threads == 1 {
+        let (start, cpu) = (Instant::now(), thread_cpu_seconds());
+        let hits = s.rays.iter().map(one).sum();
+        Timing {
+            wall: start.elapsed().as_secs_f64(),
+            cpu: Some(thread_cpu_seconds() - cpu),
+            hits,
+        }
+    } else {
+        let start = Instant::now();
+        let hits = s
+            .rays
+            .par_chunks(256)
+            .map(|c| c.iter().map(one).sum::<usize>())
+            .sum();
+        Timing {
+            wall: start.elapsed().as_secs_f64(),
+            cpu: None,
+            hits,
+        }
+    }
+}
+
+/// Mean work per ray over the whole set (boxes, leaves, triangles), where the structure counts.
+fn mean_work(p: &dyn Peer, s: &RaySet) -> [Option<f64>; 3] {
+    let t_max = rays::t_max(s.shadow);
+    let add = |a: Option<u64>, b: Option<u64>| a.zip(b).map(|(a, b)| a + b);
+    let total = s
+        .rays
+        .par_iter()
+        .map(|r| p.work(r, t_max, s.shadow))
+        .reduce(
+            || Work {
+                boxes: Some(0),
+                leaves: Some(0),
+                tris: Some(0),
+            },
+            |a, b| Work {
+                boxes: add(a.boxes, b.boxes),
+                leaves: add(a.leaves, b.leaves),
+                tris: add(a.tris, b.tris),
+            },
+        );
+    let n = s.rays.len().max(1) as f64;
+    [total.boxes, total.leaves, total.tris].map(|c| c.map(|c| c as f64 / n))
+}
+
+/// Compares a structure's answers with the reference's; one report line.
+fn check(p: &dyn Peer, s: &RaySet, expected: &[Answer]) -> String {
+    let (mut wrong, mut other_prim) = (0, 0);
+    for (r, exp) in s.rays.iter().zip(expected) {
+        match (answer(p, r, s.shadow), *exp) {
+            (Answer::Closest(Some((t, prim))), Answer::Closest(Some((te, prim_e)))) => {
+                if (t - te).abs() > 1e-4 * te.abs() {
+                    wrong += 1;
+                } else if prim != prim_e {
+                    other_prim += 1;
+                }
+            }
+            (a, e) if a != e => wrong += 1,
+            _ => {}
+        }
+    }
+    format!(
+        "  {:<28} {:<10} {:>6} of {:>6} differ (hit/miss or t beyond 1e-4 relative){}",
+        p.name(),
+        s.name,
+        wrong,
+        expected.len(),
+        if other_prim > 0 {
+            format!("; {other_prim} same t, other triangle")
+        } else {
+            String::new()
+        }
+    )
+}
+
+fn dump_hits(dir: &Path, reference: &dyn Peer, sets: &[RaySet]) -> Result<()> {
+    std::fs::create_dir_all(dir)?;
+    for s in sets {
+        let answers: Vec<Answer> = s
+            .rays
+            .par_iter()
+            .map(|r| answer(reference, r, s.shadow))
+            .collect();
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        for ans in answers {
+            match ans {
+                Answer::Closest(h) => {
+                    a.extend_from_slice(&h.map_or(f32::INFINITY, |h| h.0).to_le_bytes());
+                    b.extend_from_slice(&h.map_or(u32::MAX, |h| h.1).to_le_bytes());
+                }
+                Answer::Occluded(o) => a.push(o as u8),
+            }
+        }
+        if s.shadow {
+            std::fs::write(dir.join(format!("{}.occluded.u8", s.name)), a)?;
+        } else {
+            std::fs::write(dir.join(format!("{}.t.f32", s.name)), a)?;
+            std::fs::write(dir.join(format!("{}.prim.u32", s.name)), b)?;
+        }
+    }
+    eprintln!("wrote our bvh's answers to {}", dir.display());
+    Ok(())
+}
+
+fn opt(x: Option<f64>, digits: usize) -> String {
+    x.map_or(String::new(), |x| format!("{x:.digits$}"))
+}
+
+fn table(args: &Args, tris: &[[rt_core::glam::Vec3; 3]], sets: &[RaySet], rows: &[Row]) -> String {
+    let mut out = String::new();
+    let _ = writeln!(out, "\n{} ({} triangles)", args.mesh.display(), tris.len());
+    for s in sets {
+        let _ = writeln!(out, "  {}: {} rays", s.name, s.rays.len());
+    }
+    let _ = writeln!(
+        out,
+        "\n{:<28} {:<10} {:>3} {:>9} {:>9} {:>11} {:>7} {:>9} {:>9} {:>8} {:>7} {:>7} {:>7}",
+        "accel",
+        "rays",
+        "thr",
+        "build ms",
+        "(CPU)",
+        "bytes",
+        "B/tri",
+        "Mrays/s",
+        "(CPU)",
+        "hits",
+        "boxes",
+        "leaves",
+        "tris"
+    );
+    for r in rows {
+        let _ = writeln!(
+            out,
+            "{:<28} {:<10} {:>3} {:>9.1} {:>9} {:>11} {:>7} {:>9.3} {:>9} {:>8} {:>7} {:>7} {:>7}",
+            r.accel,
+            r.rays,
+            r.threads,
+            r.build_ms,
+            opt(r.build_cpu_ms, 1),
+            r.bytes.map_or(String::new(), |b| b.to_string()),
+            opt(r.bytes.map(|b| b as f64 / tris.len() as f64), 1),
+            r.mrays_per_s,
+            opt(r.mrays_per_cpu_s, 3),
+            r.hits,
+            opt(r.work[0], 1),
+            opt(r.work[1], 1),
+            opt(r.work[2], 1),
+        );
+    }
+    out
+}
+
+fn csv(rows: &[Row]) -> String {
+    let mut out = String::from(
+        "accel,rays,threads,build_ms,bytes,mrays_per_s,hits,boxes_per_ray,leaves_per_ray,tris_per_ray,mrays_per_cpu_s,build_cpu_ms\n",
+    );
+    for r in rows {
+        let _ = writeln!(
+            out,
+            "{},{},{},{:.2},{},{:.4},{},{},{},{},{},{}",
+            r.accel,
+            r.rays,
+            r.threads,
+            r.build_ms,
+            r.bytes.map_or(String::new(), |b| b.to_string()),
+            r.mrays_per_s,
+            r.hits,
+            opt(r.work[0], 2),
+            opt(r.work[1], 2),
+            opt(r.work[2], 2),
+            opt(r.mrays_per_cpu_s, 4),
+            opt(r.build_cpu_ms, 2),
+        );
+    }
+    out
+}
