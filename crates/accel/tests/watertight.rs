@@ -15,7 +15,6 @@ use common::{grid_cube, icosphere, rotation, torus, Mesh, Rng};
 use glam::Vec3;
 use rt_accel::{BuildParams, Bvh2, Qbvh};
 use rt_core::{triangle::geometric_normal, Accel, Ray};
-use std::collections::HashMap;
 
 const RAYS_PER_MESH: usize = 200_000;
 
@@ -45,17 +44,7 @@ fn fire(mesh: &Mesh, seed: u64, aim: Aim) {
         .map(|t| geometric_normal(t).normalize())
         .collect();
 
-    let mut vertex_faces: Vec<Vec<usize>> = vec![Vec::new(); mesh.positions.len()];
-    let mut edge_faces: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
-    for (fi, f) in mesh.faces.iter().enumerate() {
-        for k in 0..3 {
-            vertex_faces[f[k] as usize].push(fi);
-            let (a, b) = (f[k], f[(k + 1) % 3]);
-            edge_faces.entry((a.min(b), a.max(b))).or_default().push(fi);
-        }
-    }
-    let mut edges: Vec<_> = edge_faces.into_iter().collect();
-    edges.sort_unstable_by_key(|e| e.0);
+    let (vertex_faces, edges) = mesh.adjacency();
 
     let bvh = Bvh2::build(&tris, &BuildParams::default());
     bvh.validate().unwrap();

@@ -125,9 +125,11 @@ pub fn intersect_triangle(pre: &RayPrecomp, v: &[Vec3; 3], t_max: f32) -> Option
     if ts.is_nan() || ts <= 0.0 {
         return None;
     }
+    // A denormal `det` (triangles around 1e-20 and smaller) makes `1 / det` overflow, and the
+    // product can overflow too: neither is a usable hit, even for an unbounded ray.
     let inv = 1.0 / det;
     let t = t_scaled * inv;
-    if t.is_nan() || t <= 0.0 || t > t_max {
+    if t.is_nan() || t <= 0.0 || t > t_max || t.is_infinite() || inv.is_infinite() {
         return None;
     }
     Some(TriHit {
@@ -183,6 +185,20 @@ mod tests {
         let pre = RayPrecomp::new(&Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z));
         assert!(intersect_triangle(&pre, &tri, 0.5).is_none());
         assert!(intersect_triangle(&pre, &tri, 1.0).is_some());
+    }
+
+    #[test]
+    fn tiny_triangles_never_give_infinite_hits() {
+        for scale in [1e-18f32, 1e-20, 1e-22, 1e-25] {
+            let tri = [Vec3::ZERO, Vec3::X * scale, Vec3::Y * scale];
+            let o = Vec3::new(0.25, 0.25, 1.0) * scale;
+            if let Some(h) = hit(o, -Vec3::Z, &tri) {
+                assert!(
+                    h.t.is_finite() && h.b1.is_finite() && h.b2.is_finite(),
+                    "{h:?}"
+                );
+            }
+        }
     }
 
     #[test]

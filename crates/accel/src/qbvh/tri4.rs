@@ -187,8 +187,12 @@ pub(crate) fn intersect4_sse(pre: &RayPrecomp4, p: &Tri4, t_max: f32) -> Hits4 {
         ok = _mm_and_ps(ok, _mm_cmpgt_ps(ts, zero));
         let inv = _mm_div_ps(_mm_set1_ps(1.0), det);
         let t = _mm_mul_ps(t_scaled, inv);
+        let inf = _mm_set1_ps(f32::INFINITY);
         ok = _mm_and_ps(ok, _mm_cmpgt_ps(t, zero));
         ok = _mm_and_ps(ok, _mm_cmple_ps(t, _mm_set1_ps(t_max)));
+        // Finite `t` and `1 / det`, as the scalar test requires.
+        ok = _mm_and_ps(ok, _mm_cmplt_ps(t, inf));
+        ok = _mm_and_ps(ok, _mm_cmplt_ps(_mm_and_ps(inv, abs_mask), inf));
         _mm_storeu_ps(h.t.as_mut_ptr(), t);
         _mm_storeu_ps(h.b1.as_mut_ptr(), _mm_mul_ps(v, inv));
         _mm_storeu_ps(h.b2.as_mut_ptr(), _mm_mul_ps(w, inv));

@@ -381,7 +381,28 @@ pub struct Mesh {
     pub faces: Vec<[u32; 3]>,
 }
 
+/// Faces around each vertex, and the faces of each undirected edge `(low, high)`, sorted by
+/// edge.
+pub type Adjacency = (Vec<Vec<usize>>, Vec<((u32, u32), Vec<usize>)>);
+
 impl Mesh {
+    /// See [`Adjacency`].
+    pub fn adjacency(&self) -> Adjacency {
+        let mut vertex_faces: Vec<Vec<usize>> = vec![Vec::new(); self.positions.len()];
+        let mut edge_faces: std::collections::HashMap<(u32, u32), Vec<usize>> =
+            std::collections::HashMap::new();
+        for (fi, f) in self.faces.iter().enumerate() {
+            for k in 0..3 {
+                vertex_faces[f[k] as usize].push(fi);
+                let (a, b) = (f[k], f[(k + 1) % 3]);
+                edge_faces.entry((a.min(b), a.max(b))).or_default().push(fi);
+            }
+        }
+        let mut edges: Vec<_> = edge_faces.into_iter().collect();
+        edges.sort_unstable_by_key(|e| e.0);
+        (vertex_faces, edges)
+    }
+
     pub fn triangles(&self) -> Vec<[Vec3; 3]> {
         self.faces
             .iter()
@@ -660,16 +681,7 @@ pub fn rays_at_edges_and_vertices(mesh: &Mesh, rng: &mut Rng, n: usize) -> Vec<R
         .iter()
         .map(|t| rt_core::triangle::geometric_normal(t).normalize())
         .collect();
-    let mut vertex_faces: Vec<Vec<usize>> = vec![Vec::new(); mesh.positions.len()];
-    let mut edge_faces: std::collections::BTreeMap<(u32, u32), Vec<usize>> = Default::default();
-    for (fi, f) in mesh.faces.iter().enumerate() {
-        for k in 0..3 {
-            vertex_faces[f[k] as usize].push(fi);
-            let (a, b) = (f[k], f[(k + 1) % 3]);
-            edge_faces.entry((a.min(b), a.max(b))).or_default().push(fi);
-        }
-    }
-    let edges: Vec<_> = edge_faces.into_iter().collect();
+    let (vertex_faces, edges) = mesh.adjacency();
     let radius = rt_core::Aabb::from_points(&mesh.positions).bounding_radius();
     let min_sin = 5f32.to_radians().sin();
     let mut out = Vec::with_capacity(n);
