@@ -11,39 +11,6 @@ use rt_accel::AccelSpec;
 use rt_core::{Ray, TraversalCounters};
 use std::time::Instant;
 
-/// Triangles of an OBJ file (`v` and `f` lines only, fans for polygons).
-fn read_obj(path: &str) -> Vec<[Vec3; 3]> {
-    let text = std::fs::read_to_string(path).expect("RT_TIMING_OBJ readable");
-    let mut v = Vec::new();
-    let mut tris = Vec::new();
-    for line in text.lines() {
-        let mut it = line.split_whitespace();
-        match it.next() {
-            Some("v") => {
-                let c: Vec<f32> = it.take(3).map(|x| x.parse().unwrap()).collect();
-                v.push(Vec3::new(c[0], c[1], c[2]));
-            }
-            Some("f") => {
-                let idx: Vec<usize> = it
-                    .map(|f| {
-                        let i: i64 = f.split('/').next().unwrap().parse().unwrap();
-                        if i < 0 {
-                            (v.len() as i64 + i) as usize
-                        } else {
-                            i as usize - 1
-                        }
-                    })
-                    .collect();
-                for k in 1..idx.len() - 1 {
-                    tris.push([v[idx[0]], v[idx[k]], v[idx[k + 1]]]);
-                }
-            }
-            _ => {}
-        }
-    }
-    tris
-}
-
 /// Seconds this thread has run on a CPU (Linux), so that other processes sharing the machine
 /// inflate the numbers less than wall-clock time would; wall-clock time elsewhere.
 fn thread_seconds() -> f64 {
@@ -63,7 +30,7 @@ fn thread_seconds() -> f64 {
 #[ignore = "timing, not a check"]
 fn structures_and_options() {
     let tris = match std::env::var("RT_TIMING_OBJ") {
-        Ok(path) => read_obj(&path),
+        Ok(path) => common::read_obj(std::path::Path::new(&path)).expect("RT_TIMING_OBJ readable"),
         Err(_) => common::icosphere(6).triangles(),
     };
     let bounds = tris.iter().fold(rt_core::Aabb::EMPTY, |b, t| {

@@ -711,3 +711,50 @@ pub fn rays_at_edges_and_vertices(mesh: &Mesh, rng: &mut Rng, n: usize) -> Vec<R
     }
     out
 }
+
+/// Triangles of an OBJ file (`v` and `f` lines only, polygons as fans), or `None` if it cannot
+/// be read. Enough for the meshes in `../shared/data`, without a dependency.
+pub fn read_obj(path: &std::path::Path) -> Option<Vec<[Vec3; 3]>> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let mut v = Vec::new();
+    let mut tris = Vec::new();
+    for line in text.lines() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => {
+                let c: Vec<f32> = it.take(3).map(|x| x.parse().unwrap()).collect();
+                v.push(Vec3::new(c[0], c[1], c[2]));
+            }
+            Some("f") => {
+                let idx: Vec<usize> = it
+                    .map(|f| {
+                        let i: i64 = f.split('/').next().unwrap().parse().unwrap();
+                        if i < 0 {
+                            (v.len() as i64 + i) as usize
+                        } else {
+                            i as usize - 1
+                        }
+                    })
+                    .collect();
+                for k in 1..idx.len().saturating_sub(1) {
+                    tris.push([v[idx[0]], v[idx[k]], v[idx[k + 1]]]);
+                }
+            }
+            _ => {}
+        }
+    }
+    Some(tris)
+}
+
+/// A mesh from `../shared/data` (relative to the workspace root), or `None` with a message
+/// when it is absent: the meshes are not part of the repository.
+pub fn shared_mesh(relative: &str) -> Option<Vec<[Vec3; 3]>> {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data")
+        .join(relative);
+    let tris = read_obj(&path);
+    if tris.is_none() {
+        eprintln!("skipping {}: not found", path.display());
+    }
+    tris
+}
