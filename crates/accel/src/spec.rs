@@ -11,7 +11,7 @@
 //! |---|---|---|
 //! | `leaf=N` | bvh, qbvh | largest leaf (default 4 for bvh, 16 for qbvh) |
 //! | `bins=N` | bvh, qbvh | SAH bins per axis |
-//! | `icost=F` | bvh, qbvh | SAH cost of a triangle test relative to a node visit (default 1 for bvh, 0.3 for qbvh) |
+//! | `icost=F` | bvh, qbvh | SAH cost of a triangle test relative to a node visit (default 1 for bvh, 0.2 for qbvh) |
 //! | `evh=T` / `bbah=T` | bvh, qbvh | triangle splitting with threshold exponent T |
 //! | `compact` | bvh, qbvh | remove duplicate references per leaf |
 //! | `order=unsorted\|distance\|split` | qbvh | child order (default `split`) |

@@ -4,9 +4,10 @@
 pub const DEFAULT_LEAF_SIZE: usize = 16;
 
 /// SAH cost of one triangle test relative to one node visit for QBVH builds: four triangles
-/// are tested at once, so a leaf costs about a quarter per triangle of what a binary BVH's does
-/// (measured best of 0.1 to 1 on the bunny; `docs/benchmarks.md`).
-pub const DEFAULT_INTERSECTION_COST: f32 = 0.3;
+/// are tested at once, so a leaf costs much less per triangle than a binary BVH's. 0.2 was the
+/// fastest and smallest on the dragon and within noise of the best on the conference room
+/// (`docs/benchmarks.md`, section G).
+pub const DEFAULT_INTERSECTION_COST: f32 = 0.2;
 
 /// The order in which a node's hit children are visited (Dammertz §3.3.3, Table 3.1).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
