@@ -3,51 +3,9 @@
 
 use super::build::MAX_DEPTH;
 use super::Bvh2;
-use crate::traversal::{Closest, Counter, FAR_SCALE};
+use crate::traversal::{Closest, Counter, SlabRay, FAR_SCALE};
 use rt_core::triangle::RayPrecomp;
 use rt_core::{Hit, Ray};
-
-/// Per-ray constants of the slab test.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct SlabRay {
-    org: [f32; 3],
-    /// `1 / dir`, so a zero component, of either sign, becomes an infinity of the same sign.
-    inv: [f32; 3],
-    /// Sign bit of `inv` per axis: picks the near plane as `bounds[axis + 3 * neg]`. The sign bit
-    /// rather than `< 0` is what matches `-0.0` to its `-inf`.
-    neg: [bool; 3],
-}
-
-impl SlabRay {
-    #[inline]
-    pub(crate) fn new(ray: &Ray) -> Self {
-        let inv = ray.dir.recip().to_array();
-        Self {
-            org: ray.origin.to_array(),
-            inv,
-            neg: inv.map(f32::is_sign_negative),
-        }
-    }
-
-    /// Entry distance into `bounds` (packed as in [`Node`](super::Node)) if the ray overlaps it
-    /// within `[0, t_max]`, conservatively.
-    #[inline(always)]
-    pub(crate) fn hit(&self, bounds: &[f32; 6], t_max: f32) -> Option<f32> {
-        let mut t0 = 0.0f32;
-        let mut t1 = t_max;
-        for axis in 0..3 {
-            let n = self.neg[axis] as usize;
-            let near = (bounds[axis + 3 * n] - self.org[axis]) * self.inv[axis];
-            let far = (bounds[axis + 3 - 3 * n] - self.org[axis]) * self.inv[axis];
-            // A NaN arises only as 0 * inf: the ray runs parallel to this axis inside the plane
-            // of the slab's face, so it is on the box's boundary and the slab must not cull.
-            // `f32::max`/`min` return the non-NaN operand, which leaves the interval alone.
-            t0 = t0.max(near);
-            t1 = t1.min(far);
-        }
-        (t0 <= t1 * FAR_SCALE).then_some(t0)
-    }
-}
 
 impl Bvh2 {
     /// The one traversal loop behind every query. `ANY_HIT` returns the first hit found rather

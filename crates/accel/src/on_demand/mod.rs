@@ -79,7 +79,7 @@
 //! copies, but it cannot be freed through `&self`.
 
 use crate::qbvh::{QbvhOptions, MAX_TRIANGLES};
-use crate::traversal::FAR_SCALE;
+use crate::traversal::{inside, SlabRay, FAR_SCALE};
 use crate::{BuildParams, Qbvh};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -601,50 +601,6 @@ impl Accel for OnDemandQbvh {
     fn counts_traversal(&self) -> bool {
         true
     }
-}
-
-/// Per-ray constants of the slab test (as in the binary BVH's traversal).
-struct SlabRay {
-    org: [f32; 3],
-    /// `1 / dir`: a zero component, of either sign, becomes an infinity of the same sign.
-    inv: [f32; 3],
-    /// Sign bit of `inv` per axis (the sign bit, so that `-0.0` goes with its `-inf`).
-    neg: [bool; 3],
-}
-
-impl SlabRay {
-    #[inline]
-    fn new(ray: &Ray) -> Self {
-        let inv = ray.dir.recip().to_array();
-        Self {
-            org: ray.origin.to_array(),
-            inv,
-            neg: inv.map(f32::is_sign_negative),
-        }
-    }
-
-    /// Entry distance into `bounds` if the ray overlaps it within `[0, t_max]`, conservatively:
-    /// the far distance is widened by `FAR_SCALE` against the rounding of the slab distances.
-    #[inline(always)]
-    fn hit(&self, bounds: &[f32; 6], t_max: f32) -> Option<f32> {
-        let mut t0 = 0.0f32;
-        let mut t1 = t_max;
-        for axis in 0..3 {
-            let n = self.neg[axis] as usize;
-            let near = (bounds[axis + 3 * n] - self.org[axis]) * self.inv[axis];
-            let far = (bounds[axis + 3 - 3 * n] - self.org[axis]) * self.inv[axis];
-            // A NaN (0 * inf: a ray parallel to the axis within a face plane) must not cull;
-            // `f32::max`/`min` return the other operand.
-            t0 = t0.max(near);
-            t1 = t1.min(far);
-        }
-        (t0 <= t1 * FAR_SCALE).then_some(t0)
-    }
-}
-
-/// True if `inner` lies within `outer`.
-fn inside(inner: &Aabb, outer: &Aabb) -> bool {
-    inner.min.cmpge(outer.min).all() && inner.max.cmple(outer.max).all()
 }
 
 #[cfg(test)]
