@@ -170,6 +170,97 @@ impl SlabRay {
     }
 }
 
+/// A node of a binary tree whose two children are stored side by side: what [`walk_binary`]
+/// needs of it.
+pub(crate) trait BinaryNode {
+    /// `[min.x, min.y, min.z, max.x, max.y, max.z]`.
+    fn planes(&self) -> &[f32; 6];
+    /// `None` for a leaf, else the index of the first child (the second follows it).
+    fn first_child(&self) -> Option<usize>;
+}
+
+/// What a leaf visit tells [`walk_binary`].
+pub(crate) enum Step {
+    /// Nothing closer in this leaf.
+    Miss,
+    /// A hit at this distance; cull beyond it.
+    Closer(f32),
+    /// The query has its answer.
+    Done,
+}
+
+/// Front-to-back walk of a binary tree (root first in `nodes`, depth below `DEPTH`): calls
+/// `leaf` on every leaf the ray reaches within the current culling distance, nearer child
+/// first, and skips pending subtrees that start beyond it. Boxes tested go to `counter`, which
+/// `leaf` also gets.
+#[inline(always)]
+pub(crate) fn walk_binary<N: BinaryNode, C: Counter, const DEPTH: usize>(
+    nodes: &[N],
+    ray: &Ray,
+    t_max: f32,
+    counter: &mut C,
+    mut leaf: impl FnMut(&N, f32, &mut C) -> Step,
+) {
+    let Some(root) = nodes.first() else {
+        return;
+    };
+    let slab = SlabRay::new(ray);
+    counter.boxes(1);
+    if slab.hit(root.planes(), t_max).is_none() {
+        return;
+    }
+    let mut cull_t = t_max;
+    // (node index, entry distance) of far children still to visit.
+    let mut stack = [(0u32, 0.0f32); DEPTH];
+    let mut sp = 0;
+    let mut node = root;
+    loop {
+        match node.first_child() {
+            None => match leaf(node, cull_t, counter) {
+                Step::Miss => {}
+                Step::Closer(t) => cull_t = t,
+                Step::Done => return,
+            },
+            Some(first) => {
+                counter.boxes(2);
+                let t_left = slab.hit(nodes[first].planes(), cull_t);
+                let t_right = slab.hit(nodes[first + 1].planes(), cull_t);
+                let next = match (t_left, t_right) {
+                    (Some(tl), Some(tr)) => {
+                        let (near, far, far_entry) = if tl <= tr {
+                            (first, first + 1, tr)
+                        } else {
+                            (first + 1, first, tl)
+                        };
+                        stack[sp] = (far as u32, far_entry);
+                        sp += 1;
+                        Some(near)
+                    }
+                    (Some(_), None) => Some(first),
+                    (None, Some(_)) => Some(first + 1),
+                    (None, None) => None,
+                };
+                if let Some(next) = next {
+                    node = &nodes[next];
+                    continue;
+                }
+            }
+        }
+        // Pop the nearest pending subtree that can still hold something closer.
+        loop {
+            if sp == 0 {
+                return;
+            }
+            sp -= 1;
+            let (index, t_entry) = stack[sp];
+            if t_entry <= cull_t * FAR_SCALE {
+                node = &nodes[index as usize];
+                break;
+            }
+        }
+    }
+}
+
 /// True if `inner` lies within `outer` (for the `validate` methods).
 pub(crate) fn inside(inner: &Aabb, outer: &Aabb) -> bool {
     inner.min.cmpge(outer.min).all() && inner.max.cmple(outer.max).all()

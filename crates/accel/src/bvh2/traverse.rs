@@ -2,8 +2,10 @@
 //! JCGT 2013).
 
 use super::build::MAX_DEPTH;
-use super::Bvh2;
-use crate::traversal::{Closest, Counter, SlabRay, FAR_SCALE};
+use super::{Bvh2, Node};
+#[cfg(test)]
+use crate::traversal::SlabRay;
+use crate::traversal::{walk_binary, BinaryNode, Closest, Counter, Step};
 use rt_core::triangle::RayPrecomp;
 use rt_core::{Hit, Ray};
 
@@ -19,62 +21,29 @@ impl Bvh2 {
         t_max: f32,
         counter: &mut C,
     ) -> Option<Hit> {
-        let nodes = &self.nodes[..];
-        let root = nodes.first()?;
-        let slab = SlabRay::new(ray);
-        counter.boxes(1);
-        slab.hit(&root.bounds, t_max)?;
         let pre = RayPrecomp::new(ray);
-
         let mut closest = Closest::new(t_max);
-        // (node index, entry distance) of far children still to visit.
-        let mut stack = [(0u32, 0.0f32); MAX_DEPTH];
-        let mut sp = 0;
-        let mut node = root;
-        loop {
-            if let Some(prims) = node.prims() {
-                let (tris, ids) = (&self.triangles[..], &self.prim_ids[..]);
-                if closest.test_leaf::<ANY_HIT, C>(&pre, tris, ids, prims, t_max, counter) {
-                    return closest.hit;
-                }
+        let (tris, ids) = (&self.triangles[..], &self.prim_ids[..]);
+        walk_binary::<_, _, MAX_DEPTH>(&self.nodes, ray, t_max, counter, |node, _, counter| {
+            let prims = node.prims().expect("a leaf");
+            if closest.test_leaf::<ANY_HIT, C>(&pre, tris, ids, prims, t_max, counter) {
+                Step::Done
             } else {
-                let first = node.index as usize;
-                counter.boxes(2);
-                let t_left = slab.hit(&nodes[first].bounds, closest.cull_t);
-                let t_right = slab.hit(&nodes[first + 1].bounds, closest.cull_t);
-                let next = match (t_left, t_right) {
-                    (Some(tl), Some(tr)) => {
-                        let (near, far, far_entry) = if tl <= tr {
-                            (first, first + 1, tr)
-                        } else {
-                            (first + 1, first, tl)
-                        };
-                        stack[sp] = (far as u32, far_entry);
-                        sp += 1;
-                        Some(near)
-                    }
-                    (Some(_), None) => Some(first),
-                    (None, Some(_)) => Some(first + 1),
-                    (None, None) => None,
-                };
-                if let Some(next) = next {
-                    node = &nodes[next];
-                    continue;
-                }
+                Step::Closer(closest.cull_t)
             }
-            // Pop the nearest pending subtree that can still hold something closer.
-            loop {
-                if sp == 0 {
-                    return closest.hit;
-                }
-                sp -= 1;
-                let (index, t_entry) = stack[sp];
-                if t_entry <= closest.cull_t * FAR_SCALE {
-                    node = &nodes[index as usize];
-                    break;
-                }
-            }
-        }
+        });
+        closest.hit
+    }
+}
+
+impl BinaryNode for Node {
+    #[inline(always)]
+    fn planes(&self) -> &[f32; 6] {
+        &self.bounds
+    }
+    #[inline(always)]
+    fn first_child(&self) -> Option<usize> {
+        (!self.is_leaf()).then_some(self.index as usize)
     }
 }
 

@@ -79,7 +79,7 @@
 //! copies, but it cannot be freed through `&self`.
 
 use crate::qbvh::{QbvhOptions, MAX_TRIANGLES};
-use crate::traversal::{inside, SlabRay, FAR_SCALE};
+use crate::traversal::{inside, walk_binary, BinaryNode, Step};
 use crate::{BuildParams, Qbvh};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -409,66 +409,12 @@ impl OnDemandQbvh {
         boxes: &mut u64,
         mut visit: impl FnMut(&Group, &Qbvh, f32) -> Step,
     ) {
-        let nodes = &self.nodes[..];
-        let Some(root) = nodes.first() else {
-            return;
-        };
-        let slab = SlabRay::new(ray);
-        *boxes += 1;
-        if slab.hit(&root.bounds, t_max).is_none() {
-            return;
-        }
-        let mut cull_t = t_max;
-        // (node index, entry distance) of far children still to visit.
-        let mut stack = [(0u32, 0.0f32); MAX_DEPTH];
-        let mut sp = 0;
-        let mut node = root;
-        loop {
-            if node.is_leaf() {
-                let group = &self.groups[node.index as usize];
-                match visit(group, self.tree(group), cull_t) {
-                    Step::Miss => {}
-                    Step::Closer(t) => cull_t = t,
-                    Step::Done => return,
-                }
-            } else {
-                let first = node.index as usize;
-                *boxes += 2;
-                let t_left = slab.hit(&nodes[first].bounds, cull_t);
-                let t_right = slab.hit(&nodes[first + 1].bounds, cull_t);
-                let next = match (t_left, t_right) {
-                    (Some(tl), Some(tr)) => {
-                        let (near, far, far_entry) = if tl <= tr {
-                            (first, first + 1, tr)
-                        } else {
-                            (first + 1, first, tl)
-                        };
-                        stack[sp] = (far as u32, far_entry);
-                        sp += 1;
-                        Some(near)
-                    }
-                    (Some(_), None) => Some(first),
-                    (None, Some(_)) => Some(first + 1),
-                    (None, None) => None,
-                };
-                if let Some(next) = next {
-                    node = &nodes[next];
-                    continue;
-                }
-            }
-            // Pop the nearest pending subtree that can still hold something closer.
-            loop {
-                if sp == 0 {
-                    return;
-                }
-                sp -= 1;
-                let (index, t_entry) = stack[sp];
-                if t_entry <= cull_t * FAR_SCALE {
-                    node = &nodes[index as usize];
-                    break;
-                }
-            }
-        }
+        let mut top = TraversalCounters::default();
+        walk_binary::<_, _, MAX_DEPTH>(&self.nodes, ray, t_max, &mut top, |node, cull_t, _| {
+            let group = &self.groups[node.index as usize];
+            visit(group, self.tree(group), cull_t)
+        });
+        *boxes += top.nodes_visited;
     }
 
     /// Closest hit; `counters`, if given, also gets the groups' work.
@@ -514,14 +460,15 @@ fn copy(triangles: &[[Vec3; 3]], parallel: bool) -> Vec<[Vec3; 3]> {
     }
 }
 
-/// What a group visit tells the top-tree walk.
-enum Step {
-    /// Nothing closer in this group.
-    Miss,
-    /// A hit at this distance; cull beyond it.
-    Closer(f32),
-    /// The query has its answer.
-    Done,
+impl BinaryNode for TopNode {
+    #[inline(always)]
+    fn planes(&self) -> &[f32; 6] {
+        &self.bounds
+    }
+    #[inline(always)]
+    fn first_child(&self) -> Option<usize> {
+        (self.count == 0).then_some(self.index as usize)
+    }
 }
 
 impl Accel for OnDemandQbvh {
