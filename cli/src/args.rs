@@ -7,7 +7,7 @@ use std::path::PathBuf;
 /// macro so that the help text below can include it; use [`DEFAULT_ACCEL`] in code.
 macro_rules! default_accel {
     () => {
-        "qbvh"
+        "bvh8"
     };
 }
 
@@ -59,8 +59,9 @@ pub struct Args {
         value_name = "SPEC",
         help = concat!(
             "Acceleration structure and its options, KIND[:OPTION...]: bvh (binned-SAH binary ",
-            "BVH), qbvh (four-wide BVH) or brute-force (tests every triangle; for checking ",
-            "only), e.g. qbvh:evh=14:compact or qbvh:order=distance; the options are listed in ",
+            "BVH), qbvh (four-wide BVH), bvh8 (eight-wide BVH) or brute-force (tests every ",
+            "triangle; for checking only), e.g. qbvh:evh=14:compact or qbvh:order=distance; the ",
+            "options are listed in ",
             "crates/accel/src/spec.rs. [default: `[render] accel`, else ",
             default_accel!(),
             "]"

@@ -491,7 +491,7 @@ fn bench_accel_on_a_procedural_scene_writes_the_csv() {
         "bench-accel",
         "gen:worst-case",
         "--accel",
-        "bvh,qbvh,brute-force",
+        "bvh,qbvh,bvh8,brute-force",
         "--width",
         "24",
         "--height",
@@ -519,12 +519,12 @@ fn bench_accel_on_a_procedural_scene_writes_the_csv() {
         .iter()
         .map(|r| (r[0].clone(), r[1].clone(), r[2].clone()))
         .collect();
-    assert_eq!(keys.len(), 3 * 3 * 2);
+    assert_eq!(keys.len(), 4 * 3 * 2);
     keys.sort();
     keys.dedup();
-    assert_eq!(keys.len(), 3 * 3 * 2);
+    assert_eq!(keys.len(), 4 * 3 * 2);
     for row in &rows {
-        assert!(["bvh", "qbvh", "brute-force"].contains(&row[0].as_str()));
+        assert!(["bvh", "qbvh", "bvh8", "brute-force"].contains(&row[0].as_str()));
         assert!(["primary", "incoherent", "shadow"].contains(&row[1].as_str()));
         assert!(["1", "2"].contains(&row[2].as_str()));
         assert!(row[5].parse::<f64>().unwrap() > 0.0, "{row:?}");
@@ -538,6 +538,7 @@ fn bench_accel_on_a_procedural_scene_writes_the_csv() {
     };
     for rays in ["primary", "incoherent", "shadow"] {
         assert_eq!(hits("qbvh", rays), hits("bvh", rays));
+        assert_eq!(hits("bvh8", rays), hits("bvh", rays));
         assert_eq!(hits("brute-force", rays), hits("bvh", rays));
     }
     let primary: usize = rows.iter().find(|r| r[1] == "primary").unwrap()[13]
@@ -571,7 +572,11 @@ fn bench_accel_on_a_procedural_scene_writes_the_csv() {
             String::from_utf8_lossy(&out.stderr)
         );
         let file_rows = csv_rows(&r.path("file.csv"));
-        assert_eq!(file_rows.len(), 2, "bvh and qbvh, one thread, one set");
+        assert_eq!(
+            file_rows.len(),
+            3,
+            "bvh, qbvh and bvh8, one thread, one set"
+        );
         for row in &file_rows {
             assert_eq!(row[1], "file");
             assert_eq!(row[6], hits(&row[0], rays), "{file} {row:?}");
@@ -606,8 +611,8 @@ fn bench_accel_on_a_mesh_and_a_scene() {
     let rows = csv_rows(&r.path("o.csv"));
     assert_eq!(
         rows.len(),
-        2 * 3,
-        "two structures, three sets, one thread count"
+        3 * 3,
+        "three structures, three sets, one thread count"
     );
     // The automatic camera sees the mesh.
     let primary = rows.iter().find(|r| r[1] == "primary").unwrap();
@@ -636,7 +641,7 @@ fn bench_accel_on_a_mesh_and_a_scene() {
         String::from_utf8_lossy(&out.stderr)
     );
     let rows = csv_rows(&r.path("inside.csv"));
-    assert_eq!(rows.len(), 2);
+    assert_eq!(rows.len(), 3);
     for row in &rows {
         assert_eq!(row[6], row[13], "hits = rays: {row:?}");
     }

@@ -9,7 +9,7 @@
 # THREADS: threads of the multi-threaded rows (default: all CPUs; every tool also runs 1).
 # VIEW (only when this script generates the rays): outside or inside; default inside for
 # meshes under a `scenes/` directory (rooms), outside otherwise (scanned objects).
-# Environment: ACCEL (our specs, default qbvh,bvh), PEERS (accel-peers --peers), RUNS (timed
+# Environment: ACCEL (our specs, default bvh8,qbvh,bvh), PEERS (accel-peers --peers), RUNS (timed
 # runs, best reported, default 3), OUT (output directory, default a new /tmp/accel-bench.*),
 # PEERS_TARGET_DIR for accel-peers' build (default /tmp/target-peers; render builds in the
 # usual CARGO_TARGET_DIR or target/), RUSTFLAGS as usual.
@@ -28,7 +28,7 @@ view=${3:-}
 if [[ -z $view ]]; then
     case $(realpath "$mesh") in */scenes/*) view=inside ;; *) view=outside ;; esac
 fi
-accel=${ACCEL:-qbvh,bvh}
+accel=${ACCEL:-bvh8,qbvh,bvh}
 runs=${RUNS:-3}
 out=${OUT:-$(mktemp -d /tmp/accel-bench.XXXXXX)}
 mkdir -p "$out"

@@ -41,7 +41,7 @@ pub struct BenchArgs {
     pub input: String,
 
     /// Structures to measure, comma separated, each KIND[:OPTION...] as for `render --accel`.
-    #[arg(long, value_delimiter = ',', default_value = "bvh,qbvh")]
+    #[arg(long, value_delimiter = ',', default_value = "bvh,qbvh,bvh8")]
     pub accel: Vec<String>,
 
     /// Ray sets, comma separated: primary (one jittered camera ray per pixel), incoherent (a

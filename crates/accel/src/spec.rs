@@ -9,19 +9,19 @@
 //!
 //! | option | kinds | meaning |
 //! |---|---|---|
-//! | `leaf=N` | bvh, qbvh | largest leaf (default 4 for bvh, 16 for qbvh) |
-//! | `bins=N` | bvh, qbvh | SAH bins per axis |
-//! | `icost=F` | bvh, qbvh | SAH cost of a triangle test relative to a node visit (default 1 for bvh, 0.2 for qbvh) |
-//! | `evh=T` / `bbah=T` | bvh, qbvh | triangle splitting with threshold exponent T |
-//! | `compact` | bvh, qbvh | remove duplicate references per leaf |
-//! | `order=unsorted\|distance\|split` | qbvh | child order (default `split`) |
-//! | `tstack` | qbvh | keep entry distances on the stack and skip stale entries |
-//! | `shadow-cache` | qbvh | start occlusion queries at the last occluder's node |
-//! | `isect=watertight\|subdivision\|hybrid` | qbvh | triangle test (default watertight) |
+//! | `leaf=N` | bvh, qbvh, bvh8 | largest leaf (default 4 for bvh, 16 for qbvh and bvh8) |
+//! | `bins=N` | bvh, qbvh, bvh8 | SAH bins per axis |
+//! | `icost=F` | bvh, qbvh, bvh8 | SAH cost of a triangle test relative to a node visit (default 1 for bvh, 0.2 for the wide ones) |
+//! | `evh=T` / `bbah=T` | bvh, qbvh, bvh8 | triangle splitting with threshold exponent T |
+//! | `compact` | bvh, qbvh, bvh8 | remove duplicate references per leaf |
+//! | `order=unsorted\|distance\|split` | qbvh, bvh8 | child order (default `split`) |
+//! | `tstack` | qbvh, bvh8 | keep entry distances on the stack and skip stale entries |
+//! | `shadow-cache` | qbvh, bvh8 | start occlusion queries at the last occluder's node |
+//! | `isect=watertight\|subdivision\|hybrid` | qbvh, bvh8 | triangle test (default watertight) |
 //! | `lazy` | qbvh | build subtrees the first time a ray reaches them |
 
 use crate::qbvh::{Order, QbvhOptions, TriangleTest};
-use crate::{BruteForce, BuildParams, Bvh2, Qbvh, Split};
+use crate::{BruteForce, BuildParams, Bvh2, Bvh8, Qbvh, Split};
 use glam::Vec3;
 use rt_core::Accel;
 use std::fmt;
@@ -34,19 +34,32 @@ pub enum AccelKind {
     Bvh,
     /// [`Qbvh`].
     Qbvh,
+    /// [`Bvh8`].
+    Bvh8,
     /// [`BruteForce`].
     BruteForce,
 }
 
 impl AccelKind {
     /// Every kind, in the order reports list them.
-    pub const ALL: [AccelKind; 3] = [AccelKind::Qbvh, AccelKind::Bvh, AccelKind::BruteForce];
+    pub const ALL: [AccelKind; 4] = [
+        AccelKind::Qbvh,
+        AccelKind::Bvh8,
+        AccelKind::Bvh,
+        AccelKind::BruteForce,
+    ];
+
+    /// True for the wide BVHs collapsed from a binary one (QBVH and BVH8).
+    pub fn is_wide(self) -> bool {
+        matches!(self, AccelKind::Qbvh | AccelKind::Bvh8)
+    }
 
     /// The name used in specs and reports.
     pub fn name(self) -> &'static str {
         match self {
             AccelKind::Bvh => "bvh",
             AccelKind::Qbvh => "qbvh",
+            AccelKind::Bvh8 => "bvh8",
             AccelKind::BruteForce => "brute-force",
         }
     }
@@ -59,7 +72,7 @@ pub struct AccelSpec {
     pub kind: AccelKind,
     /// Build parameters of the binary BVH (the QBVH is collapsed from one).
     pub build: BuildParams,
-    /// Traversal options of the QBVH.
+    /// Traversal options of the wide BVHs (QBVH and BVH8).
     pub qbvh: QbvhOptions,
     /// Build subtrees on demand (QBVH only).
     pub lazy: bool,
@@ -69,7 +82,7 @@ pub struct AccelSpec {
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum SpecError {
     /// The text before the first `:` is not a structure.
-    #[error("unknown acceleration structure `{0}` (expected qbvh, bvh or brute-force)")]
+    #[error("unknown acceleration structure `{0}` (expected qbvh, bvh8, bvh or brute-force)")]
     UnknownKind(String),
     /// An option this crate does not know.
     #[error("unknown option `{option}` of `{kind}` (see the options table in rt_accel::spec)")]
@@ -101,14 +114,17 @@ impl AccelSpec {
     /// The default spec of `kind`.
     pub fn new(kind: AccelKind) -> Self {
         let mut build = BuildParams::default();
-        if kind == AccelKind::Qbvh {
+        if kind.is_wide() {
             build.max_leaf_size = crate::qbvh::DEFAULT_LEAF_SIZE;
             build.intersection_cost = crate::qbvh::DEFAULT_INTERSECTION_COST;
         }
         Self {
             kind,
             build,
-            qbvh: QbvhOptions::default(),
+            qbvh: match kind {
+                AccelKind::Bvh8 => QbvhOptions::defaults_for::<crate::Node8>(),
+                _ => QbvhOptions::default(),
+            },
             lazy: false,
         }
     }
@@ -121,6 +137,7 @@ impl AccelSpec {
                 Box::new(crate::OnDemandQbvh::new(triangles, &self.build, &self.qbvh))
             }
             AccelKind::Qbvh => Box::new(Qbvh::build_with(triangles, &self.build, &self.qbvh)),
+            AccelKind::Bvh8 => Box::new(Bvh8::build_with(triangles, &self.build, &self.qbvh)),
             AccelKind::BruteForce => Box::new(BruteForce::new(triangles)),
         }
     }
@@ -145,11 +162,12 @@ impl AccelSpec {
             None => Ok(()),
             Some(_) => Err(bad("this option takes no value")),
         };
-        let tree = matches!(self.kind, AccelKind::Bvh | AccelKind::Qbvh);
-        let qbvh = self.kind == AccelKind::Qbvh;
+        let tree = self.kind == AccelKind::Bvh || self.kind.is_wide();
+        let wide = self.kind.is_wide();
         let applies = match key {
             "leaf" | "bins" | "icost" | "evh" | "bbah" | "compact" => tree,
-            "order" | "tstack" | "shadow-cache" | "isect" | "lazy" => qbvh,
+            "order" | "tstack" | "shadow-cache" | "isect" => wide,
+            "lazy" => self.kind == AccelKind::Qbvh,
             _ => {
                 return Err(SpecError::UnknownOption {
                     kind,
@@ -165,13 +183,16 @@ impl AccelSpec {
         }
         match key {
             "leaf" => {
-                let hi = if qbvh {
+                let hi = if wide {
                     crate::qbvh::MAX_LEAF_TRIANGLES as u32
                 } else {
                     1 << 16
                 };
-                self.build.max_leaf_size =
-                    number(1, hi, "leaf size must be 1 to 16 (qbvh) or 65536 (bvh)")? as usize;
+                self.build.max_leaf_size = number(
+                    1,
+                    hi,
+                    "leaf size must be 1 to 16 (qbvh, bvh8) or 65536 (bvh)",
+                )? as usize;
             }
             "bins" => {
                 self.build.bins =
@@ -318,6 +339,9 @@ mod tests {
             "qbvh:icost=0.5",
             "bvh:icost=0.3",
             "qbvh:leaf=8:order=unsorted:shadow-cache:isect=hybrid:lazy",
+            "bvh8",
+            "bvh8:leaf=8:evh=14:tstack:shadow-cache",
+            "bvh8:order=split",
         ] {
             let spec: AccelSpec = s.parse().unwrap();
             assert_eq!(spec.to_string(), s);
@@ -344,6 +368,8 @@ mod tests {
         ));
         assert!(matches!(err("qbvh:tstack=1"), SpecError::BadValue { .. }));
         assert!(matches!(err("qbvh:evh"), SpecError::BadValue { .. }));
+        assert!(matches!(err("bvh8:lazy"), SpecError::NotApplicable { .. }));
+        assert!(matches!(err("bvh8:leaf=17"), SpecError::BadValue { .. }));
         assert!(err("qbvh:leaf=0").to_string().contains("leaf=0"));
     }
 }

@@ -1,17 +1,21 @@
-//! The BVHs (binary and four-wide) must give exactly the brute-force answer: same triangle and bit-identical distance and
+//! The BVHs (binary, four- and eight-wide) must give exactly the brute-force answer: same triangle and bit-identical distance and
 //! barycentrics, or, when several triangles are hit at the identical distance, any of them (see
 //! `common::check_ray` for the precise rule).
 
 mod common;
 
 use common::{soup, Rng};
-use rt_accel::{BuildParams, Bvh2, Qbvh};
+use rt_accel::{BuildParams, Bvh2, Bvh8, Qbvh};
 
-/// The soup check for both structures.
+/// The soup check for the three structures.
 fn check_soup(seed: u64, n_tris: usize, n_rays: usize, params: &BuildParams) -> usize {
     let hits = common::check_soup::<Bvh2>(seed, n_tris, n_rays, params);
     assert_eq!(
         common::check_soup::<Qbvh>(seed, n_tris, n_rays, params),
+        hits
+    );
+    assert_eq!(
+        common::check_soup::<Bvh8>(seed, n_tris, n_rays, params),
         hits
     );
     hits

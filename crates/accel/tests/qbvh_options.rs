@@ -1,5 +1,5 @@
-//! Every QBVH traversal option gives the brute-force answer, and the shadow cache never
-//! changes a visibility answer.
+//! Every traversal option of the wide BVHs (QBVH and BVH8) gives the brute-force answer, and
+//! the shadow cache never changes a visibility answer.
 
 mod common;
 
@@ -8,7 +8,7 @@ use glam::Vec3;
 use rt_accel::{AccelSpec, BruteForce};
 use rt_core::{Accel, Ray};
 
-const SPECS: [&str; 13] = [
+const SPECS: [&str; 19] = [
     "qbvh",
     "qbvh:order=distance",
     "qbvh:order=unsorted",
@@ -22,6 +22,12 @@ const SPECS: [&str; 13] = [
     "qbvh:evh=20",
     "qbvh:evh=14:compact",
     "qbvh:bbah=12:compact",
+    "bvh8",
+    "bvh8:order=split",
+    "bvh8:order=unsorted:tstack",
+    "bvh8:shadow-cache",
+    "bvh8:leaf=1",
+    "bvh8:evh=14:compact",
 ];
 
 #[test]
@@ -57,19 +63,22 @@ fn every_option_matches_brute_force() {
 /// renderer issues them), so the cache is really used: every answer equals brute force.
 #[test]
 fn shadow_cache_never_changes_an_answer() {
+    for (spec, other_spec) in [
+        ("qbvh:shadow-cache", "qbvh:shadow-cache"),
+        ("bvh8:shadow-cache", "qbvh:shadow-cache"),
+    ] {
+        shadow_cache_matches_brute_force(spec, other_spec);
+    }
+}
+
+fn shadow_cache_matches_brute_force(spec: &str, other_spec: &str) {
     let mut rng = Rng::new(4242);
     let tris = soup(&mut rng, 300);
-    let cached = "qbvh:shadow-cache"
-        .parse::<AccelSpec>()
-        .unwrap()
-        .build(&tris);
+    let cached = spec.parse::<AccelSpec>().unwrap().build(&tris);
     // A second cached structure queried on the same thread, interleaved: tables must not
     // leak node indices between structures.
     let other_tris = soup(&mut rng, 500);
-    let other = "qbvh:shadow-cache"
-        .parse::<AccelSpec>()
-        .unwrap()
-        .build(&other_tris);
+    let other = other_spec.parse::<AccelSpec>().unwrap().build(&other_tris);
     let oracle = BruteForce::new(&tris);
     let other_oracle = BruteForce::new(&other_tris);
     let lights: Vec<Vec3> = (0..4).map(|_| rng.unit_vec() * 3.0).collect();
@@ -100,12 +109,15 @@ fn shadow_cache_never_changes_an_answer() {
 /// Several threads share one structure, each with its own table.
 #[test]
 fn shadow_cache_is_per_thread() {
+    for spec in ["qbvh:shadow-cache", "bvh8:shadow-cache"] {
+        shadow_cache_per_thread_matches_brute_force(spec);
+    }
+}
+
+fn shadow_cache_per_thread_matches_brute_force(spec: &str) {
     let mut rng = Rng::new(777);
     let tris = soup(&mut rng, 2000);
-    let cached = "qbvh:shadow-cache"
-        .parse::<AccelSpec>()
-        .unwrap()
-        .build(&tris);
+    let cached = spec.parse::<AccelSpec>().unwrap().build(&tris);
     let oracle = BruteForce::new(&tris);
     std::thread::scope(|s| {
         for t in 0..4u64 {
@@ -144,7 +156,11 @@ fn crack_free_leaves_hit_closed_meshes() {
             }
         })
         .collect();
-    for spec in ["qbvh:isect=subdivision", "qbvh:isect=hybrid"] {
+    for spec in [
+        "qbvh:isect=subdivision",
+        "qbvh:isect=hybrid",
+        "bvh8:isect=subdivision",
+    ] {
         let accel = spec.parse::<AccelSpec>().unwrap().build(&tris);
         for &p in &targets {
             // From outside, well away from grazing (a grazing ray may pass an ulp beside

@@ -7,7 +7,7 @@ mod common;
 use common::{check_ray, rays, shared_mesh, Agreement, Rng};
 use rt_accel::{AccelSpec, BruteForce};
 
-const SPECS: [&str; 9] = [
+const SPECS: [&str; 11] = [
     "bvh",
     "qbvh",
     "qbvh:order=distance",
@@ -16,6 +16,8 @@ const SPECS: [&str; 9] = [
     "qbvh:bbah=12:compact",
     "qbvh:shadow-cache",
     "qbvh:lazy",
+    "bvh8",
+    "bvh8:order=split:shadow-cache",
     "bvh:evh=14",
 ];
 

@@ -11,7 +11,7 @@ use common::{
 };
 use glam::{Quat, Vec3};
 use rt_accel::bvh2::{split_pieces, split_references};
-use rt_accel::{BuildParams, Bvh2, Qbvh, Split};
+use rt_accel::{BuildParams, Bvh2, Bvh8, Qbvh, Split};
 use rt_core::{Aabb, Accel, Ray};
 use std::collections::{HashMap, HashSet};
 
@@ -93,6 +93,8 @@ fn evh_keeps_closed_meshes_watertight() {
         // The QBVH collapsed from the split tree keeps the pieces' boxes.
         let qbvh = Qbvh::from_bvh2(&bvh);
         qbvh.validate().unwrap();
+        let bvh8 = Bvh8::from_bvh2(&bvh);
+        bvh8.validate().unwrap();
         let mut rng = Rng::new(11);
         for mesh in &meshes {
             mesh.assert_closed();
@@ -100,7 +102,7 @@ fn evh_keeps_closed_meshes_watertight() {
                 .iter()
                 .enumerate()
             {
-                for accel in [&bvh as &dyn Accel, &qbvh] {
+                for accel in [&bvh as &dyn Accel, &qbvh, &bvh8] {
                     let hit = accel.intersect(ray, f32::INFINITY);
                     assert!(
                         hit.is_some_and(|h| h.t <= 1.0 + 1e-3),

@@ -13,7 +13,7 @@ mod common;
 
 use common::{grid_cube, icosphere, rotation, torus, Mesh, Rng};
 use glam::Vec3;
-use rt_accel::{BuildParams, Bvh2, Qbvh};
+use rt_accel::{BuildParams, Bvh2, Bvh8, Qbvh};
 use rt_core::{triangle::geometric_normal, Accel, Ray};
 
 const RAYS_PER_MESH: usize = 200_000;
@@ -50,7 +50,9 @@ fn fire(mesh: &Mesh, seed: u64, aim: Aim) {
     bvh.validate().unwrap();
     let qbvh = Qbvh::from_bvh2(&bvh);
     qbvh.validate().unwrap();
-    let accels: [&dyn Accel; 2] = [&bvh, &qbvh];
+    let bvh8 = Bvh8::from_bvh2(&bvh);
+    bvh8.validate().unwrap();
+    let accels: [&dyn Accel; 3] = [&bvh, &qbvh, &bvh8];
     let radius = bvh.bounds().bounding_radius();
     let mut rng = Rng::new(seed);
     let mut fired = 0;

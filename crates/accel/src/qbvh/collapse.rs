@@ -1,7 +1,8 @@
-//! Collapsing a binary BVH into a four-wide one, and packing its leaves four triangles wide.
+//! Collapsing a binary BVH into a wide one, and packing its leaves four triangles wide.
 
-use super::node::{leaf_code, QNode, MAX_LEAF_TRIANGLES, NO_AXES, NO_AXIS, NO_PARENT};
+use super::node::{leaf_code, MAX_LEAF_TRIANGLES, NO_AXES, NO_AXIS, NO_PARENT};
 use super::tri4::Tri4;
+use super::wide::{order_word, WideNode};
 use crate::bvh2::Node;
 use glam::Vec3;
 use rt_core::Aabb;
@@ -15,11 +16,15 @@ enum Src {
     Run(usize, usize),
 }
 
+/// Most children of a node, and so most binary levels above one of its slots (a node of
+/// eight slots made by expanding one chain).
+const MAX_WIDTH: usize = 8;
+
 /// The binary splits above one slot of a node: level `i` split along `axes[i]`, and the slot
 /// lies on its high side when bit `i` of `high` is set.
 #[derive(Clone, Copy, Default)]
 struct Path {
-    axes: [u32; 3],
+    axes: [u32; MAX_WIDTH - 1],
     high: u8,
     len: u8,
 }
@@ -41,48 +46,50 @@ impl Path {
             let negative = (octant >> self.axes[i]) & 1 == 1;
             let near_is_high = negative;
             let high = (self.high >> i) & 1 == 1;
-            k | (u8::from(high != near_is_high) << (2 - i))
+            k | (u8::from(high != near_is_high) << (MAX_WIDTH - 2 - i))
         })
     }
 }
 
-/// `QNode::orders` for slots with the given paths (the remaining slots are empty).
-fn orders(paths: &[Path]) -> [u8; 8] {
+/// The order words ([`WideNode::order`]) of a node of `width` slots whose first slots have
+/// the given paths (the remaining slots are empty and come last).
+fn orders(paths: &[Path], width: usize, bits: u32) -> [u32; 8] {
     std::array::from_fn(|octant| {
-        let mut slots = [0usize, 1, 2, 3];
+        let mut slots: [usize; MAX_WIDTH] = std::array::from_fn(|s| s);
         slots[..paths.len()].sort_by_key(|&s| paths[s].key(octant));
-        slots
-            .iter()
-            .enumerate()
-            .fold(0, |o, (rank, &s)| o | ((s as u8) << (2 * rank)))
+        order_word(&slots[..width], bits)
     })
 }
 
 /// The output of [`collapse`].
-pub(crate) struct Collapsed {
-    pub nodes: Vec<QNode>,
+pub(crate) struct Collapsed<N> {
+    pub nodes: Vec<N>,
     pub packets: Vec<Tri4>,
     pub packet_ids: Vec<[u32; 4]>,
 }
 
-struct Collapser<'a> {
+struct Collapser<'a, N> {
     bin: &'a [Node],
     triangles: &'a [[Vec3; 3]],
     ids: &'a [u32],
-    out: Collapsed,
+    out: Collapsed<N>,
 }
 
 /// Collapses the binary `nodes` (root first) over the leaf-ordered `triangles` with caller
 /// indices `ids`. Every binary leaf becomes one leaf code; a leaf of more than
 /// [`MAX_LEAF_TRIANGLES`] triangles becomes a small subtree of leaf codes over consecutive runs.
 /// Empty input gives no nodes.
-pub(crate) fn collapse(nodes: &[Node], triangles: &[[Vec3; 3]], ids: &[u32]) -> Collapsed {
+pub(crate) fn collapse<N: WideNode>(
+    nodes: &[Node],
+    triangles: &[[Vec3; 3]],
+    ids: &[u32],
+) -> Collapsed<N> {
     let mut c = Collapser {
         bin: nodes,
         triangles,
         ids,
         out: Collapsed {
-            nodes: Vec::with_capacity(nodes.len() / 3 + 1),
+            nodes: Vec::with_capacity(nodes.len() / (N::WIDTH - 1) + 1),
             packets: Vec::with_capacity(triangles.len() / 3 + 1),
             packet_ids: Vec::with_capacity(triangles.len() / 3 + 1),
         },
@@ -113,23 +120,21 @@ fn split_axis(a: &Aabb, b: &Aabb) -> (u32, bool) {
     (axis as u32, ca[axis] > cb[axis])
 }
 
-impl Collapser<'_> {
+impl<N: WideNode> Collapser<'_, N> {
     /// Makes the node for the inner binary node `b`: starting from its two children, replaces
-    /// the inner one of largest surface area by its two children, in place, until there are four
-    /// or only leaves are left. Returns the new node's index.
+    /// the inner one of largest surface area by its two children, in place, until there are
+    /// `N::WIDTH` or only leaves are left. Returns the new node's index.
     fn collapse_inner(&mut self, b: usize, parent: u32) -> u32 {
         let bx = |i: usize| self.bin[i].aabb();
         let [l, r] = self.bin[b].children().expect("inner node");
         let (axis, l_high) = split_axis(&bx(l), &bx(r));
-        let mut list = [l, r, 0, 0];
-        let mut paths = [
-            Path::default().child(axis, l_high),
-            Path::default().child(axis, !l_high),
-            Path::default(),
-            Path::default(),
-        ];
+        let mut list = [0; MAX_WIDTH];
+        let mut paths = [Path::default(); MAX_WIDTH];
+        (list[0], list[1]) = (l, r);
+        paths[0] = Path::default().child(axis, l_high);
+        paths[1] = Path::default().child(axis, !l_high);
         let mut len = 2;
-        while len < 4 {
+        while len < N::WIDTH {
             let best = (0..len)
                 .filter(|&k| !self.bin[list[k]].is_leaf())
                 .max_by(|&x, &y| {
@@ -150,22 +155,24 @@ impl Collapser<'_> {
         }
         let mut axes = paths[0].axes[0] | (NO_AXIS << 2) | (NO_AXIS << 4);
         if let (Some([ll, lr]), Some([rl, rr])) = (self.bin[l].children(), self.bin[r].children()) {
-            if list == [ll, lr, rl, rr] {
+            if len == 4 && list[..4] == [ll, lr, rl, rr] {
                 axes = (axes & 3) | (paths[0].axes[1] << 2) | (paths[2].axes[1] << 4);
             }
         }
         let srcs: Vec<Src> = list[..len].iter().map(|&i| Src::Bin(i)).collect();
-        self.emit(&srcs, axes, parent, Some(orders(&paths[..len])))
+        let orders = orders(&paths[..len], N::WIDTH, N::ORDER_BITS);
+        self.emit(&srcs, axes, parent, Some(orders))
     }
 
-    /// Appends a node with one slot per entry of `srcs` (at most four), making the nodes below
-    /// it depth first. Returns its index.
-    fn emit(&mut self, srcs: &[Src], axes: u32, parent: u32, orders: Option<[u8; 8]>) -> u32 {
-        debug_assert!(srcs.len() <= 4);
+    /// Appends a node with one slot per entry of `srcs` (at most `N::WIDTH`), making the nodes
+    /// below it depth first. Returns its index.
+    fn emit(&mut self, srcs: &[Src], axes: u32, parent: u32, orders: Option<[u32; 8]>) -> u32 {
+        debug_assert!(srcs.len() <= N::WIDTH);
         let index = self.out.nodes.len() as u32;
-        let mut node = QNode::new(parent, axes);
+        let mut node = N::empty(parent);
+        node.set_axes(axes);
         if let Some(o) = orders {
-            node.orders = o;
+            node.set_orders(o);
         }
         self.out.nodes.push(node);
         for (slot, &src) in srcs.iter().enumerate() {
@@ -191,7 +198,7 @@ impl Collapser<'_> {
     }
 
     /// The child code for triangle slots `first..first + count`: a leaf code over newly packed
-    /// packets, or a node over four runs if they do not fit in one.
+    /// packets, or a node over `N::WIDTH` runs if they do not fit in one.
     fn leaf(&mut self, first: usize, count: usize, parent: u32) -> u32 {
         if count <= MAX_LEAF_TRIANGLES {
             let packet = self.out.packets.len();
@@ -206,7 +213,7 @@ impl Collapser<'_> {
             }
             return leaf_code(packet, count);
         }
-        let step = count.div_ceil(4);
+        let step = count.div_ceil(N::WIDTH);
         let runs: Vec<Src> = (first..first + count)
             .step_by(step)
             .map(|s| Src::Run(s, step.min(first + count - s)))
@@ -231,8 +238,8 @@ mod tests {
             root_hi.child(2, false),
             root_hi.child(2, true),
         ];
-        let o = orders(&paths);
-        let decode = |b: u8| [0, 2, 4, 6].map(|s| (b >> s) & 3);
+        let o = orders(&paths, 4, 2);
+        let decode = |b: u32| [0, 2, 4, 6].map(|s| (b >> s) & 3);
         // All positive: low x first; within it low y (slot 1) first; then low z (slot 2).
         assert_eq!(decode(o[0]), [1, 0, 2, 3]);
         // Negative x: the high pair first.
@@ -240,7 +247,7 @@ mod tests {
         // Negative y and z.
         assert_eq!(decode(o[0b110]), [0, 1, 3, 2]);
         // Three slots: the unused slot 3 comes last.
-        let o = orders(&paths[..2]);
+        let o = orders(&paths[..2], 4, 2);
         assert_eq!(decode(o[0]), [1, 0, 2, 3]);
     }
 }

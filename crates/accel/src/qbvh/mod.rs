@@ -1,22 +1,31 @@
-//! Four-wide BVH (QBVH) made by collapsing a [`Bvh2`], after Dammertz et al., "Shallow Bounding
-//! Volume Hierarchies for Fast SIMD Ray Tracing of Incoherent Rays" (EGSR 2008).
+//! Wide BVHs made by collapsing a [`Bvh2`]: the four-wide QBVH of Dammertz et al., "Shallow
+//! Bounding Volume Hierarchies for Fast SIMD Ray Tracing of Incoherent Rays" (EGSR 2008), and
+//! its eight-wide sibling.
 //!
 //! Each [`QNode`] holds the boxes of up to four children in structure-of-arrays layout, so one
 //! ray is tested against all four with one SIMD slab test (SSE2 on x86_64, a scalar loop
-//! elsewhere). Leaves are encoded inline in the child codes and refer to the binary BVH's
-//! leaf-ordered triangle copy; a binary leaf becomes a QBVH leaf unchanged.
+//! elsewhere); a [`Node8`] holds eight, tested with one AVX2 instruction per plane where the CPU
+//! has AVX2 (two SSE2 halves otherwise). Leaves are encoded inline in the child codes and hold
+//! the binary BVH's leaf-ordered triangles, swizzled four to a [`Tri4`] packet.
+//!
+//! [`WideBvh`] is generic over the node ([`WideNode`]): [`Qbvh`] and [`Bvh8`] share the
+//! collapse, the traversal loop, the shadow cache and the validator.
 
 mod collapse;
 mod node;
+mod node8;
 mod options;
 mod shadow_cache;
 mod traverse;
 mod tri4;
 mod validate;
+mod wide;
 
 pub use node::{QChild, QNode, EMPTY, LEAF_BIT, MAX_LEAF_TRIANGLES, MAX_TRIANGLES, NO_AXIS};
+pub use node8::Node8;
 pub use options::{Order, QbvhOptions, TriangleTest, DEFAULT_INTERSECTION_COST, DEFAULT_LEAF_SIZE};
 pub use tri4::Tri4;
+pub use wide::{Avx2, Baseline, Isa, WideNode};
 
 use crate::traversal::{Counter, NoCount};
 use crate::{BuildParams, Bvh2};
@@ -24,24 +33,30 @@ use glam::Vec3;
 use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
 use traverse::{DISTANCE, SPLIT_PLANE, UNSORTED};
 
-/// A four-wide bounding volume hierarchy over triangles.
+/// A four-wide bounding volume hierarchy over triangles (Dammertz's QBVH).
+pub type Qbvh = WideBvh<QNode>;
+
+/// An eight-wide bounding volume hierarchy over triangles.
+pub type Bvh8 = WideBvh<Node8>;
+
+/// A bounding volume hierarchy whose nodes have up to `N::WIDTH` children: [`Qbvh`] or [`Bvh8`].
 #[derive(Clone, Debug)]
-pub struct Qbvh {
-    nodes: Vec<QNode>,
+pub struct WideBvh<N: WideNode> {
+    nodes: Vec<N>,
     packets: Vec<Tri4>,
     packet_ids: Vec<[u32; 4]>,
     references: usize,
     /// Built from split references: a leaf box may bound only a piece of a triangle.
     split: bool,
     bounds: Aabb,
-    /// The CPU has AVX2: traversal runs a copy compiled for it.
-    avx2: bool,
+    /// Set when the CPU has AVX2: traversal then runs a copy compiled for it.
+    avx2: Option<Avx2>,
     /// Tags this structure's entries in the per-thread shadow-cache tables.
     id: u64,
     options: QbvhOptions,
 }
 
-impl Qbvh {
+impl<N: WideNode> WideBvh<N> {
     /// Builds a [`Bvh2`] over `triangles` with `params` and collapses it.
     ///
     /// # Panics
@@ -73,7 +88,7 @@ impl Qbvh {
 
     /// Collapses `bvh`: every node takes the two children of its binary node and then
     /// repeatedly replaces the inner child of largest surface area by that child's two
-    /// children, until it has four children or only leaves. Triangles and prim ids are copied.
+    /// children, until it has `N::WIDTH` children or only leaves. Triangles and prim ids are copied.
     ///
     /// # Panics
     ///
@@ -84,7 +99,7 @@ impl Qbvh {
             "Qbvh supports fewer than 2^27 triangles, got {}",
             bvh.triangles().len()
         );
-        let c = collapse::collapse(bvh.nodes(), bvh.triangles(), bvh.prim_ids());
+        let c = collapse::collapse::<N>(bvh.nodes(), bvh.triangles(), bvh.prim_ids());
         Self {
             nodes: c.nodes,
             packets: c.packets,
@@ -92,18 +107,15 @@ impl Qbvh {
             references: bvh.triangles().len(),
             split: bvh.is_split(),
             bounds: bvh.bounds(),
-            #[cfg(target_arch = "x86_64")]
-            avx2: std::is_x86_feature_detected!("avx2"),
-            #[cfg(not(target_arch = "x86_64"))]
-            avx2: false,
+            avx2: Avx2::detect(),
             id: shadow_cache::new_id(),
-            options: QbvhOptions::default(),
+            options: QbvhOptions::defaults_for::<N>(),
         }
     }
 
     /// The nodes, root first; empty for an empty scene. The root always has a node, even when
     /// the whole scene is one leaf.
-    pub fn nodes(&self) -> &[QNode] {
+    pub fn nodes(&self) -> &[N] {
         &self.nodes
     }
 
@@ -134,15 +146,20 @@ impl Qbvh {
         c: &mut C,
     ) -> Option<Hit> {
         #[cfg(target_arch = "x86_64")]
-        if self.avx2 {
-            // SAFETY: `avx2` is set only when `is_x86_feature_detected!("avx2")` said so.
+        if let Some(avx2) = self.avx2 {
+            // SAFETY: `Avx2::detect` made `avx2`, so the CPU has AVX2.
             #[allow(unsafe_code)]
-            return unsafe { self.query_avx2::<ANY_HIT, C>(ray, t_max, c) };
+            return unsafe { self.query_avx2::<ANY_HIT, C>(ray, t_max, avx2, c) };
         }
-        self.query_any::<ANY_HIT, C>(ray, t_max, c)
+        self.query_any::<ANY_HIT, _, C>(ray, t_max, Baseline, c)
     }
 
-    /// [`Qbvh::query_any`] compiled with AVX2 enabled: the same SSE2 code, VEX-encoded.
+    /// [`WideBvh::query_any`] compiled with AVX2 enabled: the eight-wide box test in one
+    /// register, and the four-wide code VEX-encoded.
+    ///
+    /// # Safety
+    ///
+    /// The CPU must support AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
     #[allow(unsafe_code)]
@@ -150,36 +167,46 @@ impl Qbvh {
         &self,
         ray: &Ray,
         t_max: f32,
+        avx2: Avx2,
         c: &mut C,
     ) -> Option<Hit> {
-        self.query_any::<ANY_HIT, C>(ray, t_max, c)
+        self.query_any::<ANY_HIT, _, C>(ray, t_max, avx2, c)
     }
 
     #[inline(always)]
-    fn query_any<const ANY_HIT: bool, C: Counter>(
+    fn query_any<const ANY_HIT: bool, I: Isa, C: Counter>(
         &self,
         ray: &Ray,
         t_max: f32,
+        isa: I,
         c: &mut C,
     ) -> Option<Hit> {
         match (self.options.order, self.options.t_stack) {
             (Order::SplitPlane, false) => {
-                self.traverse::<ANY_HIT, SPLIT_PLANE, false, C>(ray, t_max, c)
+                self.traverse::<ANY_HIT, SPLIT_PLANE, false, I, C>(ray, t_max, isa, c)
             }
             (Order::SplitPlane, true) => {
-                self.traverse::<ANY_HIT, SPLIT_PLANE, true, C>(ray, t_max, c)
+                self.traverse::<ANY_HIT, SPLIT_PLANE, true, I, C>(ray, t_max, isa, c)
             }
-            (Order::Distance, false) => self.traverse::<ANY_HIT, DISTANCE, false, C>(ray, t_max, c),
-            (Order::Distance, true) => self.traverse::<ANY_HIT, DISTANCE, true, C>(ray, t_max, c),
-            (Order::Unsorted, false) => self.traverse::<ANY_HIT, UNSORTED, false, C>(ray, t_max, c),
-            (Order::Unsorted, true) => self.traverse::<ANY_HIT, UNSORTED, true, C>(ray, t_max, c),
+            (Order::Distance, false) => {
+                self.traverse::<ANY_HIT, DISTANCE, false, I, C>(ray, t_max, isa, c)
+            }
+            (Order::Distance, true) => {
+                self.traverse::<ANY_HIT, DISTANCE, true, I, C>(ray, t_max, isa, c)
+            }
+            (Order::Unsorted, false) => {
+                self.traverse::<ANY_HIT, UNSORTED, false, I, C>(ray, t_max, isa, c)
+            }
+            (Order::Unsorted, true) => {
+                self.traverse::<ANY_HIT, UNSORTED, true, I, C>(ray, t_max, isa, c)
+            }
         }
     }
 }
 
-impl Accel for Qbvh {
+impl<N: WideNode> Accel for WideBvh<N> {
     fn name(&self) -> &str {
-        "qbvh"
+        N::NAME
     }
 
     fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {

@@ -1,5 +1,8 @@
 //! The 128-byte QBVH node and its child encoding.
 
+use super::traverse::Slab;
+use super::wide::{Isa, WideNode};
+use super::Order;
 use glam::Vec3;
 use rt_core::Aabb;
 use std::ops::Range;
@@ -109,62 +112,46 @@ pub(crate) fn leaf_range(code: u32) -> Range<usize> {
     4 * first..4 * first + count
 }
 
+/// Decodes a child code (see [`QNode`]).
+#[inline]
+pub(crate) fn decode(code: u32) -> QChild {
+    match code {
+        EMPTY => QChild::Empty,
+        c if c & LEAF_BIT != 0 => QChild::Leaf(leaf_range(c)),
+        c => QChild::Inner(c as usize),
+    }
+}
+
+/// Writes box `b` into lane `slot` of structure-of-arrays `bounds`.
+#[inline]
+pub(crate) fn set_bounds<const W: usize>(bounds: &mut [[f32; W]; 6], slot: usize, b: Aabb) {
+    let v = [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z];
+    for (plane, value) in bounds.iter_mut().zip(v) {
+        plane[slot] = value;
+    }
+}
+
+/// Reads lane `slot` of structure-of-arrays `bounds`.
+#[inline]
+pub(crate) fn get_bounds<const W: usize>(bounds: &[[f32; W]; 6], slot: usize) -> Aabb {
+    let b = bounds;
+    Aabb::new(
+        Vec3::new(b[0][slot], b[1][slot], b[2][slot]),
+        Vec3::new(b[3][slot], b[4][slot], b[5][slot]),
+    )
+}
+
+/// Boxes of `W` empty slots: inverted, so no ray enters them.
+pub(crate) fn empty_bounds<const W: usize>() -> [[f32; W]; 6] {
+    let (lo, hi) = ([f32::INFINITY; W], [f32::NEG_INFINITY; W]);
+    [lo, lo, lo, hi, hi, hi]
+}
+
 impl QNode {
-    pub(crate) fn new(parent: u32, axes: u32) -> Self {
-        Self {
-            bounds: [
-                [f32::INFINITY; 4],
-                [f32::INFINITY; 4],
-                [f32::INFINITY; 4],
-                [f32::NEG_INFINITY; 4],
-                [f32::NEG_INFINITY; 4],
-                [f32::NEG_INFINITY; 4],
-            ],
-            children: [EMPTY; 4],
-            axes,
-            parent,
-            orders: [IDENTITY_ORDER; 8],
-        }
-    }
-
-    pub(crate) fn set(&mut self, slot: usize, b: Aabb, code: u32) {
-        let v = [b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z];
-        for (plane, value) in self.bounds.iter_mut().zip(v) {
-            plane[slot] = value;
-        }
-        self.children[slot] = code;
-    }
-
-    /// The box of slot `slot` (inverted for an empty slot).
-    #[inline]
-    pub fn child_aabb(&self, slot: usize) -> Aabb {
-        let b = &self.bounds;
-        Aabb::new(
-            Vec3::new(b[0][slot], b[1][slot], b[2][slot]),
-            Vec3::new(b[3][slot], b[4][slot], b[5][slot]),
-        )
-    }
-
-    /// The decoded child in slot `slot`.
-    #[inline]
-    pub fn child(&self, slot: usize) -> QChild {
-        match self.children[slot] {
-            EMPTY => QChild::Empty,
-            c if c & LEAF_BIT != 0 => QChild::Leaf(leaf_range(c)),
-            c => QChild::Inner(c as usize),
-        }
-    }
-
     /// The raw child codes (see the type's documentation).
     #[inline]
     pub fn child_codes(&self) -> [u32; 4] {
         self.children
-    }
-
-    /// Number of non-empty slots.
-    #[inline]
-    pub fn occupied(&self) -> usize {
-        self.children.iter().filter(|&&c| c != EMPTY).count()
     }
 
     /// `[axis0, axis1, axis2]`, each 0, 1, 2 or [`NO_AXIS`].
@@ -177,14 +164,64 @@ impl QNode {
     /// when the direction is negative along axis `a`).
     #[inline]
     pub fn slot_order(&self, octant: usize) -> [usize; 4] {
-        let o = self.orders[octant];
-        [0, 2, 4, 6].map(|s| usize::from((o >> s) & 3))
+        std::array::from_fn(|rank| self.slot_at(octant, rank))
+    }
+}
+
+impl WideNode for QNode {
+    const WIDTH: usize = 4;
+    const NAME: &'static str = "qbvh";
+    const DEFAULT_ORDER: Order = Order::SplitPlane;
+    const ORDER_BITS: u32 = 2;
+    const IDENTITY_ORDER: u32 = IDENTITY_ORDER as u32;
+    type Dists = [f32; 4];
+
+    fn empty(parent: u32) -> Self {
+        Self {
+            bounds: empty_bounds(),
+            children: [EMPTY; 4],
+            axes: NO_AXES,
+            parent,
+            orders: [IDENTITY_ORDER; 8],
+        }
     }
 
-    /// Index of the parent node, `None` for the root.
+    fn set(&mut self, slot: usize, b: Aabb, code: u32) {
+        set_bounds(&mut self.bounds, slot, b);
+        self.children[slot] = code;
+    }
+
+    fn set_orders(&mut self, orders: [u32; 8]) {
+        self.orders = orders.map(|o| o as u8);
+    }
+
+    fn set_axes(&mut self, axes: u32) {
+        self.axes = axes;
+    }
+
+    #[inline(always)]
+    fn code(&self, slot: usize) -> u32 {
+        self.children[slot]
+    }
+
+    #[inline(always)]
+    fn order(&self, octant: usize) -> u32 {
+        u32::from(self.orders[octant])
+    }
+
+    #[inline(always)]
+    fn parent_code(&self) -> u32 {
+        self.parent
+    }
+
+    #[inline(always)]
+    fn hit<I: Isa>(&self, slab: &Slab, t_max: f32, _isa: I) -> (u32, [f32; 4]) {
+        slab.hit4(&self.bounds, t_max)
+    }
+
     #[inline]
-    pub fn parent(&self) -> Option<usize> {
-        (self.parent != NO_PARENT).then_some(self.parent as usize)
+    fn child_aabb(&self, slot: usize) -> Aabb {
+        get_bounds(&self.bounds, slot)
     }
 }
 
@@ -200,7 +237,8 @@ mod tests {
             assert_eq!(leaf_parts(c), (first, count));
             assert_eq!(leaf_range(c), 4 * first..4 * first + count);
         }
-        let mut n = QNode::new(NO_PARENT, 1 | (2 << 2) | (NO_AXIS << 4));
+        let mut n = QNode::empty(NO_PARENT);
+        n.set_axes(1 | (2 << 2) | (NO_AXIS << 4));
         let b = Aabb::new(Vec3::new(-1.0, -2.0, -3.0), Vec3::new(1.0, 2.0, 3.0));
         n.set(2, b, leaf_code(9, 3));
         n.set(0, b, 17);

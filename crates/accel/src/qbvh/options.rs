@@ -36,7 +36,8 @@ pub enum TriangleTest {
     Hybrid,
 }
 
-/// How a [`Qbvh`](super::Qbvh) is traversed. The defaults are the fastest measured on this
+/// How a [`Qbvh`](super::Qbvh) or [`Bvh8`](super::Bvh8) is traversed. The defaults
+/// ([`QbvhOptions::defaults_for`]; `Default` gives the QBVH's) are the fastest measured on this
 /// project's benchmarks (see `docs/benchmarks.md`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct QbvhOptions {
@@ -50,4 +51,14 @@ pub struct QbvhOptions {
     pub shadow_cache: bool,
     /// The leaf triangle test.
     pub intersection: TriangleTest,
+}
+
+impl QbvhOptions {
+    /// The default options of a wide BVH with nodes `N`: they differ only in the child order.
+    pub fn defaults_for<N: super::WideNode>() -> Self {
+        Self {
+            order: N::DEFAULT_ORDER,
+            ..Self::default()
+        }
+    }
 }

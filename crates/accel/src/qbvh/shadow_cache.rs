@@ -16,10 +16,11 @@
 //! here the grid has 256 cells along the scene's largest extent, so it does not depend on the
 //! scene's units.
 
-use super::node::{QNode, EMPTY, LEAF_BIT, NO_PARENT};
-use super::traverse::{octant, Slab4, STACK_SIZE};
+use super::node::{EMPTY, LEAF_BIT, NO_PARENT};
+use super::traverse::{octant, Slab, STACK_SIZE};
 use super::tri4::RayPrecomp4;
-use super::Qbvh;
+use super::wide::{Avx2, Baseline, Isa, WideNode};
+use super::WideBvh;
 use crate::traversal::{Closest, Counter};
 use glam::Vec3;
 use rt_core::Ray;
@@ -31,7 +32,7 @@ const HASH_SIZE: usize = 4096;
 /// Grid cells along the scene's largest extent.
 const CELLS: f32 = 256.0;
 
-/// Source of [`Qbvh`] identities for tagging tables.
+/// Source of [`WideBvh`] identities for tagging tables.
 static NEXT_ID: AtomicU64 = AtomicU64::new(1);
 
 pub(crate) fn new_id() -> u64 {
@@ -49,7 +50,7 @@ thread_local! {
     };
 }
 
-impl Qbvh {
+impl<N: WideNode> WideBvh<N> {
     /// Table slot of the light-side endpoint `p`.
     fn shadow_hash(&self, p: Vec3) -> usize {
         let extent = self.bounds.max - self.bounds.min;
@@ -73,10 +74,47 @@ impl Qbvh {
         target: Vec3,
         counter: &mut C,
     ) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(avx2) = self.avx2 {
+            // SAFETY: `Avx2::detect` made `avx2`, so the CPU has AVX2.
+            #[allow(unsafe_code)]
+            return unsafe { self.occluded_cached_avx2(ray, t_max, target, avx2, counter) };
+        }
+        self.occluded_cached_on(ray, t_max, target, Baseline, counter)
+    }
+
+    /// [`WideBvh::occluded_cached_on`] compiled with AVX2 enabled.
+    ///
+    /// # Safety
+    ///
+    /// The CPU must support AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[allow(unsafe_code)]
+    unsafe fn occluded_cached_avx2<C: Counter>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        target: Vec3,
+        avx2: Avx2,
+        counter: &mut C,
+    ) -> bool {
+        self.occluded_cached_on(ray, t_max, target, avx2, counter)
+    }
+
+    #[inline(always)]
+    fn occluded_cached_on<I: Isa, C: Counter>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        target: Vec3,
+        isa: I,
+        counter: &mut C,
+    ) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
-        let slab = Slab4::new(ray);
+        let slab = Slab::new(ray);
         counter.boxes(1);
         if slab.hit_box(&self.bounds, t_max).is_none() {
             return false;
@@ -93,12 +131,12 @@ impl Qbvh {
             let mut entry = table.entry[h];
             let mut done = EMPTY;
             loop {
-                let found = self.any_hit_below(entry, done, &slab, &pre, oct, t_max, counter);
+                let found = self.any_hit_below(entry, done, &slab, &pre, oct, t_max, isa, counter);
                 if let Some(owner) = found {
                     table.entry[h] = owner;
                     return true;
                 }
-                let parent = self.nodes[entry as usize].parent;
+                let parent = self.nodes[entry as usize].parent_code();
                 if parent == NO_PARENT {
                     return false;
                 }
@@ -112,14 +150,16 @@ impl Qbvh {
     /// already searched, or [`EMPTY`]). Returns the node whose child slot held the occluding
     /// leaf.
     #[allow(clippy::too_many_arguments)]
-    fn any_hit_below<C: Counter>(
+    #[inline(always)]
+    fn any_hit_below<I: Isa, C: Counter>(
         &self,
         entry: u32,
         done: u32,
-        slab: &Slab4,
+        slab: &Slab,
         pre: &RayPrecomp4,
         oct: usize,
         t_max: f32,
+        isa: I,
         counter: &mut C,
     ) -> Option<u32> {
         // (child code, node holding it)
@@ -131,13 +171,12 @@ impl Qbvh {
         let mut expand = Some(entry);
         loop {
             if let Some(index) = expand.take() {
-                let node: &QNode = &self.nodes[index as usize];
+                let node = &self.nodes[index as usize];
                 counter.boxes(node.occupied() as u64);
-                let (mask, _) = slab.hit4(node, t_max);
-                let order = node.orders[oct];
-                for rank in (0..4).rev() {
-                    let slot = usize::from((order >> (2 * rank)) & 3);
-                    let code = node.children[slot];
+                let (mask, _) = node.hit(slab, t_max, isa);
+                for rank in (0..N::WIDTH).rev() {
+                    let slot = node.slot_at(oct, rank);
+                    let code = node.code(slot);
                     if mask & (1 << slot) != 0 && code != done {
                         stack[sp].write((code, index));
                         sp += 1;

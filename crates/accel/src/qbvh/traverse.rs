@@ -1,9 +1,10 @@
-//! Stack traversal with a four-wide robust slab test, in three child orders, with or without
-//! entry distances on the stack.
+//! Stack traversal of a wide BVH with a robust four- or eight-wide slab test, in three child
+//! orders, with or without entry distances on the stack.
 
-use super::node::{leaf_parts, QNode, EMPTY, IDENTITY_ORDER, LEAF_BIT};
+use super::node::{leaf_parts, EMPTY, LEAF_BIT};
 use super::tri4::{intersect4, RayPrecomp4};
-use super::{Qbvh, TriangleTest};
+use super::wide::{slot_of, Isa, WideNode};
+use super::{TriangleTest, WideBvh};
 use crate::crack_free::{intersect_hybrid, intersect_subdivision, SubdivRay};
 use crate::traversal::{Closest, Counter, FAR_SCALE};
 use rt_core::{Aabb, Hit, Ray};
@@ -12,15 +13,16 @@ use std::mem::MaybeUninit;
 /// Deepest node the traversal stack supports: the binary tree's depth bound (64) plus the
 /// levels that split over-long leaves (at most 12 for 2^27 triangles).
 pub(crate) const MAX_DEPTH: usize = 80;
-/// Traversal pushes at most three entries per inner node on the current path.
-pub(crate) const STACK_SIZE: usize = 3 * MAX_DEPTH + 1;
+/// Traversal pushes at most seven entries (eight-wide nodes) per inner node on the current path.
+pub(crate) const STACK_SIZE: usize = 7 * MAX_DEPTH + 1;
 
 /// Key of a missed or empty slot; sorts after every hit.
 const MISS: u64 = u64::MAX;
 
-/// Per-ray constants of the slab test.
+/// Per-ray constants of the slab test. (`pub` only so that [`WideNode`] may name it; the module
+/// is private.)
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Slab4 {
+pub struct Slab {
     org: [f32; 3],
     /// `1 / dir`; a zero component of either sign becomes an infinity of that sign.
     inv: [f32; 3],
@@ -30,7 +32,7 @@ pub(crate) struct Slab4 {
     far: [usize; 3],
 }
 
-impl Slab4 {
+impl Slab {
     #[inline]
     pub(crate) fn new(ray: &Ray) -> Self {
         let inv = ray.dir.recip().to_array();
@@ -58,24 +60,28 @@ impl Slab4 {
         (t0 <= t1 * FAR_SCALE).then_some(t0)
     }
 
-    /// Entry distances into the four boxes of `node` and the mask of boxes hit, one lane at a
-    /// time. A NaN slab distance (0 * inf: the ray lies in a face plane) leaves the interval
+    /// Entry distances into the `W` boxes of `bounds` (structure of arrays, as in
+    /// [`QNode`](super::QNode)) and the mask of boxes hit, one lane at a time. A NaN slab distance (0 * inf: the ray lies in a face plane) leaves the interval
     /// alone, because `f32::max`/`min` return the non-NaN operand.
     #[cfg_attr(
         all(target_arch = "x86_64", target_feature = "sse2"),
         allow(dead_code) // used by the tests only
     )]
     #[inline(always)]
-    pub(crate) fn hit4_scalar(&self, node: &QNode, t_max: f32) -> (u32, [f32; 4]) {
+    pub(crate) fn hit_scalar<const W: usize>(
+        &self,
+        bounds: &[[f32; W]; 6],
+        t_max: f32,
+    ) -> (u32, [f32; W]) {
         let mut mask = 0;
-        let mut t = [0.0f32; 4];
+        let mut t = [0.0f32; W];
         for (lane, t_lane) in t.iter_mut().enumerate() {
             let mut t0 = 0.0f32;
             let mut t1 = t_max;
             for axis in 0..3 {
                 let o = self.org[axis];
-                let near = (node.bounds[self.near[axis]][lane] - o) * self.inv[axis];
-                let far = (node.bounds[self.far[axis]][lane] - o) * self.inv[axis];
+                let near = (bounds[self.near[axis]][lane] - o) * self.inv[axis];
+                let far = (bounds[self.far[axis]][lane] - o) * self.inv[axis];
                 t0 = t0.max(near);
                 t1 = t1.min(far);
             }
@@ -85,28 +91,35 @@ impl Slab4 {
         (mask, t)
     }
 
-    /// [`Slab4::hit4_scalar`] with SSE2. `maxps`/`minps` return their second operand when the
-    /// comparison is unordered, so the slab distance goes first and a NaN leaves the running
-    /// interval alone, exactly like the scalar code.
+    /// [`Slab::hit_scalar`] over four lanes with SSE2: lanes `lane0..lane0 + 4` of the
+    /// `W`-wide `bounds`. `maxps`/`minps` return their second operand when the comparison is
+    /// unordered, so the slab distance goes first and a NaN leaves the running interval alone,
+    /// exactly like the scalar code.
     #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
     #[allow(unsafe_code)]
     #[inline(always)]
-    pub(crate) fn hit4_sse(&self, node: &QNode, t_max: f32) -> (u32, [f32; 4]) {
+    fn hit4_sse<const W: usize>(
+        &self,
+        bounds: &[[f32; W]; 6],
+        lane0: usize,
+        t_max: f32,
+    ) -> (u32, [f32; 4]) {
         use std::arch::x86_64::*;
+        assert!(lane0 + 4 <= W && lane0.is_multiple_of(4));
         let mut t = [0.0f32; 4];
         // SAFETY: the `cfg` guarantees SSE and SSE2 are enabled for the whole build, which is
-        // all these intrinsics require. `_mm_load_ps` reads 16 bytes from a `[f32; 4]` of
-        // `node.bounds`, which starts at a multiple of 16 bytes from the 64-byte-aligned node,
-        // so the pointer is valid and 16-byte aligned; `_mm_storeu_ps` writes 16 bytes to the
-        // local `[f32; 4]` `t`, which needs no alignment.
+        // all these intrinsics require. `_mm_load_ps` reads lanes `lane0..lane0 + 4` (in range
+        // by the assertion) of a row of `bounds`; node rows are arrays of 4 or 8 `f32` starting
+        // at multiples of 16 bytes in a 64-byte-aligned node, and `lane0` is a multiple of 4, so
+        // the pointer is 16-byte aligned; `_mm_storeu_ps` writes 16 bytes to the local `t`.
         let mask = unsafe {
             let mut t0 = _mm_setzero_ps();
             let mut t1 = _mm_set1_ps(t_max);
             for axis in 0..3 {
                 let o = _mm_set1_ps(self.org[axis]);
                 let inv = _mm_set1_ps(self.inv[axis]);
-                let lo = _mm_load_ps(node.bounds[self.near[axis]].as_ptr());
-                let hi = _mm_load_ps(node.bounds[self.far[axis]].as_ptr());
+                let lo = _mm_load_ps(bounds[self.near[axis]].as_ptr().add(lane0));
+                let hi = _mm_load_ps(bounds[self.far[axis]].as_ptr().add(lane0));
                 let near = _mm_mul_ps(_mm_sub_ps(lo, o), inv);
                 let far = _mm_mul_ps(_mm_sub_ps(hi, o), inv);
                 t0 = _mm_max_ps(near, t0);
@@ -122,15 +135,69 @@ impl Slab4 {
     /// The four-wide test used by traversal: SSE2 on x86_64 (part of its baseline, so no runtime
     /// detection), the scalar loop elsewhere.
     #[inline(always)]
-    pub(crate) fn hit4(&self, node: &QNode, t_max: f32) -> (u32, [f32; 4]) {
+    pub(crate) fn hit4(&self, bounds: &[[f32; 4]; 6], t_max: f32) -> (u32, [f32; 4]) {
         #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
         {
-            self.hit4_sse(node, t_max)
+            self.hit4_sse(bounds, 0, t_max)
         }
         #[cfg(not(all(target_arch = "x86_64", target_feature = "sse2")))]
         {
-            self.hit4_scalar(node, t_max)
+            self.hit_scalar(bounds, t_max)
         }
+    }
+
+    /// The eight-wide test without AVX2: two SSE2 halves on x86_64, the scalar loop elsewhere.
+    #[inline(always)]
+    pub(crate) fn hit8(&self, bounds: &[[f32; 8]; 6], t_max: f32) -> (u32, [f32; 8]) {
+        #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
+        {
+            let (m0, t0) = self.hit4_sse(bounds, 0, t_max);
+            let (m1, t1) = self.hit4_sse(bounds, 4, t_max);
+            let mut t = [0.0; 8];
+            t[..4].copy_from_slice(&t0);
+            t[4..].copy_from_slice(&t1);
+            (m0 | (m1 << 4), t)
+        }
+        #[cfg(not(all(target_arch = "x86_64", target_feature = "sse2")))]
+        {
+            self.hit_scalar(bounds, t_max)
+        }
+    }
+
+    /// [`Slab::hit_scalar`] over eight lanes with one AVX2 register per plane, with the same
+    /// operand order (and so the same NaN handling) as the SSE2 test.
+    ///
+    /// # Safety
+    ///
+    /// The CPU must support AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[allow(unsafe_code)]
+    #[inline]
+    pub(crate) unsafe fn hit8_avx2(&self, bounds: &[[f32; 8]; 6], t_max: f32) -> (u32, [f32; 8]) {
+        use std::arch::x86_64::*;
+        let mut t = [0.0f32; 8];
+        let mut t0 = _mm256_setzero_ps();
+        let mut t1 = _mm256_set1_ps(t_max);
+        for axis in 0..3 {
+            let o = _mm256_set1_ps(self.org[axis]);
+            let inv = _mm256_set1_ps(self.inv[axis]);
+            // SAFETY: each row is an `[f32; 8]`, 32 bytes, read whole without alignment needs.
+            let (lo, hi) = unsafe {
+                (
+                    _mm256_loadu_ps(bounds[self.near[axis]].as_ptr()),
+                    _mm256_loadu_ps(bounds[self.far[axis]].as_ptr()),
+                )
+            };
+            let near = _mm256_mul_ps(_mm256_sub_ps(lo, o), inv);
+            let far = _mm256_mul_ps(_mm256_sub_ps(hi, o), inv);
+            t0 = _mm256_max_ps(near, t0);
+            t1 = _mm256_min_ps(far, t1);
+        }
+        let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(t0, _mm256_mul_ps(t1, _mm256_set1_ps(FAR_SCALE)));
+        // SAFETY: writes 32 bytes to the local `[f32; 8]`, which needs no alignment.
+        unsafe { _mm256_storeu_ps(t.as_mut_ptr(), t0) };
+        (_mm256_movemask_ps(hit) as u32, t)
     }
 }
 
@@ -227,25 +294,32 @@ impl<const TSTACK: bool> Stack<TSTACK> {
     }
 }
 
-impl Qbvh {
+impl<N: WideNode> WideBvh<N> {
     /// The one traversal loop behind every query; `ANY_HIT` returns the first hit found,
-    /// `ORDER` is one of [`UNSORTED`], [`DISTANCE`], [`SPLIT_PLANE`].
+    /// `ORDER` is one of [`UNSORTED`], [`DISTANCE`], [`SPLIT_PLANE`]; `isa` picks the box test.
     ///
-    /// Leaves are tested with [`Qbvh::test_leaf`], which keeps the rule of [`Closest`]: hits are
-    /// tested against the caller's `t_max` and the closest kept with an exact `<`, so the
+    /// Leaves are tested with [`WideBvh::test_leaf`], which keeps the rule of [`Closest`]: hits
+    /// are tested against the caller's `t_max` and the closest kept with an exact `<`, so the
     /// answer does not depend on the order; boxes are culled against the closest hit so far.
     #[inline(always)]
-    pub(crate) fn traverse<const ANY_HIT: bool, const ORDER: u8, const TSTACK: bool, C: Counter>(
+    pub(crate) fn traverse<
+        const ANY_HIT: bool,
+        const ORDER: u8,
+        const TSTACK: bool,
+        I: Isa,
+        C: Counter,
+    >(
         &self,
         ray: &Ray,
         t_max: f32,
+        isa: I,
         counter: &mut C,
     ) -> Option<Hit> {
         let nodes = &self.nodes[..];
         if nodes.is_empty() {
             return None;
         }
-        let slab = Slab4::new(ray);
+        let slab = Slab::new(ray);
         counter.boxes(1);
         slab.hit_box(&self.bounds, t_max)?;
         let pre = RayPrecomp4::new(ray);
@@ -262,13 +336,13 @@ impl Qbvh {
             } else {
                 let node = &nodes[cur as usize];
                 counter.boxes(node.occupied() as u64);
-                let (mask, t) = slab.hit4(node, closest.cull_t);
+                let (mask, t) = node.hit(&slab, closest.cull_t, isa);
                 if mask != 0 {
-                    if ORDER == DISTANCE {
+                    if ORDER == DISTANCE && N::WIDTH == 4 {
                         let mut keys = [MISS; 4];
-                        for lane in 0..4 {
+                        for (lane, k) in keys.iter_mut().enumerate() {
                             if mask & (1 << lane) != 0 {
-                                keys[lane] = key(t[lane], node.children[lane]);
+                                *k = key(t[lane], node.code(lane));
                             }
                         }
                         sort4(&mut keys);
@@ -278,26 +352,47 @@ impl Qbvh {
                             }
                         }
                         cur = keys[0] as u32;
+                    } else if ORDER == DISTANCE {
+                        // Usually two or three of the eight slots are hit: insertion-sort those.
+                        let mut keys = [MISS; 8];
+                        let mut n = 0;
+                        let mut rest = mask;
+                        while rest != 0 {
+                            let lane = rest.trailing_zeros() as usize;
+                            rest &= rest - 1;
+                            let k = key(t[lane], node.code(lane));
+                            let mut i = n;
+                            while i > 0 && keys[i - 1] > k {
+                                keys[i] = keys[i - 1];
+                                i -= 1;
+                            }
+                            keys[i] = k;
+                            n += 1;
+                        }
+                        for &k in keys[1..n].iter().rev() {
+                            stack.push(k as u32, key_t(k));
+                        }
+                        cur = keys[0] as u32;
                     } else {
                         let order = if ORDER == SPLIT_PLANE {
-                            node.orders[oct]
+                            node.order(oct)
                         } else {
-                            IDENTITY_ORDER
+                            N::IDENTITY_ORDER
                         };
                         // Hit slots by rank (bit r: the r-th nearest slot was hit). The
                         // nearest is visited next, the others pushed far to near.
-                        let slot = |rank: u32| usize::from((order >> (2 * rank)) & 3);
-                        let ranks =
-                            (0..4).fold(0u32, |r, rank| r | (((mask >> slot(rank)) & 1) << rank));
+                        let slot = |rank: u32| slot_of(order, N::ORDER_BITS, rank as usize);
+                        let ranks = (0..N::WIDTH as u32)
+                            .fold(0u32, |r, rank| r | (((mask >> slot(rank)) & 1) << rank));
                         let nearest = slot(ranks.trailing_zeros());
                         let mut rest = ranks & (ranks - 1);
                         while rest != 0 {
                             let rank = 31 - rest.leading_zeros();
                             rest &= !(1 << rank);
                             let s = slot(rank);
-                            stack.push(node.children[s], t[s]);
+                            stack.push(node.code(s), t[s]);
                         }
-                        cur = node.children[nearest];
+                        cur = node.code(nearest);
                     }
                     // Empty slots have inverted boxes and never hit, so `cur` is a real child.
                     debug_assert_ne!(cur, EMPTY);
@@ -375,7 +470,9 @@ impl Qbvh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::qbvh::node::{leaf_code, NO_AXES, NO_PARENT};
+    use crate::qbvh::node::{leaf_code, QNode, NO_PARENT};
+    use crate::qbvh::node8::Node8;
+    use crate::qbvh::wide::WideNode;
     use glam::Vec3;
 
     #[test]
@@ -385,9 +482,19 @@ mod tests {
         assert_eq!(k, [1, 3, 5, MISS]);
     }
 
+    /// Compares a SIMD box test's mask and entry distances with the scalar test's.
+    fn same_hits<const W: usize>(want: (u32, [f32; W]), got: (u32, [f32; W])) {
+        assert_eq!(got.0, want.0);
+        for slot in 0..W {
+            if want.0 & (1 << slot) != 0 {
+                assert_eq!(got.1[slot], want.1[slot]);
+            }
+        }
+    }
+
     #[test]
     #[allow(clippy::needless_range_loop)] // slots index several arrays
-    fn sse_and_scalar_agree() {
+    fn simd_and_scalar_box_tests_agree() {
         let mut s = 0x1234_5678u32;
         let mut rnd = || {
             s ^= s << 13;
@@ -396,12 +503,19 @@ mod tests {
             // Few distinct values so that rays often lie in face planes.
             (s % 9) as f32 * 0.25 - 1.0
         };
+        let avx2 = crate::qbvh::Avx2::detect();
         for _ in 0..20_000 {
-            let mut node = QNode::new(NO_PARENT, NO_AXES);
-            for slot in 0..3 {
+            // Slot 3 of the four-wide node and slot 7 of the eight-wide one stay empty.
+            let mut node = QNode::empty(NO_PARENT);
+            let mut node8 = Node8::empty(NO_PARENT);
+            for slot in 0..7 {
                 let a = Vec3::new(rnd(), rnd(), rnd());
                 let b = Vec3::new(rnd(), rnd(), rnd());
-                node.set(slot, Aabb::new(a.min(b), a.max(b)), leaf_code(slot, 1));
+                let bounds = Aabb::new(a.min(b), a.max(b));
+                if slot < 3 {
+                    node.set(slot, bounds, leaf_code(slot, 1));
+                }
+                node8.set(slot, bounds, leaf_code(slot, 1));
             }
             let mut d = Vec3::new(rnd(), rnd(), rnd());
             for c in 0..3 {
@@ -413,9 +527,9 @@ mod tests {
                 d = Vec3::X;
             }
             let ray = Ray::new(Vec3::new(rnd(), rnd(), rnd()) * 2.0, d);
-            let slab = Slab4::new(&ray);
+            let slab = Slab::new(&ray);
             for t_max in [f32::INFINITY, 1.0] {
-                let (m, t) = slab.hit4_scalar(&node, t_max);
+                let (m, t) = slab.hit_scalar(&node.bounds, t_max);
                 assert_eq!(m & 8, 0, "empty slot hit");
                 for slot in 0..3 {
                     let want = slab.hit_box(&node.child_aabb(slot), t_max);
@@ -424,17 +538,20 @@ mod tests {
                         assert_eq!(w, t[slot]);
                     }
                 }
-                #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
-                {
-                    let (ms, ts) = slab.hit4_sse(&node, t_max);
-                    assert_eq!(ms, m);
-                    for slot in 0..4 {
-                        if m & (1 << slot) != 0 {
-                            assert_eq!(ts[slot], t[slot]);
-                        }
-                    }
+                same_hits((m, t), slab.hit4(&node.bounds, t_max));
+                let want8 = slab.hit_scalar(&node8.bounds, t_max);
+                assert_eq!(want8.0 & 0x80, 0, "empty slot hit");
+                assert_eq!(want8.0 & 7, m & 7);
+                same_hits(want8, slab.hit8(&node8.bounds, t_max));
+                #[cfg(target_arch = "x86_64")]
+                if avx2.is_some() {
+                    // SAFETY: `Avx2::detect` found AVX2.
+                    #[allow(unsafe_code)]
+                    same_hits(want8, unsafe { slab.hit8_avx2(&node8.bounds, t_max) });
                 }
             }
         }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = avx2;
     }
 }

@@ -2,18 +2,19 @@
 
 use super::node::{QChild, EMPTY, NO_PARENT};
 use super::traverse::MAX_DEPTH;
-use super::Qbvh;
+use super::wide::WideNode;
+use super::WideBvh;
 use crate::traversal::inside;
 use rt_core::Aabb;
 
-impl Qbvh {
+impl<N: WideNode> WideBvh<N> {
     /// Checks the invariants traversal relies on: every node is reachable exactly once, inner
     /// children lie after their parent and record it as their parent, every slot box contains
     /// the boxes below it (or, for a leaf, its triangles), empty slots have inverted boxes,
     /// every node's split-plane orders are permutations of its slots, leaves are non-empty and
     /// (unless the build split triangles, when they need only overlap it) lie inside their box,
     /// cover every packet exactly once, lanes a leaf does not fill repeat its last triangle,
-    /// the leaves hold [`Qbvh::reference_count`] references, the root's children lie inside
+    /// the leaves hold [`WideBvh::reference_count`] references, the root's children lie inside
     /// [`Accel::bounds`](rt_core::Accel::bounds), and the depth fits the traversal stack.
     /// Returns the first violation found.
     pub fn validate(&self) -> Result<(), String> {
@@ -31,7 +32,7 @@ impl Qbvh {
                 Err(format!("no nodes for {n_packets} packets"))
             };
         }
-        if self.nodes[0].parent != NO_PARENT {
+        if self.nodes[0].parent_code() != NO_PARENT {
             return Err("root has a parent".into());
         }
 
@@ -49,9 +50,11 @@ impl Qbvh {
             }
             let node = &self.nodes[i];
             for octant in 0..8 {
-                let mut order = node.slot_order(octant);
-                order.sort_unstable();
-                if order != [0, 1, 2, 3] {
+                let mut seen = 0u32;
+                for rank in 0..N::WIDTH {
+                    seen |= 1 << node.slot_at(octant, rank);
+                }
+                if seen != (1 << N::WIDTH) - 1 {
                     return Err(format!(
                         "node {i}: order of octant {octant} is no permutation"
                     ));
@@ -60,9 +63,9 @@ impl Qbvh {
             if node.occupied() == 0 {
                 return Err(format!("node {i} has no children"));
             }
-            for slot in 0..4 {
+            for slot in 0..N::WIDTH {
                 let b = node.child_aabb(slot);
-                if node.children[slot] == EMPTY {
+                if node.code(slot) == EMPTY {
                     let inverted = b.min.cmpeq(glam::Vec3::INFINITY).all()
                         && b.max.cmpeq(glam::Vec3::NEG_INFINITY).all();
                     if !inverted {
@@ -79,7 +82,7 @@ impl Qbvh {
                         if c <= i || c >= self.nodes.len() {
                             return Err(format!("node {i} has child {c} out of order or range"));
                         }
-                        if self.nodes[c].parent != i as u32 {
+                        if self.nodes[c].parent_code() != i as u32 {
                             return Err(format!("node {c} does not name {i} as parent"));
                         }
                         stack.push((c, depth + 1, b));

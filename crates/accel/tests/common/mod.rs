@@ -4,7 +4,7 @@
 
 use glam::{Quat, Vec3};
 use rt_accel::qbvh::QChild;
-use rt_accel::{BruteForce, BuildParams, Bvh2, Qbvh};
+use rt_accel::{BruteForce, BuildParams, Bvh2, WideBvh, WideNode};
 use rt_core::triangle::{intersect_triangle, RayPrecomp};
 use rt_core::{Accel, Hit, Ray, TraversalCounters};
 
@@ -538,17 +538,17 @@ impl Built for Bvh2 {
     }
 }
 
-impl Built for Qbvh {
+impl<N: WideNode> Built for WideBvh<N> {
     fn build(tris: &[[Vec3; 3]], params: &BuildParams) -> Self {
-        Qbvh::build(tris, params)
+        WideBvh::build(tris, params)
     }
     fn validate(&self) -> Result<(), String> {
-        Qbvh::validate(self)
+        WideBvh::validate(self)
     }
     fn references(&self) -> Vec<([Vec3; 3], u32)> {
         self.nodes()
             .iter()
-            .flat_map(|n| (0..4).map(move |s| n.child(s)))
+            .flat_map(|n| (0..N::WIDTH).map(move |s| n.child(s)))
             .filter_map(|c| match c {
                 QChild::Leaf(slots) => Some(slots),
                 _ => None,
