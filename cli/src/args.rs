@@ -18,7 +18,8 @@ pub const DEFAULT_ACCEL: &str = default_accel!();
 ///
 /// Settings come from the command line; any left out fall back to the scene's optional
 /// `[render]` table, then to the defaults shown here. `render bench-accel` measures the
-/// acceleration structures instead (see `render bench-accel --help`).
+/// acceleration structures instead (see `render bench-accel --help`); `render compare A B`
+/// measures the error of image A against the reference B.
 #[derive(Parser, Debug)]
 #[command(
     name = "render",
@@ -129,6 +130,9 @@ pub enum Command {
     /// primary, incoherent (diffuse bounce) and shadow rays, after checking their answers
     /// against the binary BVH (docs/benchmarks.md, "Accel benchmark").
     BenchAccel(crate::bench_accel::BenchArgs),
+    /// Compare image A with the reference B: MSE, relMSE, RMSE, PSNR and SSIM, one `name value`
+    /// per line (or JSON), optionally a false-colour error image (docs/experiments.md).
+    Compare(crate::compare::CompareArgs),
     /// Write a procedural scene's triangles to a Wavefront OBJ file (one `o` per part), e.g.
     /// to benchmark other ray tracers on the same geometry.
     GenScene {
@@ -197,6 +201,18 @@ mod tests {
         assert_eq!(b.threads, Some(2));
         let a = Args::try_parse_from(["render", "gen-scene", "rotated", "-o", "r.obj"]).unwrap();
         assert!(matches!(a.command, Some(Command::GenScene { .. })));
+        let a = Args::try_parse_from(["render", "compare", "a.exr", "b.png", "--json"]).unwrap();
+        let Some(Command::Compare(c)) = &a.command else {
+            panic!("{a:?}")
+        };
+        assert_eq!(
+            (c.test.to_str(), c.reference.to_str()),
+            (Some("a.exr"), Some("b.png"))
+        );
+        assert!(c.json && c.error_image.is_none());
+        assert_eq!((c.epsilon, c.peak), (0.01, 1.0));
+        assert!(Args::try_parse_from(["render", "compare", "a.exr"]).is_err());
+        assert!(Args::try_parse_from(["render", "compare", "a", "b", "--epsilon", "0"]).is_err());
         // The scene is still required without a subcommand.
         assert!(Args::try_parse_from(["render", "--spp", "4"]).is_err());
         let a = Args::try_parse_from(["render", "scene.toml", "-o", "out.exr"]).unwrap();

@@ -28,5 +28,5 @@ pub mod output;
 mod pixel;
 
 pub use film::{AovSet, Film, FilmStripe};
-pub use output::{read_exr, write_image, FilmError, OutputOptions};
+pub use output::{read_exr, write_image, write_rgb, FilmError, OutputOptions};
 pub use pixel::{AovPixel, FirstHit, PixelStats};

@@ -57,7 +57,47 @@ pub fn write_image(path: &Path, film: &Film, opts: &OutputOptions) -> Result<(),
         .map(str::to_ascii_lowercase);
     match ext.as_deref() {
         Some("exr") => write_atomic(path, |w| write_exr(w, film)),
-        Some("png") => write_atomic(path, |w| write_png(w, film, opts)),
+        Some("png") => write_atomic(path, |w| {
+            write_png(w, film.width(), film.height(), &film.mean_image(), opts)
+        }),
+        _ => Err(FilmError::Format(path.to_path_buf())),
+    }
+}
+
+/// Writes a plain linear RGB image (`width × height` pixels, row-major, top row first) to
+/// `path`, by extension: `.exr` (channels `R`, `G`, `B`, linear float) or `.png` (tone mapped as
+/// the film's beauty image). Atomic like [`write_image`]. For images that are not a film, e.g.
+/// error maps.
+pub fn write_rgb(
+    path: &Path,
+    width: usize,
+    height: usize,
+    pixels: &[Rgb],
+    opts: &OutputOptions,
+) -> Result<(), FilmError> {
+    let size = match (u32::try_from(width), u32::try_from(height)) {
+        (Ok(w), Ok(h)) if width.checked_mul(height) == Some(pixels.len()) => (w, h),
+        _ => {
+            return Err(FilmError::Codec {
+                path: path.to_path_buf(),
+                message: format!(
+                    "{} pixels do not make a {width}x{height} image",
+                    pixels.len()
+                ),
+            })
+        }
+    };
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("exr") => write_atomic(path, |w| {
+            let mut chans = Vec::new();
+            rgb_channels(&mut chans, "", ["R", "G", "B"], pixels);
+            write_exr_channels(w, (width, height), chans)
+        }),
+        Some("png") => write_atomic(path, |w| write_png(w, size.0, size.1, pixels, opts)),
         _ => Err(FilmError::Format(path.to_path_buf())),
     }
 }
@@ -151,7 +191,14 @@ fn write_exr(w: &mut BufWriter<File>, film: &Film) -> Result<(), String> {
             &film.variance_image(),
         );
     }
-    let size = (film.width() as usize, film.height() as usize);
+    write_exr_channels(w, (film.width() as usize, film.height() as usize), chans)
+}
+
+fn write_exr_channels(
+    w: &mut BufWriter<File>,
+    size: (usize, usize),
+    chans: Vec<AnyChannel<FlatSamples>>,
+) -> Result<(), String> {
     let layer = Layer::new(
         size,
         LayerAttributes::default(),
@@ -164,10 +211,15 @@ fn write_exr(w: &mut BufWriter<File>, film: &Film) -> Result<(), String> {
         .map_err(|e| e.to_string())
 }
 
-fn write_png(w: &mut BufWriter<File>, film: &Film, opts: &OutputOptions) -> Result<(), String> {
+fn write_png(
+    w: &mut BufWriter<File>,
+    width: u32,
+    height: u32,
+    pixels: &[Rgb],
+    opts: &OutputOptions,
+) -> Result<(), String> {
     let scale = 2f32.powf(opts.exposure);
-    let bytes: Vec<u8> = film
-        .mean_image()
+    let bytes: Vec<u8> = pixels
         .iter()
         .flat_map(|p| p.to_array())
         .map(|v| {
@@ -179,8 +231,7 @@ fn write_png(w: &mut BufWriter<File>, film: &Film, opts: &OutputOptions) -> Resu
             (linear_to_srgb(v) * 255.0 + 0.5) as u8
         })
         .collect();
-    let img = image::RgbImage::from_raw(film.width(), film.height(), bytes)
-        .ok_or("image size mismatch")?;
+    let img = image::RgbImage::from_raw(width, height, bytes).ok_or("image size mismatch")?;
     img.write_to(w, image::ImageFormat::Png)
         .map_err(|e| e.to_string())?;
     w.flush().map_err(|e| e.to_string())
@@ -320,5 +371,23 @@ mod tests {
             &OutputOptions::default(),
         );
         assert!(e.unwrap_err().to_string().contains("nope/a.exr"));
+    }
+
+    #[test]
+    fn plain_rgb_images_round_trip() {
+        let dir = tempfile::tempdir().unwrap();
+        let px: Vec<Rgb> = (0..6).map(|i| Rgb::new(i as f32 / 5.0, 0.5, 1.0)).collect();
+        let opts = OutputOptions::default();
+        write_rgb(&dir.path().join("a.exr"), 3, 2, &px, &opts).unwrap();
+        let img = read_exr(&dir.path().join("a.exr")).unwrap();
+        assert_eq!((img.width, img.height), (3, 2));
+        assert_eq!(img.rgb("").unwrap(), px);
+        write_rgb(&dir.path().join("a.png"), 3, 2, &px, &opts).unwrap();
+        let png = image::open(dir.path().join("a.png")).unwrap().to_rgb8();
+        assert_eq!(png.dimensions(), (3, 2));
+        assert_eq!(png.get_pixel(2, 1).0, [255, 188, 255]);
+        assert!(write_rgb(&dir.path().join("b.png"), 4, 2, &px, &opts).is_err());
+        assert!(write_rgb(&dir.path().join("b.tga"), 3, 2, &px, &opts).is_err());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
     }
 }

@@ -1,0 +1,221 @@
+//! `render compare A B`: how far image A is from the reference B (MSE, relMSE, RMSE, PSNR,
+//! SSIM from `rt-metrics`), printed as `name value` lines or one JSON object, plus an optional
+//! false-colour error image. Definitions: docs/experiments.md.
+
+use crate::load_image::load_rgb;
+use anyhow::{anyhow, Result};
+use rt_metrics::{
+    compare, error_image, CompareOptions, FalseColourOptions, Metrics, MetricsError, Role,
+    DEFAULT_EPSILON, DEFAULT_PEAK,
+};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// `render compare` arguments.
+#[derive(clap::Args, Debug)]
+pub struct CompareArgs {
+    /// The image to measure (.exr, .png or .jpg).
+    #[arg(value_name = "A")]
+    pub test: PathBuf,
+
+    /// The reference (ground truth) A is measured against; relMSE divides by it.
+    #[arg(value_name = "B")]
+    pub reference: PathBuf,
+
+    /// Print one JSON object (keys mse, relmse, rmse, psnr, ssim, relmse_epsilon, psnr_peak;
+    /// psnr is null for identical images) instead of `name value` lines.
+    #[arg(long)]
+    pub json: bool,
+
+    /// Also write a false-colour image of the per-pixel relative squared error (viridis, log
+    /// scale from 1e-4 to 10); .png or .exr.
+    #[arg(long, value_name = "FILE")]
+    pub error_image: Option<PathBuf>,
+
+    /// relMSE's epsilon: the mean of (a-b)^2 / (b^2 + epsilon).
+    #[arg(long, default_value_t = DEFAULT_EPSILON, value_parser = positive)]
+    pub epsilon: f64,
+
+    /// PSNR's peak value: 10 log10(peak^2 / MSE).
+    #[arg(long, default_value_t = DEFAULT_PEAK, value_parser = positive)]
+    pub peak: f64,
+}
+
+fn positive(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err("must be a positive number".into()),
+    }
+}
+
+/// Runs `render compare`.
+pub fn run(args: &CompareArgs) -> Result<()> {
+    let test = load_rgb(&args.test)?;
+    let reference = load_rgb(&args.reference)?;
+    let explain = |e| explain(e, &args.test, &args.reference);
+    let opts = CompareOptions {
+        epsilon: args.epsilon,
+        peak: args.peak,
+    };
+    let metrics = compare(&test, &reference, &opts).map_err(explain)?;
+    if let Some(path) = &args.error_image {
+        let colours = FalseColourOptions {
+            epsilon: args.epsilon,
+            ..Default::default()
+        };
+        let img = error_image(&test, &reference, &colours).map_err(explain)?;
+        rt_film::write_rgb(
+            path,
+            img.width(),
+            img.height(),
+            img.pixels(),
+            &rt_film::OutputOptions::default(),
+        )
+        // The message already holds the cause; `{:#}` would print it twice.
+        .map_err(|e| anyhow!("{e}"))?;
+    }
+    print!("{}", report(&metrics, &opts, args.json));
+    Ok(())
+}
+
+/// Restates a metrics error with the file names the user typed.
+fn explain(e: MetricsError, test: &Path, reference: &Path) -> anyhow::Error {
+    let file = |role| match role {
+        Role::Test => test.display(),
+        Role::Reference => reference.display(),
+    };
+    match e {
+        MetricsError::SizeMismatch {
+            test: (tw, th),
+            reference: (rw, rh),
+        } => anyhow!(
+            "{} is {tw}x{th} but {} is {rw}x{rh}",
+            test.display(),
+            reference.display()
+        ),
+        MetricsError::NonFinite {
+            role,
+            x,
+            y,
+            channel,
+            value,
+        } => anyhow!(
+            "{} has a non-finite value ({value}) at pixel ({x}, {y}), channel {channel}",
+            file(role)
+        ),
+        MetricsError::Empty {
+            role,
+            width,
+            height,
+        } => anyhow!("{} is empty ({width}x{height})", file(role)),
+        other => other.into(),
+    }
+}
+
+/// The JSON form; fields serialise in this order.
+#[derive(Serialize)]
+struct JsonReport {
+    mse: f64,
+    relmse: f64,
+    rmse: f64,
+    /// `None` (null) when the images are identical: JSON has no infinity.
+    psnr: Option<f64>,
+    ssim: f64,
+    relmse_epsilon: f64,
+    psnr_peak: f64,
+}
+
+/// The output: the five metrics in a fixed order, then the settings they depend on. Numbers
+/// are printed in Rust's shortest round-trip form, so they parse back to the same `f64`.
+fn report(m: &Metrics, opts: &CompareOptions, json: bool) -> String {
+    if json {
+        let r = JsonReport {
+            mse: m.mse,
+            relmse: m.relmse,
+            rmse: m.rmse,
+            psnr: m.psnr.is_finite().then_some(m.psnr),
+            ssim: m.ssim,
+            relmse_epsilon: opts.epsilon,
+            psnr_peak: opts.peak,
+        };
+        // Serialising plain numbers cannot fail.
+        serde_json::to_string(&r).unwrap_or_default() + "\n"
+    } else {
+        format!(
+            "mse {}\nrelmse {}\nrmse {}\npsnr {}\nssim {}\nrelmse_epsilon {}\npsnr_peak {}\n",
+            m.mse, m.relmse, m.rmse, m.psnr, m.ssim, opts.epsilon, opts.peak
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const M: Metrics = Metrics {
+        mse: 0.25,
+        relmse: 0.5,
+        rmse: 0.5,
+        psnr: f64::INFINITY,
+        ssim: 0.75,
+    };
+
+    #[test]
+    fn text_report() {
+        let text = report(&M, &CompareOptions::default(), false);
+        assert_eq!(
+            text,
+            "mse 0.25\nrelmse 0.5\nrmse 0.5\npsnr inf\nssim 0.75\n\
+             relmse_epsilon 0.01\npsnr_peak 1\n"
+        );
+    }
+
+    #[test]
+    fn json_report() {
+        let text = report(&M, &CompareOptions::default(), true);
+        assert_eq!(
+            text,
+            "{\"mse\":0.25,\"relmse\":0.5,\"rmse\":0.5,\"psnr\":null,\"ssim\":0.75,\
+             \"relmse_epsilon\":0.01,\"psnr_peak\":1.0}\n"
+        );
+        let finite = Metrics { psnr: 6.0, ..M };
+        assert!(report(&finite, &CompareOptions::default(), true).contains("\"psnr\":6.0"));
+    }
+
+    #[test]
+    fn errors_name_the_files() {
+        let (a, b) = (Path::new("A.exr"), Path::new("B.exr"));
+        let e = explain(
+            MetricsError::SizeMismatch {
+                test: (64, 64),
+                reference: (32, 32),
+            },
+            a,
+            b,
+        );
+        assert_eq!(e.to_string(), "A.exr is 64x64 but B.exr is 32x32");
+        let e = explain(
+            MetricsError::NonFinite {
+                role: Role::Reference,
+                x: 3,
+                y: 4,
+                channel: 'G',
+                value: f32::NAN,
+            },
+            a,
+            b,
+        );
+        assert_eq!(
+            e.to_string(),
+            "B.exr has a non-finite value (NaN) at pixel (3, 4), channel G"
+        );
+    }
+
+    #[test]
+    fn options_must_be_positive() {
+        assert_eq!(positive("0.02"), Ok(0.02));
+        for bad in ["0", "-1", "nan", "inf", "x"] {
+            assert!(positive(bad).is_err(), "{bad}");
+        }
+    }
+}

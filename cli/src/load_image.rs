@@ -1,0 +1,139 @@
+//! Reading an image to measure: EXR as linear float, PNG and JPEG as sRGB decoded to linear.
+//! Every error is one message that starts with the file name.
+
+use anyhow::{anyhow, bail, Result};
+use rt_core::color::srgb_to_linear;
+use rt_core::Rgb;
+use rt_film::output::ExrImage;
+use rt_metrics::RgbImage;
+use std::path::Path;
+
+/// Reads `path` as linear RGB, choosing the decoder by extension.
+///
+/// EXR: the first layer's `R`, `G`, `B` channels; without them, the one channel group `P.R`,
+/// `P.G`, `P.B` if exactly one prefix `P.` has all three; without any, a `Y` channel as grey.
+/// Alpha and other channels are ignored. PNG/JPEG (8 or 16 bit, grey or colour, alpha ignored)
+/// are taken to be sRGB-encoded; embedded colour profiles and gamma chunks are not read.
+pub fn load_rgb(path: &Path) -> Result<RgbImage> {
+    let name = path.display();
+    // Opening first turns a missing or unreadable file into the OS's own words, which the
+    // decoders would otherwise wrap in their own.
+    std::fs::File::open(path).map_err(|e| anyhow!("{name}: {e}"))?;
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        // `FilmError` already names the file and holds the cause.
+        Some("exr") => exr_rgb(path, rt_film::read_exr(path).map_err(|e| anyhow!("{e}"))?),
+        Some("png" | "jpg" | "jpeg") => {
+            let img = image::ImageReader::open(path)
+                .and_then(|r| r.with_guessed_format())
+                .map_err(|e| anyhow!("{name}: {e}"))?
+                .decode()
+                .map_err(|e| anyhow!("{name}: {e}"))?
+                .to_rgb32f();
+            let (w, h) = (img.width() as usize, img.height() as usize);
+            let pixels = img
+                .pixels()
+                .map(|p| Rgb::from_array(p.0.map(srgb_to_linear)))
+                .collect();
+            Ok(RgbImage::new(w, h, pixels)?)
+        }
+        _ => bail!("{name}: unsupported image format (use .exr, .png or .jpg)"),
+    }
+}
+
+fn exr_rgb(path: &Path, exr: ExrImage) -> Result<RgbImage> {
+    let name = path.display();
+    let n = exr.width * exr.height;
+    let has = |c: &str| exr.channel(c).is_some();
+    let prefixes: Vec<&str> = exr
+        .channels
+        .iter()
+        .filter_map(|(c, _)| c.strip_suffix('R'))
+        .filter(|p| p.is_empty() || p.ends_with('.'))
+        .filter(|p| has(&format!("{p}G")) && has(&format!("{p}B")))
+        .collect();
+    let prefix = match prefixes.as_slice() {
+        _ if prefixes.contains(&"") => "",
+        [one] => one,
+        [] => return exr_grey(path, &exr),
+        many => bail!(
+            "{name}: no plain R, G, B channels and several groups with them ({}); \
+             cannot tell which to compare",
+            many.join(", ")
+        ),
+    };
+    for c in ["R", "G", "B"] {
+        let len = exr.channel(&format!("{prefix}{c}")).map_or(0, <[f32]>::len);
+        if len != n {
+            let (w, h) = (exr.width, exr.height);
+            bail!("{name}: channel {prefix}{c} has {len} values for a {w}x{h} image (subsampled?)");
+        }
+    }
+    let pixels = exr
+        .rgb(prefix)
+        .ok_or_else(|| anyhow!("{name}: missing {prefix}R, {prefix}G or {prefix}B"))?;
+    Ok(RgbImage::new(exr.width, exr.height, pixels)?)
+}
+
+/// A grey EXR (one `Y` channel), as RGB.
+fn exr_grey(path: &Path, exr: &ExrImage) -> Result<RgbImage> {
+    match exr.channel("Y") {
+        Some(y) if y.len() == exr.width * exr.height => {
+            let pixels = y.iter().map(|&v| Rgb::splat(v)).collect();
+            Ok(RgbImage::new(exr.width, exr.height, pixels)?)
+        }
+        _ => {
+            let names: Vec<&str> = exr.channels.iter().map(|(c, _)| c.as_str()).collect();
+            bail!(
+                "{}: no R, G, B channels (it has {})",
+                path.display(),
+                names.join(", ")
+            )
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn exr(channels: &[&str]) -> ExrImage {
+        ExrImage {
+            width: 2,
+            height: 1,
+            channels: channels
+                .iter()
+                .enumerate()
+                .map(|(i, c)| (c.to_string(), vec![i as f32; 2]))
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn exr_channel_choice() {
+        let p = Path::new("x.exr");
+        let plain = exr_rgb(
+            p,
+            exr(&["A", "B", "G", "R", "albedo.B", "albedo.G", "albedo.R"]),
+        )
+        .unwrap();
+        assert_eq!(plain.pixel(0, 0), Rgb::new(3.0, 2.0, 1.0));
+        let layer = exr_rgb(p, exr(&["beauty.B", "beauty.G", "beauty.R", "Z"])).unwrap();
+        assert_eq!(layer.pixel(1, 0), Rgb::new(2.0, 1.0, 0.0));
+        let grey = exr_rgb(p, exr(&["Y"])).unwrap();
+        assert_eq!(grey.pixel(0, 0), Rgb::ZERO);
+        let e = exr_rgb(p, exr(&["a.B", "a.G", "a.R", "b.B", "b.G", "b.R"])).unwrap_err();
+        assert!(e.to_string().contains("a., b."), "{e}");
+        let e = exr_rgb(p, exr(&["Z", "R"])).unwrap_err();
+        assert_eq!(e.to_string(), "x.exr: no R, G, B channels (it has Z, R)");
+        let mut short = exr(&["B", "G", "R"]);
+        short.channels[0].1.pop();
+        assert!(exr_rgb(p, short)
+            .unwrap_err()
+            .to_string()
+            .contains("channel B has 1 values"));
+    }
+}
