@@ -3,7 +3,7 @@
 
 use super::node::Node;
 use super::{compact, split, BuildParams};
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 use rt_core::Aabb;
 
 /// Size of the traversal stack. The build keeps every leaf at depth `MAX_DEPTH - 1` or less, and
@@ -134,9 +134,7 @@ fn build_node(
 ) -> Node {
     let n = refs.len();
     debug_assert!(n > 0 && depth + ceil_log2(n) < MAX_DEPTH);
-    let (bounds, centroids) = refs.iter().fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), r| {
-        (b.union(r.bounds), c.grown(r.centroid()))
-    });
+    let (bounds, centroids) = bounds_and_centroid_bounds(refs);
     if n == 1 {
         return Node::leaf(bounds, first, 1);
     }
@@ -199,6 +197,28 @@ fn build_node(
     Node::inner(bounds, pair as u32)
 }
 
+/// The box of `refs` and the box of their centroids, in SIMD registers (one pass over every
+/// reference at every level of the build).
+fn bounds_and_centroid_bounds(refs: &[PrimRef]) -> (Aabb, Aabb) {
+    let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+    let (mut c_lo, mut c_hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+    for r in refs {
+        let (min, max) = (Vec3A::from(r.bounds.min), Vec3A::from(r.bounds.max));
+        // The new value first, as in `Bin::add`: a NaN centroid (a reference spanning -inf to
+        // inf) leaves the running box alone, as `f32::min` in `Aabb::grown` does.
+        lo = min.min(lo);
+        hi = max.max(hi);
+        // Same arithmetic as `PrimRef::centroid`, so binning sees the same centroids.
+        let c = min * 0.5 + max * 0.5;
+        c_lo = c.min(c_lo);
+        c_hi = c.max(c_hi);
+    }
+    (
+        Aabb::new(lo.into(), hi.into()),
+        Aabb::new(c_lo.into(), c_hi.into()),
+    )
+}
+
 /// Surface area in f64, so that boxes of extent up to `f32::MAX` do not overflow.
 fn surface_area(b: &Aabb) -> f64 {
     let e = b.extent().as_dvec3();
@@ -243,16 +263,44 @@ struct Split {
     binner: Binner,
 }
 
+/// One bin of the sweep. The box is kept in SIMD registers (`Vec3A`): binning unions every
+/// reference into three bins, and that loop is most of the build time.
 #[derive(Clone, Copy, Debug)]
 struct Bin {
-    bounds: Aabb,
+    min: Vec3A,
+    max: Vec3A,
     count: usize,
 }
 
 const EMPTY_BIN: Bin = Bin {
-    bounds: Aabb::EMPTY,
+    min: Vec3A::INFINITY,
+    max: Vec3A::NEG_INFINITY,
     count: 0,
 };
+
+impl Bin {
+    #[inline]
+    fn add(&mut self, min: Vec3A, max: Vec3A) {
+        // The new value first: SSE `minps`/`maxps` return the second operand when either is
+        // NaN, so the running box never turns NaN (as with `f32::min` in `Aabb::union`).
+        self.min = min.min(self.min);
+        self.max = max.max(self.max);
+        self.count += 1;
+    }
+
+    #[inline]
+    fn merge(&mut self, o: &Bin) {
+        self.min = self.min.min(o.min);
+        self.max = self.max.max(o.max);
+        self.count += o.count;
+    }
+
+    /// Surface area times count, the bin's (or run's) SAH term.
+    #[inline]
+    fn cost(&self) -> f64 {
+        surface_area(&Aabb::new(self.min.into(), self.max.into())) * self.count as f64
+    }
+}
 
 /// The cheapest binned split over all three axes, or `None` if no axis separates the centroids
 /// (all coincide) or every candidate's cost overflows.
@@ -261,10 +309,9 @@ fn find_sah_split(refs: &[PrimRef], centroids: &Aabb, cfg: &Config) -> Option<Sp
     let mut bins = [[EMPTY_BIN; MAX_BINS]; 3];
     for r in refs {
         let c = r.centroid();
+        let (min, max) = (Vec3A::from(r.bounds.min), Vec3A::from(r.bounds.max));
         for (axis, axis_bins) in bins.iter_mut().enumerate() {
-            let b = &mut axis_bins[binner.bin(c, axis)];
-            b.bounds = b.bounds.union(r.bounds);
-            b.count += 1;
+            axis_bins[binner.bin(c, axis)].add(min, max);
         }
     }
 
@@ -284,19 +331,15 @@ fn find_sah_split(refs: &[PrimRef], centroids: &Aabb, cfg: &Config) -> Option<Sp
         let occupied = &occupied[..m];
         // right_cost[k]: area * count of the occupied bins k.. .
         let mut right_cost = [0.0f64; MAX_BINS];
-        let (mut bounds, mut count) = (Aabb::EMPTY, 0);
+        let mut run = EMPTY_BIN;
         for k in (1..m).rev() {
-            let bin = &axis_bins[occupied[k]];
-            bounds = bounds.union(bin.bounds);
-            count += bin.count;
-            right_cost[k] = surface_area(&bounds) * count as f64;
+            run.merge(&axis_bins[occupied[k]]);
+            right_cost[k] = run.cost();
         }
-        let (mut bounds, mut count) = (Aabb::EMPTY, 0);
+        let mut run = EMPTY_BIN;
         for k in 0..m.saturating_sub(1) {
-            let bin = &axis_bins[occupied[k]];
-            bounds = bounds.union(bin.bounds);
-            count += bin.count;
-            let cost = surface_area(&bounds) * count as f64 + right_cost[k + 1];
+            run.merge(&axis_bins[occupied[k]]);
+            let cost = run.cost() + right_cost[k + 1];
             // NaN and infinite costs never compare less, so they are never chosen.
             if cost < best.map_or(f64::INFINITY, |b| b.cost) {
                 best = Some(Split {
