@@ -3,8 +3,8 @@
 //!
 //! Every random number is a hash of (seed, set, ray index), so the sets do not depend on the
 //! thread count. Secondary rays start where the path integrator's would: at the hit point
-//! reconstructed from barycentrics, offset along the geometric normal
-//! (`rt_core::ray::offset_ray_origin`, `shadow_segment`).
+//! reconstructed from barycentrics, offset along the geometric normal by its error bound
+//! (`rt_core::ray::spawn_ray`, `shadow_segment`).
 
 use anyhow::{bail, Result};
 use rayon::prelude::*;
@@ -12,7 +12,7 @@ use rt_core::{
     color::luminance,
     frame::Frame,
     glam::{Vec2, Vec3},
-    ray::{offset_ray_origin, shadow_segment},
+    ray::{shadow_segment, spawn_ray},
     sampling::{cosine_hemisphere, uniform_triangle},
     triangle, Accel, Camera, Ray, Scene,
 };
@@ -100,10 +100,11 @@ impl Lights {
         }
     }
 
-    /// A point on a light and its normal (zero for the point light, which needs no offset).
-    fn sample(&self, scene: &Scene, u_sel: f32, u: Vec2) -> (Vec3, Vec3) {
+    /// A point on a light, its error bound and its normal (zero error and normal for the point
+    /// light, which needs no offset).
+    fn sample(&self, scene: &Scene, u_sel: f32, u: Vec2) -> (Vec3, Vec3, Vec3) {
         match self {
-            Lights::Point(p) => (*p, Vec3::ZERO),
+            Lights::Point(p) => (*p, Vec3::ZERO, Vec3::ZERO),
             Lights::Emitters { prims, cdf } => {
                 let total = *cdf.last().expect("at least one emitter");
                 let target = u_sel as f64 * total;
@@ -111,7 +112,8 @@ impl Lights {
                 let v = &scene.triangles[prims[k] as usize];
                 let (b1, b2) = uniform_triangle(u);
                 let n = triangle::geometric_normal(v).normalize_or_zero();
-                (triangle::point_at(v, b1, b2), n)
+                let (p, p_error) = triangle::point_with_error(v, b1, b2);
+                (p, p_error, n)
             }
         }
     }
@@ -183,7 +185,7 @@ pub fn generate(
             let n = facing(si.ng, ray.dir);
             let mut rng = Rng::new(seed, 1, k as u64);
             let wi = Frame::from_normal(n).to_world(cosine_hemisphere(rng.vec2()));
-            Some(Ray::new(offset_ray_origin(si.p, n), wi))
+            Some(spawn_ray(si.p, si.p_error, n, wi))
         })
         .collect();
     let shadow: Vec<Ray> = hits
@@ -193,11 +195,11 @@ pub fn generate(
         .filter_map(|(k, (hit, ray))| {
             let si = scene.surface(hit.as_ref()?);
             let mut rng = Rng::new(seed, 2, k as u64);
-            let (q, nq) = lights.sample(scene, rng.f32(), rng.vec2());
+            let (q, q_error, nq) = lights.sample(scene, rng.f32(), rng.vec2());
             if facing(si.ng, ray.dir).dot(q - si.p) <= 0.0 {
                 return None;
             }
-            let (r, t_max) = shadow_segment(si.p, si.ng, q, nq);
+            let (r, t_max) = shadow_segment(si.p, si.p_error, si.ng, q, q_error, nq);
             // Fold the shadow epsilon into the direction, so the query is exactly (0, 1).
             Some(Ray::new(r.origin, r.dir * t_max))
         })

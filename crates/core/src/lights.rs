@@ -23,6 +23,9 @@ pub struct LightSample {
     pub wi: Vec3,
     /// Point on the light (for triangles) — the shadow ray's target.
     pub point: Vec3,
+    /// Error bound of `point` ([`triangle::point_with_error`]; zero for the environment): the
+    /// shadow ray's target is offset off the light by it.
+    pub point_error: Vec3,
     /// Unit front normal of the light triangle (zero for the environment).
     pub normal: Vec3,
     /// Distance to the light point (`f32::INFINITY` for the environment).
@@ -80,6 +83,7 @@ impl LightSampler {
             return Some(LightSample {
                 wi: s.dir,
                 point: Vec3::ZERO,
+                point_error: Vec3::ZERO,
                 normal: Vec3::ZERO,
                 dist: f32::INFINITY,
                 le: s.radiance,
@@ -92,7 +96,7 @@ impl LightSampler {
         let prim = self.emitters[k];
         let v = &scene.triangles[prim as usize];
         let (b1, b2) = uniform_triangle(u);
-        let p = triangle::point_at(v, b1, b2);
+        let (p, point_error) = triangle::point_with_error(v, b1, b2);
         let n_raw = triangle::geometric_normal(v);
         let area = 0.5 * n_raw.length();
         let n = n_raw / (2.0 * area);
@@ -112,6 +116,7 @@ impl LightSampler {
         Some(LightSample {
             wi,
             point: p,
+            point_error,
             normal: n,
             dist: r,
             le,

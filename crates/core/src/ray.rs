@@ -26,46 +26,72 @@ impl Ray {
     }
 }
 
-/// Moves a surface point off its surface along the geometric normal `n`, which must point to the
-/// side the new ray leaves towards.
-///
-/// This is the method of Wächter and Binder ("A Fast and Robust Method for Avoiding
-/// Self-Intersection", Ray Tracing Gems, ch. 6): far from the origin the offset is a fixed number
-/// of ULPs in integer space, so it scales with the magnitude of the coordinates and there is no
-/// scene-scale epsilon to tune; near the origin, where ULPs become tiny, a small absolute offset
-/// takes over. It assumes the point was reconstructed from barycentrics (as `rt-core` does), whose
-/// error is a few ULPs of the vertex coordinates.
+/// Higham's `γ(n) = n·u / (1 − n·u)` with `u = 2⁻²⁴`: a bound on the relative error that `n`
+/// chained f32 roundings can accumulate (Pharr et al., "Managing rounding error", PBRT §6.8).
 #[inline]
-pub fn offset_ray_origin(p: Vec3, n: Vec3) -> Vec3 {
-    const ORIGIN: f32 = 1.0 / 32.0;
-    const FLOAT_SCALE: f32 = 1.0 / 65536.0;
-    const INT_SCALE: f32 = 256.0;
-    let off = |p: f32, n: f32| -> f32 {
-        if p.abs() < ORIGIN {
-            return p + FLOAT_SCALE * n;
-        }
-        let of_i = (INT_SCALE * n) as i32;
-        let bits = p.to_bits() as i32;
-        let moved = if p < 0.0 { bits - of_i } else { bits + of_i };
-        f32::from_bits(moved as u32)
-    };
-    Vec3::new(off(p.x, n.x), off(p.y, n.y), off(p.z, n.z))
+pub const fn gamma(n: u32) -> f32 {
+    let nu = n as f32 * (f32::EPSILON * 0.5);
+    nu / (1.0 - nu)
 }
 
-/// Fraction by which shadow rays stop short of their target point, so that the light's own
-/// surface (offset just like any other) is not reported as an occluder.
+/// Where a ray leaving surface point `p` must start so that it cannot hit the surface it
+/// leaves: `p` moved along the geometric normal `n` (unit, either orientation) to the side of
+/// the direction `w`, by `d = dot(|n|, p_error)`, then one more ULP away from the surface per
+/// axis so that rounding the sum cannot pull it back (PBRT-v4's `OffsetRayOrigin`).
+///
+/// `p_error` is a per-axis bound on how far the ray queries may misplace `p` relative to its
+/// triangle: [`crate::triangle::point_with_error`] gives it for points reconstructed from
+/// barycentrics. The offset therefore scales with the triangle the point lies on, not with the
+/// point's own coordinates: a point near the origin on a triangle 10⁴ across needs an offset
+/// of 10⁴ ULPs of 1, where an offset in ULPs of the point (Wächter and Binder, Ray Tracing
+/// Gems ch. 6, used here before) gave 10⁻⁵ and let bounce rays re-hit the floor they left.
+#[inline]
+pub fn offset_ray_origin(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Vec3 {
+    let d = n.abs().dot(p_error);
+    let mut offset = n * d;
+    if w.dot(n) < 0.0 {
+        offset = -offset;
+    }
+    let mut po = p + offset;
+    for i in 0..3 {
+        if offset[i] > 0.0 {
+            po[i] = po[i].next_up();
+        } else if offset[i] < 0.0 {
+            po[i] = po[i].next_down();
+        }
+    }
+    po
+}
+
+/// A ray leaving surface point `p` (error bound `p_error`, geometric normal `n`) along `w`.
+#[inline]
+pub fn spawn_ray(p: Vec3, p_error: Vec3, n: Vec3, w: Vec3) -> Ray {
+    Ray::new(offset_ray_origin(p, p_error, n, w), w)
+}
+
+/// Fraction by which shadow rays stop short of their target point. The target is offset off
+/// its surface like the origin, but the ray query itself rounds `t`; stopping a relative 10⁻⁴
+/// short keeps the light's own triangle from being reported as an occluder (PBRT's
+/// `ShadowEpsilon`).
 pub const SHADOW_EPSILON: f32 = 1e-4;
 
-/// A shadow-ray segment from surface point `p` (normal `n`, any orientation) to a point `q` on
-/// another surface with normal `nq`: both ends are offset off their surfaces towards each other.
-/// Returns the ray (direction `q' - p'`, so the segment is `t ∈ (0, t_max)`) and `t_max`.
+/// A shadow-ray segment from surface point `p` (error bound `p_error`, normal `n`, any
+/// orientation) to a point `q` on another surface (`q_error`, normal `nq`). Both ends are
+/// offset off their surfaces; the target is offset towards the *offset* origin, so two points
+/// of one plane (where `n · (q − p)` is rounding noise) are moved to the same side of it and the
+/// segment does not cross it. Returns the ray (direction `q' − p'`, so the segment is
+/// `t ∈ (0, t_max)`) and `t_max`.
 #[inline]
-pub fn shadow_segment(p: Vec3, n: Vec3, q: Vec3, nq: Vec3) -> (Ray, f32) {
-    let d = q - p;
-    let n_out = if n.dot(d) >= 0.0 { n } else { -n };
-    let nq_out = if nq.dot(d) <= 0.0 { nq } else { -nq };
-    let o = offset_ray_origin(p, n_out);
-    let target = offset_ray_origin(q, nq_out);
+pub fn shadow_segment(
+    p: Vec3,
+    p_error: Vec3,
+    n: Vec3,
+    q: Vec3,
+    q_error: Vec3,
+    nq: Vec3,
+) -> (Ray, f32) {
+    let o = offset_ray_origin(p, p_error, n, q - p);
+    let target = offset_ray_origin(q, q_error, nq, o - q);
     (Ray::new(o, target - o), 1.0 - SHADOW_EPSILON)
 }
 
@@ -74,22 +100,67 @@ mod tests {
     use super::*;
 
     #[test]
-    fn offset_moves_to_the_normal_side_at_all_scales() {
+    fn gamma_bounds_chained_roundings() {
+        assert_eq!(gamma(0), 0.0);
+        assert!(gamma(1) > f32::EPSILON * 0.5 && gamma(1) < f32::EPSILON);
+        assert!(gamma(7) > 7.0 * gamma(1) && gamma(7) < 7.001 * gamma(1));
+    }
+
+    #[test]
+    fn offset_moves_to_the_side_of_the_direction_at_all_scales() {
         for scale in [1e-4f32, 1e-2, 1.0, 1e2, 1e4, 1e6] {
             let p = Vec3::new(0.3, -0.7, 0.5) * scale;
+            let err = Vec3::splat(gamma(7) * scale);
             let n = Vec3::new(0.0, 1.0, 0.0);
-            let q = offset_ray_origin(p, n);
-            assert!(q.y > p.y, "scale {scale}: {q} vs {p}");
+            let q = offset_ray_origin(p, err, n, Vec3::new(0.2, 0.5, 0.1));
+            assert!(q.y - p.y >= err.y, "scale {scale}: {q} vs {p}");
             assert_eq!(q.x, p.x);
-            let q = offset_ray_origin(p, -n);
-            assert!(q.y < p.y, "scale {scale}");
+            // The normal's orientation does not matter, the direction does.
+            let q2 = offset_ray_origin(p, err, -n, Vec3::new(0.2, 0.5, 0.1));
+            assert_eq!(q, q2);
+            let q = offset_ray_origin(p, err, n, -Vec3::Y);
+            assert!(p.y - q.y >= err.y, "scale {scale}");
         }
     }
 
     #[test]
+    fn only_axes_with_an_offset_take_the_extra_ulp() {
+        // A zero bound (a point known exactly) leaves the point alone; any non-zero bound, however
+        // small, moves it by at least one ULP on the axes the normal has.
+        let p = Vec3::new(1.0, 2.0, 3.0);
+        assert_eq!(offset_ray_origin(p, Vec3::ZERO, Vec3::Y, Vec3::Y), p);
+        let q = offset_ray_origin(p, Vec3::splat(1e-30), Vec3::Y, Vec3::Y);
+        assert_eq!(q.y, 2.0f32.next_up());
+    }
+
+    #[test]
     fn shadow_segment_points_at_target() {
-        let (r, tmax) = shadow_segment(Vec3::ZERO, Vec3::Y, Vec3::new(0.0, 2.0, 0.0), -Vec3::Y);
+        let e = Vec3::splat(1e-6);
+        let (r, tmax) = shadow_segment(
+            Vec3::ZERO,
+            e,
+            Vec3::Y,
+            Vec3::new(0.0, 2.0, 0.0),
+            e,
+            -Vec3::Y,
+        );
+        assert!(r.origin.y > 0.0);
         let end = r.at(tmax);
         assert!((end.y - 2.0).abs() < 1e-3 && end.y < 2.0);
+    }
+
+    #[test]
+    fn shadow_segment_between_points_of_one_plane_stays_on_one_side() {
+        // n · (q − p) is zero here: both ends must still go to the same side.
+        let e = Vec3::splat(1e-3);
+        let p = Vec3::new(-5.0, 0.0, 1.0);
+        let q = Vec3::new(7.0, 0.0, -2.0);
+        for n in [Vec3::Y, -Vec3::Y] {
+            for nq in [Vec3::Y, -Vec3::Y] {
+                let (r, t_max) = shadow_segment(p, e, n, q, e, nq);
+                let end = r.at(t_max);
+                assert!(r.origin.y * end.y > 0.0, "{n} {nq}: {r:?} ends at {end}");
+            }
+        }
     }
 }

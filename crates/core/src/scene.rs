@@ -52,6 +52,10 @@ pub struct Scene {
 pub struct SurfaceHit {
     /// Position, reconstructed from barycentrics.
     pub p: Vec3,
+    /// Per-axis bound on how far ray queries may misplace `p` relative to its triangle
+    /// ([`triangle::point_with_error`]); spawned rays start this far off the surface
+    /// ([`crate::ray::offset_ray_origin`]).
+    pub p_error: Vec3,
     /// Unit geometric normal of the front (counter-clockwise) face.
     pub ng: Vec3,
     /// Unit shading normal, on the same side as `ng`.
@@ -112,7 +116,7 @@ impl Scene {
         let v = &self.triangles[i];
         let (b1, b2) = (hit.b1, hit.b2);
         let b0 = 1.0 - b1 - b2;
-        let p = triangle::point_at(v, b1, b2);
+        let (p, p_error) = triangle::point_with_error(v, b1, b2);
         let ng = triangle::geometric_normal(v).normalize_or(Vec3::Z);
         let ns = match &self.normals[i] {
             Some(n) => {
@@ -131,6 +135,7 @@ impl Scene {
         };
         SurfaceHit {
             p,
+            p_error,
             ng,
             ns,
             uv,

@@ -10,7 +10,7 @@
 //! 1e12 relative to the ray origin (beyond, the scaled distance `t·det` overflows f32). This is what makes closed meshes crack-free;
 //! Möller–Trumbore, which the thesis used, is not.
 
-use crate::Ray;
+use crate::{ray::gamma, Ray};
 use glam::Vec3;
 
 /// Per-ray constants of the watertight test: the axis permutation and the shear.
@@ -159,6 +159,99 @@ pub fn point_at(v: &[Vec3; 3], b1: f32, b2: f32) -> Vec3 {
     v[0] * (1.0 - b1 - b2) + v[1] * b1 + v[2] * b2
 }
 
+/// Largest conditioning factor `κ` (see [`point_with_error`]) the error bound uses: a triangle
+/// thinner than about 1:10⁴ gets the offset of one of that aspect ratio. Its intersections are
+/// noise at that level anyway (the limitation noted in `docs/architecture.md`), and an uncapped
+/// `κ` would send rays from nearly degenerate triangles arbitrarily far.
+pub const MAX_CONDITIONING: f32 = 1e4;
+
+/// [`point_at`] and a per-axis bound on how far ray queries may misplace the point relative to
+/// the triangle: the `p_error` that [`crate::ray::offset_ray_origin`] offsets by. Two errors add
+/// up, both proportional to the *vertices'* magnitudes rather than the point's:
+///
+/// 1. **Reconstruction** (PBRT §6.8.5, adapted to how [`point_at`] computes): `b0 = (1 − b1) − b2`
+///    is off by at most `γ(2)·(|1 − b1| + |b2|)` in absolute terms (not relative to `b0`, which
+///    may be tiny), and the three products and two sums add `γ(3)·Σ|bᵢ·vᵢ|`. Both fit in
+///    `γ(7)·((|1 − b1| + |b2|)·|v0| + |b1·v1| + |b2·v2|)`, the margin covering the rounding of
+///    the bound itself.
+/// 2. **The intersection test's own error.** PBRT rejects hits with `t` below a bound `δt`
+///    computed in its triangle test; ours (Woop et al., shared bit for bit with the QBVH's SIMD
+///    kernel) only rejects `t ≤ 0`, so the offset must clear that error instead. The test works
+///    on vertices translated to the ray origin and sheared, so its error grows with
+///    `L = maxᵢ ‖vᵢ − p‖∞`, the triangle's extent seen from the point, on every axis alike (the
+///    shear mixes them). Its edge functions are differences of products of such coordinates,
+///    divided by twice the area, which amplifies the error by `κ = L² / |(v1 − v0) × (v2 − v0)|`
+///    on slivers (about 1 on well-shaped triangles). The bound `γ(8)·L·(1 + min(κ, 10⁴))` comes
+///    from measurement rather than proof: the worst case (PBRT's `δt` turned into a distance) is
+///    about 50 times larger and would lift rays visibly off large floors. With `γ(2)` no ray
+///    re-hit a well-shaped triangle 10³–10⁵ across in 10⁶ trials per shape, and `γ(8)` still
+///    left none on 1:1000 slivers, where `γ(4)` did. The self-hit tests in
+///    `tests/tests/self_hits.rs` and the property tests in `crates/core/tests/properties.rs`
+///    check it.
+///
+/// Part 2 dominates on large triangles: an axis-aligned floor at `y = 0` has an exact `p.y` and
+/// no reconstruction error along its normal, yet rays leaving it re-hit it unless they start
+/// about `γ(8)·L` above it.
+///
+/// The point returned is the one at `(b1, b2)` moved, if it is closer than twice its error
+/// bound to an edge, that far into the triangle (see the comment in the body), so that an
+/// origin offset from it stays on the inner side of the neighbouring triangles' planes too.
+#[inline]
+pub fn point_with_error(v: &[Vec3; 3], b1: f32, b2: f32) -> (Vec3, Vec3) {
+    let (p, err) = point_and_bound(v, b1, b2);
+    // Pull the point in from the edges by twice its error bound (which also covers the normal
+    // offset, `dot(|n|, err) ≤ |err|`): reconstructed near an edge, it may otherwise lie beyond
+    // the plane of the neighbouring triangle, and a ray offset along this triangle's own normal
+    // stays beyond it. Far from the origin that lets rays escape closed meshes at their edges
+    // (a box 200 across at 10⁵: the error is 6 ULPs of 10⁵, 0.05). The point moves by at most
+    // a few error bounds, within its own uncertainty; shading keeps the original barycentrics.
+    let twice_area = geometric_normal(v).length();
+    let e = 2.0 * err.length();
+    let edge = [
+        (v[2] - v[1]).length(),
+        (v[0] - v[2]).length(),
+        (v[1] - v[0]).length(),
+    ];
+    // Barycentric weight of vertex i at distance e from the opposite edge: e / altitude.
+    let b_min = edge.map(|l| e * l / twice_area);
+    let b = [1.0 - b1 - b2, b1, b2];
+    let room = 1.0 - (b_min[0] + b_min[1] + b_min[2]);
+    // Without an interior point that far from every edge (a sliver about as thin as the
+    // error, or a degenerate triangle), leave the point where it is.
+    if room.is_nan() || room <= 0.0 || b.iter().zip(&b_min).all(|(b, m)| b >= m) {
+        return (p, err);
+    }
+    let excess = b.map(|b| b.max(0.0));
+    let excess = [0, 1, 2].map(|i| (excess[i] - b_min[i]).max(0.0));
+    let total = excess[0] + excess[1] + excess[2];
+    let pulled = [0, 1, 2].map(|i| {
+        if total > 0.0 {
+            b_min[i] + excess[i] * (room / total)
+        } else {
+            b_min[i] + room / 3.0
+        }
+    });
+    point_and_bound(v, pulled[1], pulled[2])
+}
+
+/// [`point_at`] and its error bound (the two parts of [`point_with_error`]'s documentation).
+#[inline]
+fn point_and_bound(v: &[Vec3; 3], b1: f32, b2: f32) -> (Vec3, Vec3) {
+    let p = point_at(v, b1, b2);
+    let reconstruction =
+        ((1.0 - b1).abs() + b2.abs()) * v[0].abs() + b1.abs() * v[1].abs() + b2.abs() * v[2].abs();
+    let l = (v[0] - p)
+        .abs()
+        .max((v[1] - p).abs())
+        .max((v[2] - p).abs())
+        .max_element();
+    let twice_area = geometric_normal(v).length();
+    // Zero area gives κ = ∞, or NaN from 0/0, which `f32::min` also turns into the cap.
+    let kappa = (l * l / twice_area).min(MAX_CONDITIONING);
+    let test = gamma(8) * l * (1.0 + kappa);
+    (p, gamma(7) * reconstruction + Vec3::splat(test))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -207,6 +300,33 @@ mod tests {
         assert!(hit(Vec3::new(0.5, 0.0, 1.0), -Vec3::Z, &tri).is_none());
         let tri = [Vec3::ONE; 3];
         assert!(hit(Vec3::new(1.0, 1.0, 2.0), -Vec3::Z, &tri).is_none());
+    }
+
+    #[test]
+    fn points_near_an_edge_are_pulled_in_by_their_error() {
+        // A wall of a box 200 across, 10⁵ from the origin; a hit right on its top edge.
+        let t = Vec3::new(6e4, 4.8e4, -6.4e4);
+        let v = [
+            t + Vec3::new(-100.0, -100.0, 100.0),
+            t + Vec3::new(100.0, -100.0, 100.0),
+            t + Vec3::new(100.0, 100.0, 100.0),
+        ];
+        // b0 = 0: on the edge v1–v2 (x = t.x + 100).
+        let (p, err) = point_with_error(&v, 0.4, 0.6);
+        assert!(err.max_element() > 0.01, "{err}");
+        assert!(p.x <= t.x + 100.0 - err.length(), "{p} {err}");
+        assert!((p.y - (t.y + 20.0)).abs() < 10.0 * err.length(), "{p}");
+        // Away from the edges nothing moves.
+        assert_eq!(point_with_error(&v, 0.3, 0.3).0, point_at(&v, 0.3, 0.3));
+        // Degenerate and needle triangles keep their point and get a finite bound.
+        for v in [
+            [Vec3::ONE; 3],
+            [Vec3::ZERO, Vec3::X, Vec3::X * (1.0 + 1e-7)],
+        ] {
+            let (p, err) = point_with_error(&v, 0.0, 0.5);
+            assert_eq!(p, point_at(&v, 0.0, 0.5));
+            assert!(err.is_finite(), "{err}");
+        }
     }
 
     #[test]

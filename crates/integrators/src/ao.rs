@@ -4,9 +4,7 @@
 //! (value 1).
 
 use crate::{Ctx, Integrator, RayCounters, SampleAux};
-use rt_core::{
-    frame::Frame, ray::offset_ray_origin, sampling::cosine_hemisphere, Ray, Rgb, Sampler,
-};
+use rt_core::{frame::Frame, ray::spawn_ray, sampling::cosine_hemisphere, Ray, Rgb, Sampler};
 use rt_film::FirstHit;
 
 /// Ambient-occlusion estimator.
@@ -50,7 +48,7 @@ impl Integrator for AoIntegrator {
             return Rgb::ZERO;
         }
         counters.shadow_rays += 1;
-        let r = Ray::new(offset_ray_origin(si.p, ng), d);
+        let r = spawn_ray(si.p, si.p_error, ng, d);
         if ctx.accel.occluded(&r, self.max_distance) {
             Rgb::ZERO
         } else {

@@ -13,7 +13,7 @@
 use crate::{Ctx, Integrator, RayCounters, SampleAux};
 use rt_core::{
     material::Bsdf,
-    ray::{offset_ray_origin, shadow_segment},
+    ray::{shadow_segment, spawn_ray},
     sampling::power_heuristic,
     Ray, Rgb, Sampler,
 };
@@ -147,15 +147,17 @@ impl Integrator for PathIntegrator {
                     if f.max_element() > 0.0 && cos > 0.0 {
                         counters.shadow_rays += 1;
                         let occluded = if ls.dist.is_infinite() {
-                            let n = if ls.wi.dot(si.ng) >= 0.0 {
-                                si.ng
-                            } else {
-                                -si.ng
-                            };
-                            let r = Ray::new(offset_ray_origin(si.p, n), ls.wi);
+                            let r = spawn_ray(si.p, si.p_error, si.ng, ls.wi);
                             ctx.accel.occluded(&r, f32::INFINITY)
                         } else {
-                            let (r, t_max) = shadow_segment(si.p, si.ng, ls.point, ls.normal);
+                            let (r, t_max) = shadow_segment(
+                                si.p,
+                                si.p_error,
+                                si.ng,
+                                ls.point,
+                                ls.point_error,
+                                ls.normal,
+                            );
                             // The light point keys the shadow cache of structures that have one.
                             ctx.accel.occluded_toward(&r, t_max, ls.point)
                         };
@@ -177,12 +179,7 @@ impl Integrator for PathIntegrator {
             prev_delta = s.delta;
             prev_pdf = s.pdf;
             prev_p = si.p;
-            let n = if s.wi.dot(si.ng) >= 0.0 {
-                si.ng
-            } else {
-                -si.ng
-            };
-            ray = Ray::new(offset_ray_origin(si.p, n), s.wi);
+            ray = spawn_ray(si.p, si.p_error, si.ng, s.wi);
             depth += 1;
             if depth > self.rr_depth {
                 // Continue with probability tied to the throughput, so that surviving paths

@@ -7,7 +7,7 @@
 use anyhow::{Context, Result};
 use rayon::prelude::*;
 use rt_core::glam::Vec3;
-use rt_core::ray::offset_ray_origin;
+use rt_core::{ray::offset_ray_origin, triangle::point_with_error};
 use rt_core::Ray;
 use std::path::Path;
 
@@ -183,8 +183,9 @@ pub fn generate(tris: &[[Vec3; 3]], opts: &GenOptions) -> Result<[Vec<Ray>; 3]> 
             let Some(hit) = reference.intersect(ray, f32::INFINITY) else {
                 return out;
             };
-            let [v0, v1, v2] = tris[hit.prim as usize];
-            let p = v0 * (1.0 - hit.b1 - hit.b2) + v1 * hit.b1 + v2 * hit.b2;
+            let tri = &tris[hit.prim as usize];
+            let (p, p_error) = point_with_error(tri, hit.b1, hit.b2);
+            let [v0, v1, v2] = *tri;
             let mut n = (v1 - v0).cross(v2 - v0).normalize();
             if !n.is_finite() {
                 return out;
@@ -193,7 +194,8 @@ pub fn generate(tris: &[[Vec3; 3]], opts: &GenOptions) -> Result<[Vec<Ray>; 3]> 
                 n = -n;
             }
             let mut rng = Rng::new(opts.seed, i as u64);
-            let o = offset_ray_origin(p, n);
+            // Every ray of this hit leaves to the side of n, so one offset origin serves all.
+            let o = offset_ray_origin(p, p_error, n, n);
             let (t, b) = n.any_orthonormal_pair();
             for _ in 0..opts.per_hit {
                 // Cosine-distributed about n (Malley: a uniform disc point lifted up).
