@@ -132,11 +132,32 @@ pub fn intersect_triangle(pre: &RayPrecomp, v: &[Vec3; 3], t_max: f32) -> Option
     if t.is_nan() || t <= 0.0 || t > t_max || t.is_infinite() || inv.is_infinite() {
         return None;
     }
+    if !(t > t_error_bound([ax, bx, cx], [ay, by, cy], [az, bz, cz], [u, v_, w], inv)) {
+        return None;
+    }
     Some(TriHit {
         t,
         b1: v_ * inv,
         b2: w * inv,
     })
+}
+
+/// A bound on the rounding error of the `t` that [`intersect_triangle`] computes, from the
+/// sheared vertices, the edge functions and `1 / det` (Pharr et al., PBRT-v3 §3.9.6): a hit at
+/// `t` no larger than this may lie behind the origin. Rejecting it matters for rays that start
+/// close to a huge triangle (a blade of grass on a floor 10⁵ across): the error of `t` grows with
+/// the triangle's size, not with the distance to it. SIMD versions of the test compute it with
+/// the same operations in the same order, so they agree bit for bit. The `max` operands are
+/// absolute values of finite numbers here (non-finite `det` or `t` were rejected before).
+#[inline(always)]
+pub fn t_error_bound(x: [f32; 3], y: [f32; 3], z: [f32; 3], e: [f32; 3], inv_det: f32) -> f32 {
+    let max3 = |v: [f32; 3]| v[0].abs().max(v[1].abs()).max(v[2].abs());
+    let (max_x, max_y, max_z, max_e) = (max3(x), max3(y), max3(z), max3(e));
+    let delta_z = gamma(3) * max_z;
+    let delta_x = gamma(5) * (max_x + max_z);
+    let delta_y = gamma(5) * (max_y + max_z);
+    let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
+    3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv_det.abs()
 }
 
 /// Unnormalised geometric normal `(v1 - v0) × (v2 - v0)`: it faces the side from which the

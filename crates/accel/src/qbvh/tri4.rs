@@ -9,6 +9,7 @@
 //! precision.
 
 use glam::Vec3;
+use rt_core::ray::gamma;
 use rt_core::triangle::{intersect_triangle, RayPrecomp};
 use rt_core::Ray;
 
@@ -174,12 +175,10 @@ pub(crate) fn intersect4_sse(pre: &RayPrecomp4, p: &Tri4, t_max: f32) -> Hits4 {
         let abs_det = _mm_and_ps(det, abs_mask);
         ok = _mm_and_ps(ok, _mm_cmpneq_ps(det, zero));
         ok = _mm_and_ps(ok, _mm_cmplt_ps(abs_det, _mm_set1_ps(f32::INFINITY)));
+        let (zs_a, zs_b, zs_c) = (_mm_mul_ps(sz, az), _mm_mul_ps(sz, bz), _mm_mul_ps(sz, cz));
         let t_scaled = _mm_add_ps(
-            _mm_add_ps(
-                _mm_mul_ps(u, _mm_mul_ps(sz, az)),
-                _mm_mul_ps(v, _mm_mul_ps(sz, bz)),
-            ),
-            _mm_mul_ps(w, _mm_mul_ps(sz, cz)),
+            _mm_add_ps(_mm_mul_ps(u, zs_a), _mm_mul_ps(v, zs_b)),
+            _mm_mul_ps(w, zs_c),
         );
         // ts = t_scaled with det's sign flipped away; must be > 0 (false for NaN).
         let sign = _mm_andnot_ps(abs_mask, det);
@@ -193,6 +192,39 @@ pub(crate) fn intersect4_sse(pre: &RayPrecomp4, p: &Tri4, t_max: f32) -> Hits4 {
         // Finite `t` and `1 / det`, as the scalar test requires.
         ok = _mm_and_ps(ok, _mm_cmplt_ps(t, inf));
         ok = _mm_and_ps(ok, _mm_cmplt_ps(_mm_and_ps(inv, abs_mask), inf));
+        // `t` above its rounding error bound: `t_error_bound`, operation for operation.
+        let abs = |x: __m128| _mm_and_ps(x, abs_mask);
+        let max3 = |a: __m128, b: __m128, c: __m128| _mm_max_ps(_mm_max_ps(abs(a), abs(b)), abs(c));
+        let (max_x, max_y) = (max3(ax, bx, cx), max3(ay, by, cy));
+        let (max_z, max_e) = (max3(zs_a, zs_b, zs_c), max3(u, v, w));
+        let g = |n: u32| _mm_set1_ps(gamma(n));
+        let delta_z = _mm_mul_ps(g(3), max_z);
+        let delta_x = _mm_mul_ps(g(5), _mm_add_ps(max_x, max_z));
+        let delta_y = _mm_mul_ps(g(5), _mm_add_ps(max_y, max_z));
+        let delta_e = _mm_mul_ps(
+            _mm_set1_ps(2.0),
+            _mm_add_ps(
+                _mm_add_ps(
+                    _mm_mul_ps(_mm_mul_ps(g(2), max_x), max_y),
+                    _mm_mul_ps(delta_y, max_x),
+                ),
+                _mm_mul_ps(delta_x, max_y),
+            ),
+        );
+        let delta_t = _mm_mul_ps(
+            _mm_mul_ps(
+                _mm_set1_ps(3.0),
+                _mm_add_ps(
+                    _mm_add_ps(
+                        _mm_mul_ps(_mm_mul_ps(g(3), max_e), max_z),
+                        _mm_mul_ps(delta_e, max_z),
+                    ),
+                    _mm_mul_ps(delta_z, max_e),
+                ),
+            ),
+            abs(inv),
+        );
+        ok = _mm_and_ps(ok, _mm_cmpgt_ps(t, delta_t));
         _mm_storeu_ps(h.t.as_mut_ptr(), t);
         _mm_storeu_ps(h.b1.as_mut_ptr(), _mm_mul_ps(v, inv));
         _mm_storeu_ps(h.b2.as_mut_ptr(), _mm_mul_ps(w, inv));
