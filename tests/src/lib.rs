@@ -3,7 +3,7 @@
 //! render small scenes; the tests themselves are in `tests/tests/`.
 
 use rt_core::Scene;
-use rt_film::{AovSet, Film};
+use rt_film::{AovSet, Film, FilmBuffers};
 use rt_integrators::{Ctx, Integrator, RenderOptions};
 use std::path::Path;
 
@@ -16,7 +16,8 @@ pub fn scene_from_toml(toml: &str) -> Scene {
     }
 }
 
-/// Renders the first camera of `scene` with `spp` samples on `threads` worker threads.
+/// Renders the first camera of `scene` with `spp` samples on `threads` worker threads. The film
+/// keeps the variance buffer: the statistical tests read it.
 pub fn render(
     scene: &Scene,
     integrator: &dyn Integrator,
@@ -26,7 +27,8 @@ pub fn render(
 ) -> Film {
     let accel = rt_accel::Bvh2::build(&scene.triangles, &rt_accel::BuildParams::default());
     let camera = &scene.cameras[0];
-    let mut film = Film::new(camera.width, camera.height, AovSet::default());
+    let buffers = FilmBuffers::for_outputs(AovSet::default()).with_variance();
+    let mut film = Film::new(camera.width, camera.height, buffers);
     let ctx = Ctx {
         scene,
         accel: &accel,
@@ -55,9 +57,15 @@ pub fn image_mean(film: &Film) -> (f64, f64) {
     let mut sum = 0.0;
     let mut var = 0.0;
     for p in film.pixels() {
-        let (m, v) = (p.mean(), p.variance_of_mean());
+        let (m, v) = (p.mean(), variance_of_mean(&p));
         sum += (m.x + m.y + m.z) as f64;
         var += (v.x + v.y + v.z) as f64;
     }
     (sum / n, var.sqrt() / n)
+}
+
+/// The variance of a pixel's mean from a film rendered by [`render`] (which keeps it).
+pub fn variance_of_mean(p: &rt_film::PixelStats) -> rt_core::Rgb {
+    p.variance_of_mean()
+        .expect("render() keeps the variance buffer")
 }
