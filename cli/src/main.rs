@@ -4,8 +4,7 @@
 //! happens here: libraries return typed errors, this turns them into one line on stderr and a
 //! non-zero exit code (2 for usage errors, 1 for everything else). `render bench-accel` (in
 //! `bench_accel/`) measures the acceleration structures instead of rendering; `render compare`
-//! (`compare.rs`) measures the error of one image against another. `render --stats` prints
-//! what a render built and skipped (`stats.rs`).
+//! (`compare.rs`) measures the error of one image against another.
 
 mod args;
 mod bench_accel;

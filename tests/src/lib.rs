@@ -3,7 +3,7 @@
 //! render small scenes; the tests themselves are in `tests/tests/`.
 
 use rt_core::Scene;
-use rt_film::{AovSet, Film, FilmBuffers};
+use rt_film::{AovSet, Film};
 use rt_integrators::{Ctx, Integrator, RenderOptions};
 use std::path::Path;
 
@@ -27,7 +27,7 @@ pub fn render(
 ) -> Film {
     let accel = rt_accel::Bvh2::build(&scene.triangles, &rt_accel::BuildParams::default());
     let camera = &scene.cameras[0];
-    let buffers = FilmBuffers::for_outputs(AovSet::default()).with_variance();
+    let buffers = rt_film::FilmBuffers::for_outputs(AovSet::default()).with_variance();
     let mut film = Film::new(camera.width, camera.height, buffers);
     let ctx = Ctx {
         scene,
@@ -50,6 +50,12 @@ pub fn render(
     film
 }
 
+/// The variance of a pixel's mean from a film rendered by [`render`] (which keeps it).
+pub fn variance_of_mean(p: &rt_film::PixelStats) -> rt_core::Rgb {
+    p.variance_of_mean()
+        .expect("render() keeps the variance buffer")
+}
+
 /// Mean over all pixels and channels and its standard error (from the per-pixel variances of
 /// the mean; pixels are independent).
 pub fn image_mean(film: &Film) -> (f64, f64) {
@@ -62,10 +68,4 @@ pub fn image_mean(film: &Film) -> (f64, f64) {
         var += (v.x + v.y + v.z) as f64;
     }
     (sum / n, var.sqrt() / n)
-}
-
-/// The variance of a pixel's mean from a film rendered by [`render`] (which keeps it).
-pub fn variance_of_mean(p: &rt_film::PixelStats) -> rt_core::Rgb {
-    p.variance_of_mean()
-        .expect("render() keeps the variance buffer")
 }
