@@ -97,6 +97,13 @@ pub struct Args {
     #[arg(long, value_delimiter = ',')]
     pub aov: Option<Vec<String>>,
 
+    /// After the render, print a table of its stages to stdout: what was built and what was
+    /// skipped (the light sampling structure without emitters, the environment importance map
+    /// without an environment map, film buffers no output reads, lens samples for a pinhole
+    /// camera), with the time and the bytes held by each. Printed even with -q.
+    #[arg(long)]
+    pub stats: bool,
+
     /// Exposure in stops applied before PNG tone mapping (EXR is always written unscaled).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
@@ -152,6 +159,17 @@ mod tests {
     #[test]
     fn cli_definition_is_consistent() {
         Args::command().debug_assert();
+    }
+
+    #[test]
+    fn stats_is_an_opt_in_flag() {
+        assert!(!Args::try_parse_from(["render", "s.toml"]).unwrap().stats);
+        assert!(
+            Args::try_parse_from(["render", "s.toml", "--stats"])
+                .unwrap()
+                .stats
+        );
+        assert!(Args::try_parse_from(["render", "s.toml", "--stats=yes"]).is_err());
     }
 
     #[test]

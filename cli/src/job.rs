@@ -6,7 +6,7 @@ use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rt_accel::AccelSpec;
 use rt_core::{Accel, Scene};
-use rt_film::{AovSet, Film, OutputOptions};
+use rt_film::{AovSet, Film, FilmBuffers, OutputOptions};
 use rt_integrators::{AoIntegrator, Ctx, Integrator, PathIntegrator, RenderOptions, RenderStats};
 use rt_scene::{LoadedScene, RenderDesc};
 use std::io::IsTerminal;
@@ -196,7 +196,8 @@ pub fn build_integrator(job: &Job) -> Box<dyn Integrator> {
 pub fn run(args: &Args) -> Result<()> {
     let t_load = Instant::now();
     let loaded = load_scene(scene_arg(args))?;
-    let load_secs = t_load.elapsed().as_secs_f64();
+    let load_time = t_load.elapsed();
+    let load_secs = load_time.as_secs_f64();
     for w in &loaded.warnings {
         if !args.quiet {
             eprintln!("warning: {w}");
@@ -231,9 +232,15 @@ pub fn run(args: &Args) -> Result<()> {
 
     let t_build = Instant::now();
     let accel = pool.install(|| build_accel(&job.accel, &scene));
-    let build_secs = t_build.elapsed().as_secs_f64();
+    let build_time = t_build.elapsed();
+    let build_secs = build_time.as_secs_f64();
     let integrator = build_integrator(&job);
-    let mut film = Film::new(camera.width, camera.height, job.aovs);
+    // Only the buffers the outputs read: no variance or half-buffers unless asked for.
+    let mut film = Film::new(
+        camera.width,
+        camera.height,
+        FilmBuffers::for_outputs(job.aovs),
+    );
     let ctx = Ctx {
         scene: &scene,
         accel: accel.as_ref(),
@@ -264,6 +271,7 @@ pub fn run(args: &Args) -> Result<()> {
     });
     bar.finish_and_clear();
 
+    let t_write = Instant::now();
     rt_film::write_image(
         &job.output,
         &film,
@@ -272,6 +280,7 @@ pub fn run(args: &Args) -> Result<()> {
         },
     )
     .map_err(|e| anyhow::anyhow!("{e}"))?;
+    let write_time = t_write.elapsed();
     if !job.quiet {
         print_summary(
             &job,
@@ -283,6 +292,23 @@ pub fn run(args: &Args) -> Result<()> {
             load_secs,
             build_secs,
             pool.current_num_threads(),
+        );
+    }
+    if args.stats {
+        print!(
+            "{}",
+            crate::stats::collect(&crate::stats::Inputs {
+                scene: &scene,
+                camera,
+                accel: accel.as_ref(),
+                accel_spec: job.accel.to_string(),
+                film: &film,
+                render: &stats,
+                load_time,
+                accel_time: build_time,
+                write_time,
+                output: &job.output,
+            })
         );
     }
     Ok(())

@@ -11,6 +11,7 @@ mod bench_accel;
 mod compare;
 mod job;
 mod load_image;
+mod stats;
 
 use clap::Parser;
 use std::process::ExitCode;

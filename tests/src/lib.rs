@@ -19,7 +19,8 @@ pub fn scene_from_toml(toml: &str) -> Scene {
     }
 }
 
-/// Renders the first camera of `scene` with `spp` samples on `threads` worker threads.
+/// Renders the first camera of `scene` with `spp` samples on `threads` worker threads. The film
+/// keeps the variance buffer: the statistical tests read it.
 pub fn render(
     scene: &Scene,
     integrator: &dyn Integrator,
@@ -29,7 +30,8 @@ pub fn render(
 ) -> Film {
     let accel = rt_accel::Bvh2::build(&scene.triangles, &rt_accel::BuildParams::default());
     let camera = &scene.cameras[0];
-    let mut film = Film::new(camera.width, camera.height, AovSet::default());
+    let buffers = rt_film::FilmBuffers::for_outputs(AovSet::default()).with_variance();
+    let mut film = Film::new(camera.width, camera.height, buffers);
     let ctx = Ctx {
         scene,
         accel: &accel,
@@ -51,6 +53,12 @@ pub fn render(
     film
 }
 
+/// The variance of a pixel's mean from a film rendered by [`render`] (which keeps it).
+pub fn variance_of_mean(p: &rt_film::PixelStats) -> rt_core::Rgb {
+    p.variance_of_mean()
+        .expect("render() keeps the variance buffer")
+}
+
 /// Mean over all pixels and channels and its standard error (from the per-pixel variances of
 /// the mean; pixels are independent).
 pub fn image_mean(film: &Film) -> (f64, f64) {
@@ -58,7 +66,7 @@ pub fn image_mean(film: &Film) -> (f64, f64) {
     let mut sum = 0.0;
     let mut var = 0.0;
     for p in film.pixels() {
-        let (m, v) = (p.mean(), p.variance_of_mean());
+        let (m, v) = (p.mean(), variance_of_mean(&p));
         sum += (m.x + m.y + m.z) as f64;
         var += (v.x + v.y + v.z) as f64;
     }

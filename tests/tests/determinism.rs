@@ -26,6 +26,7 @@ fn images_do_not_depend_on_thread_count() {
     let one = render(&scene, &integrator, 16, 5, 1);
     let three = render(&scene, &integrator, 16, 5, 3);
     assert_eq!(one.mean_image(), three.mean_image());
+    assert!(one.variance_image().is_some());
     assert_eq!(one.variance_image(), three.variance_image());
     let other_seed = render(&scene, &integrator, 16, 6, 3);
     assert_ne!(one.mean_image(), other_seed.mean_image());

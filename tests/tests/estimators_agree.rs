@@ -2,7 +2,7 @@
 //! images must agree within noise: per pixel (z-test on the difference, using both variances)
 //! and over the whole image.
 
-use rt_e2e::{render, scene_from_toml};
+use rt_e2e::{render, scene_from_toml, variance_of_mean};
 use rt_film::Film;
 use rt_integrators::PathIntegrator;
 
@@ -107,9 +107,9 @@ fn compare(a: &Film, b: &Film) {
     let mut over_4 = 0;
     let (mut diff_sum, mut var_sum) = (0.0f64, 0.0f64);
     let n = a.pixels().len() * 3;
-    for (pa, pb) in a.pixels().iter().zip(b.pixels()) {
+    for (pa, pb) in a.pixels().zip(b.pixels()) {
         let d = pa.mean() - pb.mean();
-        let v = pa.variance_of_mean() + pb.variance_of_mean();
+        let v = variance_of_mean(&pa) + variance_of_mean(&pb);
         for c in 0..3 {
             diff_sum += d[c] as f64;
             var_sum += v[c] as f64;

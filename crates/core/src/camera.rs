@@ -63,15 +63,22 @@ impl Camera {
         }
     }
 
+    /// True for a pinhole (aperture 0): [`Camera::generate_ray`] ignores its lens sample, so
+    /// the render driver does not draw one.
+    #[inline]
+    pub fn is_pinhole(&self) -> bool {
+        self.aperture <= 0.0
+    }
+
     /// Primary ray through continuous raster position `film` (x right, y down, in pixels) with
-    /// lens sample `lens` in [0,1)². The direction is normalised.
+    /// lens sample `lens` in [0,1)² (ignored by a pinhole). The direction is normalised.
     #[inline]
     pub fn generate_ray(&self, film: Vec2, lens: Vec2) -> Ray {
         let aspect = self.width as f32 / self.height as f32;
         let sx = (2.0 * film.x / self.width as f32 - 1.0) * self.tan_half * aspect;
         let sy = (1.0 - 2.0 * film.y / self.height as f32) * self.tan_half;
         let d = self.forward + self.right * sx + self.up * sy;
-        if self.aperture <= 0.0 {
+        if self.is_pinhole() {
             return Ray::new(self.position, d.normalize());
         }
         let focus = self.position + d * self.focus_distance;
@@ -119,6 +126,7 @@ mod tests {
     #[test]
     fn orientation_matches_the_documented_convention() {
         let c = cam(0.0);
+        assert!(c.is_pinhole() && !cam(0.2).is_pinhole());
         assert!((c.right - Vec3::X).length() < 1e-6);
         // Left column looks to -x, top row to +y.
         let r = c.generate_ray(Vec2::new(0.0, 50.0), Vec2::ZERO);

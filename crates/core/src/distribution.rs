@@ -69,6 +69,11 @@ impl Distribution1D {
         self.integral
     }
 
+    /// Bytes of the tables held on the heap (length × element size).
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of_val(self.func.as_slice()) + std::mem::size_of_val(self.cdf.as_slice())
+    }
+
     /// Picks a bin: returns `(index, probability of that bin, u remapped to [0,1) within the bin)`.
     #[inline]
     pub fn sample_discrete(&self, u: f32) -> (usize, f32, f32) {
@@ -150,6 +155,17 @@ impl Distribution2D {
         self.marginal.integral()
     }
 
+    /// Bytes held on the heap: the row distributions and their tables, and the marginal's.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of_val(self.rows.as_slice())
+            + self
+                .rows
+                .iter()
+                .map(Distribution1D::memory_bytes)
+                .sum::<usize>()
+            + self.marginal.memory_bytes()
+    }
+
     /// Samples a point; returns it and its density.
     #[inline]
     pub fn sample(&self, u: Vec2) -> (Vec2, f32) {
@@ -203,6 +219,9 @@ mod tests {
             let (p, pdf) = d.sample(u);
             assert!((d.pdf(p) - pdf).abs() < 1e-4 * pdf.max(1.0));
         }
+        // Two rows of 3 weights and 4 cdf entries; a marginal of 2 weights and 3 cdf entries.
+        let row = std::mem::size_of::<Distribution1D>();
+        assert_eq!(d.memory_bytes(), 2 * row + 2 * 7 * 4 + 5 * 4);
         // Density integrates to one: bins have area 1/6.
         let total: f32 = (0..6)
             .map(|i| {

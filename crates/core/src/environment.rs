@@ -7,8 +7,10 @@
 use crate::{color::luminance, distribution::Distribution2D, Rgb};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
+use std::time::{Duration, Instant};
 
-/// Radiance arriving from infinitely far away.
+/// Radiance arriving from infinitely far away. Only a map has an importance map: a constant
+/// colour is sampled uniformly over the sphere, which is already proportional to it.
 #[derive(Clone, Debug)]
 pub enum Environment {
     /// The same radiance from every direction.
@@ -24,12 +26,16 @@ pub struct EnvMap {
     height: u32,
     texels: Vec<Rgb>,
     dist: Distribution2D,
+    /// How long building `dist` took, for `render --stats`: the map is built while a scene
+    /// loads, where the caller cannot time this step on its own.
+    dist_build_time: Duration,
 }
 
 impl EnvMap {
     /// Builds from row-major linear radiance (already multiplied by any strength). Non-finite and
     /// negative texels must have been rejected by the caller.
     pub fn new(width: u32, height: u32, texels: Vec<Rgb>) -> Self {
+        let start = Instant::now();
         let (w, h) = (width as usize, height as usize);
         // Weight by sinθ: rows near the poles cover less solid angle.
         let weights: Vec<f32> = (0..h)
@@ -45,7 +51,28 @@ impl EnvMap {
             height,
             texels,
             dist,
+            dist_build_time: start.elapsed(),
         }
+    }
+
+    /// Width and height in texels.
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// Bytes of the texels (length × element size).
+    pub fn texel_bytes(&self) -> usize {
+        std::mem::size_of_val(self.texels.as_slice())
+    }
+
+    /// Bytes of the importance map (the luminance × sinθ distribution).
+    pub fn importance_map_bytes(&self) -> usize {
+        self.dist.memory_bytes()
+    }
+
+    /// How long building the importance map took.
+    pub fn importance_build_time(&self) -> Duration {
+        self.dist_build_time
     }
 
     fn texel(&self, uv: Vec2) -> Rgb {
@@ -91,6 +118,14 @@ impl Environment {
         match self {
             Environment::Constant(c) => *c,
             Environment::Map(m) => m.texel(dir_to_uv(d)),
+        }
+    }
+
+    /// The map, if this is one (only a map has an importance map).
+    pub fn map(&self) -> Option<&EnvMap> {
+        match self {
+            Environment::Constant(_) => None,
+            Environment::Map(m) => Some(m),
         }
     }
 
@@ -169,6 +204,13 @@ mod tests {
             .map(|i| Rgb::splat(1.0 + (i % 7) as f32))
             .collect();
         let env = Environment::Map(EnvMap::new(w, h, texels));
+        let map = env.map().unwrap();
+        assert_eq!(map.size(), (16, 8));
+        assert_eq!(map.texel_bytes(), 16 * 8 * 12);
+        // Eight rows of 16 bins (16 weights + 17 cdf entries each) and an 8-bin marginal.
+        let rows = 8 * std::mem::size_of::<crate::distribution::Distribution1D>();
+        assert_eq!(map.importance_map_bytes(), rows + 8 * 33 * 4 + 17 * 4);
+        assert!(Environment::Constant(Rgb::ONE).map().is_none());
         for i in 0..64 {
             let u = Vec2::new(
                 (i as f32 * 0.618_034 + 0.05) % 1.0,

@@ -6,14 +6,19 @@ use crate::{
     Scene,
 };
 use glam::{Vec2, Vec3};
+use std::time::{Duration, Instant};
 
-/// Chooses lights for next-event estimation.
+/// Chooses lights for next-event estimation. Without emissive triangles it holds no emitter
+/// table and no power distribution (nothing is allocated); it may still sample the environment.
 #[derive(Clone, Debug, Default)]
 pub struct LightSampler {
     emitters: Vec<u32>,
     dist: Option<Distribution1D>,
     total_power: f32,
     env_prob: f32,
+    /// How long [`LightSampler::build`] took, for `render --stats` (it runs while a scene
+    /// loads, where the caller cannot time it on its own).
+    build_time: Duration,
 }
 
 /// A point (or direction) on a light, as seen from a shading point.
@@ -44,6 +49,7 @@ fn triangle_power(scene: &Scene, prim: u32) -> f32 {
 impl LightSampler {
     /// Collects the emissive triangles of `scene` and weighs them by power.
     pub fn build(scene: &Scene) -> Self {
+        let start = Instant::now();
         let emitters: Vec<u32> = (0..scene.triangles.len() as u32)
             .filter(|&i| scene.material_of(i).is_emissive() && triangle_power(scene, i) > 0.0)
             .collect();
@@ -62,7 +68,19 @@ impl LightSampler {
             emitters,
             total_power,
             env_prob,
+            build_time: start.elapsed(),
         }
+    }
+
+    /// Bytes of the emitter table and power distribution (zero without emissive triangles).
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of_val(self.emitters.as_slice())
+            + self.dist.as_ref().map_or(0, Distribution1D::memory_bytes)
+    }
+
+    /// How long building took (the scan for emitters included).
+    pub fn build_time(&self) -> Duration {
+        self.build_time
     }
 
     /// True if there is anything to sample.

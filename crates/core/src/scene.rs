@@ -153,3 +153,84 @@ impl Scene {
         }
     }
 }
+
+/// Bytes a [`Scene`] holds, by kind (length × element size of each buffer, names included).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SceneMemory {
+    /// Vertex positions, per-vertex normals and uvs, material ids, object records.
+    pub geometry: usize,
+    /// Materials with their names and layers.
+    pub materials: usize,
+    /// Texture texels.
+    pub textures: usize,
+    /// Environment map texels (its importance map is counted apart, as a sampling structure).
+    pub environment: usize,
+}
+
+impl SceneMemory {
+    /// All kinds together.
+    pub fn total(&self) -> usize {
+        self.geometry + self.materials + self.textures + self.environment
+    }
+}
+
+impl Scene {
+    /// What the scene's buffers hold. The light sampler and the environment's importance map
+    /// are sampling structures built from the scene and are reported by their own
+    /// `memory_bytes`, not here.
+    pub fn memory(&self) -> SceneMemory {
+        use std::mem::{size_of, size_of_val};
+        let geometry = size_of_val(self.triangles.as_slice())
+            + size_of_val(self.normals.as_slice())
+            + size_of_val(self.uvs.as_slice())
+            + size_of_val(self.material_ids.as_slice())
+            + self
+                .objects
+                .iter()
+                .map(|o| size_of::<Object>() + o.name.len())
+                .sum::<usize>();
+        let materials = self
+            .materials
+            .iter()
+            .map(|m| size_of::<Material>() + m.name.len() + size_of_val(m.layers.as_slice()))
+            .sum();
+        let textures = self
+            .textures
+            .iter()
+            .map(|t| size_of::<Texture>() + size_of_val(t.texels.as_slice()))
+            .sum();
+        SceneMemory {
+            geometry,
+            materials,
+            textures,
+            environment: self.environment.map().map_or(0, |m| m.texel_bytes()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod memory_tests {
+    use super::*;
+
+    #[test]
+    fn memory_counts_every_buffer_by_kind() {
+        let mut s = Scene::empty();
+        assert_eq!(s.memory(), SceneMemory::default());
+        s.materials.push(Material::diffuse("ab", Rgb::ONE));
+        s.push_triangle([Vec3::ZERO, Vec3::X, Vec3::Y], 0);
+        s.push_triangle([Vec3::ZERO, Vec3::Y, Vec3::Z], 0);
+        s.textures.push(Texture {
+            width: 2,
+            height: 1,
+            texels: vec![Rgb::ONE; 2],
+        });
+        let m = s.memory();
+        let per_tri = 36 + size_of::<Option<[Vec3; 3]>>() + size_of::<Option<[Vec2; 3]>>() + 4;
+        assert_eq!(m.geometry, 2 * per_tri);
+        let layer = size_of::<crate::Layer>();
+        assert_eq!(m.materials, size_of::<Material>() + 2 + layer);
+        assert_eq!(m.textures, size_of::<Texture>() + 24);
+        assert_eq!(m.environment, 0);
+        assert_eq!(m.total(), m.geometry + m.materials + m.textures);
+    }
+}

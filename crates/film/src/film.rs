@@ -1,6 +1,7 @@
 //! The film: a grid of pixel statistics plus optional first-hit AOVs.
 
-use crate::pixel::{AovPixel, FirstHit, PixelStats};
+use crate::pixel::{add_m2, FirstHit, HalfSums, MeanCount, PixelStats};
+use rt_core::glam::Vec3;
 use rt_core::Rgb;
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -15,7 +16,7 @@ pub struct AovSet {
     pub depth: bool,
     /// World position.
     pub position: bool,
-    /// Per-pixel variance of the mean (from the statistics; costs nothing extra to keep).
+    /// Per-pixel variance of the mean (needs the film's variance buffer, 12 bytes per pixel).
     pub variance: bool,
 }
 
@@ -47,14 +48,122 @@ impl AovSet {
     }
 }
 
-/// Per-pixel accumulation for a `width × height` image, row 0 at the top.
+/// Which per-pixel buffers a film allocates besides the mean and sample count, which it always
+/// keeps. The caller fills this from what its outputs and consumers read, so that a render pays
+/// only for those: the `variance` output or a z-test needs `variance`, the stopping criterion
+/// and the GREE error estimates need `halves`, each first-hit AOV needs its own buffer.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FilmBuffers {
+    /// First-hit AOVs to accumulate, and which outputs will be written. Its `variance` flag
+    /// implies [`FilmBuffers::variance`].
+    pub aovs: AovSet,
+    /// Welford `M2` per pixel, for the variance of the mean (12 bytes per pixel).
+    pub variance: bool,
+    /// Sums and counts of the even- and odd-numbered samples (32 bytes per pixel).
+    pub halves: bool,
+}
+
+impl FilmBuffers {
+    /// The buffers needed to write `aovs` and nothing else.
+    pub fn for_outputs(aovs: AovSet) -> Self {
+        Self {
+            aovs,
+            variance: aovs.variance,
+            halves: false,
+        }
+    }
+
+    /// Also keep the variance buffer (for a consumer that is not an output, e.g. a z-test).
+    pub fn with_variance(mut self) -> Self {
+        self.variance = true;
+        self
+    }
+
+    /// Also keep the even/odd half-buffers.
+    pub fn with_halves(mut self) -> Self {
+        self.halves = true;
+        self
+    }
+}
+
+impl From<AovSet> for FilmBuffers {
+    fn from(aovs: AovSet) -> Self {
+        Self::for_outputs(aovs)
+    }
+}
+
+/// Bytes held by each of a film's buffers (length × element size); `None` for a buffer the
+/// film did not allocate.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FilmMemory {
+    /// Mean and sample count (always kept).
+    pub mean: usize,
+    /// Welford `M2`.
+    pub variance: Option<usize>,
+    /// Even/odd half sums and counts.
+    pub halves: Option<usize>,
+    /// Per-pixel count of samples with a first hit, shared by the first-hit AOVs.
+    pub first_hits: Option<usize>,
+    /// Albedo sums.
+    pub albedo: Option<usize>,
+    /// Shading-normal sums.
+    pub normal: Option<usize>,
+    /// Depth sums.
+    pub depth: Option<usize>,
+    /// Position sums.
+    pub position: Option<usize>,
+}
+
+impl FilmMemory {
+    /// Bytes of all buffers together.
+    pub fn total(&self) -> usize {
+        self.mean
+            + [
+                self.variance,
+                self.halves,
+                self.first_hits,
+                self.albedo,
+                self.normal,
+                self.depth,
+                self.position,
+            ]
+            .iter()
+            .flatten()
+            .sum::<usize>()
+    }
+}
+
+/// Sums of the first-hit AOVs, one buffer per quantity; each is empty unless asked for.
+#[derive(Debug, Default)]
+struct AovBuffers {
+    /// Samples whose first hit was recorded (the divisor of every AOV average).
+    hits: Vec<u32>,
+    albedo: Vec<Rgb>,
+    normal: Vec<Vec3>,
+    depth: Vec<f32>,
+    position: Vec<Vec3>,
+}
+
+/// A band of [`AovBuffers`].
+struct AovSlices<'a> {
+    hits: &'a mut [u32],
+    albedo: &'a mut [Rgb],
+    normal: &'a mut [Vec3],
+    depth: &'a mut [f32],
+    position: &'a mut [Vec3],
+}
+
+/// Per-pixel accumulation for a `width × height` image, row 0 at the top. Only the buffers
+/// named by its [`FilmBuffers`] exist; the others have length zero.
 #[derive(Debug)]
 pub struct Film {
     width: u32,
     height: u32,
-    pixels: Vec<PixelStats>,
-    aov: Vec<AovPixel>,
-    aovs: AovSet,
+    buffers: FilmBuffers,
+    mean: Vec<MeanCount>,
+    m2: Vec<Rgb>,
+    halves: Vec<HalfSums>,
+    aov: AovBuffers,
     discarded: AtomicU64,
 }
 
@@ -65,15 +174,17 @@ pub struct FilmStripe<'a> {
     pub y0: u32,
     /// Image width.
     pub width: u32,
-    pixels: &'a mut [PixelStats],
-    aov: &'a mut [AovPixel],
+    mean: &'a mut [MeanCount],
+    m2: &'a mut [Rgb],
+    halves: &'a mut [HalfSums],
+    aov: AovSlices<'a>,
     discarded: &'a AtomicU64,
 }
 
 impl FilmStripe<'_> {
     /// Number of rows in this band.
     pub fn rows(&self) -> u32 {
-        (self.pixels.len() / self.width as usize) as u32
+        (self.mean.len() / self.width as usize) as u32
     }
 
     /// Adds a radiance sample (sample number `index`) to pixel `(x, y)` (image coordinates).
@@ -92,34 +203,103 @@ impl FilmStripe<'_> {
             self.discarded.fetch_add(1, Ordering::Relaxed);
             return false;
         }
-        self.pixels[i].add(radiance, index);
-        if let (Some(a), Some(h)) = (self.aov.get_mut(i), hit) {
-            if h.albedo.is_finite()
-                && h.normal.is_finite()
-                && h.depth.is_finite()
-                && h.position.is_finite()
-            {
-                a.add(h);
+        // Optional buffers are empty slices when not kept, so `get_mut` is the "is it kept"
+        // test: one predictable branch per buffer, no per-sample flags to consult.
+        let px = &mut self.mean[i];
+        let delta = px.add(radiance);
+        if let Some(m2) = self.m2.get_mut(i) {
+            add_m2(m2, radiance, delta, px.mean);
+        }
+        if let Some(h) = self.halves.get_mut(i) {
+            h.add(radiance, index);
+        }
+        if let (Some(n), Some(h)) = (self.aov.hits.get_mut(i), hit) {
+            if h.is_finite() {
+                *n += 1;
+                if let Some(a) = self.aov.albedo.get_mut(i) {
+                    *a += h.albedo;
+                }
+                if let Some(a) = self.aov.normal.get_mut(i) {
+                    *a += h.normal;
+                }
+                if let Some(a) = self.aov.depth.get_mut(i) {
+                    *a += h.depth;
+                }
+                if let Some(a) = self.aov.position.get_mut(i) {
+                    *a += h.position;
+                }
             }
         }
         true
     }
 }
 
+/// `v` allocated with `n` default elements if `keep`, else empty (no allocation).
+fn buffer<T: Clone + Default>(keep: bool, n: usize) -> Vec<T> {
+    if keep {
+        vec![T::default(); n]
+    } else {
+        Vec::new()
+    }
+}
+
+/// Bytes held by `v`, or `None` if it was not allocated.
+fn bytes<T>(v: &[T]) -> Option<usize> {
+    (!v.is_empty()).then(|| std::mem::size_of_val(v))
+}
+
+/// Chunks of `v`, followed by empty slices forever, so that an unallocated buffer hands every
+/// stripe an empty slice.
+fn chunks<T>(v: &mut [T], chunk: usize) -> impl Iterator<Item = &mut [T]> {
+    v.chunks_mut(chunk)
+        .chain(std::iter::repeat_with(Default::default))
+}
+
+/// Per-pixel averages of one AOV's sums (zero where no sample hit a surface), or `None` if the
+/// film does not keep it.
+fn averages<T>(sums: &[T], hits: &[u32]) -> Option<Vec<T>>
+where
+    T: Copy + Default + std::ops::Mul<f32, Output = T>,
+{
+    if sums.is_empty() {
+        return None;
+    }
+    Some(
+        sums.iter()
+            .zip(hits)
+            .map(|(&s, &n)| {
+                if n == 0 {
+                    T::default()
+                } else {
+                    s * (1.0 / n as f32)
+                }
+            })
+            .collect(),
+    )
+}
+
 impl Film {
-    /// An empty film keeping the given AOVs.
-    pub fn new(width: u32, height: u32, aovs: AovSet) -> Self {
+    /// An empty film keeping the given buffers. Passing an [`AovSet`] keeps what writing those
+    /// outputs needs ([`FilmBuffers::for_outputs`]).
+    pub fn new(width: u32, height: u32, buffers: impl Into<FilmBuffers>) -> Self {
+        let mut buffers = buffers.into();
+        buffers.variance |= buffers.aovs.variance;
         let n = width as usize * height as usize;
+        let a = buffers.aovs;
         Self {
             width,
             height,
-            pixels: vec![PixelStats::default(); n],
-            aov: if aovs.any_first_hit() {
-                vec![AovPixel::default(); n]
-            } else {
-                Vec::new()
+            buffers,
+            mean: vec![MeanCount::default(); n],
+            m2: buffer(buffers.variance, n),
+            halves: buffer(buffers.halves, n),
+            aov: AovBuffers {
+                hits: buffer(a.any_first_hit(), n),
+                albedo: buffer(a.albedo, n),
+                normal: buffer(a.normal, n),
+                depth: buffer(a.depth, n),
+                position: buffer(a.position, n),
             },
-            aovs,
             discarded: AtomicU64::new(0),
         }
     }
@@ -136,7 +316,31 @@ impl Film {
 
     /// The AOVs this film keeps.
     pub fn aovs(&self) -> AovSet {
-        self.aovs
+        self.buffers.aovs
+    }
+
+    /// The buffers this film keeps.
+    pub fn buffers(&self) -> FilmBuffers {
+        self.buffers
+    }
+
+    /// Bytes held by each buffer.
+    pub fn memory(&self) -> FilmMemory {
+        FilmMemory {
+            mean: std::mem::size_of_val(self.mean.as_slice()),
+            variance: bytes(&self.m2),
+            halves: bytes(&self.halves),
+            first_hits: bytes(&self.aov.hits),
+            albedo: bytes(&self.aov.albedo),
+            normal: bytes(&self.aov.normal),
+            depth: bytes(&self.aov.depth),
+            position: bytes(&self.aov.position),
+        }
+    }
+
+    /// Bytes held by all buffers together.
+    pub fn memory_bytes(&self) -> usize {
+        self.memory().total()
     }
 
     /// Samples dropped because they were NaN, infinite or negative.
@@ -144,77 +348,144 @@ impl Film {
         self.discarded.load(Ordering::Relaxed)
     }
 
+    fn stats_at(&self, i: usize) -> PixelStats {
+        PixelStats::new(
+            self.mean[i],
+            self.m2.get(i).copied(),
+            self.halves.get(i).copied(),
+        )
+    }
+
     /// Statistics of pixel `(x, y)`.
-    pub fn pixel(&self, x: u32, y: u32) -> &PixelStats {
-        &self.pixels[(y * self.width + x) as usize]
+    pub fn pixel(&self, x: u32, y: u32) -> PixelStats {
+        self.stats_at((y * self.width + x) as usize)
     }
 
-    /// Mutable statistics of pixel `(x, y)`.
-    pub fn pixel_mut(&mut self, x: u32, y: u32) -> &mut PixelStats {
-        &mut self.pixels[(y * self.width + x) as usize]
+    /// Statistics of all pixels, row-major.
+    pub fn pixels(&self) -> impl ExactSizeIterator<Item = PixelStats> + '_ {
+        (0..self.mean.len()).map(|i| self.stats_at(i))
     }
 
-    /// All pixels, row-major.
-    pub fn pixels(&self) -> &[PixelStats] {
-        &self.pixels
+    /// Adds a sample to pixel `(x, y)`, as [`FilmStripe::add_sample`] does, for callers that
+    /// fill the film from one thread.
+    pub fn add_sample(
+        &mut self,
+        x: u32,
+        y: u32,
+        index: u32,
+        radiance: Rgb,
+        hit: Option<&FirstHit>,
+    ) -> bool {
+        let rows = self.height;
+        self.bands(rows)
+            .next()
+            .is_some_and(|mut s| s.add_sample(x, y, index, radiance, hit))
     }
 
-    /// Averaged first-hit AOVs, row-major (empty if none were kept).
-    pub fn aov_averages(&self) -> Vec<FirstHit> {
-        self.aov.iter().map(AovPixel::average).collect()
+    /// Bands of `rows` rows (the last may be shorter), lazily, so that [`Film::add_sample`]
+    /// can borrow the whole film as one band without allocating.
+    fn bands(&mut self, rows: u32) -> impl Iterator<Item = FilmStripe<'_>> {
+        let w = self.width;
+        let rows = rows.max(1);
+        let chunk = (rows as usize * w as usize).max(1);
+        let discarded = &self.discarded;
+        let mut m2 = chunks(&mut self.m2, chunk);
+        let mut halves = chunks(&mut self.halves, chunk);
+        let mut hits = chunks(&mut self.aov.hits, chunk);
+        let mut albedo = chunks(&mut self.aov.albedo, chunk);
+        let mut normal = chunks(&mut self.aov.normal, chunk);
+        let mut depth = chunks(&mut self.aov.depth, chunk);
+        let mut position = chunks(&mut self.aov.position, chunk);
+        self.mean
+            .chunks_mut(chunk)
+            .enumerate()
+            .map(move |(i, mean)| FilmStripe {
+                y0: i as u32 * rows,
+                width: w,
+                mean,
+                m2: m2.next().unwrap_or_default(),
+                halves: halves.next().unwrap_or_default(),
+                aov: AovSlices {
+                    hits: hits.next().unwrap_or_default(),
+                    albedo: albedo.next().unwrap_or_default(),
+                    normal: normal.next().unwrap_or_default(),
+                    depth: depth.next().unwrap_or_default(),
+                    position: position.next().unwrap_or_default(),
+                },
+                discarded,
+            })
     }
 
     /// Splits the film into bands of `rows` rows for parallel rendering.
     pub fn stripes_mut(&mut self, rows: u32) -> Vec<FilmStripe<'_>> {
-        let w = self.width;
-        let chunk = (rows.max(1) * w).max(1) as usize;
-        let aov_chunks: Vec<&mut [AovPixel]> = if self.aov.is_empty() {
-            Vec::new()
-        } else {
-            self.aov.chunks_mut(chunk).collect()
-        };
-        let mut aov_iter = aov_chunks.into_iter();
-        let discarded = &self.discarded;
-        self.pixels
-            .chunks_mut(chunk)
-            .enumerate()
-            .map(|(i, p)| FilmStripe {
-                y0: i as u32 * rows.max(1),
-                width: w,
-                pixels: p,
-                aov: aov_iter.next().unwrap_or_default(),
-                discarded,
-            })
-            .collect()
+        self.bands(rows).collect()
     }
 
     /// The pixel estimates, row-major.
     pub fn mean_image(&self) -> Vec<Rgb> {
-        self.pixels.iter().map(PixelStats::mean).collect()
+        self.mean.iter().map(|p| p.mean).collect()
     }
 
-    /// Variance of each pixel estimate, row-major.
-    pub fn variance_image(&self) -> Vec<Rgb> {
-        self.pixels
-            .iter()
-            .map(PixelStats::variance_of_mean)
-            .collect()
+    /// Variance of each pixel estimate, row-major; `None` without a variance buffer.
+    pub fn variance_image(&self) -> Option<Vec<Rgb>> {
+        if self.m2.is_empty() {
+            return None;
+        }
+        Some(
+            self.pixels()
+                .map(|p| p.variance_of_mean().unwrap_or_default())
+                .collect(),
+        )
     }
 
-    /// Mean of the even (`0`) or odd (`1`) samples, row-major.
-    pub fn half_image(&self, half: usize) -> Vec<Rgb> {
-        self.pixels.iter().map(|p| p.half_mean(half)).collect()
+    /// Mean of the even (`0`) or odd (`1`) samples, row-major; `None` without half-buffers.
+    pub fn half_image(&self, half: usize) -> Option<Vec<Rgb>> {
+        if self.halves.is_empty() {
+            return None;
+        }
+        Some(self.halves.iter().map(|h| h.mean(half)).collect())
+    }
+
+    /// Average first-hit albedo, row-major (zero where no sample hit); `None` unless kept.
+    pub fn albedo_image(&self) -> Option<Vec<Rgb>> {
+        averages(&self.aov.albedo, &self.aov.hits)
+    }
+
+    /// Average first-hit shading normal (not renormalised); `None` unless kept.
+    pub fn normal_image(&self) -> Option<Vec<Vec3>> {
+        averages(&self.aov.normal, &self.aov.hits)
+    }
+
+    /// Average first-hit distance from the camera; `None` unless kept.
+    pub fn depth_image(&self) -> Option<Vec<f32>> {
+        averages(&self.aov.depth, &self.aov.hits)
+    }
+
+    /// Average first-hit world position; `None` unless kept.
+    pub fn position_image(&self) -> Option<Vec<Vec3>> {
+        averages(&self.aov.position, &self.aov.hits)
     }
 
     /// Total samples accumulated.
     pub fn total_samples(&self) -> u64 {
-        self.pixels.iter().map(|p| p.count() as u64).sum()
+        self.mean.iter().map(|p| p.n as u64).sum()
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn all_buffers() -> FilmBuffers {
+        FilmBuffers::for_outputs(AovSet {
+            albedo: true,
+            normal: true,
+            depth: true,
+            position: true,
+            variance: true,
+        })
+        .with_halves()
+    }
 
     #[test]
     fn stripes_cover_the_film_and_reject_bad_samples() {
@@ -229,6 +500,7 @@ mod tests {
         {
             let stripes = film.stripes_mut(2);
             assert_eq!(stripes.len(), 3);
+            assert_eq!(stripes.iter().map(FilmStripe::rows).sum::<u32>(), 5);
             for mut s in stripes {
                 for y in s.y0..s.y0 + s.rows() {
                     for x in 0..3 {
@@ -239,18 +511,37 @@ mod tests {
                         assert!(s.add_sample(x, y, 0, Rgb::splat(y as f32), Some(&hit)));
                         assert!(!s.add_sample(x, y, 1, Rgb::new(f32::NAN, 0.0, 0.0), None));
                         assert!(!s.add_sample(x, y, 1, Rgb::splat(f32::INFINITY), None));
+                        assert!(!s.add_sample(x, y, 1, Rgb::splat(-1.0), None));
                     }
                 }
             }
         }
-        assert_eq!(film.discarded(), 30);
+        assert_eq!(film.discarded(), 45);
         assert_eq!(film.pixel(2, 4).mean(), Rgb::splat(4.0));
         assert_eq!(film.total_samples(), 15);
-        assert_eq!(film.aov_averages()[7].depth, 2.0);
+        assert_eq!(film.depth_image().unwrap()[7], 2.0);
+        assert!(film.albedo_image().is_none());
     }
 
     #[test]
-    fn aovs_are_not_allocated_unless_asked() {
+    fn only_requested_buffers_are_allocated() {
+        let film = Film::new(4, 4, AovSet::default());
+        let m = film.memory();
+        assert_eq!(m.mean, 16 * 16, "mean (12 B) and count (4 B) per pixel");
+        assert_eq!(
+            (m.variance, m.halves, m.first_hits),
+            (None, None, None),
+            "{m:?}"
+        );
+        assert_eq!(
+            (m.albedo, m.normal, m.depth, m.position),
+            (None, None, None, None)
+        );
+        assert_eq!(film.memory_bytes(), 256);
+        assert!(film.variance_image().is_none() && film.half_image(0).is_none());
+        assert!(film.pixel(1, 1).variance_of_mean().is_none());
+
+        // The variance output brings its buffer and nothing else.
         let film = Film::new(
             4,
             4,
@@ -259,7 +550,102 @@ mod tests {
                 ..Default::default()
             },
         );
-        assert!(film.aov_averages().is_empty());
+        let m = film.memory();
+        assert_eq!(m.variance, Some(16 * 12));
+        assert_eq!((m.halves, m.first_hits, m.albedo), (None, None, None));
+        assert!(film.buffers().variance && !film.buffers().halves);
+        assert_eq!(film.variance_image().unwrap().len(), 16);
+
+        // One first-hit AOV: its sums plus the shared hit count.
+        let film = Film::new(
+            4,
+            4,
+            AovSet {
+                albedo: true,
+                ..Default::default()
+            },
+        );
+        let m = film.memory();
+        assert_eq!((m.first_hits, m.albedo), (Some(16 * 4), Some(16 * 12)));
+        assert_eq!(
+            (m.normal, m.depth, m.position, m.variance),
+            (None, None, None, None)
+        );
+
+        let film = Film::new(4, 4, all_buffers());
+        let per_pixel = film.memory_bytes() / 16;
+        assert_eq!(per_pixel, 16 + 12 + 32 + 4 + 12 + 12 + 4 + 12);
+        assert!(film.half_image(1).is_some());
         assert!(AovSet::parse_list(["albedo", "bogus"]).is_err());
+    }
+
+    /// The accumulation before the buffers became optional: one struct per pixel, Welford mean
+    /// and M2 updated together. Kept here to prove the mean's bits did not change.
+    #[derive(Default)]
+    struct Legacy {
+        mean: Rgb,
+        m2: Rgb,
+        n: u32,
+    }
+
+    impl Legacy {
+        fn add(&mut self, x: Rgb) {
+            self.n += 1;
+            let delta = x - self.mean;
+            self.mean += delta / self.n as f32;
+            self.m2 += delta * (x - self.mean);
+        }
+    }
+
+    #[test]
+    fn statistics_are_bit_identical_with_and_without_optional_buffers() {
+        let mut lean = Film::new(2, 2, AovSet::default());
+        let mut full = Film::new(2, 2, all_buffers());
+        let mut legacy: Vec<Legacy> = (0..4).map(|_| Legacy::default()).collect();
+        // A spread of magnitudes, so that rounding differences would show.
+        let mut state = 0x1234_5678u32;
+        for i in 0..1000u32 {
+            state = rt_core::sampler::hash_u32(state.wrapping_add(i));
+            let v = (state >> 8) as f32 / (1 << 24) as f32;
+            let x = Rgb::new(v * 1e3, v * v, (1.0 - v) * 7.0);
+            let p = (state & 3) as usize;
+            let (px, py) = (p as u32 % 2, p as u32 / 2);
+            assert!(lean.add_sample(px, py, i, x, None));
+            assert!(full.add_sample(px, py, i, x, Some(&FirstHit::default())));
+            legacy[p].add(x);
+        }
+        let bits = |img: &[Rgb]| -> Vec<[u32; 3]> {
+            img.iter().map(|p| p.to_array().map(f32::to_bits)).collect()
+        };
+        let legacy_mean: Vec<Rgb> = legacy.iter().map(|l| l.mean).collect();
+        assert_eq!(bits(&lean.mean_image()), bits(&legacy_mean));
+        assert_eq!(bits(&full.mean_image()), bits(&legacy_mean));
+        for (p, l) in full.pixels().zip(&legacy) {
+            let want = l.m2 / (l.n - 1) as f32 / l.n as f32;
+            assert_eq!(bits(&[p.variance_of_mean().unwrap()]), bits(&[want]));
+        }
+        assert_eq!(lean.pixels().len(), 4);
+        assert_eq!(full.total_samples(), 1000);
+    }
+
+    #[test]
+    fn aov_averages_skip_non_finite_hits_and_empty_pixels() {
+        let mut film = Film::new(2, 1, all_buffers());
+        let hit = |d: f32| FirstHit {
+            albedo: Rgb::splat(0.5),
+            normal: Vec3::Z,
+            depth: d,
+            position: Vec3::new(1.0, 2.0, 3.0),
+        };
+        film.add_sample(0, 0, 0, Rgb::ONE, Some(&hit(2.0)));
+        film.add_sample(0, 0, 1, Rgb::ONE, Some(&hit(4.0)));
+        film.add_sample(0, 0, 2, Rgb::ONE, Some(&hit(f32::NAN)));
+        film.add_sample(1, 0, 0, Rgb::ONE, None);
+        assert_eq!(film.depth_image().unwrap(), vec![3.0, 0.0]);
+        assert_eq!(film.albedo_image().unwrap()[0], Rgb::splat(0.5));
+        assert_eq!(film.normal_image().unwrap()[1], Vec3::ZERO);
+        assert_eq!(film.position_image().unwrap()[0], Vec3::new(1.0, 2.0, 3.0));
+        let h = *film.pixel(0, 0).halves().unwrap();
+        assert_eq!((h.count(0), h.count(1)), (2, 1));
     }
 }

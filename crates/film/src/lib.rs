@@ -1,10 +1,12 @@
 //! `rt-film`: where samples land, and how images leave the renderer.
 //!
-//! [`Film`] keeps per-pixel running statistics (Welford mean and variance, sample count) plus
-//! the two half-buffers of even- and odd-numbered samples that the thesis' stopping criterion
-//! (Dammertz §6.2) and the error estimators of the denoisers compare. First-hit AOVs (albedo,
-//! shading normal, depth, world position) are kept only when asked for. Nothing non-finite ever
-//! enters a buffer: such samples are counted and dropped.
+//! [`Film`] keeps per-pixel running statistics in separate buffers, and only those a consumer
+//! asked for in its [`FilmBuffers`]: the Welford mean and sample count always (16 bytes per
+//! pixel); the Welford `M2` for the variance of the mean (12 bytes); the two half-buffers of
+//! even- and odd-numbered samples that the thesis' stopping criterion (Dammertz §6.2) and the
+//! error estimators of the denoisers compare (32 bytes); each first-hit AOV (albedo, shading
+//! normal, depth, world position) and their shared hit count. [`Film::memory`] reports what is
+//! held. Nothing non-finite ever enters a buffer: such samples are counted and dropped.
 //!
 //! [`output`] writes EXR (linear float, AOVs as extra channel groups) and PNG (tone mapped
 //! sRGB), always atomically: a temporary file in the target directory renamed into place.
@@ -12,14 +14,17 @@
 //! Depends on `rt-core` (for `Rgb`), `exr` and `image`.
 //!
 //! ```
-//! use rt_film::{Film, AovSet};
+//! use rt_film::{AovSet, Film, FilmBuffers};
 //! use rt_core::glam::Vec3;
-//! let mut film = Film::new(2, 1, AovSet::default());
+//! // A consumer that reads the variance asks for it; the half-buffers are left out.
+//! let mut film = Film::new(2, 1, FilmBuffers::for_outputs(AovSet::default()).with_variance());
 //! for (i, v) in [1.0, 3.0].into_iter().enumerate() {
-//!     film.pixel_mut(0, 0).add(Vec3::splat(v), i as u32);
+//!     film.add_sample(0, 0, i as u32, Vec3::splat(v), None);
 //! }
 //! assert_eq!(film.pixel(0, 0).mean(), Vec3::splat(2.0));
-//! assert_eq!(film.pixel(0, 0).variance_of_mean(), Vec3::splat(1.0));
+//! assert_eq!(film.pixel(0, 0).variance_of_mean(), Some(Vec3::splat(1.0)));
+//! assert!(film.half_image(0).is_none());
+//! assert_eq!(film.memory_bytes(), 2 * (16 + 12));
 //! ```
 #![forbid(unsafe_code)]
 
@@ -27,6 +32,6 @@ mod film;
 pub mod output;
 mod pixel;
 
-pub use film::{AovSet, Film, FilmStripe};
+pub use film::{AovSet, Film, FilmBuffers, FilmMemory, FilmStripe};
 pub use output::{read_exr, write_image, write_rgb, FilmError, OutputOptions};
-pub use pixel::{AovPixel, FirstHit, PixelStats};
+pub use pixel::{FirstHit, HalfSums, PixelStats};

@@ -164,32 +164,24 @@ fn rgb_channels(
 fn write_exr(w: &mut BufWriter<File>, film: &Film) -> Result<(), String> {
     let mut chans = Vec::new();
     rgb_channels(&mut chans, "", ["R", "G", "B"], &film.mean_image());
-    let aovs = film.aovs();
-    if aovs.any_first_hit() {
-        let first = film.aov_averages();
-        if aovs.albedo {
-            let v: Vec<Rgb> = first.iter().map(|h| h.albedo).collect();
-            rgb_channels(&mut chans, "albedo.", ["R", "G", "B"], &v);
-        }
-        if aovs.normal {
-            let v: Vec<Rgb> = first.iter().map(|h| h.normal).collect();
-            rgb_channels(&mut chans, "normal.", ["X", "Y", "Z"], &v);
-        }
-        if aovs.depth {
-            chans.push(channel("depth.Z", first.iter().map(|h| h.depth).collect()));
-        }
-        if aovs.position {
-            let v: Vec<Rgb> = first.iter().map(|h| h.position).collect();
-            rgb_channels(&mut chans, "position.", ["X", "Y", "Z"], &v);
-        }
+    // Each accessor is `None` exactly when the AOV was not asked for (the film allocates the
+    // buffers its outputs need), so these lines write what was requested and nothing else.
+    if let Some(v) = film.albedo_image() {
+        rgb_channels(&mut chans, "albedo.", ["R", "G", "B"], &v);
     }
-    if aovs.variance {
-        rgb_channels(
-            &mut chans,
-            "variance.",
-            ["R", "G", "B"],
-            &film.variance_image(),
-        );
+    if let Some(v) = film.normal_image() {
+        rgb_channels(&mut chans, "normal.", ["X", "Y", "Z"], &v);
+    }
+    if let Some(v) = film.depth_image() {
+        chans.push(channel("depth.Z", v));
+    }
+    if let Some(v) = film.position_image() {
+        rgb_channels(&mut chans, "position.", ["X", "Y", "Z"], &v);
+    }
+    if film.aovs().variance {
+        if let Some(v) = film.variance_image() {
+            rgb_channels(&mut chans, "variance.", ["R", "G", "B"], &v);
+        }
     }
     write_exr_channels(w, (film.width() as usize, film.height() as usize), chans)
 }

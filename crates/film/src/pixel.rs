@@ -1,31 +1,92 @@
-//! Per-pixel accumulators.
+//! Per-pixel accumulators. The film keeps each kind in its own buffer so that a render pays
+//! only for the statistics some consumer reads: the mean and count always, the Welford `M2`
+//! and the even/odd half sums only when asked for (see [`crate::FilmBuffers`]).
 
 use rt_core::glam::Vec3;
 use rt_core::Rgb;
 
-/// Running statistics of one pixel's samples.
+/// Running mean and sample count of one pixel: the only per-pixel state every film keeps.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PixelStats {
-    mean: Rgb,
-    m2: Rgb,
-    n: u32,
-    half_sum: [Rgb; 2],
-    half_n: [u32; 2],
+pub(crate) struct MeanCount {
+    pub mean: Rgb,
+    pub n: u32,
 }
 
-impl PixelStats {
-    /// Adds sample number `index` (its parity picks the half-buffer). The caller guarantees the
-    /// value is finite; [`crate::FilmStripe::add_sample`] checks.
+impl MeanCount {
+    /// Welford's mean update (numerically stable where a running sum would lose the small
+    /// samples of a bright pixel). Returns `delta = x - old mean`, which the optional `M2`
+    /// update needs: computing it once here keeps the mean's bits the same whether or not the
+    /// variance is kept.
     #[inline]
-    pub fn add(&mut self, x: Rgb, index: u32) {
-        // Welford's update: numerically stable where sum and sum of squares would cancel.
+    pub fn add(&mut self, x: Rgb) -> Rgb {
         self.n += 1;
         let delta = x - self.mean;
         self.mean += delta / self.n as f32;
-        self.m2 += delta * (x - self.mean);
+        delta
+    }
+}
+
+/// Welford's `M2` update, after [`MeanCount::add`] returned `delta` and moved the mean to
+/// `mean`.
+#[inline]
+pub(crate) fn add_m2(m2: &mut Rgb, x: Rgb, delta: Rgb, mean: Rgb) {
+    *m2 += delta * (x - mean);
+}
+
+/// Sums and counts of the even- and odd-numbered samples of one pixel: two independent
+/// half-estimates whose difference the stopping criterion (Dammertz §6.2) and the GREE error
+/// estimates read. Counts are kept rather than derived from the sample index because dropped
+/// (non-finite) samples leave gaps.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct HalfSums {
+    sum: [Rgb; 2],
+    n: [u32; 2],
+}
+
+impl HalfSums {
+    /// Adds sample number `index`; its parity picks the half.
+    #[inline]
+    pub fn add(&mut self, x: Rgb, index: u32) {
         let h = (index & 1) as usize;
-        self.half_sum[h] += x;
-        self.half_n[h] += 1;
+        self.sum[h] += x;
+        self.n[h] += 1;
+    }
+
+    /// Mean of the even-numbered (`half = 0`) or odd-numbered (`half = 1`) samples; zero
+    /// without samples.
+    #[inline]
+    pub fn mean(&self, half: usize) -> Rgb {
+        if self.n[half] == 0 {
+            return Rgb::ZERO;
+        }
+        self.sum[half] / self.n[half] as f32
+    }
+
+    /// Number of samples in half `half`.
+    #[inline]
+    pub fn count(&self, half: usize) -> u32 {
+        self.n[half]
+    }
+}
+
+/// The statistics of one pixel, assembled from the film's buffers. Quantities whose buffer the
+/// film does not keep are `None`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelStats {
+    mean: Rgb,
+    n: u32,
+    m2: Option<Rgb>,
+    halves: Option<HalfSums>,
+}
+
+impl PixelStats {
+    pub(crate) fn new(mc: MeanCount, m2: Option<Rgb>, halves: Option<HalfSums>) -> Self {
+        Self {
+            mean: mc.mean,
+            n: mc.n,
+            m2,
+            halves,
+        }
     }
 
     /// Number of samples.
@@ -40,31 +101,32 @@ impl PixelStats {
         self.mean
     }
 
-    /// Unbiased sample variance of one sample.
+    /// Unbiased sample variance of one sample (zero below two samples); `None` if the film
+    /// keeps no variance buffer.
     #[inline]
-    pub fn sample_variance(&self) -> Rgb {
+    pub fn sample_variance(&self) -> Option<Rgb> {
+        let m2 = self.m2?;
         if self.n < 2 {
-            return Rgb::ZERO;
+            return Some(Rgb::ZERO);
         }
-        self.m2 / (self.n - 1) as f32
+        Some(m2 / (self.n - 1) as f32)
     }
 
-    /// Estimated variance of the mean (sample variance / n).
+    /// Estimated variance of the mean (sample variance / n); `None` if the film keeps no
+    /// variance buffer.
     #[inline]
-    pub fn variance_of_mean(&self) -> Rgb {
+    pub fn variance_of_mean(&self) -> Option<Rgb> {
+        let v = self.sample_variance()?;
         if self.n < 2 {
-            return Rgb::ZERO;
+            return Some(Rgb::ZERO);
         }
-        self.sample_variance() / self.n as f32
+        Some(v / self.n as f32)
     }
 
-    /// Mean of the even-numbered (`half = 0`) or odd-numbered (`half = 1`) samples.
+    /// The even/odd half sums; `None` if the film keeps no half-buffers.
     #[inline]
-    pub fn half_mean(&self, half: usize) -> Rgb {
-        if self.half_n[half] == 0 {
-            return Rgb::ZERO;
-        }
-        self.half_sum[half] / self.half_n[half] as f32
+    pub fn halves(&self) -> Option<&HalfSums> {
+        self.halves.as_ref()
     }
 }
 
@@ -81,44 +143,14 @@ pub struct FirstHit {
     pub position: Vec3,
 }
 
-/// Sums of first-hit AOVs over the samples of a pixel that hit something.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct AovPixel {
-    /// Sum of albedos.
-    pub albedo: Rgb,
-    /// Sum of normals.
-    pub normal: Vec3,
-    /// Sum of depths.
-    pub depth: f32,
-    /// Sum of positions.
-    pub position: Vec3,
-    /// Samples that hit a surface.
-    pub hits: u32,
-}
-
-impl AovPixel {
-    /// Accumulates one first hit.
+impl FirstHit {
+    /// True if every field is finite (a non-finite first hit is dropped whole).
     #[inline]
-    pub fn add(&mut self, h: &FirstHit) {
-        self.albedo += h.albedo;
-        self.normal += h.normal;
-        self.depth += h.depth;
-        self.position += h.position;
-        self.hits += 1;
-    }
-
-    /// Averages over hits (all zero for a pixel that saw only the background).
-    pub fn average(&self) -> FirstHit {
-        if self.hits == 0 {
-            return FirstHit::default();
-        }
-        let k = 1.0 / self.hits as f32;
-        FirstHit {
-            albedo: self.albedo * k,
-            normal: self.normal * k,
-            depth: self.depth * k,
-            position: self.position * k,
-        }
+    pub fn is_finite(&self) -> bool {
+        self.albedo.is_finite()
+            && self.normal.is_finite()
+            && self.depth.is_finite()
+            && self.position.is_finite()
     }
 }
 
@@ -126,21 +158,43 @@ impl AovPixel {
 mod tests {
     use super::*;
 
+    fn stats(xs: &[f32]) -> PixelStats {
+        let (mut mc, mut m2, mut h) = (MeanCount::default(), Rgb::ZERO, HalfSums::default());
+        for (i, &x) in xs.iter().enumerate() {
+            let x = Rgb::splat(x);
+            let delta = mc.add(x);
+            add_m2(&mut m2, x, delta, mc.mean);
+            h.add(x, i as u32);
+        }
+        PixelStats::new(mc, Some(m2), Some(h))
+    }
+
     #[test]
     fn welford_matches_two_pass_statistics() {
         let xs = [0.5f32, 2.0, 7.25, 1.0, 1e-3, 4.0, 3.5];
-        let mut p = PixelStats::default();
-        for (i, &x) in xs.iter().enumerate() {
-            p.add(Rgb::splat(x), i as u32);
-        }
+        let p = stats(&xs);
         let n = xs.len() as f32;
         let mean = xs.iter().sum::<f32>() / n;
         let var = xs.iter().map(|x| (x - mean).powi(2)).sum::<f32>() / (n - 1.0);
         assert!((p.mean().x - mean).abs() < 1e-5);
-        assert!((p.sample_variance().x - var).abs() < 1e-4);
-        assert!((p.variance_of_mean().x - var / n).abs() < 1e-5);
+        assert!((p.sample_variance().unwrap().x - var).abs() < 1e-4);
+        assert!((p.variance_of_mean().unwrap().x - var / n).abs() < 1e-5);
         let even: Vec<f32> = xs.iter().step_by(2).copied().collect();
-        assert!((p.half_mean(0).x - even.iter().sum::<f32>() / even.len() as f32).abs() < 1e-5);
+        let h = p.halves().unwrap();
+        assert!((h.mean(0).x - even.iter().sum::<f32>() / even.len() as f32).abs() < 1e-5);
+        assert_eq!((h.count(0), h.count(1)), (4, 3));
         assert_eq!(p.count(), 7);
+    }
+
+    #[test]
+    fn missing_buffers_read_as_none_and_one_sample_has_zero_variance() {
+        let mut mc = MeanCount::default();
+        mc.add(Rgb::splat(2.0));
+        let p = PixelStats::new(mc, None, None);
+        assert_eq!(p.mean(), Rgb::splat(2.0));
+        assert!(p.sample_variance().is_none() && p.variance_of_mean().is_none());
+        assert!(p.halves().is_none());
+        assert_eq!(stats(&[3.0]).variance_of_mean(), Some(Rgb::ZERO));
+        assert_eq!(HalfSums::default().mean(1), Rgb::ZERO);
     }
 }

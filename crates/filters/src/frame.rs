@@ -36,30 +36,46 @@ impl NoisyFrame {
         }
     }
 
-    /// Everything the film recorded.
+    /// Everything the film recorded (its optional buffers that it did not keep stay empty).
     pub fn from_film(film: &Film) -> Self {
-        let aovs = film.aovs();
-        let first = film.aov_averages();
-        let pick = |on: bool, f: &dyn Fn(&rt_film::FirstHit) -> Rgb| -> Vec<Rgb> {
-            if on {
-                first.iter().map(f).collect()
-            } else {
-                Vec::new()
-            }
-        };
+        let [even, odd] = [0, 1].map(|h| film.half_image(h).unwrap_or_default());
         Self {
             width: film.width() as usize,
             height: film.height() as usize,
             beauty: film.mean_image(),
-            variance: film.variance_image(),
-            halves: [film.half_image(0), film.half_image(1)],
-            albedo: pick(aovs.albedo, &|h| h.albedo),
-            normal: pick(aovs.normal, &|h| h.normal),
-            depth: if aovs.depth {
-                first.iter().map(|h| h.depth).collect()
-            } else {
-                Vec::new()
-            },
+            variance: film.variance_image().unwrap_or_default(),
+            halves: [even, odd],
+            albedo: film.albedo_image().unwrap_or_default(),
+            normal: film.normal_image().unwrap_or_default(),
+            depth: film.depth_image().unwrap_or_default(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rt_film::{AovSet, FilmBuffers};
+
+    #[test]
+    fn channels_the_film_did_not_keep_are_empty() {
+        let mut film = Film::new(2, 1, AovSet::default());
+        film.add_sample(0, 0, 0, Rgb::ONE, None);
+        let f = NoisyFrame::from_film(&film);
+        assert_eq!(f.beauty, vec![Rgb::ONE, Rgb::ZERO]);
+        assert!(f.variance.is_empty() && f.halves.iter().all(Vec::is_empty));
+        assert!(f.albedo.is_empty() && f.normal.is_empty() && f.depth.is_empty());
+
+        let aovs = AovSet {
+            normal: true,
+            ..Default::default()
+        };
+        let film = Film::new(2, 1, FilmBuffers::for_outputs(aovs).with_halves());
+        let f = NoisyFrame::from_film(&film);
+        assert_eq!(
+            (f.halves[0].len(), f.halves[1].len(), f.normal.len()),
+            (2, 2, 2)
+        );
+        assert!(f.variance.is_empty() && f.albedo.is_empty());
     }
 }

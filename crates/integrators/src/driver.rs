@@ -4,6 +4,11 @@
 //! function of (seed, pixel, sample index, dimension), so the image is bit-identical whatever
 //! the thread count or scheduling. The pixel filter is a box: a sample counts only in the pixel
 //! it was taken in, which keeps pixel noise independent for the denoisers downstream.
+//!
+//! Dimension layout of one sample: the film position (one 2D draw), the lens position (one 2D
+//! draw, only for a thin-lens camera: a pinhole ignores it, so it is not drawn), then whatever
+//! the integrator draws. Pinhole images therefore use the integrator's dimensions one draw
+//! earlier than thin-lens images do.
 
 use crate::{Ctx, Integrator, RayCounters, SampleAux};
 use rayon::prelude::*;
@@ -65,6 +70,7 @@ pub fn render(
     let totals = Mutex::new(RayCounters::default());
     let rows_done = std::sync::atomic::AtomicU32::new(0);
     let camera = ctx.camera;
+    let thin_lens = !camera.is_pinhole();
     film.stripes_mut(BAND_ROWS)
         .into_par_iter()
         .for_each(|mut stripe| {
@@ -75,7 +81,11 @@ pub fn render(
                     for i in 0..opts.spp {
                         sampler.start(x, y, i);
                         let film_pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
-                        let lens = sampler.next_2d();
+                        let lens = if thin_lens {
+                            sampler.next_2d()
+                        } else {
+                            Vec2::ZERO
+                        };
                         let ray = camera.generate_ray(film_pos, lens);
                         let mut aux = SampleAux {
                             want_first_hit,
@@ -96,5 +106,78 @@ pub fn render(
         samples: film.width() as u64 * film.height() as u64 * opts.spp as u64,
         rays,
         discarded: film.discarded() - discarded_before,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rt_core::{glam::Vec3, Camera, Ray, Rgb, Scene};
+    use rt_film::AovSet;
+
+    /// Returns the integrator's first random number as the radiance, so the image shows which
+    /// sampler dimension the integrator starts at.
+    struct FirstDimension;
+
+    impl Integrator for FirstDimension {
+        fn name(&self) -> &str {
+            "first-dimension"
+        }
+
+        fn li(
+            &self,
+            _: &Ctx<'_>,
+            _: Ray,
+            sampler: &mut Sampler,
+            _: &mut SampleAux,
+            _: &mut RayCounters,
+        ) -> Rgb {
+            Rgb::splat(sampler.next_1d())
+        }
+    }
+
+    fn first_dimension_image(aperture: f32, seed: u32) -> Vec<Rgb> {
+        let scene = Scene::empty();
+        let accel = rt_accel::BruteForce::new(&scene.triangles);
+        let camera = Camera::look_at("c", Vec3::Z, Vec3::ZERO, Vec3::Y, 40.0, 3, 2, aperture, 1.0);
+        let ctx = Ctx {
+            scene: &scene,
+            accel: &accel,
+            camera: &camera,
+        };
+        let mut film = Film::new(3, 2, AovSet::default());
+        let opts = RenderOptions { spp: 1, seed };
+        render(&ctx, &FirstDimension, &mut film, &opts, &|_| {});
+        film.mean_image()
+    }
+
+    /// What the integrator's first draw is when `skipped_2d` 2D draws precede it.
+    fn expected(seed: u32, skipped_2d: usize) -> Vec<Rgb> {
+        let mut s = Sampler::new(seed);
+        (0..2)
+            .flat_map(|y| (0..3).map(move |x| (x, y)))
+            .map(|(x, y)| {
+                s.start(x, y, 0);
+                for _ in 0..skipped_2d {
+                    s.next_2d();
+                }
+                Rgb::splat(s.next_1d())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn only_thin_lens_cameras_draw_a_lens_sample() {
+        for seed in [0, 7] {
+            // Pinhole: the film position alone precedes the integrator.
+            assert_eq!(first_dimension_image(0.0, seed), expected(seed, 1));
+            // Thin lens: the film position and the lens position.
+            assert_eq!(first_dimension_image(0.1, seed), expected(seed, 2));
+        }
+        assert_ne!(
+            expected(0, 1),
+            expected(0, 2),
+            "the test can tell them apart"
+        );
     }
 }

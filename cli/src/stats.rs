@@ -1,0 +1,364 @@
+//! `render --stats`: what a render built, what it skipped and why, and what each stage cost in
+//! time and in bytes held. The libraries report the figures (`Scene::memory`,
+//! `Accel::memory_bytes`, `LightSampler::memory_bytes`, `EnvMap::importance_map_bytes`,
+//! `Film::memory`, ...); this module only arranges and prints them. Bytes are lengths times
+//! element sizes of the buffers held after the render, not the process's resident memory.
+
+use rt_core::{environment::Environment, Accel, Camera, Scene};
+use rt_film::Film;
+use rt_integrators::RenderStats;
+use std::fmt;
+use std::path::Path;
+use std::time::Duration;
+
+/// Whether a stage ran, and if not, why not.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Status {
+    /// It ran; the word says how ("built", "allocated", "used", "done").
+    Ran(&'static str),
+    /// It was not needed, for the given reason.
+    Skipped(String),
+}
+
+/// One stage of a render.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stage {
+    /// What the stage is.
+    pub name: String,
+    /// Ran or skipped.
+    pub status: Status,
+    /// Wall-clock time, where measured.
+    pub time: Option<Duration>,
+    /// Bytes held after the render (the file's size for the output write).
+    pub bytes: Option<u64>,
+    /// Counts, names and other particulars.
+    pub details: String,
+}
+
+impl Stage {
+    fn ran(name: &str, word: &'static str, time: Option<Duration>, bytes: Option<usize>) -> Self {
+        Self {
+            name: name.to_string(),
+            status: Status::Ran(word),
+            time,
+            bytes: bytes.map(|b| b as u64),
+            details: String::new(),
+        }
+    }
+
+    fn skipped(name: &str, why: impl Into<String>) -> Self {
+        Self {
+            name: name.to_string(),
+            status: Status::Skipped(why.into()),
+            time: None,
+            bytes: None,
+            details: String::new(),
+        }
+    }
+
+    fn details(mut self, d: impl Into<String>) -> Self {
+        self.details = d.into();
+        self
+    }
+}
+
+/// The stages of one render, in order, and the bytes held at its end.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Stats {
+    /// Stages in the order they ran.
+    pub stages: Vec<Stage>,
+    /// Bytes of the scene, acceleration structure, sampling structures and film held together.
+    pub held_bytes: u64,
+}
+
+/// Everything [`collect`] reads.
+pub struct Inputs<'a> {
+    pub scene: &'a Scene,
+    pub camera: &'a Camera,
+    pub accel: &'a dyn Accel,
+    pub accel_spec: String,
+    pub film: &'a Film,
+    pub render: &'a RenderStats,
+    pub load_time: Duration,
+    pub accel_time: Duration,
+    pub write_time: Duration,
+    pub output: &'a Path,
+}
+
+/// Gathers the stages of a finished render.
+pub fn collect(i: &Inputs<'_>) -> Stats {
+    let scene = i.scene;
+    let mut stages = Vec::new();
+
+    let mem = scene.memory();
+    stages.push(
+        Stage::ran("scene load", "done", Some(i.load_time), Some(mem.total())).details(format!(
+            "triangles: {} ({} B), materials: {} ({} B), textures: {} ({} B), environment \
+             map texels: {} B",
+            scene.triangle_count(),
+            mem.geometry,
+            scene.materials.len(),
+            mem.materials,
+            scene.textures.len(),
+            mem.textures,
+            mem.environment
+        )),
+    );
+
+    let accel_bytes = i.accel.memory_bytes();
+    stages.push(
+        Stage::ran(
+            "acceleration structure",
+            "built",
+            Some(i.accel_time),
+            Some(accel_bytes),
+        )
+        .details(if i.accel.name() == i.accel_spec {
+            i.accel_spec.clone()
+        } else {
+            format!("{} ({})", i.accel.name(), i.accel_spec)
+        }),
+    );
+
+    let lights = &scene.lights;
+    let env_sampled = !scene.environment.is_black();
+    let light_stage = "light sampling structure";
+    stages.push(if lights.emitter_count() > 0 {
+        Stage::ran(
+            light_stage,
+            "built",
+            Some(lights.build_time()),
+            Some(lights.memory_bytes()),
+        )
+        .details(format!("{} emissive triangles", lights.emitter_count()))
+    } else if env_sampled {
+        Stage::skipped(
+            light_stage,
+            "no emitters (light samples go to the environment)",
+        )
+    } else {
+        Stage::skipped(light_stage, "no emitters")
+    });
+
+    let env_stage = "environment importance map";
+    stages.push(match &scene.environment {
+        Environment::Map(m) => {
+            let (w, h) = m.size();
+            Stage::ran(
+                env_stage,
+                "built",
+                Some(m.importance_build_time()),
+                Some(m.importance_map_bytes()),
+            )
+            .details(format!("{w}x{h} map"))
+        }
+        Environment::Constant(_) if env_sampled => {
+            Stage::skipped(env_stage, "constant environment")
+        }
+        Environment::Constant(_) => Stage::skipped(env_stage, "no environment"),
+    });
+
+    let film = i.film;
+    let fm = film.memory();
+    let pixels = film.width() as usize * film.height() as usize;
+    let per_pixel = |b: usize| format!("{} B/pixel", b / pixels.max(1));
+    stages.push(
+        Stage::ran("film mean + count", "allocated", None, Some(fm.mean))
+            .details(per_pixel(fm.mean)),
+    );
+    let buffer = |name: &str, bytes: Option<usize>, why_not: &str| match bytes {
+        Some(b) => Stage::ran(name, "allocated", None, Some(b)).details(per_pixel(b)),
+        None => Stage::skipped(name, why_not),
+    };
+    stages.push(buffer("film variance (M2)", fm.variance, "no consumer"));
+    stages.push(buffer("film half-buffers", fm.halves, "no consumer"));
+    stages.push(buffer(
+        "film AOV hit count",
+        fm.first_hits,
+        "no first-hit AOV requested",
+    ));
+    for (name, bytes) in [
+        ("film AOV albedo", fm.albedo),
+        ("film AOV normal", fm.normal),
+        ("film AOV depth", fm.depth),
+        ("film AOV position", fm.position),
+    ] {
+        stages.push(buffer(name, bytes, "not requested"));
+    }
+
+    stages.push(if i.camera.is_pinhole() {
+        Stage::skipped("lens sampling", "pinhole camera")
+    } else {
+        Stage::ran("lens sampling", "used", None, None)
+            .details(format!("aperture {}", i.camera.aperture))
+    });
+
+    let r = i.render;
+    stages.push(
+        Stage::ran("render", "done", Some(r.elapsed), None).details(format!(
+            "{} samples, {} rays, {} shadow rays, {} discarded samples",
+            r.samples, r.rays.rays, r.rays.shadow_rays, r.discarded
+        )),
+    );
+
+    let file_bytes = std::fs::metadata(i.output).map(|m| m.len()).ok();
+    let mut write = Stage::ran("output write", "done", Some(i.write_time), None)
+        .details(i.output.display().to_string());
+    write.bytes = file_bytes;
+    stages.push(write);
+
+    let held = mem.total()
+        + accel_bytes
+        + lights.memory_bytes()
+        + scene
+            .environment
+            .map()
+            .map_or(0, |m| m.importance_map_bytes())
+        + fm.total();
+    Stats {
+        stages,
+        held_bytes: held as u64,
+    }
+}
+
+impl Stats {
+    /// The stage named `name`.
+    #[cfg(test)]
+    pub fn stage(&self, name: &str) -> Option<&Stage> {
+        self.stages.iter().find(|s| s.name == name)
+    }
+}
+
+impl fmt::Display for Stats {
+    /// One line per stage: name, status, time, bytes, then details or the reason for a skip.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "{:<28} {:<9} {:>12} {:>12}  details",
+            "stage", "status", "time", "bytes"
+        )?;
+        for s in &self.stages {
+            let (status, details) = match &s.status {
+                Status::Ran(word) => (*word, s.details.as_str()),
+                Status::Skipped(why) => ("skipped", why.as_str()),
+            };
+            let time = s.time.map_or("-".to_string(), |t| {
+                format!("{:.3} ms", t.as_secs_f64() * 1e3)
+            });
+            let bytes = s.bytes.map_or("-".to_string(), |b| b.to_string());
+            writeln!(
+                f,
+                "{:<28} {:<9} {:>12} {:>12}  {details}",
+                s.name, status, time, bytes
+            )?;
+        }
+        writeln!(
+            f,
+            "{:<28} {:<9} {:>12} {:>12}  scene, acceleration structure, sampling structures, film",
+            "held after render", "", "", self.held_bytes
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rt_core::{glam::Vec3, Material, Rgb};
+    use rt_film::{AovSet, FilmBuffers};
+
+    fn scene(emitting: bool) -> Scene {
+        let mut s = Scene::empty();
+        let mut m = Material::diffuse("m", Rgb::splat(0.5));
+        if emitting {
+            m.emission = Rgb::ONE;
+        }
+        s.materials.push(m);
+        s.push_triangle([Vec3::ZERO, Vec3::X, Vec3::Y], 0);
+        s.build_lights();
+        s
+    }
+
+    fn stats_for(scene: &Scene, film: &Film, aperture: f32) -> Stats {
+        let camera = Camera::look_at("c", Vec3::Z, Vec3::ZERO, Vec3::Y, 40.0, 4, 2, aperture, 1.0);
+        let accel = rt_accel::BruteForce::new(&scene.triangles);
+        collect(&Inputs {
+            scene,
+            camera: &camera,
+            accel: &accel,
+            accel_spec: "brute-force".into(),
+            film,
+            render: &RenderStats::default(),
+            load_time: Duration::from_millis(2),
+            accel_time: Duration::from_millis(1),
+            write_time: Duration::from_millis(3),
+            output: Path::new("/nonexistent/out.exr"),
+        })
+    }
+
+    fn skipped(s: &Stats, name: &str) -> String {
+        match &s
+            .stage(name)
+            .unwrap_or_else(|| panic!("no stage {name}"))
+            .status
+        {
+            Status::Skipped(why) => why.clone(),
+            other => panic!("{name}: {other:?}"),
+        }
+    }
+
+    #[test]
+    fn a_bare_scene_skips_every_optional_stage() {
+        let scene = scene(false);
+        let film = Film::new(4, 2, AovSet::default());
+        let s = stats_for(&scene, &film, 0.0);
+        assert_eq!(skipped(&s, "light sampling structure"), "no emitters");
+        assert_eq!(skipped(&s, "environment importance map"), "no environment");
+        assert_eq!(skipped(&s, "film variance (M2)"), "no consumer");
+        assert_eq!(skipped(&s, "film half-buffers"), "no consumer");
+        assert_eq!(skipped(&s, "film AOV albedo"), "not requested");
+        assert_eq!(skipped(&s, "lens sampling"), "pinhole camera");
+        assert_eq!(s.stage("film mean + count").unwrap().bytes, Some(8 * 16));
+        assert_eq!(s.stage("output write").unwrap().bytes, None);
+        let sum: u64 = ["scene load", "acceleration structure", "film mean + count"]
+            .iter()
+            .map(|n| s.stage(n).unwrap().bytes.unwrap())
+            .sum();
+        assert_eq!(s.held_bytes, sum);
+        let table = s.to_string();
+        assert_eq!(table.lines().count(), 2 + s.stages.len(), "{table}");
+        assert!(
+            table.contains("pinhole camera") && table.contains("2.000 ms"),
+            "{table}"
+        );
+    }
+
+    #[test]
+    fn requested_and_present_things_are_reported_as_built() {
+        let mut scene = scene(true);
+        scene.environment = Environment::Constant(Rgb::ONE);
+        scene.build_lights();
+        let aovs = AovSet::parse_list(["variance", "albedo"]).unwrap();
+        let film = Film::new(4, 2, FilmBuffers::for_outputs(aovs).with_halves());
+        let s = stats_for(&scene, &film, 0.1);
+        let lights = s.stage("light sampling structure").unwrap();
+        assert_eq!(lights.status, Status::Ran("built"));
+        assert!(lights.bytes.unwrap() > 0);
+        assert_eq!(
+            skipped(&s, "environment importance map"),
+            "constant environment"
+        );
+        for (name, per_pixel) in [
+            ("film variance (M2)", 12),
+            ("film half-buffers", 32),
+            ("film AOV hit count", 4),
+            ("film AOV albedo", 12),
+        ] {
+            assert_eq!(s.stage(name).unwrap().bytes, Some(8 * per_pixel), "{name}");
+        }
+        assert_eq!(skipped(&s, "film AOV depth"), "not requested");
+        assert_eq!(
+            s.stage("lens sampling").unwrap().status,
+            Status::Ran("used")
+        );
+    }
+}

@@ -1,0 +1,270 @@
+//! `render --stats`: the table names what was built and what was skipped, with the bytes held,
+//! and asking for outputs changes what is allocated but not the beauty image.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// A floor under a small lamp, no `[environment]`, a pinhole camera, 8×6 pixels.
+const LAMP: &str = r#"
+[[camera]]
+name = "main"
+position = [0.0, 1.0, 3.0]
+look_at = [0.0, 1.0, 0.0]
+resolution = [8, 6]
+
+[[material]]
+name = "white"
+color = [0.7, 0.7, 0.7]
+
+[[material]]
+name = "lamp"
+emission = [5.0, 5.0, 5.0]
+
+[[geometry]]
+name = "floor"
+shape = "quad"
+vertices = [[-1, 0, 1], [1, 0, 1], [1, 0, -1], [-1, 0, -1]]
+material = "white"
+
+[[geometry]]
+name = "light"
+shape = "quad"
+vertices = [[-0.3, 2, -0.3], [0.3, 2, -0.3], [0.3, 2, 0.3], [-0.3, 2, 0.3]]
+material = "lamp"
+"#;
+
+const PIXELS: u64 = 8 * 6;
+
+fn scenes_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes")
+}
+
+/// Runs `render` in `dir`, expects success, returns stdout.
+fn render(dir: &Path, args: &[&str]) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_render"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+/// One row of the stats table.
+#[derive(Debug)]
+struct Row {
+    status: String,
+    bytes: Option<u64>,
+    details: String,
+}
+
+/// The row of stage `name`: the name is padded to 28 columns, then status, time and bytes
+/// separated by spaces, then details.
+fn row(table: &str, name: &str) -> Row {
+    let line = table
+        .lines()
+        .find(|l| l.len() > 28 && l[..28].trim_end() == name)
+        .unwrap_or_else(|| panic!("no stage {name:?} in:\n{table}"));
+    let mut rest = line[28..].split_whitespace();
+    let status = rest.next().unwrap().to_string();
+    let (time, bytes) = (rest.next().unwrap(), rest.next().unwrap());
+    // "1.234 ms" is two words.
+    let bytes = if time != "-" {
+        rest.next().unwrap()
+    } else {
+        bytes
+    };
+    Row {
+        status,
+        bytes: bytes.parse().ok(),
+        details: rest.collect::<Vec<_>>().join(" "),
+    }
+}
+
+fn assert_skipped(table: &str, name: &str, why: &str) {
+    let r = row(table, name);
+    assert_eq!(
+        (r.status.as_str(), r.bytes),
+        ("skipped", None),
+        "{name}: {r:?}"
+    );
+    assert_eq!(r.details, why, "{name}");
+}
+
+fn assert_holds(table: &str, name: &str, status: &str) -> u64 {
+    let r = row(table, name);
+    assert_eq!(r.status, status, "{name}: {r:?}");
+    let b = r
+        .bytes
+        .unwrap_or_else(|| panic!("{name} has no bytes: {r:?}"));
+    assert!(b > 0, "{name}: {r:?}");
+    b
+}
+
+#[test]
+fn stats_show_skipped_stages_for_a_scene_without_environment_map_or_aovs() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("lamp.toml"), LAMP).unwrap();
+    let table = render(dir.path(), &["lamp.toml", "--spp", "2", "-q", "--stats"]);
+    // -q silences the summary line but not the requested table.
+    assert!(!table.contains("Msamples/s"), "{table}");
+    assert!(table.starts_with("stage "), "{table}");
+
+    assert_skipped(&table, "environment importance map", "no environment");
+    assert_skipped(&table, "film variance (M2)", "no consumer");
+    assert_skipped(&table, "film half-buffers", "no consumer");
+    assert_skipped(&table, "film AOV hit count", "no first-hit AOV requested");
+    for aov in ["albedo", "normal", "depth", "position"] {
+        assert_skipped(&table, &format!("film AOV {aov}"), "not requested");
+    }
+    assert_skipped(&table, "lens sampling", "pinhole camera");
+
+    assert_holds(&table, "scene load", "done");
+    assert_holds(&table, "acceleration structure", "built");
+    // Two emitting triangles: ids, powers and a three-entry cdf, four bytes each.
+    assert_eq!(
+        assert_holds(&table, "light sampling structure", "built"),
+        28
+    );
+    assert_eq!(
+        assert_holds(&table, "film mean + count", "allocated"),
+        PIXELS * 16
+    );
+    let written = assert_holds(&table, "output write", "done");
+    assert_eq!(
+        written,
+        std::fs::metadata(dir.path().join("lamp.exr"))
+            .unwrap()
+            .len()
+    );
+    let render_row = row(&table, "render");
+    assert!(
+        render_row
+            .details
+            .starts_with(&format!("{} samples", PIXELS * 2)),
+        "{render_row:?}"
+    );
+
+    // Without emitters the emitter table is skipped too (the sky still lights the scene).
+    let sky = LAMP.replace("emission = [5.0, 5.0, 5.0]", "color = [0.5, 0.5, 0.5]")
+        + "\n[environment]\ncolor = [1, 1, 1]\n";
+    std::fs::write(dir.path().join("sky.toml"), sky).unwrap();
+    let table = render(dir.path(), &["sky.toml", "--spp", "1", "-q", "--stats"]);
+    assert_skipped(
+        &table,
+        "light sampling structure",
+        "no emitters (light samples go to the environment)",
+    );
+    assert_skipped(&table, "environment importance map", "constant environment");
+}
+
+#[test]
+fn requested_aovs_are_allocated_and_leave_the_beauty_image_unchanged() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("lamp.toml"), LAMP).unwrap();
+    let common = [
+        "lamp.toml",
+        "--spp",
+        "16",
+        "-q",
+        "--stats",
+        "--threads",
+        "2",
+    ];
+    let plain = render(dir.path(), &[&common[..], &["-o", "plain.exr"]].concat());
+    let table = render(
+        dir.path(),
+        &[&common[..], &["-o", "aov.exr", "--aov", "variance,albedo"]].concat(),
+    );
+    assert_skipped(&plain, "film variance (M2)", "no consumer");
+    assert_eq!(
+        assert_holds(&table, "film variance (M2)", "allocated"),
+        PIXELS * 12
+    );
+    assert_eq!(
+        assert_holds(&table, "film AOV albedo", "allocated"),
+        PIXELS * 12
+    );
+    assert_eq!(
+        assert_holds(&table, "film AOV hit count", "allocated"),
+        PIXELS * 4
+    );
+    assert_skipped(&table, "film AOV depth", "not requested");
+    assert_skipped(&table, "film half-buffers", "no consumer");
+
+    let a = rt_film::read_exr(&dir.path().join("plain.exr")).unwrap();
+    let b = rt_film::read_exr(&dir.path().join("aov.exr")).unwrap();
+    assert!(a.channel("variance.R").is_none() && b.channel("variance.R").is_some());
+    assert!(b.channel("albedo.G").is_some() && b.channel("depth.Z").is_none());
+    for c in ["R", "G", "B"] {
+        let bits = |img: &rt_film::output::ExrImage| -> Vec<u32> {
+            img.channel(c)
+                .unwrap()
+                .iter()
+                .map(|v| v.to_bits())
+                .collect()
+        };
+        assert_eq!(bits(&a), bits(&b), "channel {c} differs");
+    }
+}
+
+#[test]
+fn shipped_scenes_build_the_importance_map_and_use_the_lens() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenes = scenes_dir();
+    let env = scenes.join("environment.toml");
+    let out = dir.path().join("env.exr");
+    let args = |scene: &Path, out: &Path| {
+        vec![
+            scene.to_str().unwrap().to_string(),
+            "-o".into(),
+            out.to_str().unwrap().to_string(),
+            "--spp".into(),
+            "1".into(),
+            "--max-depth".into(),
+            "1".into(),
+            "-q".into(),
+            "--stats".into(),
+        ]
+    };
+    let a = args(&env, &out);
+    let table = render(
+        dir.path(),
+        &a.iter().map(String::as_str).collect::<Vec<_>>(),
+    );
+    let map = assert_holds(&table, "environment importance map", "built");
+    assert!(map > 256 * 128 * 4, "{map}");
+    assert_eq!(
+        row(&table, "environment importance map").details,
+        "256x128 map"
+    );
+    assert_skipped(
+        &table,
+        "light sampling structure",
+        "no emitters (light samples go to the environment)",
+    );
+
+    let dof = scenes.join("depth-of-field.toml");
+    let out = dir.path().join("dof.exr");
+    let a = args(&dof, &out);
+    let table = render(
+        dir.path(),
+        &a.iter().map(String::as_str).collect::<Vec<_>>(),
+    );
+    let lens = row(&table, "lens sampling");
+    assert_eq!(
+        (lens.status.as_str(), lens.details.as_str()),
+        ("used", "aperture 0.12")
+    );
+    let mut a = args(&dof, &out);
+    a.extend(["--camera".to_string(), "pinhole".to_string()]);
+    let table = render(
+        dir.path(),
+        &a.iter().map(String::as_str).collect::<Vec<_>>(),
+    );
+    assert_skipped(&table, "lens sampling", "pinhole camera");
+}
