@@ -132,7 +132,9 @@ pub fn intersect_triangle(pre: &RayPrecomp, v: &[Vec3; 3], t_max: f32) -> Option
     if t.is_nan() || t <= 0.0 || t > t_max || t.is_infinite() || inv.is_infinite() {
         return None;
     }
-    if !(t > t_error_bound([ax, bx, cx], [ay, by, cy], [az, bz, cz], [u, v_, w], inv)) {
+    // A NaN bound rejects, as the SIMD kernels' `t > bound` comparison does.
+    let bound = t_error_bound([ax, bx, cx], [ay, by, cy], [az, bz, cz], [u, v_, w], inv);
+    if bound.is_nan() || t <= bound {
         return None;
     }
     Some(TriHit {
