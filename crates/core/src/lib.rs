@@ -45,7 +45,7 @@ pub use camera::Camera;
 pub use color::Rgb;
 pub use material::{Layer, Material};
 pub use ray::Ray;
-pub use sampler::Sampler;
+pub use sampler::{SampleStream, Sampler};
 pub use scene::Scene;
 
 /// Re-export so downstream crates use the same glam version as the core.
