@@ -388,7 +388,7 @@ pub fn zoom(c: usize) -> usize {
     (128 / c.max(1)).max(1)
 }
 
-/// Writes crops/<scene>/reference.png and crops/<scene>/<method>.png; returns the blocks.
+/// Writes `crops/<scene>/reference.png` and `crops/<scene>/<method>.png`; returns the blocks.
 pub fn crops(plan: &Plan, results: &Results, out: &Path) -> Result<Vec<(usize, usize, usize)>> {
     let mut blocks = Vec::new();
     for (si, scene) in plan.scenes.iter().enumerate() {
