@@ -239,6 +239,35 @@ fn reference_command_caches_and_uses_its_own_streams() {
         .parse()
         .unwrap();
     assert!(mse > 0.0, "{text}");
+
+    // Bad input: one line, exit code 1.
+    for (bad, needle) in [
+        (
+            &["reference", "none.toml", "--spp", "4"][..],
+            "none.toml: cannot open",
+        ),
+        (
+            &["reference", "scene.toml", "--spp", "0"][..],
+            "--spp must be between",
+        ),
+        (
+            &["reference", "scene.toml", "--spp", "4", "-o", "r.png"][..],
+            "written as .exr",
+        ),
+        (
+            &["reference", "scene.toml", "--spp", "4", "--camera", "x"][..],
+            "no camera named",
+        ),
+    ] {
+        let o = d.render(bad);
+        assert_eq!(o.status.code(), Some(1), "{bad:?}: {}", stderr(&o));
+        assert_eq!(stderr(&o).lines().count(), 1, "{}", stderr(&o));
+        assert!(
+            stderr(&o).contains(needle),
+            "{needle:?} not in {}",
+            stderr(&o)
+        );
+    }
 }
 
 /// Runs `render experiment` on `config` and expects exit code 1 and one error line that

@@ -259,13 +259,22 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
     let mut scenes = Vec::new();
     let mut seen = HashSet::new();
     for s in desc.scene {
-        let scene_path = base.join(&s.path);
-        let name = s.name.clone().unwrap_or_else(|| {
-            scene_path
-                .file_stem()
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_default()
-        });
+        // Procedural scenes (`gen:NAME`) are names, not files.
+        let scene_path = if s.path.starts_with("gen:") {
+            PathBuf::from(&s.path)
+        } else {
+            base.join(&s.path)
+        };
+        let name = s
+            .name
+            .clone()
+            .unwrap_or_else(|| match s.path.strip_prefix("gen:") {
+                Some(generated) => generated.to_string(),
+                None => scene_path
+                    .file_stem()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_default(),
+            });
         let here = format!("[[scene]] \"{name}\"");
         check_name("scene", &name).map_err(|e| anyhow!("{here}: {e}"))?;
         if !seen.insert(name.clone()) {
@@ -653,6 +662,16 @@ seconds = [0.5, 0.1]
         std::fs::write(&path, config.replace("scale = 0.5", "resolution = [8, 8]")).unwrap();
         let p = load(&path).unwrap();
         assert!(matches!(p.scenes[0].reference, ReferencePlan::File { .. }));
+    }
+
+    #[test]
+    fn procedural_scenes_are_names_not_files() {
+        let config = GOOD
+            .replace("scenes/s.toml", "gen:rotated")
+            .replace("scale = 0.5", "resolution = [8, 8]");
+        let p = plan(&config).unwrap();
+        assert_eq!(p.scenes[0].name, "rotated");
+        assert_eq!(p.scenes[0].path, PathBuf::from("gen:rotated"));
     }
 
     #[test]
