@@ -140,6 +140,12 @@ pub enum Command {
     /// Compare image A with the reference B: MSE, relMSE, RMSE, PSNR and SSIM, one `name value`
     /// per line (or JSON), optionally a false-colour error image (docs/experiments.md).
     Compare(crate::compare::CompareArgs),
+    /// Render a high-sample reference image (its own random streams, independent of any normal
+    /// render) or take it from the reference cache; prints the EXR's path (docs/experiments.md).
+    Reference(crate::reference::ReferenceArgs),
+    /// Run an experiment: scenes x methods x budgets against references; writes images,
+    /// results.csv, slopes.csv, log-log plots and report.md (docs/experiments.md).
+    Experiment(crate::experiment::ExperimentArgs),
     /// Write a procedural scene's triangles to a Wavefront OBJ file (one `o` per part), e.g.
     /// to benchmark other ray tracers on the same geometry.
     GenScene {

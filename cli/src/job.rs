@@ -7,7 +7,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rt_accel::AccelSpec;
 use rt_core::{Accel, Scene};
 use rt_film::{AovSet, Film, FilmBuffers, OutputOptions};
-use rt_integrators::{AoIntegrator, Ctx, Integrator, PathIntegrator, RenderOptions, RenderStats};
+use rt_integrators::{Ctx, Integrator, RenderOptions, RenderStats};
 use rt_scene::{LoadedScene, RenderDesc};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -182,14 +182,12 @@ pub fn build_accel(spec: &AccelSpec, scene: &Scene) -> Box<dyn Accel> {
 
 /// Builds the chosen integrator.
 pub fn build_integrator(job: &Job) -> Box<dyn Integrator> {
-    match job.integrator {
-        IntegratorKind::Path => Box::new(PathIntegrator::new(job.max_depth)),
-        IntegratorKind::PathBsdf => Box::new(PathIntegrator::bsdf_only(job.max_depth)),
-        IntegratorKind::Direct => Box::new(PathIntegrator::direct()),
-        IntegratorKind::Ao => Box::new(AoIntegrator {
-            max_distance: job.ao_distance,
-        }),
+    crate::session::Estimator {
+        integrator: job.integrator,
+        max_depth: job.max_depth,
+        ao_distance: job.ao_distance,
     }
+    .build()
 }
 
 /// Loads, renders and writes; prints the summary line.
@@ -205,24 +203,7 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let job = Job::resolve(args, &loaded.render)?;
     let scene = loaded.scene;
-    let camera = match &job.camera {
-        Some(name) => scene
-            .cameras
-            .iter()
-            .find(|c| &c.name == name)
-            .with_context(|| {
-                let names: Vec<&str> = scene.cameras.iter().map(|c| c.name.as_str()).collect();
-                format!(
-                    "{}: no camera named \"{name}\" (cameras: {})",
-                    job.scene_path.display(),
-                    names.join(", ")
-                )
-            })?,
-        None => scene
-            .cameras
-            .first()
-            .with_context(|| format!("{}: the scene has no camera", job.scene_path.display()))?,
-    };
+    let camera = crate::session::camera(&scene, &job.scene_path, job.camera.as_deref())?;
 
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(t) = job.threads {

@@ -4,13 +4,20 @@
 //! happens here: libraries return typed errors, this turns them into one line on stderr and a
 //! non-zero exit code (2 for usage errors, 1 for everything else). `render bench-accel` (in
 //! `bench_accel/`) measures the acceleration structures instead of rendering; `render compare`
-//! (`compare.rs`) measures the error of one image against another.
+//! (`compare.rs`) measures the error of one image against another; `render reference` and
+//! `render experiment` (`reference/`, `experiment/`) render references and measured grids,
+//! sharing `session.rs` (one configuration, rendered progressively) with plain rendering.
 
 mod args;
+mod atomic;
 mod bench_accel;
 mod compare;
+mod experiment;
 mod job;
 mod load_image;
+mod progress;
+mod reference;
+mod session;
 mod stats;
 
 use clap::Parser;
@@ -29,6 +36,8 @@ fn main() -> ExitCode {
     let result = match &args.command {
         Some(args::Command::BenchAccel(bench)) => bench_accel::run(bench),
         Some(args::Command::Compare(c)) => compare::run(c),
+        Some(args::Command::Reference(r)) => reference::run(r),
+        Some(args::Command::Experiment(x)) => experiment::run(x),
         Some(args::Command::GenScene { name, output }) => {
             bench_accel::input::write_obj(name, output)
         }

@@ -4,6 +4,7 @@
 //! The centre column looks along -z (where the default camera looks) and `u` increases towards
 //! +x, so `u = 0.5 + atan2(d.x, -d.z) / 2π`, `v = acos(d.y) / π`.
 
+use crate::stage_time::StageTime;
 use crate::{color::luminance, distribution::Distribution2D, Rgb};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
@@ -28,7 +29,7 @@ pub struct EnvMap {
     dist: Distribution2D,
     /// How long building `dist` took, for `render --stats`: the map is built while a scene
     /// loads, where the caller cannot time this step on its own.
-    dist_build_time: Duration,
+    dist_build_time: StageTime,
 }
 
 impl EnvMap {
@@ -51,7 +52,7 @@ impl EnvMap {
             height,
             texels,
             dist,
-            dist_build_time: start.elapsed(),
+            dist_build_time: StageTime(start.elapsed()),
         }
     }
 
@@ -72,7 +73,7 @@ impl EnvMap {
 
     /// How long building the importance map took.
     pub fn importance_build_time(&self) -> Duration {
-        self.dist_build_time
+        self.dist_build_time.0
     }
 
     fn texel(&self, uv: Vec2) -> Rgb {

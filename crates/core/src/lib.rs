@@ -35,6 +35,7 @@ pub mod sampler;
 pub mod sampling;
 pub mod scene;
 pub mod shapes;
+pub mod stage_time;
 pub mod texture;
 pub mod transform;
 pub mod triangle;
@@ -45,7 +46,7 @@ pub use camera::Camera;
 pub use color::Rgb;
 pub use material::{Layer, Material};
 pub use ray::Ray;
-pub use sampler::Sampler;
+pub use sampler::{SampleStream, Sampler};
 pub use scene::Scene;
 
 /// Re-export so downstream crates use the same glam version as the core.

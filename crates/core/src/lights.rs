@@ -1,6 +1,7 @@
 //! Light sampling: emissive triangles chosen in proportion to their power (thesis §2.3.5), and
 //! the environment.
 
+use crate::stage_time::StageTime;
 use crate::{
     color::luminance, distribution::Distribution1D, sampling::uniform_triangle, triangle, Rgb,
     Scene,
@@ -18,7 +19,7 @@ pub struct LightSampler {
     env_prob: f32,
     /// How long [`LightSampler::build`] took, for `render --stats` (it runs while a scene
     /// loads, where the caller cannot time it on its own).
-    build_time: Duration,
+    build_time: StageTime,
 }
 
 /// A point (or direction) on a light, as seen from a shading point.
@@ -68,7 +69,7 @@ impl LightSampler {
             emitters,
             total_power,
             env_prob,
-            build_time: start.elapsed(),
+            build_time: StageTime(start.elapsed()),
         }
     }
 
@@ -80,7 +81,7 @@ impl LightSampler {
 
     /// How long building took (the scan for emitters included).
     pub fn build_time(&self) -> Duration {
-        self.build_time
+        self.build_time.0
     }
 
     /// True if there is anything to sample.

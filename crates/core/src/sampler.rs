@@ -6,10 +6,37 @@
 //! coordinates are Owen-scrambled with hashes of `(seed, pixel, dimension)`, which decorrelates
 //! the successive dimensions of a path (padding) while keeping each pair stratified.
 //!
-//! Every value is a pure function of `(seed, pixel, sample index, dimension)`: the image does not
-//! depend on how pixels are distributed over threads, and any sample can be replayed alone.
+//! Every value is a pure function of `(stream, seed, pixel, sample index, dimension)`: the image
+//! does not depend on how pixels are distributed over threads, and any sample can be replayed
+//! alone.
 
 use glam::Vec2;
+
+/// Which family of sample streams a render draws from.
+///
+/// The two families use disjoint ranges of dimension numbers (a normal render counts from 0, a
+/// reference from 2³¹), so no `(seed, pixel, index, dimension)` point that any normal render
+/// uses, whatever its seed, is ever used by a reference: a reference's error is independent of
+/// the image it is measured against even when both have the same seed. A path would need over
+/// two billion dimensions to reach the reference range.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum SampleStream {
+    /// Every normal render.
+    #[default]
+    Render,
+    /// High-sample reference images (`render reference`, experiments).
+    Reference,
+}
+
+impl SampleStream {
+    /// The first dimension number of the family.
+    const fn first_dimension(self) -> u32 {
+        match self {
+            SampleStream::Render => 0,
+            SampleStream::Reference => 1 << 31,
+        }
+    }
+}
 
 /// Per-pixel sample stream. Create one per worker and call [`Sampler::start`] per sample.
 #[derive(Clone, Debug)]
@@ -18,16 +45,24 @@ pub struct Sampler {
     pixel_hash: u32,
     index: u32,
     dim: u32,
+    first_dim: u32,
 }
 
 impl Sampler {
-    /// A sampler for the global `seed`.
+    /// A sampler for the global `seed` in the normal-render family.
     pub fn new(seed: u32) -> Self {
+        Self::with_stream(seed, SampleStream::Render)
+    }
+
+    /// A sampler for the global `seed` in the given family of streams.
+    pub fn with_stream(seed: u32, stream: SampleStream) -> Self {
+        let first_dim = stream.first_dimension();
         Self {
             seed,
             pixel_hash: 0,
             index: 0,
-            dim: 0,
+            dim: first_dim,
+            first_dim,
         }
     }
 
@@ -36,7 +71,7 @@ impl Sampler {
     pub fn start(&mut self, x: u32, y: u32, index: u32) {
         self.pixel_hash = hash3(x, y, self.seed);
         self.index = index;
-        self.dim = 0;
+        self.dim = self.first_dim;
     }
 
     /// The next 1D value in [0, 1).
@@ -61,7 +96,7 @@ impl Sampler {
     #[inline]
     fn dim_hash(&mut self) -> u32 {
         let h = hash2(self.pixel_hash, self.dim);
-        self.dim += 1;
+        self.dim = self.dim.wrapping_add(1);
         h
     }
 }
@@ -180,6 +215,34 @@ mod tests {
         let mut c = Sampler::new(7);
         c.start(3, 4, 5);
         assert_ne!(c.next_2d(), b.next_2d());
+    }
+
+    #[test]
+    fn reference_streams_differ_from_render_streams_of_every_seed_tried() {
+        // Same seed, pixel and index: different points. And the reference stream is still a
+        // stratified (0,2)-sequence, so references converge as fast as normal renders.
+        let first = |seed, stream| {
+            let mut s = Sampler::with_stream(seed, stream);
+            s.start(3, 4, 5);
+            (s.next_2d(), s.next_1d())
+        };
+        let reference = first(7, SampleStream::Reference);
+        for seed in 0..1000 {
+            assert_ne!(first(seed, SampleStream::Render), reference, "seed {seed}");
+        }
+        assert_eq!(first(7, SampleStream::Render), {
+            let mut s = Sampler::new(7);
+            s.start(3, 4, 5);
+            (s.next_2d(), s.next_1d())
+        });
+        let mut s = Sampler::with_stream(1, SampleStream::Reference);
+        let mut grid = [0u32; 64];
+        for i in 0..64 {
+            s.start(10, 20, i);
+            let p = s.next_2d();
+            grid[(p.y * 8.0) as usize * 8 + (p.x * 8.0) as usize] += 1;
+        }
+        assert!(grid.iter().all(|&c| c == 1), "{grid:?}");
     }
 
     #[test]

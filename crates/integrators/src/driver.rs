@@ -12,8 +12,9 @@
 
 use crate::{Ctx, Integrator, RayCounters, SampleAux};
 use rayon::prelude::*;
-use rt_core::{glam::Vec2, Sampler};
+use rt_core::{glam::Vec2, SampleStream, Sampler};
 use rt_film::Film;
+use std::ops::Range;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -55,6 +56,16 @@ impl RenderStats {
 /// that scheduling is noise.
 const BAND_ROWS: u32 = 2;
 
+/// Which samples of every pixel one call of [`render_samples`] takes.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct SamplePass {
+    /// Sample indices, taken in order. Passes `0..a`, `a..b`, ... on one film give the same
+    /// image, bit for bit, as one pass `0..b`: a pixel sees the same samples in the same order.
+    pub indices: Range<u32>,
+    /// The family of streams the samples come from (references use their own).
+    pub stream: SampleStream,
+}
+
 /// Renders `opts.spp` samples into every pixel of `film`. `progress` is called with the number
 /// of rows finished so far (from worker threads).
 pub fn render(
@@ -62,6 +73,24 @@ pub fn render(
     integrator: &dyn Integrator,
     film: &mut Film,
     opts: &RenderOptions,
+    progress: &(dyn Fn(u32) + Sync),
+) -> RenderStats {
+    let pass = SamplePass {
+        indices: 0..opts.spp,
+        stream: SampleStream::Render,
+    };
+    render_samples(ctx, integrator, film, opts.seed, &pass, progress)
+}
+
+/// Adds the samples `pass.indices` of every pixel to `film`: one pass of a progressive render
+/// (time budgets render pass after pass until the time is used). `progress` is called with the
+/// number of rows of this pass finished so far (from worker threads).
+pub fn render_samples(
+    ctx: &Ctx<'_>,
+    integrator: &dyn Integrator,
+    film: &mut Film,
+    seed: u32,
+    pass: &SamplePass,
     progress: &(dyn Fn(u32) + Sync),
 ) -> RenderStats {
     let start = Instant::now();
@@ -74,11 +103,11 @@ pub fn render(
     film.stripes_mut(BAND_ROWS)
         .into_par_iter()
         .for_each(|mut stripe| {
-            let mut sampler = Sampler::new(opts.seed);
+            let mut sampler = Sampler::with_stream(seed, pass.stream);
             let mut counters = RayCounters::default();
             for y in stripe.y0..stripe.y0 + stripe.rows() {
                 for x in 0..stripe.width {
-                    for i in 0..opts.spp {
+                    for i in pass.indices.clone() {
                         sampler.start(x, y, i);
                         let film_pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
                         let lens = if thin_lens {
@@ -103,7 +132,7 @@ pub fn render(
     let rays = totals.into_inner().unwrap_or_else(|e| e.into_inner());
     RenderStats {
         elapsed: start.elapsed(),
-        samples: film.width() as u64 * film.height() as u64 * opts.spp as u64,
+        samples: film.width() as u64 * film.height() as u64 * pass.indices.len() as u64,
         rays,
         discarded: film.discarded() - discarded_before,
     }

@@ -18,7 +18,7 @@ pub mod driver;
 mod path;
 
 pub use ao::AoIntegrator;
-pub use driver::{render, RenderOptions, RenderStats};
+pub use driver::{render, render_samples, RenderOptions, RenderStats, SamplePass};
 pub use path::PathIntegrator;
 
 use rt_core::{Accel, Camera, Rgb, Sampler, Scene};

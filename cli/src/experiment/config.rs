@@ -1,0 +1,687 @@
+//! The experiment file (TOML; every key in docs/experiments.md) and its validation. Everything
+//! that can be wrong is found here, before the first sample of a long grid: scenes load,
+//! cameras exist, names are unique, budgets are sane, reference files match the image size.
+
+use crate::args::IntegratorKind;
+use crate::load_image::load_rgb;
+use crate::session::{self, Budgets, Estimator, ImageSize, Overrides, Target, MAX_DEPTH, MAX_SPP};
+use anyhow::{anyhow, bail, Result};
+use rt_accel::AccelSpec;
+use rt_core::Camera;
+use rt_metrics::RgbImage;
+use rt_scene::LoadedScene;
+use serde::de::{self, MapAccess, Visitor};
+use serde::{Deserialize, Deserializer};
+use std::collections::HashSet;
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// Longest time budget accepted, in seconds (a day): anything longer is a typo.
+const MAX_SECONDS: f64 = 86_400.0;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ConfigDesc {
+    name: Option<String>,
+    epsilon: Option<f64>,
+    crop: Option<u32>,
+    #[serde(default)]
+    scene: Vec<SceneDesc>,
+    #[serde(default)]
+    method: Vec<MethodDesc>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneDesc {
+    path: String,
+    name: Option<String>,
+    camera: Option<String>,
+    resolution: Option<[u32; 2]>,
+    scale: Option<f64>,
+    reference: Option<ReferenceDesc>,
+}
+
+/// `reference = "file.exr"` or `reference = { spp = 4096, ... }`.
+enum ReferenceDesc {
+    File(String),
+    Render(RenderReferenceDesc),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RenderReferenceDesc {
+    spp: u32,
+    integrator: Option<String>,
+    max_depth: Option<u32>,
+    ao_distance: Option<f32>,
+    seed: Option<u64>,
+    accel: Option<String>,
+}
+
+impl<'de> Deserialize<'de> for ReferenceDesc {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = ReferenceDesc;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("an image file name or a table such as { spp = 4096 }")
+            }
+            fn visit_str<E: de::Error>(self, s: &str) -> Result<ReferenceDesc, E> {
+                Ok(ReferenceDesc::File(s.to_string()))
+            }
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<ReferenceDesc, A::Error> {
+                RenderReferenceDesc::deserialize(de::value::MapAccessDeserializer::new(map))
+                    .map(ReferenceDesc::Render)
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MethodDesc {
+    name: String,
+    integrator: Option<String>,
+    accel: Option<String>,
+    max_depth: Option<u32>,
+    ao_distance: Option<f32>,
+    seed: Option<u64>,
+    spp: Option<Vec<u32>>,
+    seconds: Option<Vec<f64>>,
+    scenes: Option<Vec<String>>,
+}
+
+/// A validated experiment.
+pub struct Plan {
+    /// Experiment name (output folder, report title).
+    pub name: String,
+    /// The experiment file.
+    pub path: PathBuf,
+    /// relMSE's epsilon.
+    pub epsilon: f64,
+    /// Side of the report's crops in pixels.
+    pub crop: u32,
+    /// Scenes in file order.
+    pub scenes: Vec<ScenePlan>,
+    /// Methods in file order.
+    pub methods: Vec<MethodPlan>,
+    /// Every (scene, method) pair to run, scene-major.
+    pub pairs: Vec<Pair>,
+    /// Things worth saying that do not stop the experiment.
+    pub warnings: Vec<String>,
+}
+
+/// One scene of the grid.
+pub struct ScenePlan {
+    /// Short name (file names, report).
+    pub name: String,
+    /// The scene file, relative to the working directory.
+    pub path: PathBuf,
+    /// The loaded scene.
+    pub loaded: LoadedScene,
+    /// The camera, resized.
+    pub camera: Camera,
+    /// Where the reference comes from.
+    pub reference: ReferencePlan,
+}
+
+/// A scene's reference.
+pub enum ReferencePlan {
+    /// A user's image, already loaded (and checked to be the right size).
+    File {
+        /// The file.
+        path: PathBuf,
+        /// Its pixels.
+        image: RgbImage,
+    },
+    /// Rendered by us (or taken from the cache).
+    Render {
+        /// Samples per pixel.
+        spp: u32,
+        /// Integrator and parameters.
+        estimator: Estimator,
+        /// Seed of the reference stream.
+        seed: u32,
+        /// Structure to render it with.
+        accel: AccelSpec,
+    },
+}
+
+/// One method of the grid.
+pub struct MethodPlan {
+    /// Short name (file names, legends).
+    pub name: String,
+    /// Its budgets.
+    pub budgets: Budgets,
+}
+
+/// A method on a scene, with its settings resolved against that scene's `[render]` table.
+pub struct Pair {
+    /// Index into [`Plan::scenes`].
+    pub scene: usize,
+    /// Index into [`Plan::methods`].
+    pub method: usize,
+    /// Integrator and parameters.
+    pub estimator: Estimator,
+    /// Acceleration structure.
+    pub accel: AccelSpec,
+    /// Seed.
+    pub seed: u32,
+}
+
+/// Names become file names: keep them portable.
+fn check_name(what: &str, name: &str) -> Result<(), String> {
+    let ok = !name.is_empty()
+        && name.len() <= 64
+        && name
+            .chars()
+            .next()
+            .is_some_and(|c| c.is_ascii_alphanumeric())
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'));
+    if ok {
+        Ok(())
+    } else {
+        Err(format!(
+            "{what} name \"{name}\" must be 1-64 letters, digits, '-', '_' or '.', starting with a letter or digit"
+        ))
+    }
+}
+
+fn parse_accel(s: &str) -> Result<AccelSpec, String> {
+    s.parse::<AccelSpec>()
+        .map_err(|e| format!("accel = \"{s}\": {e}"))
+}
+
+fn parse_integrator(s: &str) -> Result<IntegratorKind, String> {
+    session::parse_integrator(s).map_err(|e| format!("integrator = {e}"))
+}
+
+fn check_depth(d: Option<u32>) -> Result<Option<u32>, String> {
+    match d {
+        Some(d) if d > MAX_DEPTH => Err(format!("max_depth must be at most {MAX_DEPTH}, got {d}")),
+        _ => Ok(d),
+    }
+}
+
+fn check_ao(d: Option<f32>) -> Result<Option<f32>, String> {
+    match d {
+        Some(d) if d.is_nan() || d <= 0.0 => Err(format!("ao_distance must be positive, got {d}")),
+        _ => Ok(d),
+    }
+}
+
+/// Reads and validates the experiment file at `path`. Every error is one line that starts with
+/// the file's name.
+pub fn load(path: &Path) -> Result<Plan> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| anyhow!("{file}: cannot open: {e}"))?;
+    let desc: ConfigDesc = toml::from_str(&text).map_err(|e| {
+        let at = e
+            .span()
+            .map(|s| format!(":{}", rt_scene::LineCol::of_offset(&text, s.start)))
+            .unwrap_or_default();
+        let message: Vec<&str> = e.message().lines().map(str::trim).collect();
+        anyhow!("{file}{at}: {}", message.join("; "))
+    })?;
+    build(desc, path).map_err(|e| anyhow!("{file}: {e:#}"))
+}
+
+fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
+    let base = path.parent().unwrap_or(Path::new(""));
+    let name = match desc.name {
+        Some(n) => n,
+        None => path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "experiment".into()),
+    };
+    check_name("experiment", &name).map_err(|e| anyhow!(e))?;
+    let epsilon = desc.epsilon.unwrap_or(rt_metrics::DEFAULT_EPSILON);
+    if !(epsilon.is_finite() && epsilon > 0.0) {
+        bail!("epsilon must be a positive number, got {epsilon}");
+    }
+    let crop = desc.crop.unwrap_or(64);
+    if !(8..=1024).contains(&crop) {
+        bail!("crop must be between 8 and 1024 pixels, got {crop}");
+    }
+    if desc.scene.is_empty() {
+        bail!("no [[scene]]: an experiment needs at least one");
+    }
+    if desc.method.is_empty() {
+        bail!("no [[method]]: an experiment needs at least one");
+    }
+    let mut warnings = Vec::new();
+
+    let mut scenes = Vec::new();
+    let mut seen = HashSet::new();
+    for s in desc.scene {
+        // Procedural scenes (`gen:NAME`) are names, not files.
+        let scene_path = if s.path.starts_with("gen:") {
+            PathBuf::from(&s.path)
+        } else {
+            base.join(&s.path)
+        };
+        let name = s
+            .name
+            .clone()
+            .unwrap_or_else(|| match s.path.strip_prefix("gen:") {
+                Some(generated) => generated.to_string(),
+                None => scene_path
+                    .file_stem()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_default(),
+            });
+        let here = format!("[[scene]] \"{name}\"");
+        check_name("scene", &name).map_err(|e| anyhow!("{here}: {e}"))?;
+        if !seen.insert(name.clone()) {
+            bail!("{here}: two scenes are named \"{name}\" (set name = \"...\")");
+        }
+        let size = match (s.resolution, s.scale) {
+            (Some(_), Some(_)) => bail!("{here}: give resolution or scale, not both"),
+            (Some([w, h]), None) => ImageSize::Pixels(w, h),
+            (None, Some(f)) => ImageSize::Scale(f),
+            (None, None) => ImageSize::Native,
+        };
+        size.validate(&here)?;
+        let loaded = crate::job::load_scene(&scene_path).map_err(|e| anyhow!("{here}: {e:#}"))?;
+        let camera = size.apply(
+            session::camera(&loaded.scene, &scene_path, s.camera.as_deref())
+                .map_err(|e| anyhow!("{here}: {e:#}"))?,
+        );
+        let reference = match s.reference {
+            None => bail!(
+                "{here}: no reference (reference = {{ spp = N }} or reference = \"image.exr\")"
+            ),
+            Some(ReferenceDesc::File(f)) => {
+                let file = base.join(&f);
+                let image = load_rgb(&file).map_err(|e| anyhow!("{here}: reference: {e:#}"))?;
+                let (w, h) = (image.width(), image.height());
+                if (w, h) != (camera.width as usize, camera.height as usize) {
+                    bail!(
+                        "{here}: reference {} is {w}x{h} but the scene renders at {}x{}",
+                        file.display(),
+                        camera.width,
+                        camera.height
+                    );
+                }
+                ReferencePlan::File { path: file, image }
+            }
+            Some(ReferenceDesc::Render(r)) => {
+                if r.spp == 0 || r.spp > MAX_SPP {
+                    bail!(
+                        "{here}: reference spp must be between 1 and {MAX_SPP}, got {}",
+                        r.spp
+                    );
+                }
+                let at = |e: String| anyhow!("{here}: reference: {e}");
+                let overrides = Overrides {
+                    integrator: r
+                        .integrator
+                        .as_deref()
+                        .map(parse_integrator)
+                        .transpose()
+                        .map_err(at)?,
+                    max_depth: check_depth(r.max_depth).map_err(at)?,
+                    ao_distance: check_ao(r.ao_distance).map_err(at)?,
+                    seed: r.seed,
+                    accel: r
+                        .accel
+                        .as_deref()
+                        .map(parse_accel)
+                        .transpose()
+                        .map_err(at)?,
+                };
+                ReferencePlan::Render {
+                    spp: r.spp,
+                    estimator: overrides.estimator(&loaded.render, &scene_path)?,
+                    seed: overrides.seed(&loaded.render),
+                    accel: overrides.accel(&loaded.render, &scene_path)?,
+                }
+            }
+        };
+        scenes.push(ScenePlan {
+            name,
+            path: scene_path,
+            loaded,
+            camera,
+            reference,
+        });
+    }
+
+    let mut methods = Vec::new();
+    let mut method_overrides = Vec::new();
+    let mut method_scenes = Vec::new();
+    let mut seen = HashSet::new();
+    for m in desc.method {
+        let here = format!("[[method]] \"{}\"", m.name);
+        check_name("method", &m.name).map_err(|e| anyhow!("{here}: {e}"))?;
+        if m.name == "reference" {
+            bail!("{here}: \"reference\" is the name of the references' files; choose another");
+        }
+        if !seen.insert(m.name.clone()) {
+            bail!("{here}: two methods are named \"{}\"", m.name);
+        }
+        let at = |e: String| anyhow!("{here}: {e}");
+        let budgets = match (m.spp, m.seconds) {
+            (Some(_), Some(_)) => bail!("{here}: give spp or seconds, not both"),
+            (None, None) => bail!("{here}: no budgets (spp = [...] or seconds = [...])"),
+            (Some(mut v), None) => {
+                if v.is_empty() {
+                    bail!("{here}: spp is an empty list");
+                }
+                if let Some(bad) = v.iter().find(|&&n| n == 0 || n > MAX_SPP) {
+                    bail!("{here}: spp values must be between 1 and {MAX_SPP}, got {bad}");
+                }
+                v.sort_unstable();
+                v.dedup();
+                Budgets::Spp(v)
+            }
+            (None, Some(mut v)) => {
+                if v.is_empty() {
+                    bail!("{here}: seconds is an empty list");
+                }
+                if let Some(bad) = v
+                    .iter()
+                    .find(|&&t| !(t.is_finite() && t > 0.0 && t <= MAX_SECONDS))
+                {
+                    bail!("{here}: seconds values must be in (0, {MAX_SECONDS}], got {bad}");
+                }
+                v.sort_by(f64::total_cmp);
+                v.dedup();
+                Budgets::Seconds(v)
+            }
+        };
+        let overrides = Overrides {
+            integrator: m
+                .integrator
+                .as_deref()
+                .map(parse_integrator)
+                .transpose()
+                .map_err(at)?,
+            max_depth: check_depth(m.max_depth).map_err(at)?,
+            ao_distance: check_ao(m.ao_distance).map_err(at)?,
+            seed: m.seed,
+            accel: m
+                .accel
+                .as_deref()
+                .map(parse_accel)
+                .transpose()
+                .map_err(at)?,
+        };
+        if let Some(list) = &m.scenes {
+            if list.is_empty() {
+                bail!("{here}: scenes is an empty list (leave it out to run on every scene)");
+            }
+            for s in list {
+                if !scenes.iter().any(|p: &ScenePlan| &p.name == s) {
+                    let names: Vec<&str> = scenes.iter().map(|p| p.name.as_str()).collect();
+                    bail!(
+                        "{here}: no scene named \"{s}\" (scenes: {})",
+                        names.join(", ")
+                    );
+                }
+            }
+        }
+        methods.push(MethodPlan {
+            name: m.name,
+            budgets,
+        });
+        method_overrides.push(overrides);
+        method_scenes.push(m.scenes);
+    }
+
+    let mut pairs = Vec::new();
+    for (si, scene) in scenes.iter().enumerate() {
+        for (mi, method) in methods.iter().enumerate() {
+            if method_scenes[mi]
+                .as_ref()
+                .is_some_and(|list| !list.contains(&scene.name))
+            {
+                continue;
+            }
+            let o = &method_overrides[mi];
+            let desc = &scene.loaded.render;
+            let here = |e: anyhow::Error| anyhow!("[[method]] \"{}\": {e:#}", method.name);
+            let estimator = o.estimator(desc, &scene.path).map_err(here)?;
+            if let ReferencePlan::Render { estimator: r, .. } = &scene.reference {
+                if r.target() != estimator.target() {
+                    warnings.push(format!(
+                        "method \"{}\" ({}) does not converge to scene \"{}\"'s reference ({}): \
+                         its error will level off",
+                        method.name,
+                        describe(&estimator),
+                        scene.name,
+                        describe(r)
+                    ));
+                }
+            }
+            pairs.push(Pair {
+                scene: si,
+                method: mi,
+                estimator,
+                accel: o.accel(desc, &scene.path).map_err(here)?,
+                seed: o.seed(desc),
+            });
+        }
+    }
+    if pairs.is_empty() {
+        bail!("no method runs on any scene");
+    }
+    Ok(Plan {
+        name,
+        path: path.to_path_buf(),
+        epsilon,
+        crop,
+        scenes,
+        methods,
+        pairs,
+        warnings,
+    })
+}
+
+/// `path, 8 bounces` and the like, for messages.
+fn describe(e: &Estimator) -> String {
+    match e.target() {
+        Target::Radiance { bounces } => format!("{}, {bounces} bounces", e.name()),
+        Target::Occlusion { distance } => format!("{}, distance {distance}", e.name()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SCENE: &str = r#"
+[[camera]]
+name = "main"
+position = [0.0, 1.0, 3.0]
+look_at = [0.0, 1.0, 0.0]
+resolution = [64, 48]
+
+[[material]]
+name = "lamp"
+emission = [5.0, 5.0, 5.0]
+
+[[geometry]]
+name = "light"
+shape = "quad"
+vertices = [[-0.3, 2, -0.3], [0.3, 2, -0.3], [0.3, 2, 0.3], [-0.3, 2, 0.3]]
+material = "lamp"
+
+[render]
+max_depth = 5
+"#;
+
+    const GOOD: &str = r#"
+name = "t"
+[[scene]]
+path = "scenes/s.toml"
+scale = 0.5
+reference = { spp = 16 }
+
+[[method]]
+name = "a"
+spp = [4, 1, 2, 2]
+
+[[method]]
+name = "b"
+integrator = "path-bsdf"
+accel = "bvh"
+seconds = [0.5, 0.1]
+"#;
+
+    fn plan(config: &str) -> Result<Plan> {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir(dir.path().join("scenes")).unwrap();
+        std::fs::write(dir.path().join("scenes/s.toml"), SCENE).unwrap();
+        let path = dir.path().join("x.toml");
+        std::fs::write(&path, config).unwrap();
+        load(&path)
+    }
+
+    fn error(config: &str) -> String {
+        match plan(config) {
+            Ok(_) => panic!("accepted:\n{config}"),
+            Err(e) => {
+                let s = format!("{e:#}");
+                assert!(!s.contains('\n'), "{s}");
+                assert!(s.contains("x.toml"), "{s}");
+                s
+            }
+        }
+    }
+
+    #[test]
+    fn a_good_config_resolves_against_the_scene() {
+        let p = plan(GOOD).unwrap();
+        assert_eq!(p.name, "t");
+        assert_eq!(p.scenes[0].name, "s");
+        assert_eq!(
+            (p.scenes[0].camera.width, p.scenes[0].camera.height),
+            (32, 24)
+        );
+        assert_eq!(p.methods[0].budgets, Budgets::Spp(vec![1, 2, 4]));
+        assert_eq!(p.methods[1].budgets, Budgets::Seconds(vec![0.1, 0.5]));
+        assert_eq!(p.pairs.len(), 2);
+        // max_depth comes from the scene's [render] table for both method and reference.
+        assert_eq!(p.pairs[0].estimator.max_depth, 5);
+        assert_eq!(p.pairs[1].estimator.integrator, IntegratorKind::PathBsdf);
+        assert_eq!(p.pairs[1].accel.to_string(), "bvh");
+        let ReferencePlan::Render { estimator, spp, .. } = &p.scenes[0].reference else {
+            panic!()
+        };
+        assert_eq!((estimator.max_depth, *spp), (5, 16));
+        assert!(p.warnings.is_empty(), "{:?}", p.warnings);
+    }
+
+    #[test]
+    fn bad_configs_name_the_file_and_the_problem() {
+        let cases = [
+            (
+                GOOD.replace("name = \"a\"", "name = \"a\"\nsamples = 3"),
+                "unknown field `samples`",
+            ),
+            (
+                GOOD.replace("scenes/s.toml", "scenes/none.toml"),
+                "none.toml: cannot open",
+            ),
+            (
+                GOOD.replace("spp = [4, 1, 2, 2]", "spp = [4]\nseconds = [1.0]"),
+                "not both",
+            ),
+            (
+                GOOD.replace("spp = [4, 1, 2, 2]", "spp = []"),
+                "spp is an empty list",
+            ),
+            (
+                GOOD.replace("spp = [4, 1, 2, 2]", "spp = [0]"),
+                "between 1 and",
+            ),
+            (
+                GOOD.replace("seconds = [0.5, 0.1]", "seconds = [-1.0]"),
+                "seconds values",
+            ),
+            (
+                GOOD.replace("name = \"b\"", "name = \"a\""),
+                "two methods are named \"a\"",
+            ),
+            (
+                GOOD.replace("\"path-bsdf\"", "\"bdpt\""),
+                "\"bdpt\" is not one of",
+            ),
+            (GOOD.replace("\"bvh\"", "\"kd-tree\""), "kd-tree"),
+            (
+                GOOD.replace("scale = 0.5", "scale = 0.5\nresolution = [8, 8]"),
+                "not both",
+            ),
+            (GOOD.replace("reference = { spp = 16 }", ""), "no reference"),
+            (
+                GOOD.replace("{ spp = 16 }", "{ spp = 16, color = 1 }"),
+                "unknown field `color`",
+            ),
+            (
+                GOOD.replace("{ spp = 16 }", "\"missing.exr\""),
+                "missing.exr",
+            ),
+            (
+                GOOD.replace("name = \"b\"", "name = \"b/c\""),
+                "must be 1-64 letters",
+            ),
+            (
+                format!("{GOOD}\n[[method]]\nname = \"c\"\nspp = [1]\nscenes = [\"q\"]"),
+                "no scene named \"q\"",
+            ),
+            ("name = \"t\"\n".to_string(), "no [[scene]]"),
+            (
+                GOOD.replace("spp = [4, 1, 2, 2]", "spp = \"many\""),
+                "x.toml:",
+            ),
+        ];
+        for (config, needle) in cases {
+            let e = error(&config);
+            assert!(e.contains(needle), "{needle:?} not in {e:?}");
+        }
+    }
+
+    #[test]
+    fn a_reference_file_must_match_the_image_size() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir(dir.path().join("scenes")).unwrap();
+        std::fs::write(dir.path().join("scenes/s.toml"), SCENE).unwrap();
+        let img = vec![rt_core::Rgb::splat(0.5); 8 * 8];
+        rt_film::write_rgb(&dir.path().join("r.exr"), 8, 8, &img, &Default::default()).unwrap();
+        let path = dir.path().join("x.toml");
+        let config = GOOD.replace("{ spp = 16 }", "\"r.exr\"");
+        std::fs::write(&path, &config).unwrap();
+        let e = format!("{:#}", load(&path).err().unwrap());
+        assert!(e.contains("is 8x8 but the scene renders at 32x24"), "{e}");
+        std::fs::write(&path, config.replace("scale = 0.5", "resolution = [8, 8]")).unwrap();
+        let p = load(&path).unwrap();
+        assert!(matches!(p.scenes[0].reference, ReferencePlan::File { .. }));
+    }
+
+    #[test]
+    fn procedural_scenes_are_names_not_files() {
+        let config = GOOD
+            .replace("scenes/s.toml", "gen:rotated")
+            .replace("scale = 0.5", "resolution = [8, 8]");
+        let p = plan(&config).unwrap();
+        assert_eq!(p.scenes[0].name, "rotated");
+        assert_eq!(p.scenes[0].path, PathBuf::from("gen:rotated"));
+    }
+
+    #[test]
+    fn mismatched_estimators_are_a_warning() {
+        let p = plan(&GOOD.replace("accel = \"bvh\"", "accel = \"bvh\"\nmax_depth = 2")).unwrap();
+        assert_eq!(p.warnings.len(), 1);
+        assert!(
+            p.warnings[0].contains("will level off"),
+            "{}",
+            p.warnings[0]
+        );
+    }
+}

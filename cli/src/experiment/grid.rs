@@ -1,0 +1,247 @@
+//! Running the grid: references first (from the cache or rendered into it), then every method
+//! on every scene, each as one progressive render stopped at its budgets. Every stop writes its
+//! image and is measured against the scene's reference.
+
+use super::config::{Plan, ReferencePlan};
+use crate::load_image::load_rgb;
+use crate::progress::Progress;
+use crate::reference::cache::{Cache, ReferenceRequest};
+use crate::session::{Budgets, Session};
+use anyhow::{anyhow, Result};
+use rt_core::{Accel, Rgb, SampleStream};
+use rt_film::AovSet;
+use rt_integrators::Ctx;
+use rt_metrics::{compare, CompareOptions, Metrics, RgbImage};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// Progress units per run, so the bar moves within long runs.
+const UNITS: u64 = 100;
+
+/// A scene's reference, loaded.
+pub struct Reference {
+    /// Its pixels.
+    pub image: RgbImage,
+    /// The variance of each pixel mean, when the file has it (our references do).
+    pub variance: Option<Vec<Rgb>>,
+    /// Where it came from, for the report.
+    pub origin: String,
+}
+
+/// One row of results.csv: a method on a scene at one budget.
+pub struct Row {
+    /// Index into the plan's pairs.
+    pub pair: usize,
+    /// The budget asked for (spp or seconds).
+    pub budget: f64,
+    /// Samples per pixel taken.
+    pub spp: u32,
+    /// Render time in seconds.
+    pub seconds: f64,
+    /// Rays traced.
+    pub rays: u64,
+    /// Camera samples per second.
+    pub samples_per_second: f64,
+    /// Error against the reference.
+    pub metrics: Metrics,
+    /// The image, relative to the output folder.
+    pub image: String,
+}
+
+/// Everything the report needs.
+pub struct Results {
+    /// One per scene.
+    pub references: Vec<Reference>,
+    /// In run order.
+    pub rows: Vec<Row>,
+    /// Each pair's image at its largest budget.
+    pub finals: Vec<RgbImage>,
+}
+
+/// The file name of a budget: `16spp`, `0.5s`.
+pub fn budget_label(budgets: &Budgets, value: f64) -> String {
+    match budgets {
+        Budgets::Spp(_) => format!("{value}spp"),
+        Budgets::Seconds(_) => format!("{value}s"),
+    }
+}
+
+/// Reads a reference EXR: its colour and, if present, its `variance.*` channels.
+fn load_reference(path: &Path, origin: String) -> Result<Reference> {
+    let image = load_rgb(path)?;
+    let exr = rt_film::read_exr(path).map_err(|e| anyhow!("{e}"))?;
+    let variance = exr
+        .rgb("variance.")
+        .filter(|v| v.len() == image.pixels().len());
+    Ok(Reference {
+        image,
+        variance,
+        origin,
+    })
+}
+
+/// Runs the plan, writing images under `out`.
+pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &Progress) -> Result<Results> {
+    let total_runs: usize = plan.scenes.len()
+        + plan
+            .pairs
+            .iter()
+            .map(|p| plan.methods[p.method].budgets.len())
+            .sum::<usize>();
+    let bar = progress.bar();
+    bar.set_length(total_runs as u64 * UNITS);
+    let mut done_runs = 0u64;
+    let opts = CompareOptions {
+        epsilon: plan.epsilon,
+        peak: rt_metrics::DEFAULT_PEAK,
+    };
+
+    let mut references = Vec::new();
+    for scene in &plan.scenes {
+        let dir = out.join("images").join(&scene.name);
+        crate::atomic::create_dir(&dir)?;
+        let copy = dir.join("reference.exr");
+        bar.set_message(format!("{}: reference", scene.name));
+        let reference = match &scene.reference {
+            ReferencePlan::File { path, image } => {
+                let rgb = image.pixels().to_vec();
+                let (w, h) = (image.width(), image.height());
+                rt_film::write_rgb(&copy, w, h, &rgb, &Default::default())
+                    .map_err(|e| anyhow!("{e}"))?;
+                let variance = rt_film::read_exr(path)
+                    .ok()
+                    .and_then(|e| e.rgb("variance."))
+                    .filter(|v| v.len() == rgb.len());
+                Reference {
+                    image: image.clone(),
+                    variance,
+                    origin: format!("the file {}", path.display()),
+                }
+            }
+            ReferencePlan::Render {
+                spp,
+                estimator,
+                seed,
+                accel,
+            } => {
+                let req = ReferenceRequest {
+                    scene_path: &scene.path,
+                    scene: &scene.loaded.scene,
+                    camera: &scene.camera,
+                    estimator: *estimator,
+                    spp: *spp,
+                    seed: *seed,
+                };
+                let base = done_runs * UNITS;
+                let built = accel.build(&scene.loaded.scene.triangles);
+                let got =
+                    crate::reference::obtain(&req, built.as_ref(), Some(cache), None, &|f| {
+                        bar.set_position(base + (f * UNITS as f64) as u64)
+                    })?;
+                let origin = if got.cached {
+                    progress.message(&format!(
+                        "{}: reference from the cache: {}",
+                        scene.name,
+                        got.path.display()
+                    ));
+                    format!("the cache ({spp} spp, {:.1} s when rendered)", got.seconds)
+                } else {
+                    progress.message(&format!(
+                        "{}: reference rendered at {spp} spp in {:.1} s: {}",
+                        scene.name,
+                        got.seconds,
+                        got.path.display()
+                    ));
+                    format!("rendered ({spp} spp, {:.1} s)", got.seconds)
+                };
+                crate::atomic::copy(&got.path, &copy)?;
+                load_reference(&got.path, origin)?
+            }
+        };
+        references.push(reference);
+        done_runs += 1;
+        bar.set_position(done_runs * UNITS);
+    }
+
+    let mut rows = Vec::new();
+    let mut finals = Vec::new();
+    let mut accels: HashMap<(usize, String), Box<dyn Accel>> = HashMap::new();
+    for (pi, pair) in plan.pairs.iter().enumerate() {
+        let scene = &plan.scenes[pair.scene];
+        let method = &plan.methods[pair.method];
+        let reference = &references[pair.scene];
+        let accel = accels
+            .entry((pair.scene, pair.accel.to_string()))
+            .or_insert_with(|| pair.accel.build(&scene.loaded.scene.triangles));
+        let integrator = pair.estimator.build();
+        let session = Session {
+            ctx: Ctx {
+                scene: &scene.loaded.scene,
+                accel: accel.as_ref(),
+                camera: &scene.camera,
+            },
+            integrator: integrator.as_ref(),
+            seed: pair.seed,
+            stream: SampleStream::Render,
+            aovs: AovSet::default(),
+        };
+        bar.set_message(format!("{}: {}", scene.name, method.name));
+        let runs = method.budgets.len() as u64;
+        let base = done_runs * UNITS;
+        let values: Vec<f64> = match &method.budgets {
+            Budgets::Spp(v) => v.iter().map(|&n| f64::from(n)).collect(),
+            Budgets::Seconds(v) => v.clone(),
+        };
+        let mut last_image = None;
+        session.render(
+            &method.budgets,
+            &|f| bar.set_position(base + (f * (runs * UNITS) as f64) as u64),
+            &mut |film, at| {
+                let budget = values[at.budget];
+                let rel: PathBuf =
+                    ["images", &scene.name]
+                        .iter()
+                        .collect::<PathBuf>()
+                        .join(format!(
+                            "{}-{}.exr",
+                            method.name,
+                            budget_label(&method.budgets, budget)
+                        ));
+                rt_film::write_image(&out.join(&rel), film, &Default::default())
+                    .map_err(|e| anyhow!("{e}"))?;
+                let image = RgbImage::new(
+                    film.width() as usize,
+                    film.height() as usize,
+                    film.mean_image(),
+                )?;
+                let metrics = compare(&image, &reference.image, &opts).map_err(|e| {
+                    anyhow!(
+                        "{} against the reference of {}: {e}",
+                        rel.display(),
+                        scene.name
+                    )
+                })?;
+                rows.push(Row {
+                    pair: pi,
+                    budget,
+                    spp: at.spp,
+                    seconds: at.seconds,
+                    rays: at.rays,
+                    samples_per_second: at.samples as f64 / at.seconds.max(1e-9),
+                    metrics,
+                    image: rel.to_string_lossy().replace('\\', "/"),
+                });
+                last_image = Some(image);
+                Ok(())
+            },
+        )?;
+        finals.push(last_image.expect("every method has at least one budget"));
+        done_runs += runs;
+        bar.set_position(done_runs * UNITS);
+    }
+    Ok(Results {
+        references,
+        rows,
+        finals,
+    })
+}

@@ -1,0 +1,689 @@
+//! What an experiment leaves behind besides its images: results.csv, slopes.csv, the plots,
+//! the crops and report.md. Everything is computed from the rows, so the report and the CSV
+//! files always agree.
+
+use super::config::Plan;
+use super::grid::{Reference, Results, Row};
+use super::plot::{self, Chart, Series};
+use super::stats::{comparison_times, log_log_interpolate, log_log_slope, Fit};
+use crate::session::Budgets;
+use anyhow::Result;
+use rt_core::Rgb;
+use rt_metrics::RgbImage;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// The columns of results.csv, in order. The first thirteen are the fixed part of the format;
+/// new metrics are appended.
+pub const RESULTS_HEADER: &str = "scene,method,integrator,accel,spp,seconds,rays,\
+samples_per_second,mse,relmse,rmse,psnr,ssim,budget,max_depth,seed,mse_floor,relmse_floor,image";
+
+/// The columns of slopes.csv.
+pub const SLOPES_HEADER: &str = "scene,method,metric,floor,points,slope_vs_spp,se_vs_spp,\
+slope_vs_seconds,se_vs_seconds";
+
+/// How many times the equal-time table compares at when no time budgets fall in range.
+const EQUAL_TIME_POINTS: usize = 5;
+
+/// The reference's own expected contribution to the error: with `b` the reference, the
+/// variance of its pixel means averaged like MSE, and divided by `b² + ε` like relMSE. An
+/// independent, unbiased image `a` of the same scene has E[MSE(a, b)] = E[MSE(a, truth)] +
+/// this, so subtracting it estimates the error against the truth.
+pub struct Floor {
+    /// MSE floor.
+    pub mse: f64,
+    /// relMSE floor.
+    pub relmse: f64,
+}
+
+/// The floor of a reference; `None` when the file has no variance.
+pub fn floor(reference: &Reference, epsilon: f64) -> Option<Floor> {
+    let var = reference.variance.as_ref()?;
+    let n = (var.len() * 3) as f64;
+    let (mut mse, mut rel) = (0.0f64, 0.0f64);
+    for (v, b) in var.iter().zip(reference.image.pixels()) {
+        for c in 0..3 {
+            let (v, b) = (f64::from(v[c]), f64::from(b[c]));
+            mse += v;
+            rel += v / (b * b + epsilon);
+        }
+    }
+    Some(Floor {
+        mse: mse / n,
+        relmse: rel / n,
+    })
+}
+
+fn num(v: f64) -> String {
+    if v.is_nan() {
+        String::new()
+    } else {
+        format!("{v}")
+    }
+}
+
+/// results.csv.
+pub fn results_csv(plan: &Plan, results: &Results) -> String {
+    let mut s = format!("{RESULTS_HEADER}\n");
+    for row in &results.rows {
+        let pair = &plan.pairs[row.pair];
+        let f = floor(&results.references[pair.scene], plan.epsilon);
+        let m = &row.metrics;
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            plan.scenes[pair.scene].name,
+            plan.methods[pair.method].name,
+            pair.estimator.name(),
+            pair.accel,
+            row.spp,
+            row.seconds,
+            row.rays,
+            row.samples_per_second,
+            m.mse,
+            m.relmse,
+            m.rmse,
+            m.psnr,
+            m.ssim,
+            row.budget,
+            pair.estimator.max_depth,
+            pair.seed,
+            f.as_ref().map_or(String::new(), |f| num(f.mse)),
+            f.as_ref().map_or(String::new(), |f| num(f.relmse)),
+            row.image,
+        );
+    }
+    s
+}
+
+/// The rate fits of one method on one scene for one metric.
+pub struct Slopes {
+    /// Index into the plan's pairs.
+    pub pair: usize,
+    /// `mse` or `relmse`.
+    pub metric: &'static str,
+    /// Of the errors as measured, against spp and against seconds.
+    pub raw: (Option<Fit>, Option<Fit>),
+    /// Of the errors minus the reference's floor (when the reference has variance channels),
+    /// against spp and against seconds.
+    pub subtracted: Option<(Option<Fit>, Option<Fit>)>,
+}
+
+fn rows_of(results: &Results, pair: usize) -> impl Iterator<Item = &Row> {
+    results.rows.iter().filter(move |r| r.pair == pair)
+}
+
+/// Fits of log error against log spp and log seconds, for MSE and relMSE, as measured and with
+/// the reference's floor subtracted.
+///
+/// The two bracket the truth. The measured error contains the reference's own error, which
+/// flattens the slope as the test images approach the reference's quality. The floor is the
+/// reference's variance of the mean from its sample variance, which is exact for independent
+/// samples but an overestimate for our stratified ones (their error falls faster than
+/// variance/N), so subtracting it steepens the slope; where a test image beats the floor the
+/// point cannot be used at all.
+pub fn slopes(plan: &Plan, results: &Results) -> Vec<Slopes> {
+    let mut out = Vec::new();
+    for (pi, pair) in plan.pairs.iter().enumerate() {
+        let fl = floor(&results.references[pair.scene], plan.epsilon);
+        for metric in ["mse", "relmse"] {
+            let (value, sub): (fn(&Row) -> f64, Option<f64>) = match metric {
+                "mse" => (|r| r.metrics.mse, fl.as_ref().map(|f| f.mse)),
+                _ => (|r| r.metrics.relmse, fl.as_ref().map(|f| f.relmse)),
+            };
+            let fits = |floor: f64| {
+                let by = |x: fn(&Row) -> f64| -> Vec<(f64, f64)> {
+                    rows_of(results, pi)
+                        .map(|r| (x(r), value(r) - floor))
+                        .collect()
+                };
+                (
+                    log_log_slope(&by(|r| f64::from(r.spp))),
+                    log_log_slope(&by(|r| r.seconds)),
+                )
+            };
+            out.push(Slopes {
+                pair: pi,
+                metric,
+                raw: fits(0.0),
+                subtracted: sub.map(fits),
+            });
+        }
+    }
+    out
+}
+
+/// slopes.csv: one row per scene, method, metric and floor treatment (`none`, and
+/// `subtracted` when the reference has variance channels).
+pub fn slopes_csv(plan: &Plan, slopes: &[Slopes]) -> String {
+    let mut s = format!("{SLOPES_HEADER}\n");
+    for sl in slopes {
+        let pair = &plan.pairs[sl.pair];
+        let fit = |f: Option<Fit>| {
+            f.map_or((String::new(), String::new()), |f| {
+                (num(f.slope), num(f.se))
+            })
+        };
+        let mut line = |(by_spp, by_time): (Option<Fit>, Option<Fit>), floor: &str| {
+            let (a, ase) = fit(by_spp);
+            let (b, bse) = fit(by_time);
+            let points = by_spp.map_or(0, |f| f.points);
+            let _ = writeln!(
+                s,
+                "{},{},{},{floor},{points},{a},{ase},{b},{bse}",
+                plan.scenes[pair.scene].name, plan.methods[pair.method].name, sl.metric,
+            );
+        };
+        line(sl.raw, "none");
+        if let Some(sub) = sl.subtracted {
+            line(sub, "subtracted");
+        }
+    }
+    s
+}
+
+/// The equal-time comparison of one scene.
+pub struct EqualTime {
+    /// Index into the plan's scenes.
+    pub scene: usize,
+    /// Pairs compared (the scene's).
+    pub pairs: Vec<usize>,
+    /// Each time and every pair's interpolated relMSE there.
+    pub table: Vec<(f64, Vec<f64>)>,
+}
+
+impl EqualTime {
+    /// Index (into `pairs`) of the lowest error at row `i` (NaN, "no value", never wins).
+    pub fn winner(&self, i: usize) -> usize {
+        let errs = &self.table[i].1;
+        (0..errs.len())
+            .filter(|&k| !errs[k].is_nan())
+            .min_by(|&a, &b| errs[a].total_cmp(&errs[b]))
+            .unwrap_or(0)
+    }
+
+    /// The pair that wins most often (the earliest listed on ties), if any time was compared.
+    pub fn overall(&self) -> Option<(usize, usize)> {
+        let mut wins = vec![0usize; self.pairs.len()];
+        for i in 0..self.table.len() {
+            wins[self.winner(i)] += 1;
+        }
+        let best = (0..wins.len()).max_by(|&a, &b| wins[a].cmp(&wins[b]).then(b.cmp(&a)))?;
+        (wins[best] > 0).then_some((self.pairs[best], wins[best]))
+    }
+}
+
+/// A method's relMSE against time: time budgets at their nominal value (each run stops within
+/// about one sample's time of it), sample budgets at their measured time.
+fn time_curve(plan: &Plan, results: &Results, pair: usize) -> Vec<(f64, f64)> {
+    let seconds_budgets = matches!(
+        plan.methods[plan.pairs[pair].method].budgets,
+        Budgets::Seconds(_)
+    );
+    let mut c: Vec<(f64, f64)> = rows_of(results, pair)
+        .map(|r| {
+            let t = if seconds_budgets { r.budget } else { r.seconds };
+            (t, r.metrics.relmse)
+        })
+        .filter(|p| p.0 > 0.0 && p.1 > 0.0)
+        .collect();
+    c.sort_by(|a, b| a.0.total_cmp(&b.0));
+    c
+}
+
+/// Which method has the lowest relMSE at equal time, per scene.
+pub fn equal_time(plan: &Plan, results: &Results) -> Vec<EqualTime> {
+    (0..plan.scenes.len())
+        .map(|si| {
+            let pairs: Vec<usize> = (0..plan.pairs.len())
+                .filter(|&p| plan.pairs[p].scene == si)
+                .collect();
+            let curves: Vec<Vec<(f64, f64)>> = pairs
+                .iter()
+                .map(|&p| time_curve(plan, results, p))
+                .collect();
+            let budgets: Vec<f64> = pairs
+                .iter()
+                .filter_map(|&p| match &plan.methods[plan.pairs[p].method].budgets {
+                    Budgets::Seconds(v) => Some(v.clone()),
+                    Budgets::Spp(_) => None,
+                })
+                .flatten()
+                .collect();
+            let refs: Vec<&[(f64, f64)]> = curves.iter().map(Vec::as_slice).collect();
+            let table = if pairs.len() < 2 {
+                Vec::new()
+            } else {
+                comparison_times(&refs, &budgets, EQUAL_TIME_POINTS)
+                    .into_iter()
+                    .map(|t| {
+                        let errs = refs
+                            .iter()
+                            .map(|c| log_log_interpolate(c, t).unwrap_or(f64::NAN))
+                            .collect();
+                        (t, errs)
+                    })
+                    .collect()
+            };
+            EqualTime {
+                scene: si,
+                pairs,
+                table,
+            }
+        })
+        .collect()
+}
+
+/// Draws the two plots of every scene: relMSE against time and against spp.
+pub fn plots(plan: &Plan, results: &Results, out: &Path) -> Result<()> {
+    let dir = out.join("plots");
+    crate::atomic::create_dir(&dir)?;
+    for (si, scene) in plan.scenes.iter().enumerate() {
+        let pairs: Vec<usize> = (0..plan.pairs.len())
+            .filter(|&p| plan.pairs[p].scene == si)
+            .collect();
+        let series = |x: fn(&Row) -> f64| -> Vec<Series> {
+            pairs
+                .iter()
+                .map(|&p| Series {
+                    name: plan.methods[plan.pairs[p].method].name.clone(),
+                    points: rows_of(results, p)
+                        .map(|r| (x(r), r.metrics.relmse))
+                        .collect(),
+                })
+                .collect()
+        };
+        let title = format!("{}: relMSE (eps {})", scene.name, plan.epsilon);
+        let time = series(|r| r.seconds);
+        plot::write(
+            &Chart {
+                title: &title,
+                x_label: "render time (s)",
+                y_label: "relMSE",
+                x_base: 10.0,
+                series: &time,
+            },
+            &dir.join(format!("{}.png", scene.name)),
+            &dir.join(format!("{}.svg", scene.name)),
+        )?;
+        let spp = series(|r| f64::from(r.spp));
+        plot::write(
+            &Chart {
+                title: &title,
+                x_label: "samples per pixel",
+                y_label: "relMSE",
+                x_base: 2.0,
+                series: &spp,
+            },
+            &dir.join(format!("{}-spp.png", scene.name)),
+            &dir.join(format!("{}-spp.svg", scene.name)),
+        )?;
+    }
+    Ok(())
+}
+
+/// The corner and side of the crop shown for a scene: the `crop`-sized block, on a grid of
+/// half-block steps, where the methods' final images have the largest summed relative squared
+/// error (the per-pixel term of relMSE): where they differ most from the reference, and so
+/// from each other.
+pub fn crop_block(
+    reference: &RgbImage,
+    finals: &[&RgbImage],
+    crop: u32,
+    epsilon: f64,
+) -> (usize, usize, usize) {
+    let (w, h) = (reference.width(), reference.height());
+    let c = (crop as usize).min(w).min(h).max(1);
+    let step = (c / 2).max(1);
+    let err = |img: &RgbImage, x: usize, y: usize| -> f64 {
+        let (a, b) = (img.pixel(x, y), reference.pixel(x, y));
+        (0..3)
+            .map(|k| {
+                let (a, b) = (f64::from(a[k]), f64::from(b[k]));
+                (a - b) * (a - b) / (b * b + epsilon)
+            })
+            .sum()
+    };
+    let starts = |n: usize| {
+        let mut v: Vec<usize> = (0..=n - c).step_by(step).collect();
+        if v.last() != Some(&(n - c)) {
+            v.push(n - c);
+        }
+        v
+    };
+    let mut best = (0, 0, f64::NEG_INFINITY);
+    for &y0 in &starts(h) {
+        for &x0 in &starts(w) {
+            let mut score = 0.0;
+            for img in finals {
+                for y in y0..y0 + c {
+                    for x in x0..x0 + c {
+                        score += err(img, x, y);
+                    }
+                }
+            }
+            if score > best.2 {
+                best = (x0, y0, score);
+            }
+        }
+    }
+    (best.0, best.1, c)
+}
+
+/// Cuts the block out of `img` and enlarges it `zoom` times (nearest neighbour, so pixels
+/// and their noise stay visible).
+fn cut(img: &RgbImage, (x0, y0, c): (usize, usize, usize), zoom: usize) -> Vec<Rgb> {
+    let side = c * zoom;
+    let mut px = Vec::with_capacity(side * side);
+    for y in 0..side {
+        for x in 0..side {
+            px.push(img.pixel(x0 + x / zoom, y0 + y / zoom));
+        }
+    }
+    px
+}
+
+/// How much crops are enlarged: to at least 128 pixels across.
+pub fn zoom(c: usize) -> usize {
+    (128 / c.max(1)).max(1)
+}
+
+/// Writes `crops/<scene>/reference.png` and `crops/<scene>/<method>.png`; returns the blocks.
+pub fn crops(plan: &Plan, results: &Results, out: &Path) -> Result<Vec<(usize, usize, usize)>> {
+    let mut blocks = Vec::new();
+    for (si, scene) in plan.scenes.iter().enumerate() {
+        let dir = out.join("crops").join(&scene.name);
+        crate::atomic::create_dir(&dir)?;
+        let reference = &results.references[si].image;
+        let pairs: Vec<usize> = (0..plan.pairs.len())
+            .filter(|&p| plan.pairs[p].scene == si)
+            .collect();
+        let finals: Vec<&RgbImage> = pairs.iter().map(|&p| &results.finals[p]).collect();
+        let block = crop_block(reference, &finals, plan.crop, plan.epsilon);
+        let z = zoom(block.2);
+        let side = block.2 * z;
+        let write = |name: &str, img: &RgbImage| {
+            rt_film::write_rgb(
+                &dir.join(format!("{name}.png")),
+                side,
+                side,
+                &cut(img, block, z),
+                &Default::default(),
+            )
+            .map_err(|e| anyhow::anyhow!("{e}"))
+        };
+        write("reference", reference)?;
+        for (&p, img) in pairs.iter().zip(&finals) {
+            write(&plan.methods[plan.pairs[p].method].name, img)?;
+        }
+        blocks.push(block);
+    }
+    Ok(blocks)
+}
+
+fn sci(v: f64) -> String {
+    if v.is_nan() {
+        "–".into()
+    } else if v.is_infinite() {
+        "∞".into()
+    } else {
+        format!("{v:.3e}")
+    }
+}
+
+fn fit_text(f: Option<Fit>) -> String {
+    match f {
+        None => "–".into(),
+        Some(f) if f.se.is_nan() => format!("{:.3} ({} pts)", f.slope, f.points),
+        Some(f) => format!("{:.3} ± {:.3}", f.slope, f.se),
+    }
+}
+
+/// Header facts for report.md.
+pub struct RunInfo {
+    /// When the experiment started (UTC, `YYYY-MM-DD HH:MM`).
+    pub started: String,
+    /// Worker threads.
+    pub threads: usize,
+    /// Wall-clock seconds of the whole experiment.
+    pub wall_seconds: f64,
+}
+
+/// report.md.
+pub fn markdown(
+    plan: &Plan,
+    results: &Results,
+    slopes: &[Slopes],
+    equal: &[EqualTime],
+    blocks: &[(usize, usize, usize)],
+    info: &RunInfo,
+) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "# Experiment `{}`\n", plan.name);
+    let _ = writeln!(
+        s,
+        "Config `{}`, started {} UTC, {} worker threads, {:.1} s in all. relMSE uses ε = {}.\n\
+         Data: [results.csv](results.csv) (one row per run), [slopes.csv](slopes.csv); images in \
+         `images/<scene>/`.\n",
+        plan.path.display(),
+        info.started,
+        info.threads,
+        info.wall_seconds,
+        plan.epsilon
+    );
+    if !plan.warnings.is_empty() {
+        let _ = writeln!(s, "Warnings:\n");
+        for w in &plan.warnings {
+            let _ = writeln!(s, "- {w}");
+        }
+        s.push('\n');
+    }
+
+    let _ = writeln!(s, "## Summary\n");
+    let _ = writeln!(
+        s,
+        "| scene | lowest relMSE at equal time | MSE slope vs spp |"
+    );
+    let _ = writeln!(s, "|---|---|---|");
+    for (si, scene) in plan.scenes.iter().enumerate() {
+        let e = &equal[si];
+        let winner = match e.overall() {
+            Some((p, wins)) => format!(
+                "{} ({wins} of {} times)",
+                plan.methods[plan.pairs[p].method].name,
+                e.table.len()
+            ),
+            None => "–".into(),
+        };
+        let rates: Vec<String> = slopes
+            .iter()
+            .filter(|sl| sl.metric == "mse" && plan.pairs[sl.pair].scene == si)
+            .map(|sl| {
+                let name = &plan.methods[plan.pairs[sl.pair].method].name;
+                format!("{name} {}", fit_text(sl.raw.0))
+            })
+            .collect();
+        let _ = writeln!(s, "| {} | {winner} | {} |", scene.name, rates.join("; "));
+    }
+    s.push('\n');
+
+    for (si, scene) in plan.scenes.iter().enumerate() {
+        let _ = writeln!(s, "## Scene `{}`\n", scene.name);
+        let _ = writeln!(
+            s,
+            "`{}`, camera `{}` at {}×{}; reference: {}.\n",
+            scene.path.display(),
+            scene.camera.name,
+            scene.camera.width,
+            scene.camera.height,
+            results.references[si].origin
+        );
+        let _ = writeln!(
+            s,
+            "![relMSE against time](plots/{0}.png) ![relMSE against spp](plots/{0}-spp.png)\n",
+            scene.name
+        );
+        let _ = writeln!(
+            s,
+            "| method | integrator | accel | spp | seconds | Msamples/s | MSE | relMSE | PSNR | SSIM |"
+        );
+        let _ = writeln!(s, "|---|---|---|---:|---:|---:|---:|---:|---:|---:|");
+        for row in results
+            .rows
+            .iter()
+            .filter(|r| plan.pairs[r.pair].scene == si)
+        {
+            let pair = &plan.pairs[row.pair];
+            let m = &row.metrics;
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} | {:.3} | {:.2} | {} | {} | {:.2} | {:.4} |",
+                plan.methods[pair.method].name,
+                pair.estimator.name(),
+                pair.accel,
+                row.spp,
+                row.seconds,
+                row.samples_per_second / 1e6,
+                sci(m.mse),
+                sci(m.relmse),
+                m.psnr,
+                m.ssim
+            );
+        }
+        s.push('\n');
+
+        let _ = writeln!(s, "### Convergence rates\n");
+        let _ = writeln!(
+            s,
+            "Least-squares slopes of log error against log spp and log seconds, ± the standard \
+             error from the residuals. Independent samples give −1; lower (steeper) is better. \
+             The last column fits the errors minus the reference's own expected error (its \
+             pixel variance of the mean, averaged like the metric; points below it are left \
+             out): measured and subtracted slopes bracket the true rate (docs/experiments.md).\n"
+        );
+        let _ = writeln!(
+            s,
+            "| method | metric | slope vs spp | slope vs seconds | vs spp, reference noise subtracted |"
+        );
+        let _ = writeln!(s, "|---|---|---:|---:|---:|");
+        for sl in slopes.iter().filter(|sl| plan.pairs[sl.pair].scene == si) {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} | {} |",
+                plan.methods[plan.pairs[sl.pair].method].name,
+                sl.metric,
+                fit_text(sl.raw.0),
+                fit_text(sl.raw.1),
+                sl.subtracted.map_or("–".into(), |f| fit_text(f.0))
+            );
+        }
+        s.push('\n');
+
+        let e = &equal[si];
+        let _ = writeln!(s, "### Equal time\n");
+        if e.table.is_empty() {
+            let _ = writeln!(
+                s,
+                "Nothing to compare: one method, or no time that every method's curve covers.\n"
+            );
+        } else {
+            let names: Vec<&str> = e
+                .pairs
+                .iter()
+                .map(|&p| plan.methods[plan.pairs[p].method].name.as_str())
+                .collect();
+            let _ = writeln!(
+                s,
+                "relMSE of each method at the same render time (time budgets at their nominal \
+                 value, other runs interpolated linearly in log-log between measured points).\n"
+            );
+            let _ = writeln!(s, "| seconds | {} | lowest |", names.join(" | "));
+            let _ = writeln!(s, "|---:|{}---|", "---:|".repeat(names.len()));
+            for (i, (t, errs)) in e.table.iter().enumerate() {
+                let cells: Vec<String> = errs.iter().map(|&v| sci(v)).collect();
+                let _ = writeln!(
+                    s,
+                    "| {t:.3} | {} | {} |",
+                    cells.join(" | "),
+                    names[e.winner(i)]
+                );
+            }
+            s.push('\n');
+        }
+
+        let (x0, y0, c) = blocks[si];
+        let _ = writeln!(s, "### Crops\n");
+        let _ = writeln!(
+            s,
+            "The {c}×{c} block at ({x0}, {y0}) where the methods' images at their largest budget \
+             have the highest relative squared error, enlarged {}×.\n",
+            zoom(c)
+        );
+        let pairs: Vec<usize> = (0..plan.pairs.len())
+            .filter(|&p| plan.pairs[p].scene == si)
+            .collect();
+        let mut head = vec!["reference".to_string()];
+        let mut cells = vec![format!("![reference](crops/{}/reference.png)", scene.name)];
+        for &p in &pairs {
+            let name = &plan.methods[plan.pairs[p].method].name;
+            let last = rows_of(results, p).last();
+            head.push(match last {
+                Some(r) => format!("{name} ({} spp, {:.2} s)", r.spp, r.seconds),
+                None => name.clone(),
+            });
+            cells.push(format!("![{name}](crops/{}/{name}.png)", scene.name));
+        }
+        let _ = writeln!(s, "| {} |", head.join(" | "));
+        let _ = writeln!(s, "|{}", "---|".repeat(head.len()));
+        let _ = writeln!(s, "| {} |\n", cells.join(" | "));
+    }
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_crop_goes_where_the_error_is() {
+        let reference = RgbImage::from_fn(100, 80, |_, _| Rgb::splat(0.5));
+        let test = RgbImage::from_fn(100, 80, |x, y| {
+            if (70..75).contains(&x) && (10..15).contains(&y) {
+                Rgb::splat(2.0)
+            } else {
+                Rgb::splat(0.5)
+            }
+        });
+        let (x0, y0, c) = crop_block(&reference, &[&test], 32, 0.01);
+        assert_eq!(c, 32);
+        assert!(
+            (x0..x0 + c).contains(&70) && (x0..x0 + c).contains(&74),
+            "{x0}"
+        );
+        assert!(
+            (y0..y0 + c).contains(&10) && (y0..y0 + c).contains(&14),
+            "{y0}"
+        );
+        assert!(x0 + c <= 100 && y0 + c <= 80);
+        // A crop larger than the image is the whole image.
+        assert_eq!(crop_block(&reference, &[&test], 256, 0.01), (0, 0, 80));
+        assert_eq!(cut(&test, (72, 12, 2), 2).len(), 16);
+    }
+
+    #[test]
+    fn floors_average_the_reference_variance() {
+        let r = Reference {
+            image: RgbImage::from_fn(2, 1, |_, _| Rgb::splat(1.0)),
+            variance: Some(vec![Rgb::splat(0.01), Rgb::splat(0.03)]),
+            origin: String::new(),
+        };
+        let f = floor(&r, 0.01).unwrap();
+        assert!((f.mse - 0.02).abs() < 1e-9);
+        assert!((f.relmse - 0.02 / 1.01).abs() < 1e-9);
+        let none = Reference {
+            variance: None,
+            ..r
+        };
+        assert!(floor(&none, 0.01).is_none());
+    }
+}
