@@ -115,7 +115,9 @@ fn good_scene_renders_exr_and_png_atomically() {
     );
     let summary = String::from_utf8_lossy(&out.stdout);
     assert!(
-        summary.contains("Mrays/s") && summary.contains("Msamples/s"),
+        summary.contains("Mrays/s")
+            && summary.contains("Msamples/s")
+            && summary.contains(", 0 invalid samples discarded"),
         "{summary}"
     );
     let img = rt_film::read_exr(&r.path("img.exr")).unwrap();
@@ -224,6 +226,12 @@ fn nan_and_negative_numbers() {
         &replace("emission = [5.0, 5.0, 5.0]", "emission = [5.0, -5.0, 5.0]"),
         &[],
         &["scene.toml", "emission"],
+    );
+    // Finite but beyond what the film can accumulate: rejected, not rendered to infinities.
+    expect_error(
+        &replace("emission = [5.0, 5.0, 5.0]", "emission = [1e30, 5.0, 5.0]"),
+        &[],
+        &["scene.toml", "emission", "1e15"],
     );
 }
 
