@@ -18,7 +18,8 @@ pub const DEFAULT_ACCEL: &str = default_accel!();
 ///
 /// Settings come from the command line; any left out fall back to the scene's optional
 /// `[render]` table, then to the defaults shown here. `render bench-accel` measures the
-/// acceleration structures instead (see `render bench-accel --help`).
+/// acceleration structures instead (see `render bench-accel --help`); `render stress` runs the
+/// numerical stress suite.
 #[derive(Parser, Debug)]
 #[command(
     name = "render",
@@ -128,6 +129,10 @@ pub enum Command {
     /// primary, incoherent (diffuse bounce) and shadow rays, after checking their answers
     /// against the binary BVH (docs/benchmarks.md, "Accel benchmark").
     BenchAccel(crate::bench_accel::BenchArgs),
+    /// Run the numerical stress suite: scaled and moved scenes compared within noise,
+    /// self-intersection counts, bad geometry and bad values (docs/experiments.md, "Numerical
+    /// stress tests"). One line per case; exit code 1 if any fails.
+    Stress(crate::stress::StressArgs),
     /// Write a procedural scene's triangles to a Wavefront OBJ file (one `o` per part), e.g.
     /// to benchmark other ray tracers on the same geometry.
     GenScene {
@@ -194,6 +199,12 @@ mod tests {
         };
         assert_eq!(b.input, "gen:mixed");
         assert_eq!(b.threads, Some(2));
+        let a = Args::try_parse_from(["render", "stress", "--long", "--spp", "8", "--seed", "3"])
+            .unwrap();
+        let Some(Command::Stress(s)) = &a.command else {
+            panic!("{a:?}")
+        };
+        assert!(s.long && s.spp == Some(8) && s.seed == 3 && s.only.is_empty());
         let a = Args::try_parse_from(["render", "gen-scene", "rotated", "-o", "r.obj"]).unwrap();
         assert!(matches!(a.command, Some(Command::GenScene { .. })));
         // The scene is still required without a subcommand.

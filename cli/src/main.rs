@@ -3,11 +3,13 @@
 //! film (`rt-integrators`, `rt-film`) and writes the image. All error reporting to the user
 //! happens here: libraries return typed errors, this turns them into one line on stderr and a
 //! non-zero exit code (2 for usage errors, 1 for everything else). `render bench-accel` (in
-//! `bench_accel/`) measures the acceleration structures instead of rendering.
+//! `bench_accel/`) measures the acceleration structures instead of rendering; `render stress`
+//! (`stress.rs`) runs the numerical stress suite.
 
 mod args;
 mod bench_accel;
 mod job;
+mod stress;
 
 use clap::Parser;
 use std::process::ExitCode;
@@ -24,6 +26,7 @@ fn main() -> ExitCode {
     };
     let result = match &args.command {
         Some(args::Command::BenchAccel(bench)) => bench_accel::run(bench),
+        Some(args::Command::Stress(stress)) => stress::run(stress),
         Some(args::Command::GenScene { name, output }) => {
             bench_accel::input::write_obj(name, output)
         }

@@ -236,6 +236,40 @@ fn nan_and_negative_numbers() {
 }
 
 #[test]
+fn stress_command_reports_one_line_per_case_and_fails_on_bad_arguments() {
+    let r = Run::new();
+    let out = r.render(&[
+        "stress",
+        "--only",
+        "bad/nan-texels",
+        "--spp",
+        "2",
+        "--threads",
+        "2",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("bad/nan-texels"))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(
+        line.contains(" pass ") && line.contains("discarded 0") && line.ends_with(" s"),
+        "{line}"
+    );
+    assert!(text.contains("1 passed, 0 failed"), "{text}");
+    let out = r.render(&["stress", "--only", "no-such-case"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no stress case"));
+    let out = r.render(&["stress", "--spp", "0"]);
+    assert_eq!(out.status.code(), Some(1));
+}
+
+#[test]
 fn zero_and_absurd_resolution() {
     expect_error(
         &replace("resolution = [8, 6]", "resolution = [0, 6]"),
