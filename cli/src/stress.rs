@@ -14,7 +14,8 @@ use std::time::Instant;
 #[derive(clap::Args, Debug)]
 pub struct StressArgs {
     /// The long run: more samples, rays and pixels, and the extreme transformations (10⁻⁶,
-    /// 10⁶, 10⁷ from the origin). Without it, the budget of `cargo test` (about half a minute).
+    /// 10⁶, 10⁷ from the origin); about two minutes on two cores. Without it, the budget of
+    /// `cargo test` (a few seconds).
     #[arg(long)]
     pub long: bool,
     /// Samples per pixel of every render. [default: 256, or 1024 with --long]

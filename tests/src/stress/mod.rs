@@ -6,7 +6,7 @@
 //! - **Transformations** ([`transform`]): the Cornell box scaled by 10⁻⁴ and 10⁴, and scaled by
 //!   100 and moved 10⁵ from the origin, must render the same image as the original within
 //!   noise ([`compare`]: a z-test on blocks of pixels whose tolerance comes from the film's
-//!   per-pixel variance of the mean). A control case injects acne into 5 % of the secondary rays
+//!   per-pixel variance of the mean). A control case injects acne into 5 % of all rays
 //!   and must be caught by the same test.
 //! - **Self-intersection** ([`crate::self_hit`]): rays leaving huge triangles, bounce rays of
 //!   `gen:mixed` (and of the conference room when `../shared/data` has it), and shadow rays
@@ -52,7 +52,7 @@ pub struct Budget {
 }
 
 impl Budget {
-    /// The short run of `cargo test --release` (about half a minute on two cores).
+    /// The short run of `cargo test --release` (a few seconds on two cores).
     pub fn ci() -> Self {
         Self {
             spp: 256,
