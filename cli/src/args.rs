@@ -19,7 +19,8 @@ pub const DEFAULT_ACCEL: &str = default_accel!();
 /// Settings come from the command line; any left out fall back to the scene's optional
 /// `[render]` table, then to the defaults shown here. `render bench-accel` measures the
 /// acceleration structures instead (see `render bench-accel --help`); `render compare A B`
-/// measures the error of image A against the reference B.
+/// measures the error of image A against the reference B; `render stress` runs the numerical
+/// stress suite.
 #[derive(Parser, Debug)]
 #[command(
     name = "render",
@@ -146,6 +147,10 @@ pub enum Command {
     /// Run an experiment: scenes x methods x budgets against references; writes images,
     /// results.csv, slopes.csv, log-log plots and report.md (docs/experiments.md).
     Experiment(crate::experiment::ExperimentArgs),
+    /// Run the numerical stress suite: scaled and moved scenes compared within noise,
+    /// self-intersection counts, bad geometry and bad values (docs/experiments.md, "Numerical
+    /// stress tests"). One line per case; exit code 1 if any fails.
+    Stress(crate::stress::StressArgs),
     /// Write a procedural scene's triangles to a Wavefront OBJ file (one `o` per part), e.g.
     /// to benchmark other ray tracers on the same geometry.
     GenScene {
@@ -223,6 +228,12 @@ mod tests {
         };
         assert_eq!(b.input, "gen:mixed");
         assert_eq!(b.threads, Some(2));
+        let a = Args::try_parse_from(["render", "stress", "--long", "--spp", "8", "--seed", "3"])
+            .unwrap();
+        let Some(Command::Stress(s)) = &a.command else {
+            panic!("{a:?}")
+        };
+        assert!(s.long && s.spp == Some(8) && s.seed == 3 && s.only.is_empty());
         let a = Args::try_parse_from(["render", "gen-scene", "rotated", "-o", "r.obj"]).unwrap();
         assert!(matches!(a.command, Some(Command::GenScene { .. })));
         let a = Args::try_parse_from(["render", "compare", "a.exr", "b.png", "--json"]).unwrap();

@@ -307,14 +307,11 @@ fn print_summary(
     build_secs: f64,
     threads: usize,
 ) {
-    let discarded = if stats.discarded > 0 {
-        format!(", {} non-finite samples discarded", stats.discarded)
-    } else {
-        String::new()
-    };
+    // Always printed, zero included: a valid scene must discard nothing, and a reader should
+    // not have to know that silence means zero.
     println!(
         "{}: {}x{} {} spp {} {} ({} tris, {} threads): {:.2} s render ({:.2} s load, {:.2} s {} build), \
-         {:.2} Msamples/s, {:.2} Mrays/s -> {}{discarded}",
+         {:.2} Msamples/s, {:.2} Mrays/s, {} invalid samples discarded -> {}",
         job.scene_path.display(),
         camera.width,
         camera.height,
@@ -329,6 +326,7 @@ fn print_summary(
         accel.name(),
         stats.samples_per_second() / 1e6,
         stats.rays_per_second() / 1e6,
+        stats.discarded,
         job.output.display(),
     );
 }

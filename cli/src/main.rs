@@ -6,7 +6,8 @@
 //! `bench_accel/`) measures the acceleration structures instead of rendering; `render compare`
 //! (`compare.rs`) measures the error of one image against another; `render reference` and
 //! `render experiment` (`reference/`, `experiment/`) render references and measured grids,
-//! sharing `session.rs` (one configuration, rendered progressively) with plain rendering.
+//! sharing `session.rs` (one configuration, rendered progressively) with plain rendering;
+//! `render stress` (`stress.rs`) runs the numerical stress suite.
 
 mod args;
 mod atomic;
@@ -19,6 +20,7 @@ mod progress;
 mod reference;
 mod session;
 mod stats;
+mod stress;
 
 use clap::Parser;
 use std::process::ExitCode;
@@ -38,6 +40,7 @@ fn main() -> ExitCode {
         Some(args::Command::Compare(c)) => compare::run(c),
         Some(args::Command::Reference(r)) => reference::run(r),
         Some(args::Command::Experiment(x)) => experiment::run(x),
+        Some(args::Command::Stress(stress)) => stress::run(stress),
         Some(args::Command::GenScene { name, output }) => {
             bench_accel::input::write_obj(name, output)
         }

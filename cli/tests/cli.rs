@@ -115,7 +115,9 @@ fn good_scene_renders_exr_and_png_atomically() {
     );
     let summary = String::from_utf8_lossy(&out.stdout);
     assert!(
-        summary.contains("Mrays/s") && summary.contains("Msamples/s"),
+        summary.contains("Mrays/s")
+            && summary.contains("Msamples/s")
+            && summary.contains(", 0 invalid samples discarded"),
         "{summary}"
     );
     let img = rt_film::read_exr(&r.path("img.exr")).unwrap();
@@ -225,6 +227,46 @@ fn nan_and_negative_numbers() {
         &[],
         &["scene.toml", "emission"],
     );
+    // Finite but beyond what the film can accumulate: rejected, not rendered to infinities.
+    expect_error(
+        &replace("emission = [5.0, 5.0, 5.0]", "emission = [1e30, 5.0, 5.0]"),
+        &[],
+        &["scene.toml", "emission", "1e15"],
+    );
+}
+
+#[test]
+fn stress_command_reports_one_line_per_case_and_fails_on_bad_arguments() {
+    let r = Run::new();
+    let out = r.render(&[
+        "stress",
+        "--only",
+        "bad/nan-texels",
+        "--spp",
+        "2",
+        "--threads",
+        "2",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("bad/nan-texels"))
+        .unwrap_or_else(|| panic!("{text}"));
+    assert!(
+        line.contains(" pass ") && line.contains("discarded 0") && line.ends_with(" s"),
+        "{line}"
+    );
+    assert!(text.contains("1 passed, 0 failed"), "{text}");
+    let out = r.render(&["stress", "--only", "no-such-case"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no stress case"));
+    let out = r.render(&["stress", "--spp", "0"]);
+    assert_eq!(out.status.code(), Some(1));
 }
 
 #[test]

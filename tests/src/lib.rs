@@ -1,9 +1,11 @@
 //! `rt-e2e`: cross-crate checks that need the whole pipeline (scene loading, BVH, integrators,
 //! film): white-furnace tests, agreement of estimators, determinism. The helpers here build and
-//! render small scenes; the tests themselves are in `tests/tests/`.
-//! [`self_hit`] counts rays that hit the surface they leave.
+//! render small scenes; the tests themselves are in `tests/tests/`. [`self_hit`] counts rays
+//! that hit the surface they leave; [`stress`] holds the numerical stress cases, shared by
+//! `tests/tests/stress.rs` (short) and `render stress` (long).
 
 pub mod self_hit;
+pub mod stress;
 
 use rt_core::{glam::Vec3, Scene};
 use rt_film::{AovSet, Film};

@@ -154,7 +154,9 @@ impl LightSampler {
         let d = p - x;
         let dist2 = d.length_squared();
         let cos_l = ng.dot(d).abs() / dist2.sqrt();
-        if area <= 0.0 || cos_l <= 0.0 {
+        // NaN (x = p, hence 0/0) gives 0 too: a NaN pdf would make the MIS
+        // weight, and so the sample, NaN.
+        if area <= 0.0 || cos_l.is_nan() || cos_l <= 0.0 {
             return 0.0;
         }
         let pmf = triangle_power(scene, prim) / self.total_power;
@@ -167,5 +169,28 @@ impl LightSampler {
             return 0.0;
         }
         self.env_prob * scene.environment.pdf(d)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Material;
+
+    #[test]
+    fn pdf_of_a_light_point_seen_from_itself_is_zero_not_nan() {
+        let mut scene = Scene::empty();
+        let mut lamp = Material::diffuse("lamp", Rgb::ZERO);
+        lamp.emission = Rgb::ONE;
+        scene.materials.push(lamp);
+        scene.push_triangle([Vec3::ZERO, Vec3::X, Vec3::Z], 0);
+        scene.build_lights();
+        let p = Vec3::new(0.25, 0.0, 0.25);
+        let pdf = scene.lights.pdf_triangle(&scene, 0, p, p, Vec3::Y);
+        assert_eq!(pdf, 0.0);
+        let pdf = scene
+            .lights
+            .pdf_triangle(&scene, 0, p + Vec3::Y, p, Vec3::Y);
+        assert!(pdf > 0.0 && pdf.is_finite());
     }
 }

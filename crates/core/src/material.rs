@@ -109,6 +109,12 @@ impl Layer {
     }
 }
 
+/// Largest emitted or environment radiance a scene may have. A path's sample is at most about
+/// the radiance it finds times a throughput of order one, and the film sums squared deviations
+/// of up to 2²⁰ samples per pixel (the CLI's limit) in f32: 2²⁰ · (10¹⁵)² ≈ 10³⁶ stays below
+/// f32's 3.4·10³⁸, so the variance never overflows. The sun is about 10⁹ in photometric units.
+pub const MAX_RADIANCE: f32 = 1e15;
+
 /// A material: a layer stack plus emission.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Material {
@@ -145,7 +151,7 @@ pub enum MaterialError {
     )]
     WeightSum(f32),
     /// Bad emission.
-    #[error("emission must be finite and non-negative, got {0:?}")]
+    #[error("emission must be finite, non-negative and at most {MAX_RADIANCE:e}, got {0:?}")]
     Emission([f32; 3]),
 }
 
@@ -218,7 +224,7 @@ impl Material {
             return Err(MaterialError::TooManyLayers(self.layers.len()));
         }
         let e = self.emission;
-        if !e.is_finite() || e.min_element() < 0.0 {
+        if !e.is_finite() || e.min_element() < 0.0 || e.max_element() > MAX_RADIANCE {
             return Err(MaterialError::Emission(e.to_array()));
         }
         let mut sum = 0.0;

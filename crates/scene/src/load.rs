@@ -9,7 +9,7 @@ use crate::material::{self, MaterialTable};
 use crate::{LoadedScene, RenderDesc};
 use glam::Vec3;
 use rt_core::environment::{EnvMap, Environment};
-use rt_core::{Camera, Rgb, Scene};
+use rt_core::{material::MAX_RADIANCE, Camera, Rgb, Scene};
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
@@ -134,8 +134,25 @@ fn environment(ctx: &Ctx, env: &Spanned<EnvironmentDesc>) -> Result<Environment>
         }
         None => Rgb::ZERO,
     };
+    let too_bright = |radiance: Rgb, span: std::ops::Range<usize>| {
+        ctx.src.error_at(
+            span,
+            format!(
+                "environment radiance {:?} (color x strength) exceeds the maximum {MAX_RADIANCE:e}",
+                radiance.to_array()
+            ),
+        )
+    };
     let Some(map) = &e.map else {
-        return Ok(Environment::Constant(color * strength));
+        let radiance = color * strength;
+        if radiance.max_element() > MAX_RADIANCE {
+            let span = e
+                .strength
+                .as_ref()
+                .map_or_else(|| e.color.as_ref().map_or(0..0, |c| c.span()), |s| s.span());
+            return Err(too_bright(radiance, span));
+        }
+        return Ok(Environment::Constant(radiance));
     };
     if color != Rgb::ZERO {
         return Err(ctx.src.error_at(
@@ -147,6 +164,10 @@ fn environment(ctx: &Ctx, env: &Spanned<EnvironmentDesc>) -> Result<Environment>
     let (w, h, mut texels) = image_io::read_env_map(&path)?;
     for t in &mut texels {
         *t *= strength;
+        if t.max_element() > MAX_RADIANCE {
+            let span = e.strength.as_ref().map_or(map.span(), |s| s.span());
+            return Err(too_bright(*t, span));
+        }
     }
     Ok(Environment::Map(EnvMap::new(w, h, texels)))
 }
@@ -393,6 +414,11 @@ material = "light"
         assert!(e.contains("environment color must be >= 0"), "{e}");
         let e = err("[environment]\ncolor = [0, nan, 0]");
         assert!(e.contains("environment color must be finite"), "{e}");
+        // Finite but beyond what the film can accumulate without overflow.
+        let e = err("[environment]\ncolor = [1e30, 0, 0]");
+        assert!(e.contains("exceeds the maximum 1e15"), "{e}");
+        let e = err("[environment]\ncolor = [1e10, 1, 1]\nstrength = 1e10");
+        assert!(e.contains("exceeds the maximum"), "{e}");
     }
 
     #[test]

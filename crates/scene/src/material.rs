@@ -363,7 +363,12 @@ mod tests {
         );
         let e = bad("emission = [1, -1, 0]");
         assert!(
-            e.contains("m.toml:3:12:") && e.contains("emission must be finite and non-negative"),
+            e.contains("m.toml:3:12:") && e.contains("emission must be finite, non-negative"),
+            "{e}"
+        );
+        let e = bad("emission = [1e30, 1, 0]");
+        assert!(
+            e.contains("m.toml:3:12:") && e.contains("at most 1e15"),
             "{e}"
         );
         let e = bad("emission = [inf, 1, 0]");

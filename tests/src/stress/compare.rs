@@ -1,0 +1,202 @@
+//! "The same image within noise": a z-test of two renders on blocks of pixels.
+//!
+//! Each pixel of a film carries its mean and the estimated variance of that mean (Welford, in
+//! `rt-film`). For independent renders `a` and `b` of the same image, the difference of the
+//! sums over a block of pixels has variance `Σ (var_a + var_b)`, so
+//! `z = Σ (mean_a − mean_b) / sqrt(Σ (var_a + var_b))` is close to standard normal per block
+//! and channel (the central limit theorem over the block's pixels and samples); the same holds
+//! for the whole image. The test fails if any `|z|` exceeds the two-sided normal quantile at a
+//! family-wise false-alarm rate `α`, half of it split over the blocks and channels and half
+//! over the three whole-image channels (Bonferroni), so the tolerances follow from the
+//! estimator's variance and `α` alone. Blocks localise leaks and missing shadows; the whole
+//! image catches faint acne spread everywhere.
+//!
+//! Two guards: a pixel whose samples were all equal has zero estimated variance, and there the
+//! means may still differ by the rounding of the running mean, so each pixel's variance is at
+//! least `(ε · mean)²` (ε the f32 machine epsilon); and our variance estimate treats the
+//! stratified Sobol' samples as independent, which overestimates it (`docs/validation.md`), so
+//! the test is conservative rather than flaky.
+
+use rt_film::Film;
+
+/// Outcome of [`compare`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Comparison {
+    /// Blocks × channels tested.
+    pub block_tests: usize,
+    /// Largest `|z|` over the blocks.
+    pub max_block_z: f64,
+    /// Tolerance of the blocks: the two-sided normal quantile at `α / 2` split over them.
+    pub block_crit: f64,
+    /// `z` of the whole-image difference, of the channel with the largest `|z|`.
+    pub image_z: f64,
+    /// Tolerance of the whole image: the two-sided quantile at `α / 2` split over 3 channels.
+    pub image_crit: f64,
+}
+
+impl Comparison {
+    /// True if neither a block nor the whole image differs by more than its tolerance.
+    pub fn same_within_noise(&self) -> bool {
+        self.max_block_z <= self.block_crit && self.image_z.abs() <= self.image_crit
+    }
+
+    /// The larger of `max|z| / tolerance` of the blocks and of the whole image: above 1 means
+    /// a difference was detected.
+    pub fn detection(&self) -> f64 {
+        (self.max_block_z / self.block_crit).max(self.image_z.abs() / self.image_crit)
+    }
+}
+
+/// Family-wise false-alarm probability of the comparisons of the stress suite. Their seeds are
+/// fixed, so a false alarm would be a reproducible failure, not a flaky one; 10⁻³ keeps it
+/// unlikely across every case and budget while leaving the test its power.
+pub const ALPHA: f64 = 1e-3;
+
+/// Compares two films of the same size on `block × block` pixel blocks (edge blocks smaller)
+/// and as a whole. Half of `alpha` goes to the blocks, half to the whole image: a faint change
+/// everywhere (acne) shows in the whole image long before any one block, a local one (a leak
+/// in a corner) in its block.
+///
+/// # Panics
+/// If the films differ in size (a bug in the caller).
+pub fn compare(a: &Film, b: &Film, block: u32, alpha: f64) -> Comparison {
+    assert_eq!((a.width(), a.height()), (b.width(), b.height()));
+    let (w, h) = (a.width(), a.height());
+    let block = block.max(1);
+    let (bw, bh) = (w.div_ceil(block), h.div_ceil(block));
+    // Per block and channel: sum of differences and sum of variances.
+    let mut sums = vec![[(0.0f64, 0.0f64); 3]; (bw * bh) as usize];
+    let mut image = [(0.0f64, 0.0f64); 3];
+    for y in 0..h {
+        for x in 0..w {
+            let (pa, pb) = (a.pixel(x, y), b.pixel(x, y));
+            let (ma, mb) = (pa.mean(), pb.mean());
+            let variance = |p: &rt_film::PixelStats| {
+                p.variance_of_mean()
+                    .expect("compared films keep the variance buffer")
+            };
+            let (va, vb) = (variance(&pa), variance(&pb));
+            let k = ((y / block) * bw + x / block) as usize;
+            for c in 0..3 {
+                let floor = |m: f32| (f32::EPSILON as f64 * m as f64).powi(2);
+                let d = ma[c] as f64 - mb[c] as f64;
+                let v = (va[c] as f64).max(floor(ma[c])) + (vb[c] as f64).max(floor(mb[c]));
+                sums[k][c].0 += d;
+                sums[k][c].1 += v;
+                image[c].0 += d;
+                image[c].1 += v;
+            }
+        }
+    }
+    let z = |(d, v): (f64, f64)| {
+        if d == 0.0 {
+            0.0
+        } else {
+            d / v.sqrt()
+        }
+    };
+    let max_block_z = sums
+        .iter()
+        .flatten()
+        .map(|s| z(*s).abs())
+        .fold(0.0f64, f64::max);
+    let image_z =
+        image.iter().map(|s| z(*s)).fold(
+            0.0f64,
+            |best, zi| if zi.abs() > best.abs() { zi } else { best },
+        );
+    let block_tests = sums.len() * 3;
+    Comparison {
+        block_tests,
+        max_block_z,
+        block_crit: normal_quantile_upper(alpha / 2.0 / (2.0 * block_tests as f64)),
+        image_z,
+        image_crit: normal_quantile_upper(alpha / 2.0 / (2.0 * 3.0)),
+    }
+}
+
+/// Complementary error function, `erfc(x)`, with relative error below 1.2·10⁻⁷ everywhere
+/// (Numerical Recipes' Chebyshev fit).
+pub fn erfc(x: f64) -> f64 {
+    let z = x.abs();
+    let t = 1.0 / (1.0 + 0.5 * z);
+    let poly = -z * z - 1.265_512_23
+        + t * (1.000_023_68
+            + t * (0.374_091_96
+                + t * (0.096_784_18
+                    + t * (-0.186_288_06
+                        + t * (0.278_868_07
+                            + t * (-1.135_203_98
+                                + t * (1.488_515_87 + t * (-0.822_152_23 + t * 0.170_872_77))))))));
+    let r = t * poly.exp();
+    if x >= 0.0 {
+        r
+    } else {
+        2.0 - r
+    }
+}
+
+/// The `z` with `P(Z > z) = p` for a standard normal `Z` (`0 < p < 0.5`), by bisection on
+/// [`erfc`]: a few dozen evaluations, once per comparison.
+pub fn normal_quantile_upper(p: f64) -> f64 {
+    let tail = |z: f64| 0.5 * erfc(z / std::f64::consts::SQRT_2);
+    let (mut lo, mut hi) = (0.0f64, 40.0f64);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if tail(mid) > p {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rt_core::Rgb;
+    use rt_film::{AovSet, FilmBuffers};
+
+    #[test]
+    fn quantiles_match_tables() {
+        assert!((normal_quantile_upper(0.025) - 1.959_964).abs() < 1e-5);
+        assert!((normal_quantile_upper(0.001) - 3.090_232).abs() < 1e-5);
+        assert!((normal_quantile_upper(1e-6) - 4.753_424).abs() < 1e-4);
+    }
+
+    fn film(values: impl Fn(u32, u32, u32) -> f32) -> Film {
+        let mut f = Film::new(
+            8,
+            8,
+            FilmBuffers::for_outputs(AovSet::default()).with_variance(),
+        );
+        for y in 0..8 {
+            for x in 0..8 {
+                for i in 0..16 {
+                    f.add_sample(x, y, i, Rgb::splat(values(x, y, i)), None);
+                }
+            }
+        }
+        f
+    }
+
+    #[test]
+    fn identical_statistics_pass_and_a_shifted_block_fails() {
+        let noise = |x: u32, y: u32, i: u32| ((x * 7 + y * 13 + i * 5) % 11) as f32 / 10.0;
+        let a = film(noise);
+        let b = film(|x, y, i| noise(x, y, (i + 3) % 16));
+        let c = compare(&a, &b, 4, ALPHA);
+        assert!(c.same_within_noise(), "{c:?}");
+        assert_eq!(c.block_tests, 4 * 3);
+        // One block darker by 30 %: caught.
+        let dark = film(|x, y, i| noise(x, y, i) * if x < 4 && y < 4 { 0.7 } else { 1.0 });
+        let c = compare(&a, &dark, 4, ALPHA);
+        assert!(!c.same_within_noise(), "{c:?}");
+        // Zero-variance pixels that differ at all are a difference, not noise.
+        let c = compare(&film(|_, _, _| 1.0), &film(|_, _, _| 1.001), 4, ALPHA);
+        assert!(!c.same_within_noise(), "{c:?}");
+        let c = compare(&film(|_, _, _| 0.0), &film(|_, _, _| 0.0), 4, ALPHA);
+        assert_eq!((c.max_block_z, c.image_z), (0.0, 0.0));
+    }
+}

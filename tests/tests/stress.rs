@@ -1,0 +1,46 @@
+//! The numerical stress suite's short run (`rt_e2e::stress`, `Budget::ci`); `render stress
+//! --long` runs the same cases with a larger budget. One test per group, so the groups run in
+//! parallel and a failure names its group; each prints its cases' report lines.
+
+use rt_e2e::stress::{cases_named, Budget};
+
+fn run_group(prefix: &str) {
+    let mut budget = Budget::ci();
+    budget.data_dir =
+        Some(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data"));
+    let cases = cases_named(prefix);
+    assert!(!cases.is_empty(), "no case named {prefix}*");
+    let reports: Vec<_> = cases.iter().map(|c| c.run(&budget, 1)).collect();
+    let lines: Vec<String> = reports.iter().map(|r| r.to_string()).collect();
+    println!("{}", lines.join("\n"));
+    let failed: Vec<&String> = reports
+        .iter()
+        .zip(&lines)
+        .filter(|(r, _)| !r.passed())
+        .map(|(_, l)| l)
+        .collect();
+    assert!(
+        failed.is_empty(),
+        "failed:\n{}",
+        failed
+            .iter()
+            .map(|l| l.as_str())
+            .collect::<Vec<_>>()
+            .join("\n")
+    );
+}
+
+#[test]
+fn transformed_scenes_render_the_same_image() {
+    run_group("transform/");
+}
+
+#[test]
+fn rays_never_hit_the_surface_they_leave() {
+    run_group("self-hit/");
+}
+
+#[test]
+fn bad_geometry_gives_finite_images_and_discards_nothing() {
+    run_group("bad/");
+}
