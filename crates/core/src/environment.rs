@@ -2,7 +2,8 @@
 //!
 //! Orientation of maps: +y is up. Row 0 of the image is the zenith (+y), the last row the nadir.
 //! The centre column looks along -z (where the default camera looks) and `u` increases towards
-//! +x, so `u = 0.5 + atan2(d.x, -d.z) / 2π`, `v = acos(d.y) / π`.
+//! +x, so `u = 0.5 + atan2(d.x, -d.z) / 2π`, `v = θ / π` with `θ = acos(d.y)` (computed as
+//! `atan2(√(x² + z²), y)`, which keeps its precision at the poles).
 
 use crate::stage_time::StageTime;
 use crate::{color::luminance, distribution::Distribution2D, Rgb};
@@ -88,7 +89,9 @@ impl EnvMap {
 pub fn dir_to_uv(d: Vec3) -> Vec2 {
     let d = d.normalize();
     let u = 0.5 + d.x.atan2(-d.z) / (2.0 * PI);
-    let v = d.y.clamp(-1.0, 1.0).acos() / PI;
+    // θ from atan2 rather than acos(d.y): acos loses precision near the poles (d.y ≈ ±1),
+    // where it moved sin θ, and so the pdf, by a few per cent from the sampled direction's.
+    let v = d.x.hypot(d.z).atan2(d.y) / PI;
     Vec2::new(u.clamp(0.0, 1.0), v.clamp(0.0, 1.0))
 }
 

@@ -265,9 +265,8 @@ proptest! {
         prop_assert!((again - pdf).abs() <= 1e-4 * pdf, "{again} vs {pdf}");
     }
 
-    /// Environment-map sampling: finite unit directions whose pdf the map reproduces. Within
-    /// about 5° of the poles `dir_to_uv`'s `acos` loses precision and the round trip changes
-    /// `sin θ` (and so the pdf) by a few per cent; the property is checked away from them.
+    /// Environment-map sampling: finite unit directions whose pdf the map reproduces, up to
+    /// 0.1° from the poles (there `sin θ` is below 2·10⁻³ and its own rounding dominates).
     #[test]
     fn environment_samples_have_consistent_pdfs(
         texels in prop::collection::vec(0.0f32..4.0, 8 * 4),
@@ -276,7 +275,7 @@ proptest! {
         prop_assume!(texels.iter().any(|&x| x > 0.0));
         let env = Environment::Map(EnvMap::new(8, 4, texels.iter().map(|&x| Rgb::splat(x)).collect()));
         if let Some(s) = env.sample(u) {
-            prop_assume!(s.dir.y.abs() < 0.995);
+            prop_assume!(s.dir.y.abs() < 0.999_999);
             prop_assert!(s.dir.is_finite() && (s.dir.length() - 1.0).abs() < 1e-4);
             prop_assert!(s.pdf.is_finite() && s.pdf > 0.0 && s.radiance.is_finite());
             let again = env.pdf(s.dir);
