@@ -197,9 +197,13 @@ pub const MAX_CONDITIONING: f32 = 1e4;
 ///    may be tiny), and the three products and two sums add `γ(3)·Σ|bᵢ·vᵢ|`. Both fit in
 ///    `γ(7)·((|1 − b1| + |b2|)·|v0| + |b1·v1| + |b2·v2|)`, the margin covering the rounding of
 ///    the bound itself.
-/// 2. **The intersection test's own error.** PBRT rejects hits with `t` below a bound `δt`
-///    computed in its triangle test; ours (Woop et al., shared bit for bit with the QBVH's SIMD
-///    kernel) only rejects `t ≤ 0`, so the offset must clear that error instead. The test works
+/// 2. **The intersection test's own error.** Like PBRT's, our test rejects hits with `t` within
+///    its error bound `δt` ([`t_error_bound`]), which protects rays that start near a huge
+///    triangle without leaving it. A ray that does leave the triangle, and above all a shadow
+///    segment between two points of one plane (nearly parallel to it), still needs this margin:
+///    without it `shadow_segments_along_a_plane_stay_off_it` in
+///    `crates/core/tests/properties.rs` fails (a segment 400 units long re-crossed its plane).
+///    The test works
 ///    on vertices translated to the ray origin and sheared, so its error grows with
 ///    `L = maxᵢ ‖vᵢ − p‖∞`, the triangle's extent seen from the point, on every axis alike (the
 ///    shear mixes them). Its edge functions are differences of products of such coordinates,
