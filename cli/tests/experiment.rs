@@ -5,37 +5,23 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-const SCENE: &str = r#"
+mod common;
+
+/// The floor under a small lamp seen by a 64×64 camera, three bounces.
+fn scene() -> String {
+    let camera = r#"
 [[camera]]
 name = "main"
 position = [0.0, 1.0, 3.0]
 look_at = [0.0, 1.0, 0.0]
 fov = 40.0
 resolution = [64, 64]
-
-[[material]]
-name = "white"
-color = [0.7, 0.7, 0.7]
-
-[[material]]
-name = "lamp"
-emission = [5.0, 5.0, 5.0]
-
-[[geometry]]
-name = "floor"
-shape = "quad"
-vertices = [[-1, 0, 1], [1, 0, 1], [1, 0, -1], [-1, 0, -1]]
-material = "white"
-
-[[geometry]]
-name = "light"
-shape = "quad"
-vertices = [[-0.3, 2, -0.3], [0.3, 2, -0.3], [0.3, 2, 0.3], [-0.3, 2, 0.3]]
-material = "lamp"
-
-[render]
-max_depth = 3
 "#;
+    format!(
+        "{camera}{}\n[render]\nmax_depth = 3\n",
+        common::FLOOR_AND_LAMP
+    )
+}
 
 const CONFIG: &str = r#"
 name = "tiny"
@@ -62,7 +48,7 @@ struct Dir(tempfile::TempDir);
 impl Dir {
     fn new() -> Self {
         let d = Dir(tempfile::tempdir().unwrap());
-        d.write("scene.toml", SCENE);
+        d.write("scene.toml", &scene());
         d.write("x.toml", CONFIG);
         d
     }
@@ -182,7 +168,7 @@ fn experiment_writes_csv_plots_and_report_and_reuses_its_reference() {
     // Changing the scene file's content makes a new reference.
     d.write(
         "scene.toml",
-        &SCENE.replace("[5.0, 5.0, 5.0]", "[6.0, 6.0, 6.0]"),
+        &scene().replace("[5.0, 5.0, 5.0]", "[6.0, 6.0, 6.0]"),
     );
     let o = ok(d.render(&["experiment", "x.toml", "--out", "out4"]));
     assert!(stderr(&o).contains("reference rendered"), "{}", stderr(&o));
@@ -223,7 +209,7 @@ fn reference_command_caches_and_uses_its_own_streams() {
     // reference.
     let render =
         |out: &str| ok(d.render(&["scene.toml", "--spp", "16", "--seed", "3", "-o", out, "-q"]));
-    let mut scene = SCENE.replace("[64, 64]", "[16, 12]");
+    let mut scene = scene().replace("[64, 64]", "[16, 12]");
     scene.push('\n');
     d.write("scene.toml", &scene);
     ok(d.render(&[&args[..], &["-o", "ref16.exr", "--seed", "3"]].concat()));

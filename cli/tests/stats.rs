@@ -4,34 +4,19 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// A floor under a small lamp, no `[environment]`, a pinhole camera, 8×6 pixels.
-const LAMP: &str = r#"
+mod common;
+
+/// The floor under a small lamp, no `[environment]`, a pinhole camera, 8×6 pixels.
+fn lamp() -> String {
+    let camera = r#"
 [[camera]]
 name = "main"
 position = [0.0, 1.0, 3.0]
 look_at = [0.0, 1.0, 0.0]
 resolution = [8, 6]
-
-[[material]]
-name = "white"
-color = [0.7, 0.7, 0.7]
-
-[[material]]
-name = "lamp"
-emission = [5.0, 5.0, 5.0]
-
-[[geometry]]
-name = "floor"
-shape = "quad"
-vertices = [[-1, 0, 1], [1, 0, 1], [1, 0, -1], [-1, 0, -1]]
-material = "white"
-
-[[geometry]]
-name = "light"
-shape = "quad"
-vertices = [[-0.3, 2, -0.3], [0.3, 2, -0.3], [0.3, 2, 0.3], [-0.3, 2, 0.3]]
-material = "lamp"
 "#;
+    format!("{camera}{}", common::FLOOR_AND_LAMP)
+}
 
 const PIXELS: u64 = 8 * 6;
 
@@ -108,7 +93,7 @@ fn assert_holds(table: &str, name: &str, status: &str) -> u64 {
 #[test]
 fn stats_show_skipped_stages_for_a_scene_without_environment_map_or_aovs() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("lamp.toml"), LAMP).unwrap();
+    std::fs::write(dir.path().join("lamp.toml"), lamp()).unwrap();
     let table = render(dir.path(), &["lamp.toml", "--spp", "2", "-q", "--stats"]);
     // -q silences the summary line but not the requested table.
     assert!(!table.contains("Msamples/s"), "{table}");
@@ -150,7 +135,7 @@ fn stats_show_skipped_stages_for_a_scene_without_environment_map_or_aovs() {
     );
 
     // Without emitters the emitter table is skipped too (the sky still lights the scene).
-    let sky = LAMP.replace("emission = [5.0, 5.0, 5.0]", "color = [0.5, 0.5, 0.5]")
+    let sky = lamp().replace("emission = [5.0, 5.0, 5.0]", "color = [0.5, 0.5, 0.5]")
         + "\n[environment]\ncolor = [1, 1, 1]\n";
     std::fs::write(dir.path().join("sky.toml"), sky).unwrap();
     let table = render(dir.path(), &["sky.toml", "--spp", "1", "-q", "--stats"]);
@@ -165,7 +150,7 @@ fn stats_show_skipped_stages_for_a_scene_without_environment_map_or_aovs() {
 #[test]
 fn requested_aovs_are_allocated_and_leave_the_beauty_image_unchanged() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(dir.path().join("lamp.toml"), LAMP).unwrap();
+    std::fs::write(dir.path().join("lamp.toml"), lamp()).unwrap();
     let common = [
         "lamp.toml",
         "--spp",
