@@ -304,3 +304,32 @@ fn bad_experiment_files_give_one_line_naming_the_file() {
         stderr(&o)
     );
 }
+
+/// The shipped experiment files stay valid: every scene loads and every setting resolves.
+#[test]
+fn shipped_configs_are_valid() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    for name in ["configs/convergence.toml", "configs/accel.toml"] {
+        let out = Command::new(env!("CARGO_BIN_EXE_render"))
+            .current_dir(&root)
+            .args(["experiment", name, "--check"])
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(stdout.contains("valid;"), "{name}: {stdout}");
+    }
+    // A bad file still fails under --check.
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "name = \"x\"\nbogus = 1\n").unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_render"))
+        .args(["experiment", bad.to_str().unwrap(), "--check"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+}

@@ -38,6 +38,11 @@ pub struct ExperimentArgs {
     /// No progress bar and no messages (the output folder is still printed).
     #[arg(short, long)]
     pub quiet: bool,
+
+    /// Only read and validate the file (loading every scene and resolving every setting), print
+    /// the size of the grid and exit: nothing is rendered or written.
+    #[arg(long)]
+    pub check: bool,
 }
 
 /// A rayon pool of `threads` workers (all cores by default).
@@ -94,6 +99,19 @@ fn prepare_out(out: &Path) -> Result<()> {
 pub fn run(args: &ExperimentArgs) -> Result<()> {
     let wall = Instant::now();
     let plan = config::load(&args.config)?;
+    if args.check {
+        for w in &plan.warnings {
+            eprintln!("warning: {w}");
+        }
+        println!(
+            "{}: valid; {} scenes, {} methods, {} scene-method pairs",
+            args.config.display(),
+            plan.scenes.len(),
+            plan.methods.len(),
+            plan.pairs.len()
+        );
+        return Ok(());
+    }
     let pool = thread_pool(args.threads)?;
     let now = SystemTime::now()
         .duration_since(UNIX_EPOCH)
