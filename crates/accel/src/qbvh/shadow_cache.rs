@@ -191,7 +191,7 @@ impl<N: WideNode> WideBvh<N> {
             #[allow(unsafe_code)]
             let (code, owner) = unsafe { stack[sp].assume_init() };
             if code & LEAF_BIT != 0 {
-                if self.test_leaf::<true, C>(pre, code, t_max, &mut closest, counter) {
+                if self.test_leaf::<true, I, C>(pre, code, t_max, &mut closest, isa, counter) {
                     return Some(owner);
                 }
             } else {

@@ -112,124 +112,307 @@ pub(crate) fn intersect4_scalar(pre: &RayPrecomp4, p: &Tri4, t_max: f32) -> Hits
     h
 }
 
+/// The watertight test on every lane of SIMD vectors, written once for SSE2 (four lanes) and
+/// AVX2 (eight lanes): `$ops` is a module of same-named lane operations on its vector type `V`
+/// ([`sse`] or [`avx`]), `$load(vertex, axis)` loads one coordinate of every lane. Each lane
+/// performs exactly the operations of [`intersect_triangle`] in the same order (no fused
+/// multiply-add), so the results agree bit for bit. Evaluates to the masks of lanes whose
+/// edge function was zero (to be redone by the scalar test) and of lanes that hit, and the
+/// vectors `t`, `b1`, `b2`.
+macro_rules! watertight_lanes {
+    ($ops:ident, $pre:expr, $t_max:expr, $load:expr) => {{
+        use $ops::*;
+        let pre: &RayPrecomp4 = $pre;
+        let [kx, ky, kz] = pre.k;
+        let load = $load;
+        let (ox, oy, oz) = (splat(pre.org[0]), splat(pre.org[1]), splat(pre.org[2]));
+        let (sx, sy, sz) = (
+            splat(pre.shear[0]),
+            splat(pre.shear[1]),
+            splat(pre.shear[2]),
+        );
+        // Vertex relative to the origin, sheared: (x - sx z, y - sy z) and z.
+        let rel = |vertex: usize| {
+            let x = sub(load(vertex, kx), ox);
+            let y = sub(load(vertex, ky), oy);
+            let z = sub(load(vertex, kz), oz);
+            (sub(x, mul(sx, z)), sub(y, mul(sy, z)), z)
+        };
+        let (ax, ay, az) = rel(0);
+        let (bx, by, bz) = rel(1);
+        let (cx, cy, cz) = rel(2);
+        let u = sub(mul(cx, by), mul(cy, bx));
+        let v = sub(mul(ax, cy), mul(ay, cx));
+        let w = sub(mul(bx, ay), mul(by, ax));
+        let zero = splat(0.0);
+        let zero_edge = movemask(or(eq(u, zero), or(eq(v, zero), eq(w, zero))));
+        let any_neg = or(lt(u, zero), or(lt(v, zero), lt(w, zero)));
+        let any_pos = or(gt(u, zero), or(gt(v, zero), gt(w, zero)));
+        let mut ok = andnot(and(any_neg, any_pos), all_ones());
+        let det = add(add(u, v), w);
+        // det != 0 and finite: |det| < inf (false for NaN too).
+        let abs_mask = abs_mask();
+        let abs = |x| and(x, abs_mask);
+        let inf = splat(f32::INFINITY);
+        ok = and(ok, neq(det, zero));
+        ok = and(ok, lt(abs(det), inf));
+        let (zs_a, zs_b, zs_c) = (mul(sz, az), mul(sz, bz), mul(sz, cz));
+        let t_scaled = add(add(mul(u, zs_a), mul(v, zs_b)), mul(w, zs_c));
+        // ts = t_scaled with det's sign flipped away; must be > 0 (false for NaN).
+        let ts = xor(t_scaled, andnot(abs_mask, det));
+        ok = and(ok, gt(ts, zero));
+        let inv = div(splat(1.0), det);
+        let t = mul(t_scaled, inv);
+        ok = and(ok, gt(t, zero));
+        ok = and(ok, le(t, splat($t_max)));
+        // Finite `t` and `1 / det`, as the scalar test requires.
+        ok = and(ok, lt(t, inf));
+        ok = and(ok, lt(abs(inv), inf));
+        // `t` above its rounding error bound: `t_error_bound`, operation for operation.
+        let max3 = |a, b, c| max(max(abs(a), abs(b)), abs(c));
+        let (max_x, max_y) = (max3(ax, bx, cx), max3(ay, by, cy));
+        let (max_z, max_e) = (max3(zs_a, zs_b, zs_c), max3(u, v, w));
+        let g = |n: u32| splat(gamma(n));
+        let delta_z = mul(g(3), max_z);
+        let delta_x = mul(g(5), add(max_x, max_z));
+        let delta_y = mul(g(5), add(max_y, max_z));
+        let delta_e = mul(
+            splat(2.0),
+            add(
+                add(mul(mul(g(2), max_x), max_y), mul(delta_y, max_x)),
+                mul(delta_x, max_y),
+            ),
+        );
+        let delta_t = mul(
+            mul(
+                splat(3.0),
+                add(
+                    add(mul(mul(g(3), max_e), max_z), mul(delta_e, max_z)),
+                    mul(delta_z, max_e),
+                ),
+            ),
+            abs(inv),
+        );
+        ok = and(ok, gt(t, delta_t));
+        (zero_edge, movemask(ok), t, mul(v, inv), mul(w, inv))
+    }};
+}
+
+/// SSE2 lane operations for [`watertight_lanes!`]. SSE2 is part of the x86_64 baseline, but a
+/// caller without `#[target_feature]` still calls them in an `unsafe` block.
+#[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
+mod sse {
+    use std::arch::x86_64::*;
+    pub type V = __m128;
+    #[target_feature(enable = "sse2")]
+    #[inline]
+    pub fn splat(x: f32) -> V {
+        _mm_set1_ps(x)
+    }
+    #[target_feature(enable = "sse2")]
+    #[inline]
+    pub fn all_ones() -> V {
+        _mm_castsi128_ps(_mm_set1_epi32(-1))
+    }
+    #[target_feature(enable = "sse2")]
+    #[inline]
+    pub fn abs_mask() -> V {
+        _mm_castsi128_ps(_mm_set1_epi32(0x7FFF_FFFF))
+    }
+    #[target_feature(enable = "sse2")]
+    #[inline]
+    pub fn add(a: V, b: V) -> V {
+        _mm_add_ps(a, b)
+    }
+    #[target_feature(enable = "sse2")]
+    #[inline]
+    pub fn sub(a: V, b: V) -> V {
+        _mm_sub_ps(a, b)
+    }
+    #[target_feature(enable = "sse2")]
+    #[inline]
+    pub fn mul(a: V, b: V) -> V {
+        _mm_mul_ps(a, b)
+    }
+    #[target_feature(enable = "sse2")]
+    #[inline]
+    pub fn div(a: V, b: V) -> V {
+        _mm_div_ps(a, b)
+    }
+    #[target_feature(enable = "sse2")]
+    #[inline]
+    pub fn and(a: V, b: V) -> V {
+        _mm_and_ps(a, b)
+    }
+    #[target_feature(enable = "sse2")]
+    #[inline]
+    pub fn or(a: V, b: V) -> V {
+        _mm_or_ps(a, b)
+    }
+    #[target_feature(enable = "sse2")]
+    #[inline]
+    pub fn andnot(a: V, b: V) -> V {
+        _mm_andnot_ps(a, b)
+    }
+    #[target_feature(enable = "sse2")]
+    #[inline]
+    pub fn xor(a: V, b: V) -> V {
+        _mm_xor_ps(a, b)
+    }
+    #[target_feature(enable = "sse2")]
+    #[inline]
+    pub fn max(a: V, b: V) -> V {
+        _mm_max_ps(a, b)
+    }
+    #[target_feature(enable = "sse2")]
+    #[inline]
+    pub fn eq(a: V, b: V) -> V {
+        _mm_cmpeq_ps(a, b)
+    }
+    #[target_feature(enable = "sse2")]
+    #[inline]
+    pub fn neq(a: V, b: V) -> V {
+        _mm_cmpneq_ps(a, b)
+    }
+    #[target_feature(enable = "sse2")]
+    #[inline]
+    pub fn lt(a: V, b: V) -> V {
+        _mm_cmplt_ps(a, b)
+    }
+    #[target_feature(enable = "sse2")]
+    #[inline]
+    pub fn le(a: V, b: V) -> V {
+        _mm_cmple_ps(a, b)
+    }
+    #[target_feature(enable = "sse2")]
+    #[inline]
+    pub fn gt(a: V, b: V) -> V {
+        _mm_cmpgt_ps(a, b)
+    }
+    #[target_feature(enable = "sse2")]
+    #[inline]
+    pub fn movemask(a: V) -> u32 {
+        _mm_movemask_ps(a) as u32
+    }
+}
+
+/// AVX2 lane operations for [`watertight_lanes!`]: the same operations eight lanes wide,
+/// compiled with AVX2, so only code that has checked for AVX2 may call them. The comparison
+/// predicates are the SSE2 ones' (`neq` is unordered, as `cmpneqps` is).
+#[cfg(target_arch = "x86_64")]
+mod avx {
+    use std::arch::x86_64::*;
+    pub type V = __m256;
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn splat(x: f32) -> V {
+        _mm256_set1_ps(x)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn all_ones() -> V {
+        _mm256_castsi256_ps(_mm256_set1_epi32(-1))
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn abs_mask() -> V {
+        _mm256_castsi256_ps(_mm256_set1_epi32(0x7FFF_FFFF))
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn add(a: V, b: V) -> V {
+        _mm256_add_ps(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn sub(a: V, b: V) -> V {
+        _mm256_sub_ps(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn mul(a: V, b: V) -> V {
+        _mm256_mul_ps(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn div(a: V, b: V) -> V {
+        _mm256_div_ps(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn and(a: V, b: V) -> V {
+        _mm256_and_ps(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn or(a: V, b: V) -> V {
+        _mm256_or_ps(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn andnot(a: V, b: V) -> V {
+        _mm256_andnot_ps(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn xor(a: V, b: V) -> V {
+        _mm256_xor_ps(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn max(a: V, b: V) -> V {
+        _mm256_max_ps(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn eq(a: V, b: V) -> V {
+        _mm256_cmp_ps::<_CMP_EQ_OQ>(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn neq(a: V, b: V) -> V {
+        _mm256_cmp_ps::<_CMP_NEQ_UQ>(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn lt(a: V, b: V) -> V {
+        _mm256_cmp_ps::<_CMP_LT_OQ>(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn le(a: V, b: V) -> V {
+        _mm256_cmp_ps::<_CMP_LE_OQ>(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn gt(a: V, b: V) -> V {
+        _mm256_cmp_ps::<_CMP_GT_OQ>(a, b)
+    }
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    pub fn movemask(a: V) -> u32 {
+        _mm256_movemask_ps(a) as u32
+    }
+}
+
 /// [`intersect4_scalar`] with SSE2.
 #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
 #[allow(unsafe_code)]
 #[inline(always)]
 pub(crate) fn intersect4_sse(pre: &RayPrecomp4, p: &Tri4, t_max: f32) -> Hits4 {
     use std::arch::x86_64::*;
+    // SAFETY: `_mm_load_ps` reads a 16-byte row of `p.v`; rows start at multiples of 16 bytes
+    // in a 16-byte-aligned `Tri4`. (SSE2 is enabled for the whole x86_64 build.)
+    let load = |vertex: usize, axis: usize| unsafe { _mm_load_ps(p.v[3 * vertex + axis].as_ptr()) };
+    // SAFETY: the lane operations need SSE2, which the `cfg` guarantees for the whole build.
+    let (zero_edge, sign_ok, t, b1, b2) = unsafe { watertight_lanes!(sse, pre, t_max, load) };
     let mut h = Hits4::default();
-    let [kx, ky, kz] = pre.k;
-    // SAFETY: the `cfg` guarantees SSE and SSE2 for the whole build, which is all these
-    // intrinsics need. `_mm_load_ps` reads the 16-byte rows of `p.v`, which start at multiples
-    // of 16 bytes in a 16-byte-aligned `Tri4`; the stores write whole local `[f32; 4]`s.
-    let (zero_edge, sign_ok) = unsafe {
-        let load = |vertex: usize, axis: usize| _mm_load_ps(p.v[3 * vertex + axis].as_ptr());
-        let (ox, oy, oz) = (
-            _mm_set1_ps(pre.org[0]),
-            _mm_set1_ps(pre.org[1]),
-            _mm_set1_ps(pre.org[2]),
-        );
-        let (sx, sy, sz) = (
-            _mm_set1_ps(pre.shear[0]),
-            _mm_set1_ps(pre.shear[1]),
-            _mm_set1_ps(pre.shear[2]),
-        );
-        // Vertex relative to the origin, sheared: (x - sx z, y - sy z) and z.
-        let rel = |vertex: usize| {
-            let x = _mm_sub_ps(load(vertex, kx), ox);
-            let y = _mm_sub_ps(load(vertex, ky), oy);
-            let z = _mm_sub_ps(load(vertex, kz), oz);
-            (
-                _mm_sub_ps(x, _mm_mul_ps(sx, z)),
-                _mm_sub_ps(y, _mm_mul_ps(sy, z)),
-                z,
-            )
-        };
-        let (ax, ay, az) = rel(0);
-        let (bx, by, bz) = rel(1);
-        let (cx, cy, cz) = rel(2);
-        let u = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
-        let v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
-        let w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
-        let zero = _mm_setzero_ps();
-        let zero_edge = _mm_movemask_ps(_mm_or_ps(
-            _mm_cmpeq_ps(u, zero),
-            _mm_or_ps(_mm_cmpeq_ps(v, zero), _mm_cmpeq_ps(w, zero)),
-        )) as u32;
-        let any_neg = _mm_or_ps(
-            _mm_cmplt_ps(u, zero),
-            _mm_or_ps(_mm_cmplt_ps(v, zero), _mm_cmplt_ps(w, zero)),
-        );
-        let any_pos = _mm_or_ps(
-            _mm_cmpgt_ps(u, zero),
-            _mm_or_ps(_mm_cmpgt_ps(v, zero), _mm_cmpgt_ps(w, zero)),
-        );
-        let mut ok = _mm_andnot_ps(
-            _mm_and_ps(any_neg, any_pos),
-            _mm_castsi128_ps(_mm_set1_epi32(-1)),
-        );
-        let det = _mm_add_ps(_mm_add_ps(u, v), w);
-        // det != 0 and finite: |det| < inf (false for NaN too).
-        let abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7FFF_FFFF));
-        let abs_det = _mm_and_ps(det, abs_mask);
-        ok = _mm_and_ps(ok, _mm_cmpneq_ps(det, zero));
-        ok = _mm_and_ps(ok, _mm_cmplt_ps(abs_det, _mm_set1_ps(f32::INFINITY)));
-        let (zs_a, zs_b, zs_c) = (_mm_mul_ps(sz, az), _mm_mul_ps(sz, bz), _mm_mul_ps(sz, cz));
-        let t_scaled = _mm_add_ps(
-            _mm_add_ps(_mm_mul_ps(u, zs_a), _mm_mul_ps(v, zs_b)),
-            _mm_mul_ps(w, zs_c),
-        );
-        // ts = t_scaled with det's sign flipped away; must be > 0 (false for NaN).
-        let sign = _mm_andnot_ps(abs_mask, det);
-        let ts = _mm_xor_ps(t_scaled, sign);
-        ok = _mm_and_ps(ok, _mm_cmpgt_ps(ts, zero));
-        let inv = _mm_div_ps(_mm_set1_ps(1.0), det);
-        let t = _mm_mul_ps(t_scaled, inv);
-        let inf = _mm_set1_ps(f32::INFINITY);
-        ok = _mm_and_ps(ok, _mm_cmpgt_ps(t, zero));
-        ok = _mm_and_ps(ok, _mm_cmple_ps(t, _mm_set1_ps(t_max)));
-        // Finite `t` and `1 / det`, as the scalar test requires.
-        ok = _mm_and_ps(ok, _mm_cmplt_ps(t, inf));
-        ok = _mm_and_ps(ok, _mm_cmplt_ps(_mm_and_ps(inv, abs_mask), inf));
-        // `t` above its rounding error bound: `t_error_bound`, operation for operation.
-        let abs = |x: __m128| _mm_and_ps(x, abs_mask);
-        let max3 = |a: __m128, b: __m128, c: __m128| _mm_max_ps(_mm_max_ps(abs(a), abs(b)), abs(c));
-        let (max_x, max_y) = (max3(ax, bx, cx), max3(ay, by, cy));
-        let (max_z, max_e) = (max3(zs_a, zs_b, zs_c), max3(u, v, w));
-        let g = |n: u32| _mm_set1_ps(gamma(n));
-        let delta_z = _mm_mul_ps(g(3), max_z);
-        let delta_x = _mm_mul_ps(g(5), _mm_add_ps(max_x, max_z));
-        let delta_y = _mm_mul_ps(g(5), _mm_add_ps(max_y, max_z));
-        let delta_e = _mm_mul_ps(
-            _mm_set1_ps(2.0),
-            _mm_add_ps(
-                _mm_add_ps(
-                    _mm_mul_ps(_mm_mul_ps(g(2), max_x), max_y),
-                    _mm_mul_ps(delta_y, max_x),
-                ),
-                _mm_mul_ps(delta_x, max_y),
-            ),
-        );
-        let delta_t = _mm_mul_ps(
-            _mm_mul_ps(
-                _mm_set1_ps(3.0),
-                _mm_add_ps(
-                    _mm_add_ps(
-                        _mm_mul_ps(_mm_mul_ps(g(3), max_e), max_z),
-                        _mm_mul_ps(delta_e, max_z),
-                    ),
-                    _mm_mul_ps(delta_z, max_e),
-                ),
-            ),
-            abs(inv),
-        );
-        ok = _mm_and_ps(ok, _mm_cmpgt_ps(t, delta_t));
+    // SAFETY: each store writes 16 bytes to a whole local `[f32; 4]`, unaligned.
+    unsafe {
         _mm_storeu_ps(h.t.as_mut_ptr(), t);
-        _mm_storeu_ps(h.b1.as_mut_ptr(), _mm_mul_ps(v, inv));
-        _mm_storeu_ps(h.b2.as_mut_ptr(), _mm_mul_ps(w, inv));
-        (zero_edge, _mm_movemask_ps(ok) as u32)
-    };
+        _mm_storeu_ps(h.b1.as_mut_ptr(), b1);
+        _mm_storeu_ps(h.b2.as_mut_ptr(), b2);
+    }
     h.mask = sign_ok;
     if zero_edge != 0 {
         for lane in 0..4 {
@@ -239,6 +422,60 @@ pub(crate) fn intersect4_sse(pre: &RayPrecomp4, p: &Tri4, t_max: f32) -> Hits4 {
         }
     }
     h
+}
+
+/// The test of two packets, eight lanes (`p`'s four, then `q`'s), in one AVX2 pass.
+///
+/// # Safety
+///
+/// The CPU must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[allow(unsafe_code)]
+#[inline]
+pub(crate) unsafe fn intersect8_avx2(pre: &RayPrecomp4, p: &Tri4, q: &Tri4, t_max: f32) -> Hits8 {
+    use std::arch::x86_64::*;
+    // SAFETY: each `_mm_loadu_ps` reads one whole 16-byte row of a packet.
+    let load = |vertex: usize, axis: usize| unsafe {
+        let r = 3 * vertex + axis;
+        _mm256_set_m128(_mm_loadu_ps(q.v[r].as_ptr()), _mm_loadu_ps(p.v[r].as_ptr()))
+    };
+    let (zero_edge, sign_ok, t, b1, b2) = watertight_lanes!(avx, pre, t_max, load);
+    let mut h = Hits8::default();
+    // SAFETY: each store writes 32 bytes to a whole local `[f32; 8]`, unaligned.
+    unsafe {
+        _mm256_storeu_ps(h.t.as_mut_ptr(), t);
+        _mm256_storeu_ps(h.b1.as_mut_ptr(), b1);
+        _mm256_storeu_ps(h.b2.as_mut_ptr(), b2);
+    }
+    h.mask = sign_ok;
+    let mut redo = zero_edge;
+    while redo != 0 {
+        let lane = redo.trailing_zeros() as usize;
+        redo &= redo - 1;
+        let tri = if lane < 4 {
+            p.triangle(lane)
+        } else {
+            q.triangle(lane - 4)
+        };
+        h.mask &= !(1 << lane);
+        if let Some(x) = intersect_triangle(&pre.scalar, &tri, t_max) {
+            h.mask |= 1 << lane;
+            h.t[lane] = x.t;
+            h.b1[lane] = x.b1;
+            h.b2[lane] = x.b2;
+        }
+    }
+    h
+}
+
+/// Hits of one ray against the eight lanes of two packets (see [`Hits4`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Hits8 {
+    pub mask: u32,
+    pub t: [f32; 8],
+    pub b1: [f32; 8],
+    pub b2: [f32; 8],
 }
 
 /// The four-wide test used by traversal: SSE2 on x86_64 (part of its baseline), scalar elsewhere.
@@ -258,8 +495,9 @@ pub(crate) fn intersect4(pre: &RayPrecomp4, p: &Tri4, t_max: f32) -> Hits4 {
 mod tests {
     use super::*;
 
-    /// Lanes of a packet agree bit for bit with the scalar test, including rays along edges and
-    /// through vertices (where an edge function is zero) and degenerate triangles.
+    /// Lanes of a packet agree bit for bit with the scalar test, in the SSE2 and the AVX2
+    /// kernel, including rays along edges and through vertices (where an edge function is zero)
+    /// and degenerate triangles.
     #[test]
     fn simd_and_scalar_agree() {
         let mut s = 0x9E37_79B9u32;
@@ -287,6 +525,24 @@ mod tests {
                 for (lane, tri) in tris.iter().enumerate() {
                     let h = intersect_triangle(&pre.scalar, tri, t_max);
                     assert_eq!(h.is_some(), want.mask & (1 << lane) != 0);
+                }
+                #[cfg(target_arch = "x86_64")]
+                if std::is_x86_feature_detected!("avx2") {
+                    // The packet in both halves, and against a second packet of its reversal.
+                    let r = Tri4::pack(&[tris[3], tris[2], tris[1], tris[0]]);
+                    // SAFETY: AVX2 was just detected.
+                    #[allow(unsafe_code)]
+                    let got = unsafe { intersect8_avx2(&pre, &p, &r, t_max) };
+                    let want_r = intersect4_scalar(&pre, &r, t_max);
+                    assert_eq!(got.mask, want.mask | (want_r.mask << 4), "{tris:?} {ray:?}");
+                    for lane in 0..8 {
+                        let w = if lane < 4 { &want } else { &want_r };
+                        if got.mask & (1 << lane) != 0 {
+                            assert_eq!(got.t[lane].to_bits(), w.t[lane % 4].to_bits());
+                            assert_eq!(got.b1[lane].to_bits(), w.b1[lane % 4].to_bits());
+                            assert_eq!(got.b2[lane].to_bits(), w.b2[lane % 4].to_bits());
+                        }
+                    }
                 }
                 #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
                 {
