@@ -418,7 +418,7 @@ impl<N: WideNode> WideBvh<N> {
         code: u32,
         t_max: f32,
         closest: &mut Closest,
-        isa: I,
+        _isa: I,
         counter: &mut C,
     ) -> bool {
         let (first, count) = leaf_parts(code);
@@ -448,7 +448,6 @@ impl<N: WideNode> WideBvh<N> {
                 p += 2;
             }
         }
-        let _ = isa;
         for p in p..end {
             let h = intersect4(pre, &self.packets[p], t_max);
             if h.mask == 0 {
