@@ -3,17 +3,6 @@
 use clap::{Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 
-/// The acceleration structure used when neither `--accel` nor `[render] accel` names one. A
-/// macro so that the help text below can include it; use [`DEFAULT_ACCEL`] in code.
-macro_rules! default_accel {
-    () => {
-        "bvh8"
-    };
-}
-
-/// The acceleration structure used when neither `--accel` nor `[render] accel` names one.
-pub const DEFAULT_ACCEL: &str = default_accel!();
-
 /// Render a TOML scene (see docs/scene-format.md) to an EXR or PNG image.
 ///
 /// Settings come from the command line; any left out fall back to the scene's optional
@@ -56,19 +45,7 @@ pub struct Args {
     #[arg(long, value_enum)]
     pub integrator: Option<IntegratorKind>,
 
-    #[arg(
-        long,
-        value_name = "SPEC",
-        help = concat!(
-            "Acceleration structure and its options, KIND[:OPTION...]: bvh (binned-SAH binary ",
-            "BVH), qbvh (four-wide BVH), bvh8 (eight-wide BVH) or brute-force (tests every ",
-            "triangle; for checking only), e.g. qbvh:evh=14:compact or qbvh:order=distance; the ",
-            "options are listed in ",
-            "crates/accel/src/spec.rs. [default: `[render] accel`, else ",
-            default_accel!(),
-            "]"
-        )
-    )]
+    #[arg(long, value_name = "SPEC", help = accel_help())]
     pub accel: Option<String>,
 
     /// Maximum number of bounces (scattering events). Light arriving after the last bounce
@@ -116,6 +93,17 @@ pub struct Args {
     /// No progress bar and no summary line.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// `--accel`'s help, naming the default from the accel crate.
+fn accel_help() -> String {
+    format!(
+        "Acceleration structure and its options, KIND[:OPTION...]: bvh (binned-SAH binary BVH), \
+         qbvh (four-wide BVH), bvh8 (eight-wide BVH) or brute-force (tests every triangle; for \
+         checking only), e.g. qbvh:evh=14:compact or qbvh:order=distance; the options are listed \
+         in crates/accel/src/spec.rs. [default: `[render] accel`, else {}]",
+        rt_accel::DEFAULT_ACCEL
+    )
 }
 
 /// `--integrator` values.

@@ -1,6 +1,6 @@
 //! Turning arguments and the scene's `[render]` table into a render, and running it.
 
-use crate::args::{Args, IntegratorKind, DEFAULT_ACCEL};
+use crate::args::{Args, IntegratorKind};
 use anyhow::{bail, Context, Result};
 use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -86,9 +86,7 @@ impl Job {
             (None, Some(s)) => s.parse::<AccelSpec>().map_err(|e| {
                 anyhow::anyhow!("{}: [render] accel = \"{s}\": {e}", scene.display())
             })?,
-            (None, None) => DEFAULT_ACCEL
-                .parse()
-                .expect("the default accel spec parses"),
+            (None, None) => AccelSpec::default(),
         };
         // Names where a value came from, so that a bad `[render]` default points at the file.
         let origin = |flag: &str, key: &str, from_cli: bool| {

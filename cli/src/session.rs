@@ -5,7 +5,7 @@
 //! into one film, so a list of budgets costs only its largest, and the image at N spp is bit for
 //! bit the one a single N-spp render gives.
 
-use crate::args::{IntegratorKind, DEFAULT_ACCEL};
+use crate::args::IntegratorKind;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::ValueEnum;
 use rt_accel::AccelSpec;
@@ -90,9 +90,7 @@ impl Overrides {
             Some(s) => s
                 .parse::<AccelSpec>()
                 .map_err(|e| anyhow!("{}: [render] accel = \"{s}\": {e}", scene_path.display())),
-            None => Ok(DEFAULT_ACCEL
-                .parse()
-                .expect("the default accel spec parses")),
+            None => Ok(AccelSpec::default()),
         }
     }
 }

@@ -49,4 +49,4 @@ pub use brute_force::BruteForce;
 pub use bvh2::{BuildParams, Bvh2, BvhStats, Node, Split, MAX_BINS};
 pub use on_demand::OnDemandQbvh;
 pub use qbvh::{Bvh8, Node8, Order, QNode, Qbvh, QbvhOptions, TriangleTest, WideBvh, WideNode};
-pub use spec::{AccelKind, AccelSpec, SpecError};
+pub use spec::{AccelKind, AccelSpec, SpecError, DEFAULT_ACCEL};

@@ -27,8 +27,13 @@ use rt_core::Accel;
 use std::fmt;
 use std::str::FromStr;
 
+/// The structure `render` uses when neither `--accel` nor `[render] accel` names one, as spec
+/// text ([`AccelSpec::default`] parses it).
+pub const DEFAULT_ACCEL: &str = "bvh8";
+
 /// The structures this crate builds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum AccelKind {
     /// [`Bvh2`].
     Bvh,
@@ -80,6 +85,7 @@ pub struct AccelSpec {
 
 /// Why an accel spec was rejected.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
 pub enum SpecError {
     /// The text before the first `:` is not a structure.
     #[error("unknown acceleration structure `{0}` (expected qbvh, bvh8, bvh or brute-force)")]
@@ -108,6 +114,13 @@ pub enum SpecError {
         /// What is wrong with it.
         reason: &'static str,
     },
+}
+
+impl Default for AccelSpec {
+    /// [`DEFAULT_ACCEL`], the structure `render` uses unless told otherwise.
+    fn default() -> Self {
+        DEFAULT_ACCEL.parse().expect("DEFAULT_ACCEL parses")
+    }
 }
 
 impl AccelSpec {
@@ -326,6 +339,14 @@ impl fmt::Display for AccelSpec {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn default_spec_is_the_default_accel() {
+        let d = AccelSpec::default();
+        assert_eq!(d.kind, AccelKind::Bvh8);
+        assert_eq!(d, AccelSpec::new(AccelKind::Bvh8));
+        assert_eq!(d.to_string(), DEFAULT_ACCEL);
+    }
 
     #[test]
     fn parses_and_prints_back() {
