@@ -1,6 +1,7 @@
 //! Command-line arguments.
 
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Parser, Subcommand};
+use rt_integrators::IntegratorSpec;
 use std::path::PathBuf;
 
 /// Render a TOML scene (see docs/scene-format.md) to an EXR or PNG image.
@@ -39,11 +40,13 @@ pub struct Args {
     #[arg(long)]
     pub spp: Option<u32>,
 
-    /// Light transport algorithm: path (path tracing, next-event estimation + MIS),
-    /// path-bsdf (path tracing with BSDF sampling only), direct (direct lighting: one bounce,
-    /// NEE + MIS), ao (ambient occlusion). [default: `[render] integrator`, else path]
-    #[arg(long, value_enum)]
-    pub integrator: Option<IntegratorKind>,
+    /// Light transport algorithm and its options, KIND[:OPTION...]: path (path tracing,
+    /// next-event estimation + MIS), path-bsdf (path tracing with BSDF sampling only), direct
+    /// (direct lighting: one bounce, NEE + MIS), ao (ambient occlusion); options max-depth=N
+    /// (path, path-bsdf) and distance=F (ao), e.g. path:max-depth=4 (crates/integrators/src/spec.rs).
+    /// [default: `[render] integrator`, else path]
+    #[arg(long, value_name = "SPEC", value_parser = parse_integrator)]
+    pub integrator: Option<IntegratorSpec>,
 
     #[arg(long, value_name = "SPEC", help = accel_help())]
     pub accel: Option<String>,
@@ -106,17 +109,10 @@ fn accel_help() -> String {
     )
 }
 
-/// `--integrator` values.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum IntegratorKind {
-    /// Path tracing with next-event estimation and MIS.
-    Path,
-    /// Path tracing with BSDF sampling only.
-    PathBsdf,
-    /// Direct lighting.
-    Direct,
-    /// Ambient occlusion.
-    Ao,
+/// Parses `--integrator` (a usage error, exit code 2, when it does not parse).
+pub fn parse_integrator(s: &str) -> Result<IntegratorSpec, String> {
+    s.parse()
+        .map_err(|e: rt_integrators::IntegratorSpecError| e.to_string())
 }
 
 /// Subcommands.
@@ -199,7 +195,7 @@ mod tests {
         ])
         .unwrap();
         assert_eq!(a.spp, Some(8));
-        assert_eq!(a.integrator, Some(IntegratorKind::PathBsdf));
+        assert_eq!(a.integrator, "path-bsdf".parse().ok());
         assert_eq!(a.accel.as_deref(), Some("brute-force"));
         assert!(a.command.is_none());
         assert_eq!(a.aov.unwrap(), vec!["albedo", "normal"]);

@@ -2,8 +2,8 @@
 //! SSIM from `rt-metrics`), printed as `name value` lines or one JSON object, plus an optional
 //! false-colour error image. Definitions: docs/experiments.md.
 
-use crate::load_image::load_rgb;
 use anyhow::{anyhow, Result};
+use rt_film::read_rgb as load_rgb;
 use rt_metrics::{
     compare, error_image, CompareOptions, FalseColourOptions, Metrics, MetricsError, Role,
     DEFAULT_EPSILON, DEFAULT_PEAK,

@@ -1,52 +1,28 @@
 //! Turning arguments and the scene's `[render]` table into a render, and running it.
 
-use crate::args::{Args, IntegratorKind};
+use crate::args::Args;
 use anyhow::{bail, Context, Result};
-use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rt_accel::AccelSpec;
 use rt_core::{Accel, Scene};
 use rt_film::{AovSet, Film, FilmBuffers, OutputOptions};
 use rt_integrators::{Ctx, Integrator, RenderOptions, RenderStats};
 use rt_scene::{LoadedScene, RenderDesc};
+use rt_session::{pick_camera, Overrides, RenderReport, ReportInputs, Settings};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-const MAX_SPP: u32 = 1 << 20;
-const MAX_THREADS: usize = 1024;
-const MAX_DEPTH: u32 = 10_000;
-
-/// Fully resolved settings of one render.
+/// Fully resolved settings of one render: the library's [`Settings`] plus what only the
+/// command line has.
 #[derive(Debug)]
 pub struct Job {
     pub scene_path: PathBuf,
     pub output: PathBuf,
-    pub spp: u32,
-    pub integrator: IntegratorKind,
-    pub accel: AccelSpec,
-    pub max_depth: u32,
-    pub threads: Option<usize>,
-    pub seed: u32,
+    pub settings: Settings,
     pub camera: Option<String>,
-    pub aovs: AovSet,
     pub exposure: f32,
-    pub ao_distance: f32,
     pub quiet: bool,
-}
-
-fn enum_from_table<T: ValueEnum>(scene: &Path, key: &str, value: &str) -> Result<T> {
-    T::from_str(value, true).map_err(|_| {
-        let names: Vec<String> = T::value_variants()
-            .iter()
-            .filter_map(|v| v.to_possible_value().map(|p| p.get_name().to_string()))
-            .collect();
-        anyhow::anyhow!(
-            "{}: [render] {key} = \"{value}\" is not one of {}",
-            scene.display(),
-            names.join(", ")
-        )
-    })
 }
 
 /// The scene path; clap requires it whenever there is no subcommand.
@@ -56,78 +32,38 @@ fn scene_arg(args: &Args) -> &Path {
         .expect("clap requires SCENE when no subcommand is given")
 }
 
-/// Loads a scene file, or generates the procedural scene `gen:NAME` (`rt_scene::procedural`).
+/// Loads a scene file or `gen:NAME`.
 pub fn load_scene(path: &Path) -> Result<LoadedScene> {
-    if let Some(name) = path.to_str().and_then(|p| p.strip_prefix("gen:")) {
-        let scene = rt_scene::procedural::generate(name)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-        return Ok(LoadedScene {
-            scene,
-            render: RenderDesc::default(),
-            warnings: Vec::new(),
-        });
-    }
-    rt_scene::load(path).map_err(|e| anyhow::anyhow!("{e}"))
+    rt_scene::load_any(path).map_err(|e| anyhow::anyhow!("{e}"))
 }
 
 impl Job {
-    /// Command line first, then the scene's `[render]` table, then defaults.
+    /// Command line first, then the scene's `[render]` table, then defaults
+    /// ([`Overrides::resolve`]); then the checks only the command line needs.
     pub fn resolve(args: &Args, desc: &RenderDesc) -> Result<Job> {
         let scene = scene_arg(args);
-        let integrator = match (args.integrator, &desc.integrator) {
-            (Some(i), _) => i,
-            (None, Some(s)) => enum_from_table(scene, "integrator", s)?,
-            (None, None) => IntegratorKind::Path,
+        let accel = match &args.accel {
+            Some(a) => Some(
+                a.parse::<AccelSpec>()
+                    .map_err(|e| anyhow::anyhow!("--accel {a}: {e}"))?,
+            ),
+            None => None,
         };
-        let accel = match (&args.accel, &desc.accel) {
-            (Some(a), _) => a
-                .parse::<AccelSpec>()
-                .map_err(|e| anyhow::anyhow!("--accel {a}: {e}"))?,
-            (None, Some(s)) => s.parse::<AccelSpec>().map_err(|e| {
-                anyhow::anyhow!("{}: [render] accel = \"{s}\": {e}", scene.display())
-            })?,
-            (None, None) => AccelSpec::default(),
-        };
-        // Names where a value came from, so that a bad `[render]` default points at the file.
-        let origin = |flag: &str, key: &str, from_cli: bool| {
-            if from_cli {
-                format!("--{flag}")
-            } else {
-                format!("{}: [render] {key}", scene.display())
-            }
-        };
-        let spp = args.spp.or(desc.spp).unwrap_or(64);
-        if spp == 0 || spp > MAX_SPP {
-            let at = origin("spp", "spp", args.spp.is_some());
-            bail!("{at}: samples per pixel must be between 1 and {MAX_SPP}, got {spp}");
+        let settings = Overrides {
+            integrator: args.integrator,
+            max_depth: args.max_depth,
+            ao_distance: args.ao_distance,
+            spp: args.spp,
+            threads: args.threads,
+            seed: args.seed,
+            accel,
+            aovs: args.aov.clone(),
+            output: args.output.clone(),
         }
-        let max_depth = args.max_depth.or(desc.max_depth).unwrap_or(16);
-        if max_depth > MAX_DEPTH {
-            let at = origin("max-depth", "max_depth", args.max_depth.is_some());
-            bail!("{at}: max depth must be at most {MAX_DEPTH}, got {max_depth}");
-        }
-        let threads = args.threads.or(desc.threads);
-        if let Some(t) = threads {
-            if t == 0 || t > MAX_THREADS {
-                let at = origin("threads", "threads", args.threads.is_some());
-                bail!("{at}: thread count must be between 1 and {MAX_THREADS}, got {t}");
-            }
-        }
-        let seed = args.seed.or(desc.seed).unwrap_or(0);
-        let aov_names: Vec<String> = args
-            .aov
-            .clone()
-            .or_else(|| desc.aov.clone())
-            .unwrap_or_default();
-        let aovs = AovSet::parse_list(aov_names.iter().map(String::as_str))
-            .map_err(|e| anyhow::anyhow!("{}: {e}", origin("aov", "aov", args.aov.is_some())))?;
-        let output = match (&args.output, &desc.output) {
-            (Some(o), _) => o.clone(),
-            (None, Some(o)) => PathBuf::from(o),
-            (None, None) => {
-                PathBuf::from(scene.file_stem().unwrap_or_default()).with_extension("exr")
-            }
-        };
+        .resolve(desc, scene)?;
+        let output = settings.output.clone().unwrap_or_else(|| {
+            PathBuf::from(scene.file_stem().unwrap_or_default()).with_extension("exr")
+        });
         match output
             .extension()
             .and_then(|e| e.to_str())
@@ -137,7 +73,7 @@ impl Job {
             Some("exr") | Some("png") => {}
             _ => bail!("{}: output must end in .exr or .png", output.display()),
         }
-        if aovs != AovSet::default()
+        if settings.aovs != AovSet::default()
             && output
                 .extension()
                 .is_some_and(|e| e.eq_ignore_ascii_case("png"))
@@ -150,42 +86,15 @@ impl Job {
         if !args.exposure.is_finite() {
             bail!("--exposure must be a finite number");
         }
-        let ao_distance = args.ao_distance.unwrap_or(f32::INFINITY);
-        if ao_distance.is_nan() || ao_distance <= 0.0 {
-            bail!("--ao-distance must be positive, got {ao_distance}");
-        }
         Ok(Job {
             scene_path: scene.to_path_buf(),
             output,
-            spp,
-            integrator,
-            accel,
-            max_depth,
-            threads,
-            // Fold the 64-bit seed into the 32-bit stream key without discarding the high half.
-            seed: (seed ^ (seed >> 32)) as u32,
+            settings,
             camera: args.camera.clone(),
-            aovs,
             exposure: args.exposure,
-            ao_distance,
             quiet: args.quiet,
         })
     }
-}
-
-/// Builds the chosen acceleration structure.
-pub fn build_accel(spec: &AccelSpec, scene: &Scene) -> Box<dyn Accel> {
-    spec.build(&scene.triangles)
-}
-
-/// Builds the chosen integrator.
-pub fn build_integrator(job: &Job) -> Box<dyn Integrator> {
-    crate::session::Estimator {
-        integrator: job.integrator,
-        max_depth: job.max_depth,
-        ao_distance: job.ao_distance,
-    }
-    .build()
 }
 
 /// Loads, renders and writes; prints the summary line.
@@ -201,24 +110,24 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let job = Job::resolve(args, &loaded.render)?;
     let scene = loaded.scene;
-    let camera = crate::session::camera(&scene, &job.scene_path, job.camera.as_deref())?;
+    let camera = pick_camera(&scene, &job.scene_path, job.camera.as_deref())?;
 
     let mut pool = rayon::ThreadPoolBuilder::new();
-    if let Some(t) = job.threads {
+    if let Some(t) = job.settings.threads {
         pool = pool.num_threads(t);
     }
     let pool = pool.build().context("cannot start worker threads")?;
 
     let t_build = Instant::now();
-    let accel = pool.install(|| build_accel(&job.accel, &scene));
+    let accel = pool.install(|| job.settings.accel.build(&scene.triangles));
     let build_time = t_build.elapsed();
     let build_secs = build_time.as_secs_f64();
-    let integrator = build_integrator(&job);
+    let integrator = job.settings.integrator.build();
     // Only the buffers the outputs read: no variance or half-buffers unless asked for.
     let mut film = Film::new(
         camera.width,
         camera.height,
-        FilmBuffers::for_outputs(job.aovs),
+        FilmBuffers::for_outputs(job.settings.aovs),
     );
     let ctx = Ctx {
         scene: &scene,
@@ -226,8 +135,8 @@ pub fn run(args: &Args) -> Result<()> {
         camera,
     };
     let opts = RenderOptions {
-        spp: job.spp,
-        seed: job.seed,
+        spp: job.settings.spp,
+        seed: job.settings.seed,
     };
 
     let bar = if job.quiet || !std::io::stderr().is_terminal() {
@@ -276,11 +185,11 @@ pub fn run(args: &Args) -> Result<()> {
     if args.stats {
         print!(
             "{}",
-            crate::stats::collect(&crate::stats::Inputs {
+            RenderReport::collect(&ReportInputs {
                 scene: &scene,
                 camera,
                 accel: accel.as_ref(),
-                accel_spec: job.accel.to_string(),
+                accel_spec: job.settings.accel.to_string(),
                 film: &film,
                 render: &stats,
                 load_time,
@@ -313,9 +222,9 @@ fn print_summary(
         job.scene_path.display(),
         camera.width,
         camera.height,
-        job.spp,
+        job.settings.spp,
         integrator.name(),
-        job.accel,
+        job.settings.accel,
         scene.triangle_count(),
         threads,
         stats.elapsed.as_secs_f64(),

@@ -10,16 +10,12 @@
 //! `render stress` (`stress.rs`) runs the numerical stress suite.
 
 mod args;
-mod atomic;
 mod bench_accel;
 mod compare;
 mod experiment;
 mod job;
-mod load_image;
 mod progress;
 mod reference;
-mod session;
-mod stats;
 mod stress;
 
 use clap::Parser;
@@ -49,8 +45,22 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", one_line(&e));
             ExitCode::from(1)
         }
     }
+}
+
+/// The error and its causes on one line. Library errors already print their cause (so that
+/// they read well alone), so a cause whose text is already there is not repeated.
+fn one_line(e: &anyhow::Error) -> String {
+    let mut line = e.to_string();
+    for cause in e.chain().skip(1) {
+        let text = cause.to_string();
+        if !line.contains(&text) {
+            line.push_str(": ");
+            line.push_str(&text);
+        }
+    }
+    line
 }

@@ -48,3 +48,21 @@ impl Progress {
         self.bar.finish_and_clear();
     }
 }
+
+impl rt_experiment::Progress for Progress {
+    fn set_length(&self, units: u64) {
+        self.bar.set_length(units);
+    }
+
+    fn set_position(&self, units: u64) {
+        self.bar.set_position(units);
+    }
+
+    fn set_message(&self, text: String) {
+        self.bar.set_message(text);
+    }
+
+    fn message(&self, line: &str) {
+        Progress::message(self, line);
+    }
+}

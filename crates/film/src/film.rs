@@ -27,7 +27,7 @@ impl AovSet {
     }
 
     /// Parses a comma-separated list such as `albedo,normal,variance`.
-    pub fn parse_list<'a>(names: impl IntoIterator<Item = &'a str>) -> Result<Self, String> {
+    pub fn parse_list<'a>(names: impl IntoIterator<Item = &'a str>) -> Result<Self, UnknownAov> {
         let mut s = Self::default();
         for n in names {
             match n.trim() {
@@ -37,16 +37,17 @@ impl AovSet {
                 "position" => s.position = true,
                 "variance" => s.variance = true,
                 "" => {}
-                other => {
-                    return Err(format!(
-                        "unknown AOV '{other}' (expected albedo, normal, depth, position, variance)"
-                    ))
-                }
+                other => return Err(UnknownAov(other.to_string())),
             }
         }
         Ok(s)
     }
 }
+
+/// An AOV name [`AovSet::parse_list`] does not know.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("unknown AOV '{0}' (expected albedo, normal, depth, position, variance)")]
+pub struct UnknownAov(pub String);
 
 /// Which per-pixel buffers a film allocates besides the mean and sample count, which it always
 /// keeps. The caller fills this from what its outputs and consumers read, so that a render pays

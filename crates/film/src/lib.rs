@@ -8,7 +8,8 @@
 //! normal, depth, world position) and their shared hit count. [`Film::memory`] reports what is
 //! held. Nothing non-finite ever enters a buffer: such samples are counted and dropped.
 //!
-//! [`output`] writes EXR (linear float, AOVs as extra channel groups) and PNG (tone mapped
+//! [`input`] reads any image (EXR, PNG, JPEG) as a linear [`rt_core::RgbImage`]. [`output`]
+//! writes EXR (linear float, AOVs as extra channel groups) and PNG (tone mapped
 //! sRGB), always atomically: a temporary file in the target directory renamed into place.
 //!
 //! Depends on `rt-core` (for `Rgb`), `exr` and `image`.
@@ -29,9 +30,13 @@
 #![forbid(unsafe_code)]
 
 mod film;
+pub mod input;
 pub mod output;
 mod pixel;
 
-pub use film::{AovSet, Film, FilmBuffers, FilmMemory, FilmStripe};
-pub use output::{read_exr, write_image, write_rgb, FilmError, OutputOptions};
+pub use film::{AovSet, Film, FilmBuffers, FilmMemory, FilmStripe, UnknownAov};
+pub use input::read_rgb;
+pub use output::{
+    copy_atomic, read_exr, write_bytes_atomic, write_image, write_rgb, FilmError, OutputOptions,
+};
 pub use pixel::{FirstHit, HalfSums, PixelStats};

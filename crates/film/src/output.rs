@@ -102,6 +102,21 @@ pub fn write_rgb(
     }
 }
 
+/// Writes `bytes` to `path` atomically (as [`write_atomic`]): for CSVs, reports and sidecars,
+/// so every file the renderer writes is either whole or absent.
+pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<(), FilmError> {
+    write_atomic(path, |w| w.write_all(bytes).map_err(|e| e.to_string()))
+}
+
+/// Copies `from` to `to` atomically.
+pub fn copy_atomic(from: &Path, to: &Path) -> Result<(), FilmError> {
+    let bytes = std::fs::read(from).map_err(|source| FilmError::Io {
+        path: from.to_path_buf(),
+        source,
+    })?;
+    write_bytes_atomic(to, &bytes)
+}
+
 /// Writes through a temporary file in the same directory, then renames it over `path`, so
 /// readers never see a half-written image and an interrupted run leaves the old file (or none).
 fn write_atomic(

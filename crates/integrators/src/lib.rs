@@ -10,16 +10,24 @@
 //! sampling only), direct lighting (the same estimator stopped after one bounce) and
 //! [`AoIntegrator`] (ambient occlusion).
 //!
+//! [`IntegratorSpec`] is the one place integrators are named, parsed from text such as
+//! `path:max-depth=8` and built, so a program using this crate offers the same choice as
+//! `render --integrator`.
+//!
 //! Depends on `rt-core` and `rt-film`.
 #![forbid(unsafe_code)]
 
 mod ao;
 pub mod driver;
 mod path;
+pub mod spec;
 
 pub use ao::AoIntegrator;
 pub use driver::{render, render_samples, RenderOptions, RenderStats, SamplePass};
 pub use path::PathIntegrator;
+pub use spec::{
+    IntegratorKind, IntegratorSpec, IntegratorSpecError, Target, DEFAULT_MAX_DEPTH, MAX_DEPTH,
+};
 
 use rt_core::{Accel, Camera, Rgb, Sampler, Scene};
 use rt_film::FirstHit;

@@ -25,15 +25,8 @@ impl fmt::Display for Role {
 #[non_exhaustive]
 pub enum MetricsError {
     /// [`RgbImage::new`](crate::RgbImage::new) got a pixel vector of the wrong length.
-    #[error("{pixels} pixels do not make a {width}x{height} image")]
-    PixelCount {
-        /// Requested width.
-        width: usize,
-        /// Requested height.
-        height: usize,
-        /// Length of the pixel vector.
-        pixels: usize,
-    },
+    #[error(transparent)]
+    PixelCount(#[from] rt_core::PixelCountError),
     /// An image has no pixels, so no mean exists.
     #[error("the {role} is empty ({width}x{height})")]
     Empty {

@@ -96,7 +96,7 @@ pub fn error_image(
             viridis((e.log10() - lo) / (hi - lo))
         })
         .collect();
-    RgbImage::new(test.width(), test.height(), pixels)
+    Ok(RgbImage::new(test.width(), test.height(), pixels)?)
 }
 
 #[cfg(test)]

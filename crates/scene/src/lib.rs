@@ -103,6 +103,24 @@ pub struct RenderDesc {
     pub output: Option<String>,
 }
 
+/// Loads the scene file at `path`, or generates the procedural scene `gen:NAME`
+/// ([`procedural::generate`], with an empty `[render]` table): what every command that takes
+/// a scene argument accepts.
+pub fn load_any(path: &Path) -> Result<LoadedScene, SceneError> {
+    if let Some(name) = path.to_str().and_then(|p| p.strip_prefix("gen:")) {
+        let scene = procedural::generate(name).map_err(|e| SceneError::File {
+            file: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        return Ok(LoadedScene {
+            scene,
+            render: RenderDesc::default(),
+            warnings: Vec::new(),
+        });
+    }
+    load(path)
+}
+
 /// Loads the scene file at `path`. Relative paths inside it (meshes, textures, environment
 /// maps) are resolved against the file's directory, and errors name `path` as given.
 pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {

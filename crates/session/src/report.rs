@@ -1,7 +1,8 @@
-//! `render --stats`: what a render built, what it skipped and why, and what each stage cost in
-//! time and in bytes held. The libraries report the figures (`Scene::memory`,
-//! `Accel::memory_bytes`, `LightSampler::memory_bytes`, `EnvMap::importance_map_bytes`,
-//! `Film::memory`, ...); this module only arranges and prints them. Bytes are lengths times
+//! The render report behind `render --stats`: what a render built, what it skipped and why,
+//! and what each stage cost in time and in bytes held. The libraries report the figures
+//! (`Scene::memory`, `Accel::memory_bytes`, `LightSampler::memory_bytes`,
+//! `EnvMap::importance_map_bytes`, `Film::memory`, ...); this module arranges them, and its
+//! `Display` prints the table. Bytes are lengths times
 //! element sizes of the buffers held after the render, not the process's resident memory.
 
 use rt_core::{environment::Environment, Accel, Camera, Scene};
@@ -64,172 +65,183 @@ impl Stage {
 
 /// The stages of one render, in order, and the bytes held at its end.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct Stats {
+pub struct RenderReport {
     /// Stages in the order they ran.
     pub stages: Vec<Stage>,
     /// Bytes of the scene, acceleration structure, sampling structures and film held together.
     pub held_bytes: u64,
 }
 
-/// Everything [`collect`] reads.
-pub struct Inputs<'a> {
+/// Everything [`RenderReport::collect`] reads.
+pub struct ReportInputs<'a> {
+    /// The scene rendered.
     pub scene: &'a Scene,
+    /// The camera (after any resize).
     pub camera: &'a Camera,
+    /// The structure built.
     pub accel: &'a dyn Accel,
+    /// The spec it was built from, as text.
     pub accel_spec: String,
+    /// The film after the render.
     pub film: &'a Film,
+    /// What the render passes reported.
     pub render: &'a RenderStats,
+    /// Scene load time.
     pub load_time: Duration,
+    /// Acceleration structure build time.
     pub accel_time: Duration,
+    /// Output write time.
     pub write_time: Duration,
+    /// The output written (its size is read from disk).
     pub output: &'a Path,
 }
 
-/// Gathers the stages of a finished render.
-pub fn collect(i: &Inputs<'_>) -> Stats {
-    let scene = i.scene;
-    let mut stages = Vec::new();
+impl RenderReport {
+    /// Gathers the stages of a finished render.
+    pub fn collect(i: &ReportInputs<'_>) -> RenderReport {
+        let scene = i.scene;
+        let mut stages = Vec::new();
 
-    let mem = scene.memory();
-    stages.push(
-        Stage::ran("scene load", "done", Some(i.load_time), Some(mem.total())).details(format!(
-            "triangles: {} ({} B), materials: {} ({} B), textures: {} ({} B), environment \
+        let mem = scene.memory();
+        stages.push(
+            Stage::ran("scene load", "done", Some(i.load_time), Some(mem.total())).details(
+                format!(
+                    "triangles: {} ({} B), materials: {} ({} B), textures: {} ({} B), environment \
              map texels: {} B",
-            scene.triangle_count(),
-            mem.geometry,
-            scene.materials.len(),
-            mem.materials,
-            scene.textures.len(),
-            mem.textures,
-            mem.environment
-        )),
-    );
+                    scene.triangle_count(),
+                    mem.geometry,
+                    scene.materials.len(),
+                    mem.materials,
+                    scene.textures.len(),
+                    mem.textures,
+                    mem.environment
+                ),
+            ),
+        );
 
-    let accel_bytes = i.accel.memory_bytes();
-    stages.push(
-        Stage::ran(
-            "acceleration structure",
-            "built",
-            Some(i.accel_time),
-            Some(accel_bytes),
-        )
-        .details(if i.accel.name() == i.accel_spec {
-            i.accel_spec.clone()
-        } else {
-            format!("{} ({})", i.accel.name(), i.accel_spec)
-        }),
-    );
-
-    let lights = &scene.lights;
-    let env_sampled = !scene.environment.is_black();
-    let light_stage = "light sampling structure";
-    stages.push(if lights.emitter_count() > 0 {
-        Stage::ran(
-            light_stage,
-            "built",
-            Some(lights.build_time()),
-            Some(lights.memory_bytes()),
-        )
-        .details(format!("{} emissive triangles", lights.emitter_count()))
-    } else if env_sampled {
-        Stage::skipped(
-            light_stage,
-            "no emitters (light samples go to the environment)",
-        )
-    } else {
-        Stage::skipped(light_stage, "no emitters")
-    });
-
-    let env_stage = "environment importance map";
-    stages.push(match &scene.environment {
-        Environment::Map(m) => {
-            let (w, h) = m.size();
+        let accel_bytes = i.accel.memory_bytes();
+        stages.push(
             Stage::ran(
-                env_stage,
+                "acceleration structure",
                 "built",
-                Some(m.importance_build_time()),
-                Some(m.importance_map_bytes()),
+                Some(i.accel_time),
+                Some(accel_bytes),
             )
-            .details(format!("{w}x{h} map"))
-        }
-        Environment::Constant(_) if env_sampled => {
-            Stage::skipped(env_stage, "constant environment")
-        }
-        Environment::Constant(_) => Stage::skipped(env_stage, "no environment"),
-    });
+            .details(if i.accel.name() == i.accel_spec {
+                i.accel_spec.clone()
+            } else {
+                format!("{} ({})", i.accel.name(), i.accel_spec)
+            }),
+        );
 
-    let film = i.film;
-    let fm = film.memory();
-    let pixels = film.width() as usize * film.height() as usize;
-    let per_pixel = |b: usize| format!("{} B/pixel", b / pixels.max(1));
-    stages.push(
-        Stage::ran("film mean + count", "allocated", None, Some(fm.mean))
-            .details(per_pixel(fm.mean)),
-    );
-    let buffer = |name: &str, bytes: Option<usize>, why_not: &str| match bytes {
-        Some(b) => Stage::ran(name, "allocated", None, Some(b)).details(per_pixel(b)),
-        None => Stage::skipped(name, why_not),
-    };
-    stages.push(buffer("film variance (M2)", fm.variance, "no consumer"));
-    stages.push(buffer("film half-buffers", fm.halves, "no consumer"));
-    stages.push(buffer(
-        "film AOV hit count",
-        fm.first_hits,
-        "no first-hit AOV requested",
-    ));
-    for (name, bytes) in [
-        ("film AOV albedo", fm.albedo),
-        ("film AOV normal", fm.normal),
-        ("film AOV depth", fm.depth),
-        ("film AOV position", fm.position),
-    ] {
-        stages.push(buffer(name, bytes, "not requested"));
+        let lights = &scene.lights;
+        let env_sampled = !scene.environment.is_black();
+        let light_stage = "light sampling structure";
+        stages.push(if lights.emitter_count() > 0 {
+            Stage::ran(
+                light_stage,
+                "built",
+                Some(lights.build_time()),
+                Some(lights.memory_bytes()),
+            )
+            .details(format!("{} emissive triangles", lights.emitter_count()))
+        } else if env_sampled {
+            Stage::skipped(
+                light_stage,
+                "no emitters (light samples go to the environment)",
+            )
+        } else {
+            Stage::skipped(light_stage, "no emitters")
+        });
+
+        let env_stage = "environment importance map";
+        stages.push(match &scene.environment {
+            Environment::Map(m) => {
+                let (w, h) = m.size();
+                Stage::ran(
+                    env_stage,
+                    "built",
+                    Some(m.importance_build_time()),
+                    Some(m.importance_map_bytes()),
+                )
+                .details(format!("{w}x{h} map"))
+            }
+            Environment::Constant(_) if env_sampled => {
+                Stage::skipped(env_stage, "constant environment")
+            }
+            Environment::Constant(_) => Stage::skipped(env_stage, "no environment"),
+        });
+
+        let film = i.film;
+        let fm = film.memory();
+        let pixels = film.width() as usize * film.height() as usize;
+        let per_pixel = |b: usize| format!("{} B/pixel", b / pixels.max(1));
+        stages.push(
+            Stage::ran("film mean + count", "allocated", None, Some(fm.mean))
+                .details(per_pixel(fm.mean)),
+        );
+        let buffer = |name: &str, bytes: Option<usize>, why_not: &str| match bytes {
+            Some(b) => Stage::ran(name, "allocated", None, Some(b)).details(per_pixel(b)),
+            None => Stage::skipped(name, why_not),
+        };
+        stages.push(buffer("film variance (M2)", fm.variance, "no consumer"));
+        stages.push(buffer("film half-buffers", fm.halves, "no consumer"));
+        stages.push(buffer(
+            "film AOV hit count",
+            fm.first_hits,
+            "no first-hit AOV requested",
+        ));
+        for (name, bytes) in [
+            ("film AOV albedo", fm.albedo),
+            ("film AOV normal", fm.normal),
+            ("film AOV depth", fm.depth),
+            ("film AOV position", fm.position),
+        ] {
+            stages.push(buffer(name, bytes, "not requested"));
+        }
+
+        stages.push(if i.camera.is_pinhole() {
+            Stage::skipped("lens sampling", "pinhole camera")
+        } else {
+            Stage::ran("lens sampling", "used", None, None)
+                .details(format!("aperture {}", i.camera.aperture))
+        });
+
+        let r = i.render;
+        stages.push(
+            Stage::ran("render", "done", Some(r.elapsed), None).details(format!(
+                "{} samples, {} rays, {} shadow rays, {} discarded samples",
+                r.samples, r.rays.rays, r.rays.shadow_rays, r.discarded
+            )),
+        );
+
+        let file_bytes = std::fs::metadata(i.output).map(|m| m.len()).ok();
+        let mut write = Stage::ran("output write", "done", Some(i.write_time), None)
+            .details(i.output.display().to_string());
+        write.bytes = file_bytes;
+        stages.push(write);
+
+        let held = mem.total()
+            + accel_bytes
+            + lights.memory_bytes()
+            + scene
+                .environment
+                .map()
+                .map_or(0, |m| m.importance_map_bytes())
+            + fm.total();
+        RenderReport {
+            stages,
+            held_bytes: held as u64,
+        }
     }
 
-    stages.push(if i.camera.is_pinhole() {
-        Stage::skipped("lens sampling", "pinhole camera")
-    } else {
-        Stage::ran("lens sampling", "used", None, None)
-            .details(format!("aperture {}", i.camera.aperture))
-    });
-
-    let r = i.render;
-    stages.push(
-        Stage::ran("render", "done", Some(r.elapsed), None).details(format!(
-            "{} samples, {} rays, {} shadow rays, {} discarded samples",
-            r.samples, r.rays.rays, r.rays.shadow_rays, r.discarded
-        )),
-    );
-
-    let file_bytes = std::fs::metadata(i.output).map(|m| m.len()).ok();
-    let mut write = Stage::ran("output write", "done", Some(i.write_time), None)
-        .details(i.output.display().to_string());
-    write.bytes = file_bytes;
-    stages.push(write);
-
-    let held = mem.total()
-        + accel_bytes
-        + lights.memory_bytes()
-        + scene
-            .environment
-            .map()
-            .map_or(0, |m| m.importance_map_bytes())
-        + fm.total();
-    Stats {
-        stages,
-        held_bytes: held as u64,
-    }
-}
-
-impl Stats {
     /// The stage named `name`.
-    #[cfg(test)]
     pub fn stage(&self, name: &str) -> Option<&Stage> {
         self.stages.iter().find(|s| s.name == name)
     }
 }
 
-impl fmt::Display for Stats {
+impl fmt::Display for RenderReport {
     /// One line per stage: name, status, time, bytes, then details or the reason for a skip.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
@@ -278,10 +290,10 @@ mod tests {
         s
     }
 
-    fn stats_for(scene: &Scene, film: &Film, aperture: f32) -> Stats {
+    fn stats_for(scene: &Scene, film: &Film, aperture: f32) -> RenderReport {
         let camera = Camera::look_at("c", Vec3::Z, Vec3::ZERO, Vec3::Y, 40.0, 4, 2, aperture, 1.0);
         let accel = rt_accel::BruteForce::new(&scene.triangles);
-        collect(&Inputs {
+        RenderReport::collect(&ReportInputs {
             scene,
             camera: &camera,
             accel: &accel,
@@ -295,7 +307,7 @@ mod tests {
         })
     }
 
-    fn skipped(s: &Stats, name: &str) -> String {
+    fn skipped(s: &RenderReport, name: &str) -> String {
         match &s
             .stage(name)
             .unwrap_or_else(|| panic!("no stage {name}"))

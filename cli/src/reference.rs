@@ -1,22 +1,13 @@
-//! `render reference SCENE --spp N`: a high-sample image to measure other renders against.
-//!
-//! A reference draws its samples from the reference family of streams
-//! (`rt_core::SampleStream::Reference`), which no normal render uses whatever its seed, so its
-//! noise is independent of the noise of any image it is compared with. It is cached on disk
-//! (`cache.rs`) and rendered only when no entry with the same key exists; experiments go
-//! through the same cache.
+//! `render reference SCENE --spp N`: arguments, then `rt_experiment::reference` takes the
+//! reference from the cache or renders it there (its own random streams, independent of any
+//! normal render), and this prints its path.
 
-pub mod cache;
-
-use crate::args::IntegratorKind;
 use crate::progress::Progress;
-use crate::session::{self, Budgets, Checkpoint, Estimator, ImageSize, Overrides, Session};
 use anyhow::{anyhow, bail, Result};
-use cache::{Cache, Key, ReferenceRequest, Sidecar, DEFAULT_CACHE_DIR};
-use rt_core::{Accel, SampleStream};
-use rt_film::{AovSet, Film};
-use rt_integrators::Ctx;
-use std::path::{Path, PathBuf};
+use rt_experiment::{Cache, ReferenceRequest, DEFAULT_CACHE_DIR};
+use rt_integrators::IntegratorSpec;
+use rt_session::{parse_resolution, pick_camera, ImageSize, Overrides};
+use std::path::PathBuf;
 
 /// `render reference` arguments.
 #[derive(clap::Args, Debug)]
@@ -39,8 +30,8 @@ pub struct ReferenceArgs {
     pub seed: Option<u64>,
 
     /// Integrator (see `render --help`). [default: `[render] integrator`, else path]
-    #[arg(long, value_enum)]
-    pub integrator: Option<IntegratorKind>,
+    #[arg(long, value_name = "SPEC", value_parser = crate::args::parse_integrator)]
+    pub integrator: Option<IntegratorSpec>,
 
     /// Maximum number of bounces. [default: `[render] max_depth`, else 16]
     #[arg(long)]
@@ -55,7 +46,7 @@ pub struct ReferenceArgs {
     pub camera: Option<String>,
 
     /// Render at WIDTHxHEIGHT instead of the camera's resolution (vertical field of view kept).
-    #[arg(long, value_parser = session::parse_resolution, conflicts_with = "scale")]
+    #[arg(long, value_parser = resolution, conflicts_with = "scale")]
     pub resolution: Option<(u32, u32)>,
 
     /// Render at the camera's resolution times this factor.
@@ -84,97 +75,17 @@ pub struct ReferenceArgs {
     pub quiet: bool,
 }
 
-/// A reference ready to use.
-pub struct Obtained {
-    /// The EXR (in the cache, or wherever it was written).
-    pub path: PathBuf,
-    /// True if it came from the cache.
-    pub cached: bool,
-    /// Render time (of the original render when cached).
-    pub seconds: f64,
-}
-
-/// Finds `req` in `cache` or renders it (with `accel`) and stores it there. With no cache, the
-/// reference is rendered and written to `write_to`. Call inside the thread pool to use.
-pub fn obtain(
-    req: &ReferenceRequest<'_>,
-    accel: &dyn Accel,
-    cache: Option<&Cache>,
-    write_to: Option<&Path>,
-    progress: &(dyn Fn(f64) + Sync),
-) -> Result<Obtained> {
-    let key: Key = req.key()?;
-    if let Some(cache) = cache {
-        if let Some((path, sidecar)) = cache.lookup(req.scene_path, &key) {
-            return Ok(Obtained {
-                path,
-                cached: true,
-                seconds: sidecar.seconds,
-            });
-        }
-    }
-    let (film, at) = render(req, accel, progress)?;
-    let sidecar = Sidecar {
-        key: key.hex.clone(),
-        description: key.description.clone(),
-        scene: req.scene_path.display().to_string(),
-        width: req.camera.width,
-        height: req.camera.height,
-        spp: req.spp,
-        seconds: at.seconds,
-        samples_per_second: at.samples as f64 / at.seconds.max(1e-9),
-    };
-    let path = match (cache, write_to) {
-        (Some(cache), _) => cache.store(req.scene_path, &key, &film, &sidecar)?,
-        (None, Some(out)) => {
-            rt_film::write_image(out, &film, &rt_film::OutputOptions::default())
-                .map_err(|e| anyhow!("{e}"))?;
-            out.to_path_buf()
-        }
-        (None, None) => bail!("a reference needs a cache or an output file"),
-    };
-    Ok(Obtained {
-        path,
-        cached: false,
-        seconds: at.seconds,
-    })
-}
-
-/// Renders the reference: the reference stream, the variance AOV kept.
-fn render(
-    req: &ReferenceRequest<'_>,
-    accel: &dyn Accel,
-    progress: &(dyn Fn(f64) + Sync),
-) -> Result<(Film, Checkpoint)> {
-    let integrator = req.estimator.build();
-    let session = Session {
-        ctx: Ctx {
-            scene: req.scene,
-            accel,
-            camera: req.camera,
-        },
-        integrator: integrator.as_ref(),
-        seed: req.seed,
-        stream: SampleStream::Reference,
-        aovs: AovSet {
-            variance: true,
-            ..AovSet::default()
-        },
-    };
-    let mut last = Checkpoint::default();
-    let film = session.render(&Budgets::Spp(vec![req.spp]), progress, &mut |_, at| {
-        last = *at;
-        Ok(())
-    })?;
-    Ok((film, last))
+/// Parses `--resolution WxH`.
+fn resolution(s: &str) -> Result<(u32, u32), String> {
+    parse_resolution(s).map_err(|e| e.to_string())
 }
 
 /// Runs `render reference`.
 pub fn run(args: &ReferenceArgs) -> Result<()> {
-    if args.spp == 0 || args.spp > session::MAX_SPP {
+    if args.spp == 0 || args.spp > rt_session::MAX_SPP {
         bail!(
             "--spp must be between 1 and {}, got {}",
-            session::MAX_SPP,
+            rt_session::MAX_SPP,
             args.spp
         );
     }
@@ -203,10 +114,11 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         ao_distance: args.ao_distance,
         seed: args.seed,
         accel,
+        ..Overrides::default()
     };
-    let estimator: Estimator = overrides.estimator(&loaded.render, &args.scene)?;
-    let accel_spec = overrides.accel(&loaded.render, &args.scene)?;
-    let camera = size.apply(session::camera(
+    let estimator = overrides.integrator_spec(&loaded.render, &args.scene)?;
+    let accel_spec = overrides.accel_spec(&loaded.render, &args.scene)?;
+    let camera = size.apply(pick_camera(
         &loaded.scene,
         &args.scene,
         args.camera.as_deref(),
@@ -228,7 +140,7 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     let cache = (!args.no_cache).then(|| Cache::new(&args.cache));
     let obtained = pool.install(|| {
         let accel = accel_spec.build(&loaded.scene.triangles);
-        obtain(
+        rt_experiment::reference::obtain(
             &req,
             accel.as_ref(),
             cache.as_ref(),
@@ -255,7 +167,7 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     }
     let printed = match &args.output {
         Some(out) if obtained.path != *out => {
-            crate::atomic::copy(&obtained.path, out)?;
+            rt_film::copy_atomic(&obtained.path, out)?;
             out.clone()
         }
         _ => obtained.path,

@@ -21,10 +21,10 @@
 //! counts only when both exist and the sidecar's key matches, so an interrupted store is
 //! re-rendered rather than trusted.
 
-use crate::session::Estimator;
-use anyhow::{anyhow, Result};
+use crate::error::{io, ExperimentError, Result};
 use rt_core::{Camera, Scene};
 use rt_film::Film;
+use rt_integrators::IntegratorSpec;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::fmt::Write as _;
@@ -45,7 +45,7 @@ pub struct ReferenceRequest<'a> {
     /// The camera to render, already resized.
     pub camera: &'a Camera,
     /// Integrator and parameters.
-    pub estimator: Estimator,
+    pub estimator: IntegratorSpec,
     /// Samples per pixel.
     pub spp: u32,
     /// Seed of the reference stream.
@@ -107,8 +107,9 @@ impl ReferenceRequest<'_> {
         let file_bytes = if name.starts_with("gen:") {
             name.as_bytes().to_vec()
         } else {
-            std::fs::read(self.scene_path)
-                .map_err(|e| anyhow!("{}: cannot open: {e}", self.scene_path.display()))?
+            std::fs::read(self.scene_path).map_err(|e| {
+                ExperimentError::Run(format!("{}: cannot open: {e}", self.scene_path.display()))
+            })?
         };
         let mut scene_hash = HashWriter(Sha256::new());
         // Writing into a hash cannot fail.
@@ -125,7 +126,7 @@ impl ReferenceRequest<'_> {
             self.camera.width,
             self.camera.height,
             hex(&camera.0.finalize()),
-            e.name(),
+            e.kind,
             e.max_depth,
             e.ao_distance,
             self.spp,
@@ -191,12 +192,11 @@ impl Cache {
         film: &Film,
         sidecar: &Sidecar,
     ) -> Result<PathBuf> {
-        crate::atomic::create_dir(&self.dir)?;
+        std::fs::create_dir_all(&self.dir).map_err(io(&self.dir))?;
         let (exr, json) = self.paths(scene_path, key);
-        rt_film::write_image(&exr, film, &rt_film::OutputOptions::default())
-            .map_err(|e| anyhow!("{e}"))?;
-        let text = serde_json::to_string_pretty(sidecar)?;
-        crate::atomic::write(&json, text.as_bytes())?;
+        rt_film::write_image(&exr, film, &rt_film::OutputOptions::default())?;
+        let text = serde_json::to_string_pretty(sidecar).expect("a sidecar always serialises");
+        rt_film::write_bytes_atomic(&json, text.as_bytes())?;
         Ok(exr)
     }
 }
@@ -204,8 +204,8 @@ impl Cache {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::args::IntegratorKind;
     use rt_core::glam::Vec3;
+    use rt_integrators::IntegratorKind;
 
     const SCENE: &str = r#"
 [[camera]]
@@ -234,11 +234,9 @@ material = "lamp"
             scene_path: &path,
             scene: &loaded.scene,
             camera: &camera,
-            estimator: Estimator {
-                integrator: IntegratorKind::Path,
-                max_depth: 8,
-                ao_distance: f32::INFINITY,
-            },
+            estimator: IntegratorSpec::new(IntegratorKind::Path)
+                .with_max_depth(8)
+                .unwrap(),
             spp: 64,
             seed: 0,
         };
@@ -268,9 +266,7 @@ material = "lamp"
         );
         assert_ne!(
             base.hex,
-            key_of(d, SCENE, |r| r.estimator.integrator =
-                IntegratorKind::PathBsdf)
-            .hex
+            key_of(d, SCENE, |r| r.estimator.kind = IntegratorKind::PathBsdf).hex
         );
     }
 

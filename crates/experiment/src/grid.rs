@@ -2,16 +2,15 @@
 //! on every scene, each as one progressive render stopped at its budgets. Every stop writes its
 //! image and is measured against the scene's reference.
 
-use super::config::{Plan, ReferencePlan};
-use crate::load_image::load_rgb;
-use crate::progress::Progress;
-use crate::reference::cache::{Cache, ReferenceRequest};
-use crate::session::{Budgets, Session};
-use anyhow::{anyhow, Result};
-use rt_core::{Accel, Rgb, SampleStream};
-use rt_film::AovSet;
+use crate::cache::{Cache, ReferenceRequest};
+use crate::config::{Plan, ReferencePlan};
+use crate::error::{io, ExperimentError, Result};
+use crate::Progress;
+use rt_core::{Accel, Rgb, RgbImage, SampleStream};
+use rt_film::{read_rgb, AovSet};
 use rt_integrators::Ctx;
-use rt_metrics::{compare, CompareOptions, Metrics, RgbImage};
+use rt_metrics::{compare, CompareOptions, Metrics};
+use rt_session::{Budgets, Session};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -68,8 +67,8 @@ pub fn budget_label(budgets: &Budgets, value: f64) -> String {
 
 /// Reads a reference EXR: its colour and, if present, its `variance.*` channels.
 fn load_reference(path: &Path, origin: String) -> Result<Reference> {
-    let image = load_rgb(path)?;
-    let exr = rt_film::read_exr(path).map_err(|e| anyhow!("{e}"))?;
+    let image = read_rgb(path)?;
+    let exr = rt_film::read_exr(path)?;
     let variance = exr
         .rgb("variance.")
         .filter(|v| v.len() == image.pixels().len());
@@ -81,14 +80,14 @@ fn load_reference(path: &Path, origin: String) -> Result<Reference> {
 }
 
 /// Runs the plan, writing images under `out`.
-pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &Progress) -> Result<Results> {
+pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> Result<Results> {
     let total_runs: usize = plan.scenes.len()
         + plan
             .pairs
             .iter()
             .map(|p| plan.methods[p.method].budgets.len())
             .sum::<usize>();
-    let bar = progress.bar();
+    let bar = progress;
     bar.set_length(total_runs as u64 * UNITS);
     let mut done_runs = 0u64;
     let opts = CompareOptions {
@@ -99,15 +98,14 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &Progress) -> Resul
     let mut references = Vec::new();
     for scene in &plan.scenes {
         let dir = out.join("images").join(&scene.name);
-        crate::atomic::create_dir(&dir)?;
+        std::fs::create_dir_all(&dir).map_err(io(&dir))?;
         let copy = dir.join("reference.exr");
         bar.set_message(format!("{}: reference", scene.name));
         let reference = match &scene.reference {
             ReferencePlan::File { path, image } => {
                 let rgb = image.pixels().to_vec();
                 let (w, h) = (image.width(), image.height());
-                rt_film::write_rgb(&copy, w, h, &rgb, &Default::default())
-                    .map_err(|e| anyhow!("{e}"))?;
+                rt_film::write_rgb(&copy, w, h, &rgb, &Default::default())?;
                 let variance = rt_film::read_exr(path)
                     .ok()
                     .and_then(|e| e.rgb("variance."))
@@ -154,7 +152,7 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &Progress) -> Resul
                     ));
                     format!("rendered ({spp} spp, {:.1} s)", got.seconds)
                 };
-                crate::atomic::copy(&got.path, &copy)?;
+                rt_film::copy_atomic(&got.path, &copy)?;
                 load_reference(&got.path, origin)?
             }
         };
@@ -207,19 +205,18 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &Progress) -> Resul
                             method.name,
                             budget_label(&method.budgets, budget)
                         ));
-                rt_film::write_image(&out.join(&rel), film, &Default::default())
-                    .map_err(|e| anyhow!("{e}"))?;
+                rt_film::write_image(&out.join(&rel), film, &Default::default())?;
                 let image = RgbImage::new(
                     film.width() as usize,
                     film.height() as usize,
                     film.mean_image(),
                 )?;
                 let metrics = compare(&image, &reference.image, &opts).map_err(|e| {
-                    anyhow!(
+                    ExperimentError::Run(format!(
                         "{} against the reference of {}: {e}",
                         rel.display(),
                         scene.name
-                    )
+                    ))
                 })?;
                 rows.push(Row {
                     pair: pi,
@@ -232,7 +229,7 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &Progress) -> Resul
                     image: rel.to_string_lossy().replace('\\', "/"),
                 });
                 last_image = Some(image);
-                Ok(())
+                Ok::<(), ExperimentError>(())
             },
         )?;
         finals.push(last_image.expect("every method has at least one budget"));

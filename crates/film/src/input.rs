@@ -1,12 +1,21 @@
-//! Reading an image to measure: EXR as linear float, PNG and JPEG as sRGB decoded to linear.
-//! Every error is one message that starts with the file name.
+//! Reading an image as linear RGB: EXR as linear float, PNG and JPEG as sRGB decoded to linear.
+//! Every error names the file.
 
-use anyhow::{anyhow, bail, Result};
+use crate::output::{read_exr, ExrImage};
+use crate::FilmError;
 use rt_core::color::srgb_to_linear;
-use rt_core::Rgb;
-use rt_film::output::ExrImage;
-use rt_metrics::RgbImage;
+use rt_core::{Rgb, RgbImage};
 use std::path::Path;
+
+type Result<T> = std::result::Result<T, FilmError>;
+
+/// A [`FilmError::Codec`] about `path`.
+fn codec(path: &Path, message: impl Into<String>) -> FilmError {
+    FilmError::Codec {
+        path: path.to_path_buf(),
+        message: message.into(),
+    }
+}
 
 /// Reads `path` as linear RGB, choosing the decoder by extension.
 ///
@@ -14,38 +23,42 @@ use std::path::Path;
 /// `P.G`, `P.B` if exactly one prefix `P.` has all three; without any, a `Y` channel as grey.
 /// Alpha and other channels are ignored. PNG/JPEG (8 or 16 bit, grey or colour, alpha ignored)
 /// are taken to be sRGB-encoded; embedded colour profiles and gamma chunks are not read.
-pub fn load_rgb(path: &Path) -> Result<RgbImage> {
-    let name = path.display();
+pub fn read_rgb(path: &Path) -> Result<RgbImage> {
     // Opening first turns a missing or unreadable file into the OS's own words, which the
     // decoders would otherwise wrap in their own.
-    std::fs::File::open(path).map_err(|e| anyhow!("{name}: {e}"))?;
+    std::fs::File::open(path).map_err(|source| FilmError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     match ext.as_deref() {
         // `FilmError` already names the file and holds the cause.
-        Some("exr") => exr_rgb(path, rt_film::read_exr(path).map_err(|e| anyhow!("{e}"))?),
+        Some("exr") => exr_rgb(path, read_exr(path)?),
         Some("png" | "jpg" | "jpeg") => {
             let img = image::ImageReader::open(path)
                 .and_then(|r| r.with_guessed_format())
-                .map_err(|e| anyhow!("{name}: {e}"))?
+                .map_err(|e| codec(path, e.to_string()))?
                 .decode()
-                .map_err(|e| anyhow!("{name}: {e}"))?
+                .map_err(|e| codec(path, e.to_string()))?
                 .to_rgb32f();
             let (w, h) = (img.width() as usize, img.height() as usize);
             let pixels = img
                 .pixels()
                 .map(|p| Rgb::from_array(p.0.map(srgb_to_linear)))
                 .collect();
-            Ok(RgbImage::new(w, h, pixels)?)
+            RgbImage::new(w, h, pixels).map_err(|e| codec(path, e.to_string()))
         }
-        _ => bail!("{name}: unsupported image format (use .exr, .png or .jpg)"),
+        _ => Err(codec(
+            path,
+            "unsupported image format (use .exr, .png or .jpg)",
+        )),
     }
 }
 
 fn exr_rgb(path: &Path, exr: ExrImage) -> Result<RgbImage> {
-    let name = path.display();
     let n = exr.width * exr.height;
     let has = |c: &str| exr.channel(c).is_some();
     let prefixes: Vec<&str> = exr
@@ -59,23 +72,31 @@ fn exr_rgb(path: &Path, exr: ExrImage) -> Result<RgbImage> {
         _ if prefixes.contains(&"") => "",
         [one] => one,
         [] => return exr_grey(path, &exr),
-        many => bail!(
-            "{name}: no plain R, G, B channels and several groups with them ({}); \
-             cannot tell which to compare",
-            many.join(", ")
-        ),
+        many => {
+            return Err(codec(
+                path,
+                format!(
+                    "no plain R, G, B channels and several groups with them ({}); \
+                     cannot tell which to compare",
+                    many.join(", ")
+                ),
+            ))
+        }
     };
     for c in ["R", "G", "B"] {
         let len = exr.channel(&format!("{prefix}{c}")).map_or(0, <[f32]>::len);
         if len != n {
             let (w, h) = (exr.width, exr.height);
-            bail!("{name}: channel {prefix}{c} has {len} values for a {w}x{h} image (subsampled?)");
+            return Err(codec(
+                path,
+                format!("channel {prefix}{c} has {len} values for a {w}x{h} image (subsampled?)"),
+            ));
         }
     }
     let pixels = exr
         .rgb(prefix)
-        .ok_or_else(|| anyhow!("{name}: missing {prefix}R, {prefix}G or {prefix}B"))?;
-    Ok(RgbImage::new(exr.width, exr.height, pixels)?)
+        .ok_or_else(|| codec(path, format!("missing {prefix}R, {prefix}G or {prefix}B")))?;
+    RgbImage::new(exr.width, exr.height, pixels).map_err(|e| codec(path, e.to_string()))
 }
 
 /// A grey EXR (one `Y` channel), as RGB.
@@ -83,15 +104,14 @@ fn exr_grey(path: &Path, exr: &ExrImage) -> Result<RgbImage> {
     match exr.channel("Y") {
         Some(y) if y.len() == exr.width * exr.height => {
             let pixels = y.iter().map(|&v| Rgb::splat(v)).collect();
-            Ok(RgbImage::new(exr.width, exr.height, pixels)?)
+            RgbImage::new(exr.width, exr.height, pixels).map_err(|e| codec(path, e.to_string()))
         }
         _ => {
             let names: Vec<&str> = exr.channels.iter().map(|(c, _)| c.as_str()).collect();
-            bail!(
-                "{}: no R, G, B channels (it has {})",
-                path.display(),
-                names.join(", ")
-            )
+            Err(codec(
+                path,
+                format!("no R, G, B channels (it has {})", names.join(", ")),
+            ))
         }
     }
 }

@@ -3,17 +3,17 @@
 //! The PNG is drawn into a memory buffer and encoded with `image`, so plotters needs neither
 //! its own image encoder nor the system's fonts: text is laid out and rasterised with
 //! `ab_glyph` from a subset of DejaVu Sans compiled into the binary
-//! (`cli/assets/fonts/`, Bitstream Vera licence). The SVG names the `sans-serif` family and lets
+//! (`crates/experiment/assets/fonts/`, Bitstream Vera licence). The SVG names the `sans-serif` family and lets
 //! the viewer draw the text.
 
-use anyhow::{anyhow, Result};
+use crate::error::{ExperimentError, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
 use std::sync::Once;
 
 /// The bundled font.
-const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans-ascii.ttf");
+const FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans-ascii.ttf");
 
 /// Plot size in pixels (SVG user units).
 const SIZE: (u32, u32) = (760, 520);
@@ -69,9 +69,8 @@ pub fn write(chart: &Chart<'_>, png: &Path, svg: &Path) -> Result<()> {
     let mut rgb = vec![0u8; w as usize * h as usize * 3];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
-        draw(&root, chart).map_err(|e| anyhow!("{}: cannot draw the plot: {e}", png.display()))?;
-        root.present()
-            .map_err(|e| anyhow!("{}: cannot draw the plot: {e}", png.display()))?;
+        draw(&root, chart).map_err(plot_error(png))?;
+        root.present().map_err(plot_error(png))?;
     }
     let mut bytes = Vec::new();
     image::ImageEncoder::write_image(
@@ -81,17 +80,24 @@ pub fn write(chart: &Chart<'_>, png: &Path, svg: &Path) -> Result<()> {
         h,
         image::ExtendedColorType::Rgb8,
     )
-    .map_err(|e| anyhow!("{}: {e}", png.display()))?;
-    crate::atomic::write(png, &bytes)?;
+    .map_err(plot_error(png))?;
+    rt_film::write_bytes_atomic(png, &bytes)?;
 
     let mut text = String::new();
     {
         let root = SVGBackend::with_string(&mut text, SIZE).into_drawing_area();
-        draw(&root, chart).map_err(|e| anyhow!("{}: cannot draw the plot: {e}", svg.display()))?;
-        root.present()
-            .map_err(|e| anyhow!("{}: cannot draw the plot: {e}", svg.display()))?;
+        draw(&root, chart).map_err(plot_error(svg))?;
+        root.present().map_err(plot_error(svg))?;
     }
-    crate::atomic::write(svg, text.as_bytes())
+    Ok(rt_film::write_bytes_atomic(svg, text.as_bytes())?)
+}
+
+/// An [`ExperimentError::Plot`] about `path`.
+fn plot_error<E: std::fmt::Display>(path: &Path) -> impl FnOnce(E) -> ExperimentError + '_ {
+    move |e| ExperimentError::Plot {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    }
 }
 
 /// Tick labels: plain decimals where they are short, powers of ten elsewhere.

@@ -2,14 +2,13 @@
 //! the crops and report.md. Everything is computed from the rows, so the report and the CSV
 //! files always agree.
 
-use super::config::Plan;
-use super::grid::{Reference, Results, Row};
-use super::plot::{self, Chart, Series};
-use super::stats::{comparison_times, log_log_interpolate, log_log_slope, Fit};
-use crate::session::Budgets;
-use anyhow::Result;
-use rt_core::Rgb;
-use rt_metrics::RgbImage;
+use crate::config::Plan;
+use crate::error::{io, Result};
+use crate::fit::{comparison_times, log_log_interpolate, log_log_slope, Fit};
+use crate::grid::{Reference, Results, Row};
+use crate::plot::{self, Chart, Series};
+use rt_core::{Rgb, RgbImage};
+use rt_session::Budgets;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -74,7 +73,7 @@ pub fn results_csv(plan: &Plan, results: &Results) -> String {
             "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             plan.scenes[pair.scene].name,
             plan.methods[pair.method].name,
-            pair.estimator.name(),
+            pair.estimator.kind,
             pair.accel,
             row.spp,
             row.seconds,
@@ -277,7 +276,7 @@ pub fn equal_time(plan: &Plan, results: &Results) -> Vec<EqualTime> {
 /// Draws the two plots of every scene: relMSE against time and against spp.
 pub fn plots(plan: &Plan, results: &Results, out: &Path) -> Result<()> {
     let dir = out.join("plots");
-    crate::atomic::create_dir(&dir)?;
+    std::fs::create_dir_all(&dir).map_err(io(&dir))?;
     for (si, scene) in plan.scenes.iter().enumerate() {
         let pairs: Vec<usize> = (0..plan.pairs.len())
             .filter(|&p| plan.pairs[p].scene == si)
@@ -393,7 +392,7 @@ pub fn crops(plan: &Plan, results: &Results, out: &Path) -> Result<Vec<(usize, u
     let mut blocks = Vec::new();
     for (si, scene) in plan.scenes.iter().enumerate() {
         let dir = out.join("crops").join(&scene.name);
-        crate::atomic::create_dir(&dir)?;
+        std::fs::create_dir_all(&dir).map_err(io(&dir))?;
         let reference = &results.references[si].image;
         let pairs: Vec<usize> = (0..plan.pairs.len())
             .filter(|&p| plan.pairs[p].scene == si)
@@ -410,7 +409,7 @@ pub fn crops(plan: &Plan, results: &Results, out: &Path) -> Result<Vec<(usize, u
                 &cut(img, block, z),
                 &Default::default(),
             )
-            .map_err(|e| anyhow::anyhow!("{e}"))
+            .map_err(crate::ExperimentError::from)
         };
         write("reference", reference)?;
         for (&p, img) in pairs.iter().zip(&finals) {
@@ -539,7 +538,7 @@ pub fn markdown(
                 s,
                 "| {} | {} | {} | {} | {:.3} | {:.2} | {} | {} | {:.2} | {:.4} |",
                 plan.methods[pair.method].name,
-                pair.estimator.name(),
+                pair.estimator.kind,
                 pair.accel,
                 row.spp,
                 row.seconds,

@@ -2,14 +2,14 @@
 //! that can be wrong is found here, before the first sample of a long grid: scenes load,
 //! cameras exist, names are unique, budgets are sane, reference files match the image size.
 
-use crate::args::IntegratorKind;
-use crate::load_image::load_rgb;
-use crate::session::{self, Budgets, Estimator, ImageSize, Overrides, Target, MAX_DEPTH, MAX_SPP};
-use anyhow::{anyhow, bail, Result};
+use crate::{ExperimentError, Result as CrateResult};
 use rt_accel::AccelSpec;
 use rt_core::Camera;
+use rt_film::read_rgb;
+use rt_integrators::{IntegratorSpec, MAX_DEPTH};
 use rt_metrics::RgbImage;
 use rt_scene::LoadedScene;
+use rt_session::{pick_camera, Budgets, ImageSize, Overrides, MAX_SPP};
 use serde::de::{self, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 use std::collections::HashSet;
@@ -18,6 +18,17 @@ use std::path::{Path, PathBuf};
 
 /// Longest time budget accepted, in seconds (a day): anything longer is a typo.
 const MAX_SECONDS: f64 = 86_400.0;
+
+/// Validation inside [`build`] speaks in messages about one entry; [`load`] makes them a
+/// [`ExperimentError::Config`] naming the file.
+type Result<T, E = String> = std::result::Result<T, E>;
+
+/// Returns a validation message.
+macro_rules! bail {
+    ($($arg:tt)*) => {
+        return Err(format!($($arg)*))
+    };
+}
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -141,7 +152,7 @@ pub enum ReferencePlan {
         /// Samples per pixel.
         spp: u32,
         /// Integrator and parameters.
-        estimator: Estimator,
+        estimator: IntegratorSpec,
         /// Seed of the reference stream.
         seed: u32,
         /// Structure to render it with.
@@ -164,7 +175,7 @@ pub struct Pair {
     /// Index into [`Plan::methods`].
     pub method: usize,
     /// Integrator and parameters.
-    pub estimator: Estimator,
+    pub estimator: IntegratorSpec,
     /// Acceleration structure.
     pub accel: AccelSpec,
     /// Seed.
@@ -196,8 +207,9 @@ fn parse_accel(s: &str) -> Result<AccelSpec, String> {
         .map_err(|e| format!("accel = \"{s}\": {e}"))
 }
 
-fn parse_integrator(s: &str) -> Result<IntegratorKind, String> {
-    session::parse_integrator(s).map_err(|e| format!("integrator = {e}"))
+fn parse_integrator(s: &str) -> Result<IntegratorSpec, String> {
+    s.parse::<IntegratorSpec>()
+        .map_err(|e| format!("integrator = {e}"))
 }
 
 fn check_depth(d: Option<u32>) -> Result<Option<u32>, String> {
@@ -216,18 +228,24 @@ fn check_ao(d: Option<f32>) -> Result<Option<f32>, String> {
 
 /// Reads and validates the experiment file at `path`. Every error is one line that starts with
 /// the file's name.
-pub fn load(path: &Path) -> Result<Plan> {
-    let file = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| anyhow!("{file}: cannot open: {e}"))?;
+pub fn load(path: &Path) -> CrateResult<Plan> {
+    let config = |message: String| ExperimentError::Config {
+        file: path.to_path_buf(),
+        message,
+    };
+    let text = std::fs::read_to_string(path).map_err(|e| config(format!("cannot open: {e}")))?;
     let desc: ConfigDesc = toml::from_str(&text).map_err(|e| {
         let at = e
             .span()
             .map(|s| format!(":{}", rt_scene::LineCol::of_offset(&text, s.start)))
             .unwrap_or_default();
         let message: Vec<&str> = e.message().lines().map(str::trim).collect();
-        anyhow!("{file}{at}: {}", message.join("; "))
+        ExperimentError::Config {
+            file: PathBuf::from(format!("{}{at}", path.display())),
+            message: message.join("; "),
+        }
     })?;
-    build(desc, path).map_err(|e| anyhow!("{file}: {e:#}"))
+    build(desc, path).map_err(config)
 }
 
 fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
@@ -239,7 +257,7 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_else(|| "experiment".into()),
     };
-    check_name("experiment", &name).map_err(|e| anyhow!(e))?;
+    check_name("experiment", &name)?;
     let epsilon = desc.epsilon.unwrap_or(rt_metrics::DEFAULT_EPSILON);
     if !(epsilon.is_finite() && epsilon > 0.0) {
         bail!("epsilon must be a positive number, got {epsilon}");
@@ -276,7 +294,7 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
                     .unwrap_or_default(),
             });
         let here = format!("[[scene]] \"{name}\"");
-        check_name("scene", &name).map_err(|e| anyhow!("{here}: {e}"))?;
+        check_name("scene", &name).map_err(|e| format!("{here}: {e}"))?;
         if !seen.insert(name.clone()) {
             bail!("{here}: two scenes are named \"{name}\" (set name = \"...\")");
         }
@@ -286,11 +304,11 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
             (None, Some(f)) => ImageSize::Scale(f),
             (None, None) => ImageSize::Native,
         };
-        size.validate(&here)?;
-        let loaded = crate::job::load_scene(&scene_path).map_err(|e| anyhow!("{here}: {e:#}"))?;
+        size.validate(&here).map_err(|e| e.to_string())?;
+        let loaded = rt_scene::load_any(&scene_path).map_err(|e| format!("{here}: {e}"))?;
         let camera = size.apply(
-            session::camera(&loaded.scene, &scene_path, s.camera.as_deref())
-                .map_err(|e| anyhow!("{here}: {e:#}"))?,
+            pick_camera(&loaded.scene, &scene_path, s.camera.as_deref())
+                .map_err(|e| format!("{here}: {e}"))?,
         );
         let reference = match s.reference {
             None => bail!(
@@ -298,7 +316,7 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
             ),
             Some(ReferenceDesc::File(f)) => {
                 let file = base.join(&f);
-                let image = load_rgb(&file).map_err(|e| anyhow!("{here}: reference: {e:#}"))?;
+                let image = read_rgb(&file).map_err(|e| format!("{here}: reference: {e}"))?;
                 let (w, h) = (image.width(), image.height());
                 if (w, h) != (camera.width as usize, camera.height as usize) {
                     bail!(
@@ -317,7 +335,7 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
                         r.spp
                     );
                 }
-                let at = |e: String| anyhow!("{here}: reference: {e}");
+                let at = |e: String| format!("{here}: reference: {e}");
                 let overrides = Overrides {
                     integrator: r
                         .integrator
@@ -334,12 +352,17 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
                         .map(parse_accel)
                         .transpose()
                         .map_err(at)?,
+                    ..Overrides::default()
                 };
                 ReferencePlan::Render {
                     spp: r.spp,
-                    estimator: overrides.estimator(&loaded.render, &scene_path)?,
+                    estimator: overrides
+                        .integrator_spec(&loaded.render, &scene_path)
+                        .map_err(|e| e.to_string())?,
                     seed: overrides.seed(&loaded.render),
-                    accel: overrides.accel(&loaded.render, &scene_path)?,
+                    accel: overrides
+                        .accel_spec(&loaded.render, &scene_path)
+                        .map_err(|e| e.to_string())?,
                 }
             }
         };
@@ -358,14 +381,14 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
     let mut seen = HashSet::new();
     for m in desc.method {
         let here = format!("[[method]] \"{}\"", m.name);
-        check_name("method", &m.name).map_err(|e| anyhow!("{here}: {e}"))?;
+        check_name("method", &m.name).map_err(|e| format!("{here}: {e}"))?;
         if m.name == "reference" {
             bail!("{here}: \"reference\" is the name of the references' files; choose another");
         }
         if !seen.insert(m.name.clone()) {
             bail!("{here}: two methods are named \"{}\"", m.name);
         }
-        let at = |e: String| anyhow!("{here}: {e}");
+        let at = |e: String| format!("{here}: {e}");
         let budgets = match (m.spp, m.seconds) {
             (Some(_), Some(_)) => bail!("{here}: give spp or seconds, not both"),
             (None, None) => bail!("{here}: no budgets (spp = [...] or seconds = [...])"),
@@ -411,6 +434,7 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
                 .map(parse_accel)
                 .transpose()
                 .map_err(at)?,
+            ..Overrides::default()
         };
         if let Some(list) = &m.scenes {
             if list.is_empty() {
@@ -445,8 +469,9 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
             }
             let o = &method_overrides[mi];
             let desc = &scene.loaded.render;
-            let here = |e: anyhow::Error| anyhow!("[[method]] \"{}\": {e:#}", method.name);
-            let estimator = o.estimator(desc, &scene.path).map_err(here)?;
+            let here =
+                |e: rt_session::SettingsError| format!("[[method]] \"{}\": {e}", method.name);
+            let estimator = o.integrator_spec(desc, &scene.path).map_err(here)?;
             if let ReferencePlan::Render { estimator: r, .. } = &scene.reference {
                 if r.target() != estimator.target() {
                     warnings.push(format!(
@@ -463,7 +488,7 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
                 scene: si,
                 method: mi,
                 estimator,
-                accel: o.accel(desc, &scene.path).map_err(here)?,
+                accel: o.accel_spec(desc, &scene.path).map_err(here)?,
                 seed: o.seed(desc),
             });
         }
@@ -484,11 +509,8 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
 }
 
 /// `path, 8 bounces` and the like, for messages.
-fn describe(e: &Estimator) -> String {
-    match e.target() {
-        Target::Radiance { bounces } => format!("{}, {bounces} bounces", e.name()),
-        Target::Occlusion { distance } => format!("{}, distance {distance}", e.name()),
-    }
+fn describe(e: &IntegratorSpec) -> String {
+    format!("{}, {}", e.kind, e.target())
 }
 
 #[cfg(test)]
@@ -534,7 +556,7 @@ accel = "bvh"
 seconds = [0.5, 0.1]
 "#;
 
-    fn plan(config: &str) -> Result<Plan> {
+    fn plan(config: &str) -> CrateResult<Plan> {
         let dir = tempfile::tempdir().unwrap();
         std::fs::create_dir(dir.path().join("scenes")).unwrap();
         std::fs::write(dir.path().join("scenes/s.toml"), SCENE).unwrap();
@@ -547,7 +569,7 @@ seconds = [0.5, 0.1]
         match plan(config) {
             Ok(_) => panic!("accepted:\n{config}"),
             Err(e) => {
-                let s = format!("{e:#}");
+                let s = format!("{e}");
                 assert!(!s.contains('\n'), "{s}");
                 assert!(s.contains("x.toml"), "{s}");
                 s
@@ -569,7 +591,10 @@ seconds = [0.5, 0.1]
         assert_eq!(p.pairs.len(), 2);
         // max_depth comes from the scene's [render] table for both method and reference.
         assert_eq!(p.pairs[0].estimator.max_depth, 5);
-        assert_eq!(p.pairs[1].estimator.integrator, IntegratorKind::PathBsdf);
+        assert_eq!(
+            p.pairs[1].estimator.kind,
+            rt_integrators::IntegratorKind::PathBsdf
+        );
         assert_eq!(p.pairs[1].accel.to_string(), "bvh");
         let ReferencePlan::Render { estimator, spp, .. } = &p.scenes[0].reference else {
             panic!()

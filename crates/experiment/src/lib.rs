@@ -1,0 +1,200 @@
+//! `rt-experiment`: measured rendering experiments, the machinery behind `render reference` and
+//! `render experiment`, usable without the CLI.
+//!
+//! - [`config`]: the experiment file (TOML; docs/experiments.md) read and validated into a
+//!   [`Plan`] before the first sample: scenes load, cameras exist, budgets are sane.
+//! - [`reference`] and [`cache`]: high-sample references from their own random streams, stored
+//!   on disk under a key that changes with anything that changes the image.
+//! - [`grid`]: every method on every scene, rendered progressively to its budgets and measured
+//!   against the reference.
+//! - [`fit`]: log-log slopes and interpolation; [`report`]: results.csv, slopes.csv, equal-time
+//!   comparisons, crops and report.md; [`plot`]: the log-log error plots.
+//!
+//! [`run`] does all of it into one output folder.
+//!
+//! Depends on `rt-session` (progressive rendering of one configuration), `rt-metrics`
+//! (errors), `rt-film` (image files), `rt-scene`, `rt-accel`, `rt-integrators` and `rt-core`;
+//! `plotters` draws, `sha2` keys the cache, `toml`/`serde` read the file.
+//!
+//! ```no_run
+//! // Run configs/convergence.toml into a fresh folder, as `render experiment` does.
+//! let plan = rt_experiment::config::load("configs/convergence.toml".as_ref())?;
+//! let cache = rt_experiment::Cache::new(rt_experiment::DEFAULT_CACHE_DIR.as_ref());
+//! let out = std::path::Path::new("experiments/mine");
+//! rt_experiment::prepare_out(out)?;
+//! let outcome = rt_experiment::run(&plan, &"configs/convergence.toml".as_ref(), out, &cache, &rt_experiment::Silent)?;
+//! println!("{}", outcome.report.display());
+//! # Ok::<(), rt_experiment::ExperimentError>(())
+//! ```
+#![forbid(unsafe_code)]
+
+pub mod cache;
+pub mod config;
+mod error;
+pub mod fit;
+pub mod grid;
+pub mod plot;
+pub mod reference;
+pub mod report;
+
+pub use cache::{Cache, ReferenceRequest, CACHE_VERSION, DEFAULT_CACHE_DIR};
+pub use config::Plan;
+pub use error::{ExperimentError, Result};
+
+use crate::error::io;
+use std::path::{Path, PathBuf};
+use std::time::{Instant, SystemTime, UNIX_EPOCH};
+
+/// Where a long run reports how far it is. Called from worker threads, hence `Sync`. Every
+/// method does nothing by default.
+pub trait Progress: Sync {
+    /// The total amount of work, in the units of [`Progress::set_position`].
+    fn set_length(&self, _units: u64) {}
+    /// Work done so far.
+    fn set_position(&self, _units: u64) {}
+    /// What is running now.
+    fn set_message(&self, _text: String) {}
+    /// One line of information for the user.
+    fn message(&self, _line: &str) {}
+}
+
+/// A [`Progress`] that reports nothing.
+pub struct Silent;
+
+impl Progress for Silent {}
+
+impl From<rt_core::PixelCountError> for ExperimentError {
+    fn from(e: rt_core::PixelCountError) -> Self {
+        Self::Metrics(e.into())
+    }
+}
+
+/// The UTC calendar date and time of `secs` since the Unix epoch (Howard Hinnant's
+/// civil-from-days), so that no date crate is needed for a time stamp.
+pub fn utc(secs: u64) -> (i64, u32, u32, u32, u32, u32) {
+    let days = (secs / 86_400) as i64;
+    let rem = secs % 86_400;
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = (doy - (153 * mp + 2) / 5 + 1) as u32;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    (
+        y,
+        m,
+        d,
+        (rem / 3600) as u32,
+        (rem / 60 % 60) as u32,
+        (rem % 60) as u32,
+    )
+}
+
+/// `experiments/NAME-YYYYMMDD-HHMMSS` for the current UTC time: the default output folder.
+pub fn default_out_dir(plan: &Plan) -> PathBuf {
+    let (y, mo, d, h, mi, s) = utc(now_secs());
+    PathBuf::from("experiments").join(format!(
+        "{}-{y:04}{mo:02}{d:02}-{h:02}{mi:02}{s:02}",
+        plan.name
+    ))
+}
+
+fn now_secs() -> u64 {
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs())
+}
+
+/// Refuses an output folder that already holds files, so no earlier result is overwritten;
+/// creates it otherwise.
+pub fn prepare_out(out: &Path) -> Result<()> {
+    if out.exists() {
+        let mut entries = std::fs::read_dir(out).map_err(io(out))?;
+        if entries.next().is_some() {
+            return Err(ExperimentError::Run(format!(
+                "{}: the output folder is not empty; choose another --out or remove it",
+                out.display()
+            )));
+        }
+    }
+    std::fs::create_dir_all(out).map_err(io(out))
+}
+
+/// What [`run`] produced.
+pub struct Outcome {
+    /// Every run's measurements and the references.
+    pub results: grid::Results,
+    /// The equal-time comparison of each scene.
+    pub equal_time: Vec<report::EqualTime>,
+    /// The Markdown report (inside the output folder).
+    pub report: PathBuf,
+}
+
+/// Runs `plan` (read from `config`, which is copied beside the results) into the folder `out`
+/// (see [`prepare_out`]): references, the grid, images, results.csv, slopes.csv, plots, crops
+/// and report.md. Call it inside the thread pool that should do the work.
+pub fn run(
+    plan: &Plan,
+    config: &Path,
+    out: &Path,
+    cache: &Cache,
+    progress: &dyn Progress,
+) -> Result<Outcome> {
+    let wall = Instant::now();
+    let (y, mo, d, h, mi, _) = utc(now_secs());
+    let results = grid::run(plan, out, cache, progress)?;
+    let slopes = report::slopes(plan, &results);
+    let equal_time = report::equal_time(plan, &results);
+    report::plots(plan, &results, out)?;
+    let blocks = report::crops(plan, &results, out)?;
+    rt_film::write_bytes_atomic(
+        &out.join("results.csv"),
+        report::results_csv(plan, &results).as_bytes(),
+    )?;
+    rt_film::write_bytes_atomic(
+        &out.join("slopes.csv"),
+        report::slopes_csv(plan, &slopes).as_bytes(),
+    )?;
+    rt_film::copy_atomic(config, &out.join("config.toml"))?;
+    let info = report::RunInfo {
+        started: format!("{y:04}-{mo:02}-{d:02} {h:02}:{mi:02}"),
+        threads: rayon::current_num_threads(),
+        wall_seconds: wall.elapsed().as_secs_f64(),
+    };
+    let md = report::markdown(plan, &results, &slopes, &equal_time, &blocks, &info);
+    let report = out.join("report.md");
+    rt_film::write_bytes_atomic(&report, md.as_bytes())?;
+    Ok(Outcome {
+        results,
+        equal_time,
+        report,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn utc_dates() {
+        assert_eq!(utc(0), (1970, 1, 1, 0, 0, 0));
+        // 2000-02-29 12:34:56 (a leap day in a century leap year).
+        assert_eq!(utc(951_827_696), (2000, 2, 29, 12, 34, 56));
+        // 2026-11-22 00:00:00.
+        assert_eq!(utc(1_795_305_600), (2026, 11, 22, 0, 0, 0));
+    }
+
+    #[test]
+    fn output_folders_are_never_overwritten() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("a/b");
+        prepare_out(&out).unwrap();
+        prepare_out(&out).unwrap();
+        std::fs::write(out.join("results.csv"), "x").unwrap();
+        let e = prepare_out(&out).unwrap_err().to_string();
+        assert!(e.contains("not empty"), "{e}");
+    }
+}

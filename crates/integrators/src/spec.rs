@@ -1,0 +1,326 @@
+//! Naming an integrator and its options in one string, and building it: the one dispatch point
+//! for integrators, as `rt_accel::AccelSpec` is for acceleration structures.
+//!
+//! `--integrator`, the scene's `[render] integrator` and an experiment's `methods` all take the
+//! same text: a kind followed by `:`-separated options, e.g. `path`, `path:max-depth=4`,
+//! `path-bsdf`, `direct`, `ao:distance=0.5`. [`IntegratorSpec`] parses it
+//! ([`std::str::FromStr`]), prints it back in a canonical form ([`std::fmt::Display`]: options
+//! at their default are left out), builds the integrator ([`IntegratorSpec::build`]) and says
+//! what it converges to ([`IntegratorSpec::target`]).
+//!
+//! | option | kinds | meaning |
+//! |---|---|---|
+//! | `max-depth=N` | path, path-bsdf | bounce limit (default [`DEFAULT_MAX_DEPTH`], at most [`MAX_DEPTH`]) |
+//! | `distance=F` | ao | occluder distance (default unlimited) |
+
+use crate::{AoIntegrator, Integrator, PathIntegrator};
+use std::fmt;
+use std::str::FromStr;
+
+/// Bounce limit when nothing sets one.
+pub const DEFAULT_MAX_DEPTH: u32 = 16;
+
+/// Largest bounce limit a spec accepts; beyond it a path is numerically meaningless and a typo
+/// is the likelier explanation.
+pub const MAX_DEPTH: u32 = 10_000;
+
+/// The integrators this crate builds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum IntegratorKind {
+    /// Path tracing with next-event estimation and MIS ([`PathIntegrator::new`]).
+    Path,
+    /// Path tracing with BSDF sampling only ([`PathIntegrator::bsdf_only`]).
+    PathBsdf,
+    /// Direct lighting: one bounce, NEE + MIS ([`PathIntegrator::direct`]).
+    Direct,
+    /// Ambient occlusion ([`AoIntegrator`]).
+    Ao,
+}
+
+impl IntegratorKind {
+    /// Every kind, in the order help texts list them.
+    pub const ALL: [IntegratorKind; 4] = [
+        IntegratorKind::Path,
+        IntegratorKind::PathBsdf,
+        IntegratorKind::Direct,
+        IntegratorKind::Ao,
+    ];
+
+    /// The name used in specs and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            IntegratorKind::Path => "path",
+            IntegratorKind::PathBsdf => "path-bsdf",
+            IntegratorKind::Direct => "direct",
+            IntegratorKind::Ao => "ao",
+        }
+    }
+
+    /// True for the kinds whose bounce limit is an option.
+    pub fn has_depth(self) -> bool {
+        matches!(self, IntegratorKind::Path | IntegratorKind::PathBsdf)
+    }
+
+    fn names() -> String {
+        Self::ALL.map(Self::name).join(", ")
+    }
+}
+
+impl FromStr for IntegratorKind {
+    type Err = IntegratorSpecError;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name().eq_ignore_ascii_case(s))
+            .ok_or_else(|| IntegratorSpecError::UnknownKind(s.to_string()))
+    }
+}
+
+impl fmt::Display for IntegratorKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// An integrator and the parameters that change what it converges to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IntegratorSpec {
+    /// Which integrator.
+    pub kind: IntegratorKind,
+    /// Bounce limit (path tracers; `direct` is always one bounce, `ao` ignores it).
+    pub max_depth: u32,
+    /// Occluder distance of `ao` (infinite: unlimited).
+    pub ao_distance: f32,
+}
+
+/// What an estimator converges to. Two estimators with the same target can be measured against
+/// one reference; otherwise the error levels off at the difference of the two images.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum Target {
+    /// Light transport with at most this many bounces (`path`, `path-bsdf`, and `direct` = 1).
+    Radiance {
+        /// Bounce limit.
+        bounces: u32,
+    },
+    /// Ambient occlusion with this occluder distance.
+    Occlusion {
+        /// Occluder distance.
+        distance: f32,
+    },
+}
+
+impl fmt::Display for Target {
+    /// `8 bounces`, `distance 0.5`: for messages about estimators that do not compare.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Target::Radiance { bounces } => write!(f, "{bounces} bounces"),
+            Target::Occlusion { distance } => write!(f, "distance {distance}"),
+        }
+    }
+}
+
+/// Why an integrator spec was rejected.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum IntegratorSpecError {
+    /// The text before the first `:` is not an integrator.
+    #[error("\"{0}\" is not one of {names}", names = IntegratorKind::names())]
+    UnknownKind(String),
+    /// An option this crate does not know, or one that does not apply to the kind.
+    #[error("option `{option}` does not apply to `{kind}` (options: max-depth=N for path and path-bsdf, distance=F for ao)")]
+    UnknownOption {
+        /// The integrator.
+        kind: IntegratorKind,
+        /// The option as written.
+        option: String,
+    },
+    /// A bounce limit above [`MAX_DEPTH`] or one that does not parse.
+    #[error("max depth must be an integer between 0 and {MAX_DEPTH}, got {0}")]
+    BadDepth(String),
+    /// An occluder distance that is not positive or does not parse.
+    #[error("ao distance must be positive, got {0}")]
+    BadDistance(String),
+}
+
+impl IntegratorSpec {
+    /// The default spec of `kind`.
+    pub fn new(kind: IntegratorKind) -> Self {
+        Self {
+            kind,
+            max_depth: DEFAULT_MAX_DEPTH,
+            ao_distance: f32::INFINITY,
+        }
+    }
+
+    /// This spec with bounce limit `depth`, checked against [`MAX_DEPTH`].
+    pub fn with_max_depth(mut self, depth: u32) -> Result<Self, IntegratorSpecError> {
+        if depth > MAX_DEPTH {
+            return Err(IntegratorSpecError::BadDepth(depth.to_string()));
+        }
+        self.max_depth = depth;
+        Ok(self)
+    }
+
+    /// This spec with `ao` occluder distance `distance` (positive; infinite is unlimited).
+    pub fn with_ao_distance(mut self, distance: f32) -> Result<Self, IntegratorSpecError> {
+        if distance.is_nan() || distance <= 0.0 {
+            return Err(IntegratorSpecError::BadDistance(distance.to_string()));
+        }
+        self.ao_distance = distance;
+        Ok(self)
+    }
+
+    /// Builds the integrator.
+    pub fn build(&self) -> Box<dyn Integrator> {
+        match self.kind {
+            IntegratorKind::Path => Box::new(PathIntegrator::new(self.max_depth)),
+            IntegratorKind::PathBsdf => Box::new(PathIntegrator::bsdf_only(self.max_depth)),
+            IntegratorKind::Direct => Box::new(PathIntegrator::direct()),
+            IntegratorKind::Ao => Box::new(AoIntegrator {
+                max_distance: self.ao_distance,
+            }),
+        }
+    }
+
+    /// What the integrator converges to.
+    pub fn target(&self) -> Target {
+        match self.kind {
+            IntegratorKind::Path | IntegratorKind::PathBsdf => Target::Radiance {
+                bounces: self.max_depth,
+            },
+            IntegratorKind::Direct => Target::Radiance { bounces: 1 },
+            IntegratorKind::Ao => Target::Occlusion {
+                distance: self.ao_distance,
+            },
+        }
+    }
+}
+
+impl Default for IntegratorSpec {
+    /// `path` with the default bounce limit.
+    fn default() -> Self {
+        Self::new(IntegratorKind::Path)
+    }
+}
+
+impl FromStr for IntegratorSpec {
+    type Err = IntegratorSpecError;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let mut parts = s.split(':');
+        let kind: IntegratorKind = parts.next().unwrap_or_default().trim().parse()?;
+        let mut spec = IntegratorSpec::new(kind);
+        for option in parts {
+            let (key, value) = option.split_once('=').unwrap_or((option, ""));
+            spec = match (key.trim(), kind) {
+                ("max-depth", k) if k.has_depth() => {
+                    let depth = value
+                        .trim()
+                        .parse()
+                        .map_err(|_| IntegratorSpecError::BadDepth(value.to_string()))?;
+                    spec.with_max_depth(depth)?
+                }
+                ("distance", IntegratorKind::Ao) => {
+                    let d: f32 = value
+                        .trim()
+                        .parse()
+                        .map_err(|_| IntegratorSpecError::BadDistance(value.to_string()))?;
+                    spec.with_ao_distance(d)?
+                }
+                _ => {
+                    return Err(IntegratorSpecError::UnknownOption {
+                        kind,
+                        option: option.to_string(),
+                    })
+                }
+            };
+        }
+        Ok(spec)
+    }
+}
+
+impl fmt::Display for IntegratorSpec {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.kind.name())?;
+        if self.kind.has_depth() && self.max_depth != DEFAULT_MAX_DEPTH {
+            write!(f, ":max-depth={}", self.max_depth)?;
+        }
+        if self.kind == IntegratorKind::Ao && self.ao_distance.is_finite() {
+            write!(f, ":distance={}", self.ao_distance)?;
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip() {
+        for k in IntegratorKind::ALL {
+            assert_eq!(k.name().parse::<IntegratorKind>(), Ok(k));
+            assert_eq!(
+                k.name().parse::<IntegratorSpec>(),
+                Ok(IntegratorSpec::new(k))
+            );
+        }
+        let e = "bdpt".parse::<IntegratorSpec>().unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "\"bdpt\" is not one of path, path-bsdf, direct, ao"
+        );
+    }
+
+    #[test]
+    fn options_parse_print_and_validate() {
+        let s: IntegratorSpec = "path:max-depth=4".parse().unwrap();
+        assert_eq!((s.kind, s.max_depth), (IntegratorKind::Path, 4));
+        assert_eq!(s.to_string(), "path:max-depth=4");
+        let a: IntegratorSpec = "ao:distance=0.5".parse().unwrap();
+        assert_eq!(a.ao_distance, 0.5);
+        assert_eq!(a.to_string().parse::<IntegratorSpec>(), Ok(a));
+        assert_eq!(
+            "path:max-depth=16"
+                .parse::<IntegratorSpec>()
+                .unwrap()
+                .to_string(),
+            "path"
+        );
+        for bad in [
+            "direct:max-depth=3",
+            "ao:max-depth=3",
+            "path:distance=1",
+            "path:max-depth=-1",
+            "path:max-depth=10001",
+            "ao:distance=0",
+            "ao:distance=nan",
+            "path:fast",
+        ] {
+            assert!(bad.parse::<IntegratorSpec>().is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn targets_tell_comparable_estimators() {
+        let e = |kind, depth| IntegratorSpec::new(kind).with_max_depth(depth).unwrap();
+        let path = e(IntegratorKind::Path, 8);
+        assert_eq!(path.target(), e(IntegratorKind::PathBsdf, 8).target());
+        assert_ne!(path.target(), e(IntegratorKind::Path, 4).target());
+        assert_eq!(
+            e(IntegratorKind::Direct, 8).target(),
+            e(IntegratorKind::Path, 1).target()
+        );
+        assert_ne!(path.target(), e(IntegratorKind::Ao, 8).target());
+    }
+
+    #[test]
+    fn built_integrators_are_named_as_specs() {
+        for k in IntegratorKind::ALL {
+            assert_eq!(IntegratorSpec::new(k).build().name(), k.name());
+        }
+    }
+}

@@ -1,0 +1,386 @@
+//! The one place where a render's settings are resolved: each value comes from what the caller
+//! gives (command-line flags, an experiment method, `render reference` flags), else from the
+//! scene's `[render]` table, else from the default. Limits are checked here, for both sources,
+//! and errors name where the bad value came from (the flag, or the scene file and key).
+
+use rt_accel::AccelSpec;
+use rt_film::AovSet;
+use rt_integrators::{IntegratorSpec, IntegratorSpecError, DEFAULT_MAX_DEPTH, MAX_DEPTH};
+use rt_scene::RenderDesc;
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// Largest sample count of one render.
+pub const MAX_SPP: u32 = 1 << 20;
+
+/// Most worker threads a render may ask for.
+pub const MAX_THREADS: usize = 1024;
+
+/// Samples per pixel when nothing sets them.
+pub const DEFAULT_SPP: u32 = 64;
+
+/// Settings a caller gives; each one left `None` falls back to the scene's `[render]` table,
+/// then to the default.
+#[derive(Clone, Debug, Default)]
+pub struct Overrides {
+    /// Integrator and its options. An explicit `max-depth=` in it wins over [`Self::max_depth`].
+    pub integrator: Option<IntegratorSpec>,
+    /// Bounce limit (`--max-depth`).
+    pub max_depth: Option<u32>,
+    /// `ao` occluder distance (never in `[render]`; unlimited by default).
+    pub ao_distance: Option<f32>,
+    /// Samples per pixel.
+    pub spp: Option<u32>,
+    /// Worker threads.
+    pub threads: Option<usize>,
+    /// Seed of the sample streams.
+    pub seed: Option<u64>,
+    /// Acceleration structure.
+    pub accel: Option<AccelSpec>,
+    /// AOV names.
+    pub aovs: Option<Vec<String>>,
+    /// Output path.
+    pub output: Option<PathBuf>,
+}
+
+/// Fully resolved settings of one render.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Settings {
+    /// Integrator and its parameters.
+    pub integrator: IntegratorSpec,
+    /// Acceleration structure.
+    pub accel: AccelSpec,
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Worker threads (`None`: all cores).
+    pub threads: Option<usize>,
+    /// The 32-bit stream key ([`fold_seed`] of the 64-bit seed).
+    pub seed: u32,
+    /// AOVs to write.
+    pub aovs: AovSet,
+    /// Output path, if the caller or the table named one.
+    pub output: Option<PathBuf>,
+}
+
+/// Where a value came from, for error messages.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Origin {
+    /// The caller (printed as the flag, e.g. `--spp`).
+    Given(&'static str),
+    /// The scene file's `[render]` table.
+    Table {
+        /// The scene file.
+        file: PathBuf,
+        /// The key.
+        key: &'static str,
+    },
+}
+
+impl fmt::Display for Origin {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Origin::Given(flag) => write!(f, "--{flag}"),
+            Origin::Table { file, key } => write!(f, "{}: [render] {key}", file.display()),
+        }
+    }
+}
+
+/// Why settings could not be resolved.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SettingsError {
+    /// A bad integrator name, option or parameter.
+    #[error("{origin}: {source}")]
+    Integrator {
+        /// Where it came from.
+        origin: Origin,
+        /// What is wrong.
+        source: IntegratorSpecError,
+    },
+    /// A bad acceleration structure spec.
+    #[error("{origin} = \"{text}\": {source}")]
+    Accel {
+        /// Where it came from.
+        origin: Origin,
+        /// The spec as written.
+        text: String,
+        /// What is wrong.
+        source: rt_accel::SpecError,
+    },
+    /// A number outside its range.
+    #[error("{origin}: {what} must be between {min} and {max}, got {value}")]
+    OutOfRange {
+        /// Where it came from.
+        origin: Origin,
+        /// What the number is.
+        what: &'static str,
+        /// Smallest allowed.
+        min: u64,
+        /// Largest allowed.
+        max: u64,
+        /// As given.
+        value: u64,
+    },
+    /// An unknown AOV name.
+    #[error("{origin}: {source}")]
+    Aov {
+        /// Where it came from.
+        origin: Origin,
+        /// The name.
+        source: rt_film::UnknownAov,
+    },
+}
+
+/// Folds a 64-bit seed into the 32-bit stream key without discarding the high half.
+pub fn fold_seed(seed: u64) -> u32 {
+    (seed ^ (seed >> 32)) as u32
+}
+
+/// Checks that `value` is in `min..=max`.
+fn in_range(
+    origin: impl FnOnce() -> Origin,
+    what: &'static str,
+    value: u64,
+    min: u64,
+    max: u64,
+) -> Result<(), SettingsError> {
+    if (min..=max).contains(&value) {
+        return Ok(());
+    }
+    Err(SettingsError::OutOfRange {
+        origin: origin(),
+        what,
+        min,
+        max,
+        value,
+    })
+}
+
+/// Checks a sample count against `1..=MAX_SPP`; `flag` names it in the error.
+pub fn check_spp(spp: u32, flag: &'static str) -> Result<u32, SettingsError> {
+    in_range(
+        || Origin::Given(flag),
+        "samples per pixel",
+        spp.into(),
+        1,
+        MAX_SPP.into(),
+    )?;
+    Ok(spp)
+}
+
+impl Overrides {
+    /// Resolves every setting for the scene at `scene_path` with `[render]` table `desc`.
+    pub fn resolve(&self, desc: &RenderDesc, scene_path: &Path) -> Result<Settings, SettingsError> {
+        let table = |key: &'static str| Origin::Table {
+            file: scene_path.to_path_buf(),
+            key,
+        };
+        let origin = |given: bool, flag: &'static str, key: &'static str| {
+            if given {
+                Origin::Given(flag)
+            } else {
+                table(key)
+            }
+        };
+        let spp = self.spp.or(desc.spp).unwrap_or(DEFAULT_SPP);
+        in_range(
+            || origin(self.spp.is_some(), "spp", "spp"),
+            "samples per pixel",
+            spp.into(),
+            1,
+            MAX_SPP.into(),
+        )?;
+        let threads = self.threads.or(desc.threads);
+        if let Some(t) = threads {
+            in_range(
+                || origin(self.threads.is_some(), "threads", "threads"),
+                "thread count",
+                t as u64,
+                1,
+                MAX_THREADS as u64,
+            )?;
+        }
+        let names = self.aovs.as_ref().or(desc.aov.as_ref());
+        let aovs = match names {
+            None => AovSet::default(),
+            Some(list) => {
+                AovSet::parse_list(list.iter().map(String::as_str)).map_err(|source| {
+                    SettingsError::Aov {
+                        origin: origin(self.aovs.is_some(), "aov", "aov"),
+                        source,
+                    }
+                })?
+            }
+        };
+        Ok(Settings {
+            integrator: self.integrator_spec(desc, scene_path)?,
+            accel: self.accel_spec(desc, scene_path)?,
+            spp,
+            threads,
+            seed: fold_seed(self.seed.or(desc.seed).unwrap_or(0)),
+            aovs,
+            output: self
+                .output
+                .clone()
+                .or_else(|| desc.output.as_ref().map(PathBuf::from)),
+        })
+    }
+
+    /// The integrator alone (experiments and references need no more).
+    pub fn integrator_spec(
+        &self,
+        desc: &RenderDesc,
+        scene_path: &Path,
+    ) -> Result<IntegratorSpec, SettingsError> {
+        let table = |key: &'static str| Origin::Table {
+            file: scene_path.to_path_buf(),
+            key,
+        };
+        let (spec, explicit_depth) = match (&self.integrator, &desc.integrator) {
+            (Some(spec), _) => (*spec, spec.max_depth != DEFAULT_MAX_DEPTH),
+            (None, Some(text)) => {
+                let spec: IntegratorSpec =
+                    text.parse().map_err(|source| SettingsError::Integrator {
+                        origin: table("integrator"),
+                        source,
+                    })?;
+                (spec, spec.max_depth != DEFAULT_MAX_DEPTH)
+            }
+            (None, None) => (IntegratorSpec::default(), false),
+        };
+        let mut spec = spec;
+        if !explicit_depth {
+            let depth = self.max_depth.or(desc.max_depth);
+            if let Some(d) = depth {
+                let at = if self.max_depth.is_some() {
+                    Origin::Given("max-depth")
+                } else {
+                    table("max_depth")
+                };
+                in_range(|| at, "max depth", d.into(), 0, MAX_DEPTH.into())?;
+                spec.max_depth = d;
+            }
+        }
+        if let Some(d) = self.ao_distance {
+            spec = spec
+                .with_ao_distance(d)
+                .map_err(|source| SettingsError::Integrator {
+                    origin: Origin::Given("ao-distance"),
+                    source,
+                })?;
+        }
+        Ok(spec)
+    }
+
+    /// The acceleration structure alone.
+    pub fn accel_spec(
+        &self,
+        desc: &RenderDesc,
+        scene_path: &Path,
+    ) -> Result<AccelSpec, SettingsError> {
+        if let Some(a) = self.accel {
+            return Ok(a);
+        }
+        match &desc.accel {
+            Some(text) => text.parse().map_err(|source| SettingsError::Accel {
+                origin: Origin::Table {
+                    file: scene_path.to_path_buf(),
+                    key: "accel",
+                },
+                text: text.clone(),
+                source,
+            }),
+            None => Ok(AccelSpec::default()),
+        }
+    }
+
+    /// The 32-bit stream seed alone.
+    pub fn seed(&self, desc: &RenderDesc) -> u32 {
+        fold_seed(self.seed.or(desc.seed).unwrap_or(0))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rt_integrators::IntegratorKind;
+
+    fn table(toml_like: impl FnOnce(&mut RenderDesc)) -> RenderDesc {
+        let mut d = RenderDesc::default();
+        toml_like(&mut d);
+        d
+    }
+
+    #[test]
+    fn given_wins_over_table_over_default() {
+        let path = Path::new("s.toml");
+        let none = Overrides::default()
+            .resolve(&RenderDesc::default(), path)
+            .unwrap();
+        assert_eq!(none.spp, DEFAULT_SPP);
+        assert_eq!(none.integrator, IntegratorSpec::default());
+        assert_eq!(none.accel, AccelSpec::default());
+        let desc = table(|d| {
+            d.spp = Some(8);
+            d.max_depth = Some(3);
+            d.integrator = Some("path-bsdf".into());
+            d.seed = Some(1 << 32);
+        });
+        let t = Overrides::default().resolve(&desc, path).unwrap();
+        assert_eq!((t.spp, t.integrator.max_depth), (8, 3));
+        assert_eq!(t.integrator.kind, IntegratorKind::PathBsdf);
+        assert_eq!(t.seed, 1);
+        let o = Overrides {
+            spp: Some(2),
+            max_depth: Some(5),
+            ..Overrides::default()
+        };
+        let g = o.resolve(&desc, path).unwrap();
+        assert_eq!((g.spp, g.integrator.max_depth), (2, 5));
+        // An explicit option in the spec text is the most specific setting.
+        let o = Overrides {
+            integrator: Some("path:max-depth=2".parse().unwrap()),
+            max_depth: Some(5),
+            ..Overrides::default()
+        };
+        assert_eq!(o.resolve(&desc, path).unwrap().integrator.max_depth, 2);
+    }
+
+    #[test]
+    fn errors_name_their_origin() {
+        let path = Path::new("s.toml");
+        let e = Overrides::default()
+            .resolve(&table(|d| d.spp = Some(0)), path)
+            .unwrap_err();
+        assert!(e.to_string().starts_with("s.toml: [render] spp:"), "{e}");
+        let e = Overrides {
+            threads: Some(0),
+            ..Overrides::default()
+        }
+        .resolve(&RenderDesc::default(), path)
+        .unwrap_err();
+        assert!(e.to_string().starts_with("--threads: thread count"), "{e}");
+        let e = Overrides::default()
+            .resolve(&table(|d| d.integrator = Some("bdpt".into())), path)
+            .unwrap_err();
+        assert!(
+            e.to_string().contains("[render] integrator: \"bdpt\""),
+            "{e}"
+        );
+        let e = Overrides::default()
+            .resolve(&table(|d| d.accel = Some("kd".into())), path)
+            .unwrap_err();
+        assert!(e.to_string().contains("[render] accel = \"kd\""), "{e}");
+        let e = Overrides::default()
+            .resolve(&table(|d| d.max_depth = Some(MAX_DEPTH + 1)), path)
+            .unwrap_err();
+        assert!(e.to_string().contains("max_depth"), "{e}");
+        let e = Overrides {
+            aovs: Some(vec!["gloss".into()]),
+            ..Overrides::default()
+        }
+        .resolve(&RenderDesc::default(), path)
+        .unwrap_err();
+        assert!(e.to_string().contains("--aov") && e.to_string().contains("gloss"));
+    }
+}
