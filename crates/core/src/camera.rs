@@ -105,6 +105,35 @@ impl Camera {
     }
 }
 
+impl crate::content_hash::ContentHash for Camera {
+    /// Everything but `tan_half`, which follows from the field of view.
+    fn content_hash(&self, out: &mut crate::content_hash::Sink<'_>) {
+        let Camera {
+            name,
+            position,
+            forward,
+            right,
+            up,
+            fov_y_deg,
+            width,
+            height,
+            aperture,
+            focus_distance,
+            tan_half: _,
+        } = self;
+        name.content_hash(out);
+        position.content_hash(out);
+        forward.content_hash(out);
+        right.content_hash(out);
+        up.content_hash(out);
+        fov_y_deg.content_hash(out);
+        width.content_hash(out);
+        height.content_hash(out);
+        aperture.content_hash(out);
+        focus_distance.content_hash(out);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -186,6 +186,30 @@ impl Environment {
     }
 }
 
+impl crate::content_hash::ContentHash for Environment {
+    /// The radiance; the importance map follows from it and its build time is a measurement.
+    fn content_hash(&self, out: &mut crate::content_hash::Sink<'_>) {
+        match self {
+            Environment::Constant(c) => {
+                out(b"constant");
+                c.content_hash(out);
+            }
+            Environment::Map(EnvMap {
+                width,
+                height,
+                texels,
+                dist: _,
+                dist_build_time: _,
+            }) => {
+                out(b"map");
+                width.content_hash(out);
+                height.content_hash(out);
+                texels.content_hash(out);
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

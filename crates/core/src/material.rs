@@ -594,6 +594,44 @@ fn eval_layer(l: &Layer, tint: Rgb, wo: Vec3, wi: Vec3, reflect: bool) -> (Rgb, 
     (c * (pdf / (ci * eta * eta)), pdf)
 }
 
+impl crate::content_hash::ContentHash for Layer {
+    fn content_hash(&self, out: &mut crate::content_hash::Sink<'_>) {
+        let Layer {
+            weight,
+            color,
+            color90,
+            hardness,
+            transmission,
+            ior,
+            coat,
+        } = self;
+        weight.content_hash(out);
+        color.content_hash(out);
+        color90.content_hash(out);
+        hardness.content_hash(out);
+        transmission.content_hash(out);
+        ior.content_hash(out);
+        coat.content_hash(out);
+    }
+}
+
+impl crate::content_hash::ContentHash for Material {
+    fn content_hash(&self, out: &mut crate::content_hash::Sink<'_>) {
+        let Material {
+            name,
+            layers,
+            emission,
+            two_sided,
+            texture,
+        } = self;
+        name.content_hash(out);
+        layers.content_hash(out);
+        emission.content_hash(out);
+        two_sided.content_hash(out);
+        texture.content_hash(out);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -208,6 +208,42 @@ impl Scene {
     }
 }
 
+impl crate::content_hash::ContentHash for Object {
+    fn content_hash(&self, out: &mut crate::content_hash::Sink<'_>) {
+        let Object { name, first, count } = self;
+        name.content_hash(out);
+        first.content_hash(out);
+        count.content_hash(out);
+    }
+}
+
+impl crate::content_hash::ContentHash for Scene {
+    /// Everything but the light sampler, which is built from the triangles and materials.
+    fn content_hash(&self, out: &mut crate::content_hash::Sink<'_>) {
+        let Scene {
+            triangles,
+            normals,
+            uvs,
+            material_ids,
+            materials,
+            textures,
+            environment,
+            cameras,
+            objects,
+            lights: _,
+        } = self;
+        triangles.content_hash(out);
+        normals.content_hash(out);
+        uvs.content_hash(out);
+        material_ids.content_hash(out);
+        materials.content_hash(out);
+        textures.content_hash(out);
+        environment.content_hash(out);
+        cameras.content_hash(out);
+        objects.content_hash(out);
+    }
+}
+
 #[cfg(test)]
 mod memory_tests {
     use super::*;

@@ -49,6 +49,19 @@ impl Texture {
     }
 }
 
+impl crate::content_hash::ContentHash for Texture {
+    fn content_hash(&self, out: &mut crate::content_hash::Sink<'_>) {
+        let Texture {
+            width,
+            height,
+            texels,
+        } = self;
+        width.content_hash(out);
+        height.content_hash(out);
+        texels.content_hash(out);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

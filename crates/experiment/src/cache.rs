@@ -5,9 +5,10 @@
 //! - a format version ([`CACHE_VERSION`]);
 //! - the SHA-256 of the scene file's bytes;
 //! - the SHA-256 of the loaded scene: every triangle, normal, UV, material, texture texel,
-//!   environment texel and camera as the renderer sees them (their `Debug` text, streamed into
-//!   the hash). This is how the content of every file the scene references (meshes with their
-//!   `.mtl`s and buffers, textures, environment maps) enters the key, whatever loader read it;
+//!   environment texel and camera as the renderer sees them, floats by their bits
+//!   ([`rt_core::ContentHash`]). This is how the content of every file the scene references
+//!   (meshes with their `.mtl`s and buffers, textures, environment maps) enters the key,
+//!   whatever loader read it;
 //! - the camera actually rendered (after any resolution override), the integrator, bounce
 //!   limit, ao distance, samples per pixel, seed and stream.
 //!
@@ -22,7 +23,7 @@
 //! re-rendered rather than trusted.
 
 use crate::error::{io, ExperimentError, Result};
-use rt_core::{Camera, Scene};
+use rt_core::{Camera, ContentHash, Scene};
 use rt_film::Film;
 use rt_integrators::IntegratorSpec;
 use serde::{Deserialize, Serialize};
@@ -31,7 +32,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 /// Bump when the renderer's output for the same settings changes, to retire old entries.
-pub const CACHE_VERSION: u32 = 1;
+pub const CACHE_VERSION: u32 = 2;
 
 /// The default cache directory, relative to the working directory.
 pub const DEFAULT_CACHE_DIR: &str = ".render-cache/references";
@@ -82,15 +83,11 @@ pub struct Sidecar {
     pub samples_per_second: f64,
 }
 
-/// Feeds `Debug` text into a hash without building the string (a big mesh prints to hundreds
-/// of megabytes).
-struct HashWriter(Sha256);
-
-impl std::fmt::Write for HashWriter {
-    fn write_str(&mut self, s: &str) -> std::fmt::Result {
-        self.0.update(s.as_bytes());
-        Ok(())
-    }
+/// The SHA-256 of `value`'s content.
+fn content_digest(value: &impl ContentHash) -> String {
+    let mut hash = Sha256::new();
+    value.content_hash(&mut |bytes: &[u8]| hash.update(bytes));
+    hex(&hash.finalize())
 }
 
 fn hex(bytes: &[u8]) -> String {
@@ -111,21 +108,16 @@ impl ReferenceRequest<'_> {
                 ExperimentError::Run(format!("{}: cannot open: {e}", self.scene_path.display()))
             })?
         };
-        let mut scene_hash = HashWriter(Sha256::new());
-        // Writing into a hash cannot fail.
-        let _ = write!(scene_hash, "{:?}", self.scene);
-        let mut camera = HashWriter(Sha256::new());
-        let _ = write!(camera, "{:?}", self.camera);
         let e = &self.estimator;
         let description = format!(
             "version {CACHE_VERSION}\nscene-file {}\nscene-data {}\ncamera {} {}x{} {}\n\
              integrator {}\nmax-depth {}\nao-distance {}\nspp {}\nseed {}\nstream reference\n",
             hex(&Sha256::digest(&file_bytes)),
-            hex(&scene_hash.0.finalize()),
+            content_digest(self.scene),
             self.camera.name,
             self.camera.width,
             self.camera.height,
-            hex(&camera.0.finalize()),
+            content_digest(self.camera),
             e.kind,
             e.max_depth,
             e.ao_distance,
