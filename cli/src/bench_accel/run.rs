@@ -190,11 +190,11 @@ pub fn count(accel: &dyn Accel, set: &RaySet) -> Option<TraversalCounters> {
             for r in chunk {
                 match set.query {
                     Query::Closest => {
-                        accel.intersect_counted(r, t_max, &mut c);
+                        accel.closest_hit(r, t_max, Some(&mut c));
                     }
                     Query::Occluded => {
                         let target = r.origin + r.dir * t_max;
-                        accel.occluded_toward_counted(r, t_max, target, &mut c);
+                        accel.any_hit(r, t_max, Some(target), Some(&mut c));
                     }
                 }
             }

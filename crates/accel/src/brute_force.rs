@@ -62,12 +62,30 @@ impl Accel for BruteForce {
         "brute-force"
     }
 
-    fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        self.query(ray, t_max, false, &mut 0)
+    fn closest_hit(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        counters: Option<&mut TraversalCounters>,
+    ) -> Option<Hit> {
+        match counters {
+            Some(c) => self.query(ray, t_max, false, &mut c.prims_tested),
+            None => self.query(ray, t_max, false, &mut 0),
+        }
     }
 
-    fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        self.query(ray, t_max, true, &mut 0).is_some()
+    fn any_hit(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        _toward: Option<Vec3>,
+        counters: Option<&mut TraversalCounters>,
+    ) -> bool {
+        match counters {
+            Some(c) => self.query(ray, t_max, true, &mut c.prims_tested),
+            None => self.query(ray, t_max, true, &mut 0),
+        }
+        .is_some()
     }
 
     fn bounds(&self) -> Aabb {
@@ -76,15 +94,6 @@ impl Accel for BruteForce {
 
     fn memory_bytes(&self) -> usize {
         std::mem::size_of_val(self.triangles.as_slice())
-    }
-
-    fn intersect_counted(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        counters: &mut TraversalCounters,
-    ) -> Option<Hit> {
-        self.query(ray, t_max, false, &mut counters.prims_tested)
     }
 
     fn counts_traversal(&self) -> bool {
@@ -111,7 +120,7 @@ mod tests {
         assert!(bf.occluded(&ray, 2.5));
         assert!(!bf.occluded(&ray, 1.5));
         let mut c = TraversalCounters::default();
-        bf.intersect_counted(&ray, f32::INFINITY, &mut c);
+        bf.closest_hit(&ray, f32::INFINITY, Some(&mut c));
         assert_eq!(c.prims_tested, 3);
     }
 

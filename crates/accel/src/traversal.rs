@@ -27,6 +27,21 @@ pub(crate) trait Counter {
     fn triangles(&mut self, n: u64);
 }
 
+/// Runs `$body` with `$c` bound to the given counters, or to [`NoCount`] without them: one
+/// branch per query, and each arm a traversal monomorphised for its counter.
+macro_rules! with_counter {
+    ($counters:expr, |$c:ident| $body:expr) => {
+        match $counters {
+            Some($c) => $body,
+            None => {
+                let $c = &mut $crate::traversal::NoCount;
+                $body
+            }
+        }
+    };
+}
+pub(crate) use with_counter;
+
 /// The counter of the uncounted queries.
 pub(crate) struct NoCount;
 

@@ -40,7 +40,7 @@ fn empty_scene_hits_nothing() {
     for _ in 0..100 {
         let ray = Ray::new(rng.vec_in(-1.0, 1.0), rng.unit_vec());
         let mut c = TraversalCounters::default();
-        assert_eq!(bvh.intersect_counted(&ray, f32::INFINITY, &mut c), None);
+        assert_eq!(bvh.closest_hit(&ray, f32::INFINITY, Some(&mut c)), None);
         assert_eq!(c, TraversalCounters::default());
         assert!(!bvh.occluded(&ray, f32::INFINITY));
     }
@@ -65,7 +65,7 @@ fn single_triangle() {
         .intersect(&Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::Z), 9.0)
         .is_none());
     let mut c = TraversalCounters::default();
-    bvh.intersect_counted(&down, f32::INFINITY, &mut c);
+    bvh.closest_hit(&down, f32::INFINITY, Some(&mut c));
     assert_eq!(
         c,
         TraversalCounters {
@@ -109,7 +109,11 @@ fn counters_count_boxes_and_triangles() {
     assert!(bvh.counts_traversal());
     assert_eq!(bvh.name(), "bvh");
     let mut c = TraversalCounters::default();
-    let hit = bvh.intersect_counted(&Ray::new(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z), 9.0, &mut c);
+    let hit = bvh.closest_hit(
+        &Ray::new(Vec3::new(0.25, 0.25, 1.0), -Vec3::Z),
+        9.0,
+        Some(&mut c),
+    );
     assert_eq!(hit.unwrap().prim, 0);
     assert_eq!(
         c,

@@ -22,20 +22,23 @@ impl<const G: usize> Accel for Small<G> {
     fn name(&self) -> &str {
         self.0.name()
     }
-    fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        self.0.intersect(ray, t_max)
+    fn closest_hit(&self, ray: &Ray, t_max: f32, c: Option<&mut TraversalCounters>) -> Option<Hit> {
+        self.0.closest_hit(ray, t_max, c)
     }
-    fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        self.0.occluded(ray, t_max)
+    fn any_hit(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        toward: Option<Vec3>,
+        c: Option<&mut TraversalCounters>,
+    ) -> bool {
+        self.0.any_hit(ray, t_max, toward, c)
     }
     fn bounds(&self) -> Aabb {
         self.0.bounds()
     }
     fn memory_bytes(&self) -> usize {
         self.0.memory_bytes()
-    }
-    fn intersect_counted(&self, ray: &Ray, t_max: f32, c: &mut TraversalCounters) -> Option<Hit> {
-        self.0.intersect_counted(ray, t_max, c)
     }
     fn counts_traversal(&self) -> bool {
         self.0.counts_traversal()
@@ -190,7 +193,7 @@ fn counted_queries_count_the_top_tree_too() {
     assert!(q.counts_traversal());
     let ray = Ray::new(Vec3::new(0.1, 0.2, 3.0), -Vec3::Z);
     let mut c = TraversalCounters::default();
-    let hit = q.intersect_counted(&ray, f32::INFINITY, &mut c);
+    let hit = q.closest_hit(&ray, f32::INFINITY, Some(&mut c));
     assert_eq!(hit, q.intersect(&ray, f32::INFINITY));
     assert!(hit.is_some());
     // Root, at least one pair of top-tree children and the group's own root.
@@ -198,7 +201,7 @@ fn counted_queries_count_the_top_tree_too() {
     assert!(c.leaves_visited >= 1 && c.prims_tested >= 1, "{c:?}");
     // Counters accumulate.
     let before = c;
-    q.intersect_counted(&ray, f32::INFINITY, &mut c);
+    q.closest_hit(&ray, f32::INFINITY, Some(&mut c));
     assert_eq!(c.nodes_visited, 2 * before.nodes_visited);
 }
 
@@ -252,7 +255,7 @@ fn empty_scene() {
     assert_eq!(q.intersect(&ray, f32::INFINITY), None);
     assert!(!q.occluded(&ray, f32::INFINITY));
     let mut c = TraversalCounters::default();
-    assert_eq!(q.intersect_counted(&ray, f32::INFINITY, &mut c), None);
+    assert_eq!(q.closest_hit(&ray, f32::INFINITY, Some(&mut c)), None);
     assert!(q.bounds().is_empty());
     assert_eq!(q.name(), "qbvh-lazy");
     q.build_all();
@@ -391,7 +394,7 @@ fn lazy_vs_eager_timing() {
     for a in [&full as &dyn Accel, &q] {
         let mut c = TraversalCounters::default();
         for r in &views[0].1 {
-            a.intersect_counted(r, f32::INFINITY, &mut c);
+            a.closest_hit(r, f32::INFINITY, Some(&mut c));
         }
         let n = views[0].1.len() as f64;
         println!(

@@ -77,7 +77,7 @@ fn structures_and_options() {
             }
             let mut c = TraversalCounters::default();
             for r in rays.iter() {
-                a.intersect_counted(r, f32::INFINITY, &mut c);
+                a.closest_hit(r, f32::INFINITY, Some(&mut c));
             }
             let per = |x: u64| x as f64 / rays.len() as f64;
             println!(

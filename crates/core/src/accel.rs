@@ -22,7 +22,7 @@ pub struct Hit {
 }
 
 /// Counts of traversal work, for benchmarks and for comparing structures. Only implementations
-/// that override [`Accel::intersect_counted`] fill them in.
+/// whose [`Accel::counts_traversal`] is true fill them in.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct TraversalCounters {
     /// Boxes tested: every child box of every inner node visited (a four-wide node counts its
@@ -43,38 +43,40 @@ impl std::ops::AddAssign for TraversalCounters {
 }
 
 /// A ray-query acceleration structure over the scene's triangles.
+///
+/// A structure implements two queries, [`Accel::closest_hit`] and [`Accel::any_hit`], once
+/// each: both take optional [`TraversalCounters`], so benchmarks can count the work of the same
+/// code that renders. An implementation dispatches on the option once per ray (e.g. to a
+/// traversal generic over a counter whose uncounted form compiles to nothing), so the uncounted
+/// path pays one branch per ray, not one per node. [`Accel::intersect`], [`Accel::occluded`] and
+/// [`Accel::occluded_toward`] are the uncounted shorthands integrators call; they are not meant
+/// to be overridden.
 pub trait Accel: Send + Sync {
     /// Short name for reports ("bvh", "brute-force", ...).
     fn name(&self) -> &str;
 
-    /// Closest hit with `t ∈ (0, t_max]`.
-    fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit>;
-
-    /// True if anything is hit with `t ∈ (0, t_max]`. Implementations should stop at the first hit.
-    fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        self.intersect(ray, t_max).is_some()
-    }
-
-    /// Occlusion of a shadow ray whose light-side endpoint is `target` (the light sample the
-    /// ray goes toward). Always the same answer as [`Accel::occluded`]; structures with a
-    /// shadow cache use `target` to start where the last occluder toward the same light region
-    /// was found.
-    fn occluded_toward(&self, ray: &Ray, t_max: f32, target: Vec3) -> bool {
-        let _ = target;
-        self.occluded(ray, t_max)
-    }
-
-    /// Like [`Accel::occluded_toward`], also counting work into `counters` if the structure
-    /// supports it.
-    fn occluded_toward_counted(
+    /// Closest hit with `t ∈ (0, t_max]`, counting work into `counters` when given (and
+    /// [`Accel::counts_traversal`]).
+    fn closest_hit(
         &self,
         ray: &Ray,
         t_max: f32,
-        target: Vec3,
-        counters: &mut TraversalCounters,
+        counters: Option<&mut TraversalCounters>,
+    ) -> Option<Hit>;
+
+    /// True if anything is hit with `t ∈ (0, t_max]`; implementations stop at the first hit.
+    /// `toward` is the light-side endpoint of a shadow ray when there is one: structures with a
+    /// shadow cache start where the last occluder toward the same light region was found. The
+    /// answer never depends on it.
+    fn any_hit(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        toward: Option<Vec3>,
+        counters: Option<&mut TraversalCounters>,
     ) -> bool {
-        let _ = counters;
-        self.occluded_toward(ray, t_max, target)
+        let _ = toward;
+        self.closest_hit(ray, t_max, counters).is_some()
     }
 
     /// Bounds of all geometry.
@@ -83,19 +85,23 @@ pub trait Accel: Send + Sync {
     /// Bytes of memory held by the structure (nodes and any primitive copies it keeps).
     fn memory_bytes(&self) -> usize;
 
-    /// Like [`Accel::intersect`], also counting work into `counters` if the structure supports it.
-    fn intersect_counted(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        counters: &mut TraversalCounters,
-    ) -> Option<Hit> {
-        let _ = counters;
-        self.intersect(ray, t_max)
-    }
-
-    /// True if [`Accel::intersect_counted`] really counts.
+    /// True if the queries really fill the counters they are given.
     fn counts_traversal(&self) -> bool {
         false
+    }
+
+    /// Closest hit with `t ∈ (0, t_max]`, uncounted.
+    fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        self.closest_hit(ray, t_max, None)
+    }
+
+    /// True if anything is hit with `t ∈ (0, t_max]`, uncounted.
+    fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        self.any_hit(ray, t_max, None, None)
+    }
+
+    /// Occlusion of a shadow ray toward the light sample `target`, uncounted.
+    fn occluded_toward(&self, ray: &Ray, t_max: f32, target: Vec3) -> bool {
+        self.any_hit(ray, t_max, Some(target), None)
     }
 }

@@ -129,7 +129,15 @@ mod tests {
         s.materials.push(Material::diffuse("m", Rgb::splat(0.5)));
         s.push_triangle([Vec3::ZERO, Vec3::X, Vec3::Y], 0);
         s.cameras.push(Camera::look_at(
-            "c", Vec3::Z, Vec3::ZERO, Vec3::Y, 40.0, 4, 2, 0.0, 1.0,
+            "c",
+            Vec3::Z,
+            Vec3::ZERO,
+            Vec3::Y,
+            40.0,
+            4,
+            2,
+            0.0,
+            1.0,
         ));
         s.build_lights();
         s
@@ -151,6 +159,9 @@ mod tests {
         // -0.0 and 0.0 differ by their bits, and so may render differently (1/x).
         assert_ne!(digest(&0.0f32), digest(&-0.0f32));
         // Lengths are part of the hash: ["ab"] and ["a", "b"] differ.
-        assert_ne!(digest(&vec!["ab".to_string()]), digest(&vec!["a".to_string(), "b".into()]));
+        assert_ne!(
+            digest(&vec!["ab".to_string()]),
+            digest(&vec!["a".to_string(), "b".into()])
+        );
     }
 }

@@ -9,7 +9,7 @@
 
 use super::{compare, render_film, Budget, Case, Check, Outcome};
 use crate::LoadError;
-use rt_core::{glam::Vec3, Aabb, Accel, Camera, Hit, Ray, Scene};
+use rt_core::{glam::Vec3, Aabb, Accel, Camera, Hit, Ray, Scene, TraversalCounters};
 use rt_integrators::PathIntegrator;
 
 /// The Cornell box of `scenes/cornell-box.toml` with a `resolution²` camera.
@@ -119,20 +119,34 @@ impl Accel for Acne<'_> {
         "acne"
     }
 
-    fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+    fn closest_hit(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        counters: Option<&mut TraversalCounters>,
+    ) -> Option<Hit> {
         match self.sabotage(ray) {
-            Some((r, dt)) => self.inner.intersect(&r, t_max + dt).map(|mut h| {
-                h.t = (h.t - dt).max(f32::MIN_POSITIVE);
-                h
-            }),
-            None => self.inner.intersect(ray, t_max),
+            Some((r, dt)) => self
+                .inner
+                .closest_hit(&r, t_max + dt, counters)
+                .map(|mut h| {
+                    h.t = (h.t - dt).max(f32::MIN_POSITIVE);
+                    h
+                }),
+            None => self.inner.closest_hit(ray, t_max, counters),
         }
     }
 
-    fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+    fn any_hit(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        _toward: Option<Vec3>,
+        counters: Option<&mut TraversalCounters>,
+    ) -> bool {
         match self.sabotage(ray) {
-            Some((r, dt)) => self.inner.occluded(&r, t_max + dt),
-            None => self.inner.occluded(ray, t_max),
+            Some((r, dt)) => self.inner.any_hit(&r, t_max + dt, None, counters),
+            None => self.inner.any_hit(ray, t_max, None, counters),
         }
     }
 

@@ -44,7 +44,7 @@ impl Peer for Ours {
             return Work::default();
         }
         let mut c = TraversalCounters::default();
-        self.accel.intersect_counted(ray, t_max, &mut c);
+        self.accel.closest_hit(ray, t_max, Some(&mut c));
         Work {
             boxes: Some(c.nodes_visited),
             leaves: Some(c.leaves_visited),

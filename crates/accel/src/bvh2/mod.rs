@@ -22,7 +22,7 @@ pub use node::Node;
 pub use split::{split_pieces, split_references};
 pub use stats::BvhStats;
 
-use crate::traversal::NoCount;
+use crate::traversal::with_counter;
 use build::Config;
 use glam::Vec3;
 use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
@@ -145,12 +145,25 @@ impl Accel for Bvh2 {
         "bvh"
     }
 
-    fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        self.traverse::<false, _>(ray, t_max, &mut NoCount)
+    fn closest_hit(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        counters: Option<&mut TraversalCounters>,
+    ) -> Option<Hit> {
+        with_counter!(counters, |c| self.traverse::<false, _>(ray, t_max, c))
     }
 
-    fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        self.traverse::<true, _>(ray, t_max, &mut NoCount).is_some()
+    fn any_hit(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        _toward: Option<Vec3>,
+        counters: Option<&mut TraversalCounters>,
+    ) -> bool {
+        with_counter!(counters, |c| self
+            .traverse::<true, _>(ray, t_max, c)
+            .is_some())
     }
 
     fn bounds(&self) -> Aabb {
@@ -161,25 +174,6 @@ impl Accel for Bvh2 {
         std::mem::size_of_val(self.nodes.as_slice())
             + std::mem::size_of_val(self.triangles.as_slice())
             + std::mem::size_of_val(self.prim_ids.as_slice())
-    }
-
-    fn occluded_toward_counted(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        _target: Vec3,
-        counters: &mut TraversalCounters,
-    ) -> bool {
-        self.traverse::<true, _>(ray, t_max, counters).is_some()
-    }
-
-    fn intersect_counted(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        counters: &mut TraversalCounters,
-    ) -> Option<Hit> {
-        self.traverse::<false, _>(ray, t_max, counters)
     }
 
     fn counts_traversal(&self) -> bool {

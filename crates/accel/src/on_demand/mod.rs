@@ -429,7 +429,7 @@ impl OnDemandQbvh {
         let mut best: Option<Hit> = None;
         self.walk(ray, t_max, boxes, |group, tree, cull_t| {
             let hit = match counters.as_deref_mut() {
-                Some(c) => tree.intersect_counted(ray, cull_t, c),
+                Some(c) => tree.closest_hit(ray, cull_t, Some(c)),
                 None => tree.intersect(ray, cull_t),
             };
             match hit {
@@ -476,41 +476,43 @@ impl Accel for OnDemandQbvh {
         "qbvh-lazy"
     }
 
-    fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        self.closest(ray, t_max, &mut 0, None)
-    }
-
-    fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        let mut hit = false;
-        self.walk(ray, t_max, &mut 0, |_, tree, _| {
-            if tree.occluded(ray, t_max) {
-                hit = true;
-                Step::Done
-            } else {
-                Step::Miss
-            }
-        });
-        hit
-    }
-
-    fn occluded_toward_counted(
+    fn closest_hit(
         &self,
         ray: &Ray,
         t_max: f32,
-        target: Vec3,
-        counters: &mut TraversalCounters,
+        counters: Option<&mut TraversalCounters>,
+    ) -> Option<Hit> {
+        let Some(counters) = counters else {
+            return self.closest(ray, t_max, &mut 0, None);
+        };
+        let mut work = TraversalCounters::default();
+        let mut boxes = 0;
+        let hit = self.closest(ray, t_max, &mut boxes, Some(&mut work));
+        work.nodes_visited += boxes;
+        *counters += work;
+        hit
+    }
+
+    fn any_hit(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        toward: Option<Vec3>,
+        mut counters: Option<&mut TraversalCounters>,
     ) -> bool {
         let mut hit = false;
         let mut boxes = 0;
         self.walk(ray, t_max, &mut boxes, |_, tree, _| {
-            if tree.occluded_toward_counted(ray, t_max, target, counters) {
+            if tree.any_hit(ray, t_max, toward, counters.as_deref_mut()) {
                 hit = true;
                 Step::Done
             } else {
                 Step::Miss
             }
         });
-        counters.nodes_visited += boxes;
+        if let Some(c) = counters {
+            c.nodes_visited += boxes;
+        }
         hit
     }
 
@@ -529,20 +531,6 @@ impl Accel for OnDemandQbvh {
                 .filter_map(|g| g.tree.get())
                 .map(Qbvh::memory_bytes)
                 .sum::<usize>()
-    }
-
-    fn intersect_counted(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        counters: &mut TraversalCounters,
-    ) -> Option<Hit> {
-        let mut work = TraversalCounters::default();
-        let mut boxes = 0;
-        let hit = self.closest(ray, t_max, &mut boxes, Some(&mut work));
-        work.nodes_visited += boxes;
-        *counters += work;
-        hit
     }
 
     fn counts_traversal(&self) -> bool {

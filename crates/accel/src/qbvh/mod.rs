@@ -27,7 +27,7 @@ pub use options::{Order, QbvhOptions, TriangleTest, DEFAULT_INTERSECTION_COST, D
 pub use tri4::Tri4;
 pub use wide::{Avx2, Baseline, Isa, WideNode};
 
-use crate::traversal::{Counter, NoCount};
+use crate::traversal::{with_counter, Counter};
 use crate::{BuildParams, Bvh2};
 use glam::Vec3;
 use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
@@ -209,33 +209,27 @@ impl<N: WideNode> Accel for WideBvh<N> {
         N::NAME
     }
 
-    fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
-        self.query::<false, _>(ray, t_max, &mut NoCount)
-    }
-
-    fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        self.query::<true, _>(ray, t_max, &mut NoCount).is_some()
-    }
-
-    fn occluded_toward(&self, ray: &Ray, t_max: f32, target: Vec3) -> bool {
-        if self.options.shadow_cache {
-            self.occluded_cached(ray, t_max, target, &mut NoCount)
-        } else {
-            self.occluded(ray, t_max)
-        }
-    }
-
-    fn occluded_toward_counted(
+    fn closest_hit(
         &self,
         ray: &Ray,
         t_max: f32,
-        target: Vec3,
-        counters: &mut TraversalCounters,
+        counters: Option<&mut TraversalCounters>,
+    ) -> Option<Hit> {
+        with_counter!(counters, |c| self.query::<false, _>(ray, t_max, c))
+    }
+
+    fn any_hit(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        toward: Option<Vec3>,
+        counters: Option<&mut TraversalCounters>,
     ) -> bool {
-        if self.options.shadow_cache {
-            self.occluded_cached(ray, t_max, target, counters)
-        } else {
-            self.query::<true, _>(ray, t_max, counters).is_some()
+        match toward {
+            Some(target) if self.options.shadow_cache => {
+                with_counter!(counters, |c| self.occluded_cached(ray, t_max, target, c))
+            }
+            _ => with_counter!(counters, |c| self.query::<true, _>(ray, t_max, c).is_some()),
         }
     }
 
@@ -247,15 +241,6 @@ impl<N: WideNode> Accel for WideBvh<N> {
         std::mem::size_of_val(self.nodes.as_slice())
             + std::mem::size_of_val(self.packets.as_slice())
             + std::mem::size_of_val(self.packet_ids.as_slice())
-    }
-
-    fn intersect_counted(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        counters: &mut TraversalCounters,
-    ) -> Option<Hit> {
-        self.query::<false, _>(ray, t_max, counters)
     }
 
     fn counts_traversal(&self) -> bool {

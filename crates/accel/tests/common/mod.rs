@@ -594,7 +594,7 @@ pub fn check_soup<A: Built>(
         }
         let got = accel.intersect(&ray, t_max);
         let mut counters = TraversalCounters::default();
-        assert_eq!(accel.intersect_counted(&ray, t_max, &mut counters), got);
+        assert_eq!(accel.closest_hit(&ray, t_max, Some(&mut counters)), got);
         assert!(counters.nodes_visited >= 1);
         if got.is_some() {
             assert!(counters.prims_tested >= 1);
