@@ -6,11 +6,16 @@
 //! - [`Bvh2`]: a binary bounding volume hierarchy built with the binned surface area heuristic
 //!   and traversed front to back with a robust slab test. Hits come from the watertight
 //!   triangle test in `rt-core` and culling is conservative, so closed meshes have no cracks.
-//! - [`Qbvh`]: a four-wide BVH collapsed from a [`Bvh2`], with 128-byte nodes whose child boxes
-//!   are tested together (SSE2 on x86_64).
+//! - [`Bvh8`] (the default, [`DEFAULT_ACCEL`]) and [`Qbvh`]: eight- and four-wide BVHs collapsed
+//!   from a [`Bvh2`] (module [`wide`]: one generic [`WideBvh`] over the node type), whose child
+//!   boxes are tested together (AVX2 or SSE2, chosen at run time, with a portable fallback),
+//!   with split-plane or distance child order, a shadow cache, EVH/BBAH triangle splitting and
+//!   an on-demand variant ([`OnDemandQbvh`]).
+//! - [`crack_free`]: the crack-free intersection tests of Dammertz §3.4.
 //! - [`BruteForce`]: tests every triangle; the reference the others are checked against.
 //!
-//! Later work adds the implicit IOSP BVH behind the same trait.
+//! [`AccelSpec`] is the one dispatch point: it parses `bvh8:order=distance` and the like and
+//! builds the structure. Later work adds the implicit IOSP BVH behind the same trait.
 //!
 //! Depends on `rt-core` (rays, boxes, the triangle test and the `Accel` trait), `glam` for
 //! vectors and `rayon` to build large subtrees in parallel.
@@ -32,7 +37,19 @@
 //! assert!(!bvh.occluded(&ray, 2.5));
 //! assert_eq!(BruteForce::new(&triangles).intersect(&ray, f32::INFINITY), Some(hit));
 //! ```
-// Unsafe code is allowed only in the QBVH's SIMD kernels and its uninitialised traversal
+//!
+//! Build the default structure from a spec, as `render --accel` does:
+//!
+//! ```
+//! use rt_accel::AccelSpec;
+//! use rt_core::{glam::Vec3, Ray};
+//! let triangles = [[Vec3::ZERO, Vec3::X, Vec3::Y]];
+//! let accel = AccelSpec::default().build(&triangles);
+//! assert_eq!(accel.name(), "bvh8");
+//! let hit = accel.intersect(&Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z), f32::INFINITY);
+//! assert_eq!(hit.map(|h| h.t), Some(1.0));
+//! ```
+// Unsafe code is allowed only in the wide BVHs' SIMD kernels and its uninitialised traversal
 // stacks, item by item, each with its safety argument.
 #![deny(unsafe_code)]
 #![deny(missing_docs)]
@@ -41,12 +58,23 @@ pub mod brute_force;
 pub mod bvh2;
 pub mod crack_free;
 pub mod on_demand;
-pub mod qbvh;
 pub mod spec;
 mod traversal;
+pub mod wide;
 
 pub use brute_force::BruteForce;
+
+/// A structure that breaks one of its invariants (found by its `validate`, which the tests and
+/// `bench-accel --check` run after every build).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("invalid {structure}: {problem}")]
+pub struct ValidationError {
+    /// The structure's name (`bvh`, `qbvh`, `bvh8`, ...).
+    pub structure: String,
+    /// The first broken invariant found.
+    pub problem: String,
+}
 pub use bvh2::{BuildParams, Bvh2, BvhStats, Node, Split, MAX_BINS};
 pub use on_demand::OnDemandQbvh;
-pub use qbvh::{Bvh8, Node8, Order, QNode, Qbvh, QbvhOptions, TriangleTest, WideBvh, WideNode};
 pub use spec::{AccelKind, AccelSpec, SpecError, DEFAULT_ACCEL};
+pub use wide::{Bvh8, Node8, Order, QNode, Qbvh, TriangleTest, WideBvh, WideNode, WideOptions};

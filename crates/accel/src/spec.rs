@@ -20,7 +20,7 @@
 //! | `isect=watertight\|subdivision\|hybrid` | qbvh, bvh8 | triangle test (default watertight) |
 //! | `lazy` | qbvh | build subtrees the first time a ray reaches them |
 
-use crate::qbvh::{Order, QbvhOptions, TriangleTest};
+use crate::wide::{Order, TriangleTest, WideOptions};
 use crate::{BruteForce, BuildParams, Bvh2, Bvh8, Qbvh, Split};
 use glam::Vec3;
 use rt_core::Accel;
@@ -78,7 +78,7 @@ pub struct AccelSpec {
     /// Build parameters of the binary BVH (the QBVH is collapsed from one).
     pub build: BuildParams,
     /// Traversal options of the wide BVHs (QBVH and BVH8).
-    pub qbvh: QbvhOptions,
+    pub wide: WideOptions,
     /// Build subtrees on demand (QBVH only).
     pub lazy: bool,
 }
@@ -128,15 +128,15 @@ impl AccelSpec {
     pub fn new(kind: AccelKind) -> Self {
         let mut build = BuildParams::default();
         if kind.is_wide() {
-            build.max_leaf_size = crate::qbvh::DEFAULT_LEAF_SIZE;
-            build.intersection_cost = crate::qbvh::DEFAULT_INTERSECTION_COST;
+            build.max_leaf_size = crate::wide::DEFAULT_LEAF_SIZE;
+            build.intersection_cost = crate::wide::DEFAULT_INTERSECTION_COST;
         }
         Self {
             kind,
             build,
-            qbvh: match kind {
-                AccelKind::Bvh8 => QbvhOptions::defaults_for::<crate::Node8>(),
-                _ => QbvhOptions::default(),
+            wide: match kind {
+                AccelKind::Bvh8 => WideOptions::defaults_for::<crate::Node8>(),
+                _ => WideOptions::default(),
             },
             lazy: false,
         }
@@ -147,10 +147,10 @@ impl AccelSpec {
         match self.kind {
             AccelKind::Bvh => Box::new(Bvh2::build(triangles, &self.build)),
             AccelKind::Qbvh if self.lazy => {
-                Box::new(crate::OnDemandQbvh::new(triangles, &self.build, &self.qbvh))
+                Box::new(crate::OnDemandQbvh::new(triangles, &self.build, &self.wide))
             }
-            AccelKind::Qbvh => Box::new(Qbvh::build_with(triangles, &self.build, &self.qbvh)),
-            AccelKind::Bvh8 => Box::new(Bvh8::build_with(triangles, &self.build, &self.qbvh)),
+            AccelKind::Qbvh => Box::new(Qbvh::build_with(triangles, &self.build, &self.wide)),
+            AccelKind::Bvh8 => Box::new(Bvh8::build_with(triangles, &self.build, &self.wide)),
             AccelKind::BruteForce => Box::new(BruteForce::new(triangles)),
         }
     }
@@ -197,7 +197,7 @@ impl AccelSpec {
         match key {
             "leaf" => {
                 let hi = if wide {
-                    crate::qbvh::MAX_LEAF_TRIANGLES as u32
+                    crate::wide::MAX_LEAF_TRIANGLES as u32
                 } else {
                     1 << 16
                 };
@@ -232,7 +232,7 @@ impl AccelSpec {
                 self.build.compact_leaves = true;
             }
             "order" => {
-                self.qbvh.order = match value {
+                self.wide.order = match value {
                     Some("unsorted") => Order::Unsorted,
                     Some("distance") => Order::Distance,
                     Some("split") => Order::SplitPlane,
@@ -241,14 +241,14 @@ impl AccelSpec {
             }
             "tstack" => {
                 flag()?;
-                self.qbvh.t_stack = true;
+                self.wide.t_stack = true;
             }
             "shadow-cache" => {
                 flag()?;
-                self.qbvh.shadow_cache = true;
+                self.wide.shadow_cache = true;
             }
             "isect" => {
-                self.qbvh.intersection = match value {
+                self.wide.intersection = match value {
                     Some("watertight") => TriangleTest::Watertight,
                     Some("subdivision") => TriangleTest::Subdivision,
                     Some("hybrid") => TriangleTest::Hybrid,
@@ -306,7 +306,7 @@ impl fmt::Display for AccelSpec {
         if b.compact_leaves {
             f.write_str(":compact")?;
         }
-        let (q, dq) = (&self.qbvh, &default.qbvh);
+        let (q, dq) = (&self.wide, &default.wide);
         if q.order != dq.order {
             let o = match q.order {
                 Order::Unsorted => "unsorted",

@@ -9,8 +9,8 @@ mod common;
 use common::{check_soup, icosphere, soup, Built, Rng};
 use glam::Vec3;
 use rayon::prelude::*;
-use rt_accel::qbvh::DEFAULT_LEAF_SIZE;
-use rt_accel::{BuildParams, OnDemandQbvh, Qbvh, QbvhOptions, Split};
+use rt_accel::wide::DEFAULT_LEAF_SIZE;
+use rt_accel::{BuildParams, OnDemandQbvh, Qbvh, Split, WideOptions};
 use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
 use std::time::Instant;
 
@@ -47,11 +47,11 @@ impl<const G: usize> Accel for Small<G> {
 
 impl<const G: usize> Built for Small<G> {
     fn build(tris: &[[Vec3; 3]], params: &BuildParams) -> Self {
-        let q = OnDemandQbvh::with_group_size(tris, params, &QbvhOptions::default(), G);
+        let q = OnDemandQbvh::with_group_size(tris, params, &WideOptions::default(), G);
         assert_eq!(q.built_groups(), 0);
         Small(q)
     }
-    fn validate(&self) -> Result<(), String> {
+    fn validate(&self) -> Result<(), rt_accel::ValidationError> {
         self.0.validate()
     }
     fn references(&self) -> Vec<([Vec3; 3], u32)> {
@@ -128,7 +128,7 @@ fn occluded_agrees_with_intersect() {
     let mut rng = Rng::new(77);
     let mut tris = icosphere(4).triangles();
     tris.extend(soup(&mut rng, 2000));
-    let q = OnDemandQbvh::with_group_size(&tris, &qbvh_params(), &QbvhOptions::default(), 200);
+    let q = OnDemandQbvh::with_group_size(&tris, &qbvh_params(), &WideOptions::default(), 200);
     let mut hits = 0;
     for (ray, t_max) in common::rays(&mut rng, &tris, 5000) {
         let hit = q.intersect(&ray, t_max);
@@ -142,8 +142,8 @@ fn occluded_agrees_with_intersect() {
 #[test]
 fn a_narrow_bundle_builds_only_the_groups_it_reaches() {
     let tris = icosphere(5).triangles();
-    let q = OnDemandQbvh::with_group_size(&tris, &qbvh_params(), &QbvhOptions::default(), 256);
-    let full = Qbvh::build_with(&tris, &qbvh_params(), &QbvhOptions::default());
+    let q = OnDemandQbvh::with_group_size(&tris, &qbvh_params(), &WideOptions::default(), 256);
+    let full = Qbvh::build_with(&tris, &qbvh_params(), &WideOptions::default());
     assert!(q.groups() >= tris.len() / 256);
     assert_eq!((q.built_groups(), q.build_count()), (0, 0));
     let top_only = q.memory_bytes();
@@ -189,7 +189,7 @@ fn a_narrow_bundle_builds_only_the_groups_it_reaches() {
 #[test]
 fn counted_queries_count_the_top_tree_too() {
     let tris = icosphere(4).triangles();
-    let q = OnDemandQbvh::with_group_size(&tris, &qbvh_params(), &QbvhOptions::default(), 64);
+    let q = OnDemandQbvh::with_group_size(&tris, &qbvh_params(), &WideOptions::default(), 64);
     assert!(q.counts_traversal());
     let ray = Ray::new(Vec3::new(0.1, 0.2, 3.0), -Vec3::Z);
     let mut c = TraversalCounters::default();
@@ -212,7 +212,7 @@ fn counted_queries_count_the_top_tree_too() {
 fn concurrent_queries_build_each_group_once() {
     let tris = icosphere(6).triangles();
     let params = qbvh_params();
-    let full = Qbvh::build_with(&tris, &params, &QbvhOptions::default());
+    let full = Qbvh::build_with(&tris, &params, &WideOptions::default());
     let mut rng = Rng::new(11);
     let rays: Vec<Ray> = (0..100_000).map(|_| ray_at_sphere(&mut rng)).collect();
     let want: Vec<Option<Hit>> = rays
@@ -223,8 +223,8 @@ fn concurrent_queries_build_each_group_once() {
 
     for group_size in [None, Some(300), Some(10_000)] {
         let q = match group_size {
-            None => OnDemandQbvh::new(&tris, &params, &QbvhOptions::default()),
-            Some(g) => OnDemandQbvh::with_group_size(&tris, &params, &QbvhOptions::default(), g),
+            None => OnDemandQbvh::new(&tris, &params, &WideOptions::default()),
+            Some(g) => OnDemandQbvh::with_group_size(&tris, &params, &WideOptions::default(), g),
         };
         assert_eq!(q.built_groups(), 0);
         let got: Vec<(Option<Hit>, bool)> = rays
@@ -248,7 +248,7 @@ fn concurrent_queries_build_each_group_once() {
 
 #[test]
 fn empty_scene() {
-    let q = OnDemandQbvh::new(&[], &BuildParams::default(), &QbvhOptions::default());
+    let q = OnDemandQbvh::new(&[], &BuildParams::default(), &WideOptions::default());
     q.validate().unwrap();
     assert_eq!((q.groups(), q.built_groups()), (0, 0));
     let ray = Ray::new(Vec3::ZERO, Vec3::X);
@@ -269,7 +269,7 @@ fn single_triangle() {
         Vec3::new(1.0, 0.0, 0.0),
         Vec3::new(0.0, 1.0, 0.0),
     ]];
-    let q = OnDemandQbvh::new(&tri, &BuildParams::default(), &QbvhOptions::default());
+    let q = OnDemandQbvh::new(&tri, &BuildParams::default(), &WideOptions::default());
     q.validate().unwrap();
     assert_eq!((q.groups(), q.built_groups()), (1, 0));
     assert_eq!(q.bounds(), Aabb::from_points(&tri[0]));
@@ -316,7 +316,7 @@ fn render(a: &dyn Accel, rays: &[Ray]) -> usize {
 fn lazy_vs_eager_timing() {
     let tris = icosphere(8).triangles();
     let params = qbvh_params();
-    let opts = QbvhOptions::default();
+    let opts = WideOptions::default();
     println!(
         "icosphere(8): {} triangles, {} rayon threads, group size {}",
         tris.len(),

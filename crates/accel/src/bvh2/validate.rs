@@ -17,7 +17,15 @@ impl Bvh2 {
     /// every reference the build started from (the triangle's, or each piece's when splitting)
     /// lies in a leaf that references the triangle, and the depth fits the traversal stack.
     /// Returns the first violation found.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), crate::ValidationError> {
+        self.find_problem()
+            .map_err(|problem| crate::ValidationError {
+                structure: rt_core::Accel::name(self).to_string(),
+                problem,
+            })
+    }
+
+    fn find_problem(&self) -> Result<(), String> {
         let originals = self.check_ids()?;
         let n_slots = self.triangles.len();
         if self.nodes.is_empty() {

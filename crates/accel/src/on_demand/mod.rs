@@ -31,7 +31,7 @@
 //! [`BruteForce`](crate::BruteForce)'s up to the ties and degenerate-triangle cases described
 //! at the other structures.
 //!
-//! The [`QbvhOptions`] apply to every group. The per-thread shadow-cache table is tagged with
+//! The [`WideOptions`] apply to every group. The per-thread shadow-cache table is tagged with
 //! the QBVH it belongs to, so with many groups it stays correct but is reset whenever a thread
 //! moves to another group, which takes most of its benefit away.
 //!
@@ -78,8 +78,8 @@
 //! built so far. Once every group is built the triangle copy is redundant with the QBVHs' own
 //! copies, but it cannot be freed through `&self`.
 
-use crate::qbvh::{QbvhOptions, MAX_TRIANGLES};
 use crate::traversal::{inside, walk_binary, BinaryNode, Step};
+use crate::wide::{WideOptions, MAX_TRIANGLES};
 use crate::{BuildParams, Qbvh};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -171,7 +171,7 @@ pub struct OnDemandQbvh {
     bounds: Aabb,
     /// The caller's parameters with `parallel` off.
     params: BuildParams,
-    options: QbvhOptions,
+    options: WideOptions,
     group_size: usize,
     builds: AtomicUsize,
 }
@@ -184,7 +184,7 @@ impl OnDemandQbvh {
     /// # Panics
     ///
     /// If there are more than `u32::MAX` triangles.
-    pub fn new(triangles: &[[Vec3; 3]], params: &BuildParams, options: &QbvhOptions) -> Self {
+    pub fn new(triangles: &[[Vec3; 3]], params: &BuildParams, options: &WideOptions) -> Self {
         Self::with_group_size(
             triangles,
             params,
@@ -202,7 +202,7 @@ impl OnDemandQbvh {
     pub fn with_group_size(
         triangles: &[[Vec3; 3]],
         params: &BuildParams,
-        options: &QbvhOptions,
+        options: &WideOptions,
         group_size: usize,
     ) -> Self {
         assert!(
@@ -287,7 +287,15 @@ impl OnDemandQbvh {
     /// are non-empty, no larger than the group size and cover every triangle exactly once, that
     /// [`OnDemandQbvh::group_order`] is a permutation, that the depth fits the traversal stack, and
     /// that the QBVHs built so far lie in their leaves' boxes. Returns the first violation found.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), crate::ValidationError> {
+        self.find_problem()
+            .map_err(|problem| crate::ValidationError {
+                structure: rt_core::Accel::name(self).to_string(),
+                problem,
+            })
+    }
+
+    fn find_problem(&self) -> Result<(), String> {
         let n = self.triangles.len();
         if self.order.len() != n {
             return Err(format!("{} indices for {n} triangles", self.order.len()));

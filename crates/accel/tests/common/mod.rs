@@ -3,7 +3,7 @@
 #![allow(dead_code)] // each test binary uses a different subset
 
 use glam::{Quat, Vec3};
-use rt_accel::qbvh::QChild;
+use rt_accel::wide::QChild;
 use rt_accel::{BruteForce, BuildParams, Bvh2, WideBvh, WideNode};
 use rt_core::triangle::{intersect_triangle, RayPrecomp};
 use rt_core::{Accel, Hit, Ray, TraversalCounters};
@@ -517,7 +517,7 @@ pub fn rotation(rng: &mut Rng) -> Quat {
 /// What the soup checks need of a built structure besides `Accel`.
 pub trait Built: Accel {
     fn build(tris: &[[Vec3; 3]], params: &BuildParams) -> Self;
-    fn validate(&self) -> Result<(), String>;
+    fn validate(&self) -> Result<(), rt_accel::ValidationError>;
     /// Every (triangle, caller index) reference in the leaves.
     fn references(&self) -> Vec<([Vec3; 3], u32)>;
 }
@@ -526,7 +526,7 @@ impl Built for Bvh2 {
     fn build(tris: &[[Vec3; 3]], params: &BuildParams) -> Self {
         Bvh2::build(tris, params)
     }
-    fn validate(&self) -> Result<(), String> {
+    fn validate(&self) -> Result<(), rt_accel::ValidationError> {
         Bvh2::validate(self)
     }
     fn references(&self) -> Vec<([Vec3; 3], u32)> {
@@ -542,7 +542,7 @@ impl<N: WideNode> Built for WideBvh<N> {
     fn build(tris: &[[Vec3; 3]], params: &BuildParams) -> Self {
         WideBvh::build(tris, params)
     }
-    fn validate(&self) -> Result<(), String> {
+    fn validate(&self) -> Result<(), rt_accel::ValidationError> {
         WideBvh::validate(self)
     }
     fn references(&self) -> Vec<([Vec3; 3], u32)> {
@@ -614,9 +614,9 @@ pub fn check_soup<A: Built>(
 // `validate` checks the top tree and the groups built so far.
 impl Built for rt_accel::OnDemandQbvh {
     fn build(tris: &[[Vec3; 3]], params: &BuildParams) -> Self {
-        rt_accel::OnDemandQbvh::new(tris, params, &rt_accel::QbvhOptions::default())
+        rt_accel::OnDemandQbvh::new(tris, params, &rt_accel::WideOptions::default())
     }
-    fn validate(&self) -> Result<(), String> {
+    fn validate(&self) -> Result<(), rt_accel::ValidationError> {
         rt_accel::OnDemandQbvh::validate(self)
     }
     fn references(&self) -> Vec<([Vec3; 3], u32)> {

@@ -112,8 +112,8 @@ impl WideNode for Node8 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::qbvh::node::{leaf_code, QChild, NO_PARENT};
-    use crate::qbvh::wide::order_word;
+    use crate::wide::node::{leaf_code, QChild, NO_PARENT};
+    use crate::wide::wide::order_word;
     use glam::Vec3;
 
     #[test]

@@ -496,9 +496,9 @@ impl<N: WideNode> WideBvh<N> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::qbvh::node::{leaf_code, QNode, NO_PARENT};
-    use crate::qbvh::node8::Node8;
-    use crate::qbvh::wide::WideNode;
+    use crate::wide::node::{leaf_code, QNode, NO_PARENT};
+    use crate::wide::node8::Node8;
+    use crate::wide::wide::WideNode;
     use glam::Vec3;
 
     #[test]
@@ -529,7 +529,7 @@ mod tests {
             // Few distinct values so that rays often lie in face planes.
             (s % 9) as f32 * 0.25 - 1.0
         };
-        let avx2 = crate::qbvh::Avx2::detect();
+        let avx2 = crate::wide::Avx2::detect();
         for _ in 0..20_000 {
             // Slot 3 of the four-wide node and slot 7 of the eight-wide one stay empty.
             let mut node = QNode::empty(NO_PARENT);

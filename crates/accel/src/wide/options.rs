@@ -37,10 +37,10 @@ pub enum TriangleTest {
 }
 
 /// How a [`Qbvh`](super::Qbvh) or [`Bvh8`](super::Bvh8) is traversed. The defaults
-/// ([`QbvhOptions::defaults_for`]; `Default` gives the QBVH's) are the fastest measured on this
+/// ([`WideOptions::defaults_for`]; `Default` gives the QBVH's) are the fastest measured on this
 /// project's benchmarks (see `docs/benchmarks.md`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct QbvhOptions {
+pub struct WideOptions {
     /// Child visiting order.
     pub order: Order,
     /// Keep each pending child's entry distance on the stack and skip it when popped if a
@@ -53,7 +53,7 @@ pub struct QbvhOptions {
     pub intersection: TriangleTest,
 }
 
-impl QbvhOptions {
+impl WideOptions {
     /// The default options of a wide BVH with nodes `N`: they differ only in the child order.
     pub fn defaults_for<N: super::WideNode>() -> Self {
         Self {

@@ -17,7 +17,15 @@ impl<N: WideNode> WideBvh<N> {
     /// the leaves hold [`WideBvh::reference_count`] references, the root's children lie inside
     /// [`Accel::bounds`](rt_core::Accel::bounds), and the depth fits the traversal stack.
     /// Returns the first violation found.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), crate::ValidationError> {
+        self.find_problem()
+            .map_err(|problem| crate::ValidationError {
+                structure: rt_core::Accel::name(self).to_string(),
+                problem,
+            })
+    }
+
+    fn find_problem(&self) -> Result<(), String> {
         let n_packets = self.packets.len();
         if self.packet_ids.len() != n_packets {
             return Err(format!(

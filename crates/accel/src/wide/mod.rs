@@ -23,7 +23,7 @@ mod wide;
 
 pub use node::{QChild, QNode, EMPTY, LEAF_BIT, MAX_LEAF_TRIANGLES, MAX_TRIANGLES, NO_AXIS};
 pub use node8::Node8;
-pub use options::{Order, QbvhOptions, TriangleTest, DEFAULT_INTERSECTION_COST, DEFAULT_LEAF_SIZE};
+pub use options::{Order, TriangleTest, WideOptions, DEFAULT_INTERSECTION_COST, DEFAULT_LEAF_SIZE};
 pub use tri4::Tri4;
 pub use wide::{Avx2, Baseline, Isa, WideNode};
 
@@ -53,7 +53,7 @@ pub struct WideBvh<N: WideNode> {
     avx2: Option<Avx2>,
     /// Tags this structure's entries in the per-thread shadow-cache tables.
     id: u64,
-    options: QbvhOptions,
+    options: WideOptions,
 }
 
 impl<N: WideNode> WideBvh<N> {
@@ -74,7 +74,7 @@ impl<N: WideNode> WideBvh<N> {
     pub fn build_with(
         triangles: &[[Vec3; 3]],
         params: &BuildParams,
-        options: &QbvhOptions,
+        options: &WideOptions,
     ) -> Self {
         let mut q = Self::build(triangles, params);
         q.options = *options;
@@ -82,7 +82,7 @@ impl<N: WideNode> WideBvh<N> {
     }
 
     /// The traversal options.
-    pub fn options(&self) -> &QbvhOptions {
+    pub fn options(&self) -> &WideOptions {
         &self.options
     }
 
@@ -109,7 +109,7 @@ impl<N: WideNode> WideBvh<N> {
             bounds: bvh.bounds(),
             avx2: Avx2::detect(),
             id: shadow_cache::new_id(),
-            options: QbvhOptions::defaults_for::<N>(),
+            options: WideOptions::defaults_for::<N>(),
         }
     }
 

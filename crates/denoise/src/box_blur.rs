@@ -1,21 +1,21 @@
 //! The k×k box filter.
 
-use crate::{Filter, FilterError, NoisyFrame};
+use crate::{DenoiseError, Denoiser, NoisyFrame};
 use rt_core::Rgb;
 
 /// Mean over a `(2r+1)²` window, clamped at the image border (the window shrinks, so a constant
 /// image stays constant up to the edge).
 #[derive(Clone, Debug)]
-pub struct BoxFilter {
+pub struct BoxBlur {
     radius: usize,
 }
 
-impl BoxFilter {
+impl BoxBlur {
     /// A filter of the given radius (0 is the identity). Radii above 64 are rejected: they are
     /// almost certainly a mistake and would be slow with this direct implementation.
-    pub fn new(radius: usize) -> Result<Self, FilterError> {
+    pub fn new(radius: usize) -> Result<Self, DenoiseError> {
         if radius > 64 {
-            return Err(FilterError::Param {
+            return Err(DenoiseError::Param {
                 name: "radius",
                 message: format!("must be at most 64, got {radius}"),
             });
@@ -24,7 +24,7 @@ impl BoxFilter {
     }
 }
 
-impl Filter for BoxFilter {
+impl Denoiser for BoxBlur {
     fn name(&self) -> &str {
         "box"
     }
@@ -63,7 +63,7 @@ mod tests {
     #[test]
     fn constant_stays_constant_and_mean_is_kept_inside() {
         let f = NoisyFrame::from_beauty(5, 4, vec![Rgb::splat(2.0); 20]);
-        assert!(BoxFilter::new(2)
+        assert!(BoxBlur::new(2)
             .unwrap()
             .apply(&f)
             .iter()
@@ -71,9 +71,9 @@ mod tests {
         let mut img = vec![Rgb::ZERO; 25];
         img[12] = Rgb::splat(9.0);
         let f = NoisyFrame::from_beauty(5, 5, img);
-        let out = BoxFilter::new(1).unwrap().apply(&f);
+        let out = BoxBlur::new(1).unwrap().apply(&f);
         assert!((out[12].x - 1.0).abs() < 1e-6 && (out[6].x - 1.0).abs() < 1e-6 && out[0].x == 0.0);
-        assert_eq!(BoxFilter::new(0).unwrap().apply(&f), f.beauty);
-        assert!(BoxFilter::new(65).is_err());
+        assert_eq!(BoxBlur::new(0).unwrap().apply(&f), f.beauty);
+        assert!(BoxBlur::new(65).is_err());
     }
 }
