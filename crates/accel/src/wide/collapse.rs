@@ -2,7 +2,7 @@
 
 use super::node::{leaf_code, MAX_LEAF_TRIANGLES, NO_AXES, NO_AXIS, NO_PARENT};
 use super::tri4::Tri4;
-use super::wide::{order_word, WideNode};
+use super::bvh::{order_word, WideNode};
 use crate::bvh2::Node;
 use glam::Vec3;
 use rt_core::Aabb;

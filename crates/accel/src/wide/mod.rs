@@ -19,13 +19,13 @@ mod shadow_cache;
 mod traverse;
 mod tri4;
 mod validate;
-mod wide;
+mod bvh;
 
 pub use node::{QChild, QNode, EMPTY, LEAF_BIT, MAX_LEAF_TRIANGLES, MAX_TRIANGLES, NO_AXIS};
 pub use node8::Node8;
 pub use options::{Order, TriangleTest, WideOptions, DEFAULT_INTERSECTION_COST, DEFAULT_LEAF_SIZE};
 pub use tri4::Tri4;
-pub use wide::{Avx2, Baseline, Isa, WideNode};
+pub use bvh::{Avx2, Baseline, Isa, WideNode};
 
 use crate::traversal::{with_counter, Counter};
 use crate::{BuildParams, Bvh2};

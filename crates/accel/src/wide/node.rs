@@ -1,7 +1,7 @@
 //! The 128-byte QBVH node and its child encoding.
 
 use super::traverse::Slab;
-use super::wide::{Isa, WideNode};
+use super::bvh::{Isa, WideNode};
 use super::Order;
 use glam::Vec3;
 use rt_core::Aabb;

@@ -2,7 +2,7 @@
 
 use super::node::{empty_bounds, get_bounds, set_bounds, EMPTY};
 use super::traverse::Slab;
-use super::wide::{Isa, WideNode};
+use super::bvh::{Isa, WideNode};
 use super::Order;
 use rt_core::Aabb;
 
@@ -113,7 +113,7 @@ impl WideNode for Node8 {
 mod tests {
     use super::*;
     use crate::wide::node::{leaf_code, QChild, NO_PARENT};
-    use crate::wide::wide::order_word;
+    use crate::wide::bvh::order_word;
     use glam::Vec3;
 
     #[test]

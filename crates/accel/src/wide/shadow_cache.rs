@@ -19,7 +19,7 @@
 use super::node::{EMPTY, LEAF_BIT, NO_PARENT};
 use super::traverse::{octant, Slab, STACK_SIZE};
 use super::tri4::RayPrecomp4;
-use super::wide::{Avx2, Baseline, Isa, WideNode};
+use super::bvh::{Avx2, Baseline, Isa, WideNode};
 use super::WideBvh;
 use crate::traversal::{Closest, Counter};
 use glam::Vec3;

@@ -5,7 +5,7 @@ use super::node::{leaf_parts, EMPTY, LEAF_BIT};
 #[cfg(target_arch = "x86_64")]
 use super::tri4::intersect8_avx2;
 use super::tri4::{intersect4, RayPrecomp4};
-use super::wide::{slot_of, Isa, WideNode};
+use super::bvh::{slot_of, Isa, WideNode};
 use super::{TriangleTest, WideBvh};
 use crate::crack_free::{intersect_hybrid, intersect_subdivision, SubdivRay};
 use crate::traversal::{Closest, Counter, FAR_SCALE};
@@ -498,7 +498,7 @@ mod tests {
     use super::*;
     use crate::wide::node::{leaf_code, QNode, NO_PARENT};
     use crate::wide::node8::Node8;
-    use crate::wide::wide::WideNode;
+    use crate::wide::bvh::WideNode;
     use glam::Vec3;
 
     #[test]

@@ -2,7 +2,7 @@
 
 use super::node::{QChild, EMPTY, NO_PARENT};
 use super::traverse::MAX_DEPTH;
-use super::wide::WideNode;
+use super::bvh::WideNode;
 use super::WideBvh;
 use crate::traversal::inside;
 use rt_core::Aabb;
