@@ -1,8 +1,8 @@
 //! Collapsing a binary BVH into a wide one, and packing its leaves four triangles wide.
 
+use super::bvh::{order_word, WideNode};
 use super::node::{leaf_code, MAX_LEAF_TRIANGLES, NO_AXES, NO_AXIS, NO_PARENT};
 use super::tri4::Tri4;
-use super::bvh::{order_word, WideNode};
 use crate::bvh2::Node;
 use glam::Vec3;
 use rt_core::Aabb;

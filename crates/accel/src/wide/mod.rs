@@ -11,6 +11,7 @@
 //! [`WideBvh`] is generic over the node ([`WideNode`]): [`Qbvh`] and [`Bvh8`] share the
 //! collapse, the traversal loop, the shadow cache and the validator.
 
+mod bvh;
 mod collapse;
 mod node;
 mod node8;
@@ -19,13 +20,12 @@ mod shadow_cache;
 mod traverse;
 mod tri4;
 mod validate;
-mod bvh;
 
+pub use bvh::{Avx2, Baseline, Isa, WideNode};
 pub use node::{QChild, QNode, EMPTY, LEAF_BIT, MAX_LEAF_TRIANGLES, MAX_TRIANGLES, NO_AXIS};
 pub use node8::Node8;
 pub use options::{Order, TriangleTest, WideOptions, DEFAULT_INTERSECTION_COST, DEFAULT_LEAF_SIZE};
 pub use tri4::Tri4;
-pub use bvh::{Avx2, Baseline, Isa, WideNode};
 
 use crate::traversal::{with_counter, Counter};
 use crate::{BuildParams, Bvh2};

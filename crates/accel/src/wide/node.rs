@@ -1,7 +1,7 @@
 //! The 128-byte QBVH node and its child encoding.
 
-use super::traverse::Slab;
 use super::bvh::{Isa, WideNode};
+use super::traverse::Slab;
 use super::Order;
 use glam::Vec3;
 use rt_core::Aabb;

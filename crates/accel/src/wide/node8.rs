@@ -1,8 +1,8 @@
 //! The 256-byte eight-wide node.
 
+use super::bvh::{Isa, WideNode};
 use super::node::{empty_bounds, get_bounds, set_bounds, EMPTY};
 use super::traverse::Slab;
-use super::bvh::{Isa, WideNode};
 use super::Order;
 use rt_core::Aabb;
 
@@ -112,8 +112,8 @@ impl WideNode for Node8 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::wide::node::{leaf_code, QChild, NO_PARENT};
     use crate::wide::bvh::order_word;
+    use crate::wide::node::{leaf_code, QChild, NO_PARENT};
     use glam::Vec3;
 
     #[test]

@@ -16,10 +16,10 @@
 //! here the grid has 256 cells along the scene's largest extent, so it does not depend on the
 //! scene's units.
 
+use super::bvh::{Avx2, Baseline, Isa, WideNode};
 use super::node::{EMPTY, LEAF_BIT, NO_PARENT};
 use super::traverse::{octant, Slab, STACK_SIZE};
 use super::tri4::RayPrecomp4;
-use super::bvh::{Avx2, Baseline, Isa, WideNode};
 use super::WideBvh;
 use crate::traversal::{Closest, Counter};
 use glam::Vec3;

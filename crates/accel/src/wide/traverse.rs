@@ -1,11 +1,11 @@
 //! Stack traversal of a wide BVH with a robust four- or eight-wide slab test, in three child
 //! orders, with or without entry distances on the stack.
 
+use super::bvh::{slot_of, Isa, WideNode};
 use super::node::{leaf_parts, EMPTY, LEAF_BIT};
 #[cfg(target_arch = "x86_64")]
 use super::tri4::intersect8_avx2;
 use super::tri4::{intersect4, RayPrecomp4};
-use super::bvh::{slot_of, Isa, WideNode};
 use super::{TriangleTest, WideBvh};
 use crate::crack_free::{intersect_hybrid, intersect_subdivision, SubdivRay};
 use crate::traversal::{Closest, Counter, FAR_SCALE};
@@ -496,9 +496,9 @@ impl<N: WideNode> WideBvh<N> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::wide::bvh::WideNode;
     use crate::wide::node::{leaf_code, QNode, NO_PARENT};
     use crate::wide::node8::Node8;
-    use crate::wide::bvh::WideNode;
     use glam::Vec3;
 
     #[test]

@@ -1,8 +1,8 @@
 //! Structural self-check of a collapsed tree.
 
+use super::bvh::WideNode;
 use super::node::{QChild, EMPTY, NO_PARENT};
 use super::traverse::MAX_DEPTH;
-use super::bvh::WideNode;
 use super::WideBvh;
 use crate::traversal::inside;
 use rt_core::Aabb;

@@ -1,0 +1,32 @@
+//! Ambient occlusion of a procedural scene at 4 spp through `IntegratorSpec` and the driver,
+//! printing the image mean: the integrators crate used on its own.
+//! `cargo run --release -p rt-integrators --example ao_mean [SPEC]` (default `ao:distance=2`).
+use rt_film::{Film, FilmBuffers};
+use rt_integrators::{Ctx, IntegratorSpec, RenderOptions};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let spec: IntegratorSpec = std::env::args()
+        .nth(1)
+        .unwrap_or("ao:distance=2".into())
+        .parse()?;
+    let scene = rt_scene::procedural::generate("rotated")?;
+    let mut camera = scene.cameras[0].clone();
+    (camera.width, camera.height) = (64, 48);
+    let accel = rt_accel::AccelSpec::default().build(&scene.triangles);
+    let ctx = Ctx {
+        scene: &scene,
+        accel: accel.as_ref(),
+        camera: &camera,
+    };
+    let mut film = Film::new(camera.width, camera.height, FilmBuffers::default());
+    let stats = rt_integrators::render(
+        &ctx,
+        spec.build().as_ref(),
+        &mut film,
+        &RenderOptions { spp: 4, seed: 0 },
+        &|_| {},
+    );
+    let mean = film.mean_image().iter().sum::<rt_core::Rgb>() / (64.0 * 48.0);
+    println!("{spec}: mean {mean:?}, {} rays", stats.rays.rays);
+    Ok(())
+}
