@@ -9,8 +9,8 @@
 
 use crate::Film;
 use exr::prelude::{
-    AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec,
-    WritableImage,
+    AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, LineOrder,
+    SmallVec, WritableImage,
 };
 use rt_core::{color::linear_to_srgb, Rgb};
 use std::fs::File;
@@ -209,7 +209,12 @@ fn write_exr_channels(
     let layer = Layer::new(
         size,
         LayerAttributes::default(),
-        Encoding::FAST_LOSSLESS,
+        // Tiles in increasing order: the file's bytes then depend on the image only, not on
+        // which compression thread finished first (equal renders give equal files).
+        Encoding {
+            line_order: LineOrder::Increasing,
+            ..Encoding::FAST_LOSSLESS
+        },
         AnyChannels::sort(SmallVec::from_vec(chans)),
     );
     Image::from_layer(layer)
@@ -334,6 +339,25 @@ mod tests {
             }
         }
         film
+    }
+
+    #[test]
+    fn exr_bytes_do_not_depend_on_compression_threads() {
+        // 64 tiles compressed in parallel: without a fixed line order the tiles land in the
+        // file in completion order, so equal images gave different files.
+        let (w, h) = (512, 512);
+        let pixels: Vec<Rgb> = (0..w * h)
+            .map(|i| Rgb::new((i % 7) as f32, (i % 13) as f32 * 0.5, (i / w) as f32))
+            .collect();
+        let dir = tempfile::tempdir().unwrap();
+        let files: Vec<Vec<u8>> = (0..6)
+            .map(|k| {
+                let p = dir.path().join(format!("{k}.exr"));
+                write_rgb(&p, w, h, &pixels, &OutputOptions::default()).unwrap();
+                std::fs::read(p).unwrap()
+            })
+            .collect();
+        assert!(files.windows(2).all(|f| f[0] == f[1]));
     }
 
     #[test]
