@@ -64,15 +64,9 @@ pub fn run(args: &CompareArgs) -> Result<()> {
             ..Default::default()
         };
         let img = error_image(&test, &reference, &colours).map_err(explain)?;
-        rt_film::write_rgb(
-            path,
-            img.width(),
-            img.height(),
-            img.pixels(),
-            &rt_film::OutputOptions::default(),
-        )
-        // The message already holds the cause; `{:#}` would print it twice.
-        .map_err(|e| anyhow!("{e}"))?;
+        rt_film::write_rgb(path, &img, &rt_film::OutputOptions::default())
+            // The message already holds the cause; `{:#}` would print it twice.
+            .map_err(|e| anyhow!("{e}"))?;
     }
     print!("{}", report(&metrics, &opts, args.json));
     Ok(())

@@ -24,7 +24,8 @@ impl Dir {
             .map(|(x, y)| f(x, y))
             .collect();
         let p = self.path(name);
-        rt_film::write_rgb(&p, w, h, &px, &Default::default()).unwrap();
+        let image = rt_core::RgbImage::new(w, h, px).unwrap();
+        rt_film::write_rgb(&p, &image, &Default::default()).unwrap();
         p
     }
 

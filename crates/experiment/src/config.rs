@@ -677,8 +677,8 @@ seconds = [0.5, 0.1]
         let dir = tempfile::tempdir().unwrap();
         std::fs::create_dir(dir.path().join("scenes")).unwrap();
         std::fs::write(dir.path().join("scenes/s.toml"), SCENE).unwrap();
-        let img = vec![rt_core::Rgb::splat(0.5); 8 * 8];
-        rt_film::write_rgb(&dir.path().join("r.exr"), 8, 8, &img, &Default::default()).unwrap();
+        let img = RgbImage::from_fn(8, 8, |_, _| rt_core::Rgb::splat(0.5));
+        rt_film::write_rgb(&dir.path().join("r.exr"), &img, &Default::default()).unwrap();
         let path = dir.path().join("x.toml");
         let config = GOOD.replace("{ spp = 16 }", "\"r.exr\"");
         std::fs::write(&path, &config).unwrap();

@@ -103,13 +103,11 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
         bar.set_message(format!("{}: reference", scene.name));
         let reference = match &scene.reference {
             ReferencePlan::File { path, image } => {
-                let rgb = image.pixels().to_vec();
-                let (w, h) = (image.width(), image.height());
-                rt_film::write_rgb(&copy, w, h, &rgb, &Default::default())?;
+                rt_film::write_rgb(&copy, image, &Default::default())?;
                 let variance = rt_film::read_exr(path)
                     .ok()
                     .and_then(|e| e.rgb("variance."))
-                    .filter(|v| v.len() == rgb.len());
+                    .filter(|v| v.len() == image.pixels().len());
                 Reference {
                     image: image.clone(),
                     variance,

@@ -402,14 +402,9 @@ pub fn crops(plan: &Plan, results: &Results, out: &Path) -> Result<Vec<(usize, u
         let z = zoom(block.2);
         let side = block.2 * z;
         let write = |name: &str, img: &RgbImage| {
-            rt_film::write_rgb(
-                &dir.join(format!("{name}.png")),
-                side,
-                side,
-                &cut(img, block, z),
-                &Default::default(),
-            )
-            .map_err(crate::ExperimentError::from)
+            let crop = RgbImage::new(side, side, cut(img, block, z))?;
+            rt_film::write_rgb(&dir.join(format!("{name}.png")), &crop, &Default::default())
+                .map_err(crate::ExperimentError::from)
         };
         write("reference", reference)?;
         for (&p, img) in pairs.iter().zip(&finals) {

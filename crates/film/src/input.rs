@@ -38,24 +38,43 @@ pub fn read_rgb(path: &Path) -> Result<RgbImage> {
         // `FilmError` already names the file and holds the cause.
         Some("exr") => exr_rgb(path, read_exr(path)?),
         Some("png" | "jpg" | "jpeg") => {
-            let img = image::ImageReader::open(path)
-                .and_then(|r| r.with_guessed_format())
-                .map_err(|e| codec(path, e.to_string()))?
-                .decode()
-                .map_err(|e| codec(path, e.to_string()))?
-                .to_rgb32f();
-            let (w, h) = (img.width() as usize, img.height() as usize);
-            let pixels = img
-                .pixels()
-                .map(|p| Rgb::from_array(p.0.map(srgb_to_linear)))
-                .collect();
-            RgbImage::new(w, h, pixels).map_err(|e| codec(path, e.to_string()))
+            let bytes = std::fs::read(path).map_err(|source| FilmError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?;
+            decode_srgb(&bytes).map_err(|e| codec(path, e))
         }
         _ => Err(codec(
             path,
             "unsupported image format (use .exr, .png or .jpg)",
         )),
     }
+}
+
+/// Decodes a PNG or JPEG (any bit depth, grey or colour; alpha ignored) held in memory, taking
+/// its values to be sRGB-encoded, to linear RGB: the one decoder for image files and for images
+/// inside other files (glTF). Eight-bit values go through an exact table.
+pub fn decode_srgb(bytes: &[u8]) -> std::result::Result<RgbImage, String> {
+    let img = image::load_from_memory(bytes).map_err(|e| format!("cannot decode image: {e}"))?;
+    let (width, height) = (img.width() as usize, img.height() as usize);
+    let pixels = match img {
+        image::DynamicImage::ImageLuma8(_)
+        | image::DynamicImage::ImageLumaA8(_)
+        | image::DynamicImage::ImageRgb8(_)
+        | image::DynamicImage::ImageRgba8(_) => {
+            let lut: Vec<f32> = (0..256).map(|i| srgb_to_linear(i as f32 / 255.0)).collect();
+            img.to_rgb8()
+                .pixels()
+                .map(|p| Rgb::new(lut[p[0] as usize], lut[p[1] as usize], lut[p[2] as usize]))
+                .collect()
+        }
+        _ => img
+            .to_rgb32f()
+            .pixels()
+            .map(|p| Rgb::from_array(p.0.map(|v| srgb_to_linear(v.clamp(0.0, 1.0)))))
+            .collect(),
+    };
+    RgbImage::new(width, height, pixels).map_err(|e| e.to_string())
 }
 
 fn exr_rgb(path: &Path, exr: ExrImage) -> Result<RgbImage> {

@@ -35,7 +35,7 @@ pub mod output;
 mod pixel;
 
 pub use film::{AovSet, Film, FilmBuffers, FilmMemory, FilmStripe, UnknownAov};
-pub use input::read_rgb;
+pub use input::{decode_srgb, read_rgb};
 pub use output::{
     copy_atomic, read_exr, write_bytes_atomic, write_image, write_rgb, FilmError, OutputOptions,
 };

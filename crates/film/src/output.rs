@@ -12,7 +12,7 @@ use exr::prelude::{
     AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, LineOrder,
     SmallVec, WritableImage,
 };
-use rt_core::{color::linear_to_srgb, Rgb};
+use rt_core::{color::linear_to_srgb, Rgb, RgbImage};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -64,26 +64,17 @@ pub fn write_image(path: &Path, film: &Film, opts: &OutputOptions) -> Result<(),
     }
 }
 
-/// Writes a plain linear RGB image (`width × height` pixels, row-major, top row first) to
-/// `path`, by extension: `.exr` (channels `R`, `G`, `B`, linear float) or `.png` (tone mapped as
-/// the film's beauty image). Atomic like [`write_image`]. For images that are not a film, e.g.
-/// error maps.
-pub fn write_rgb(
-    path: &Path,
-    width: usize,
-    height: usize,
-    pixels: &[Rgb],
-    opts: &OutputOptions,
-) -> Result<(), FilmError> {
+/// Writes a plain linear RGB image to `path`, by extension: `.exr` (channels `R`, `G`, `B`,
+/// linear float) or `.png` (tone mapped as the film's beauty image). Atomic like
+/// [`write_image`]. For images that are not a film, e.g. references and error maps.
+pub fn write_rgb(path: &Path, image: &RgbImage, opts: &OutputOptions) -> Result<(), FilmError> {
+    let (width, height, pixels) = (image.width(), image.height(), image.pixels());
     let size = match (u32::try_from(width), u32::try_from(height)) {
-        (Ok(w), Ok(h)) if width.checked_mul(height) == Some(pixels.len()) => (w, h),
+        (Ok(w), Ok(h)) => (w, h),
         _ => {
             return Err(FilmError::Codec {
                 path: path.to_path_buf(),
-                message: format!(
-                    "{} pixels do not make a {width}x{height} image",
-                    pixels.len()
-                ),
+                message: format!("a {width}x{height} image is too large to write"),
             })
         }
     };
@@ -353,7 +344,12 @@ mod tests {
         let files: Vec<Vec<u8>> = (0..6)
             .map(|k| {
                 let p = dir.path().join(format!("{k}.exr"));
-                write_rgb(&p, w, h, &pixels, &OutputOptions::default()).unwrap();
+                write_rgb(
+                    &p,
+                    &RgbImage::new(w, h, pixels.clone()).unwrap(),
+                    &OutputOptions::default(),
+                )
+                .unwrap();
                 std::fs::read(p).unwrap()
             })
             .collect();
@@ -409,16 +405,16 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let px: Vec<Rgb> = (0..6).map(|i| Rgb::new(i as f32 / 5.0, 0.5, 1.0)).collect();
         let opts = OutputOptions::default();
-        write_rgb(&dir.path().join("a.exr"), 3, 2, &px, &opts).unwrap();
+        let image = RgbImage::new(3, 2, px.clone()).unwrap();
+        write_rgb(&dir.path().join("a.exr"), &image, &opts).unwrap();
         let img = read_exr(&dir.path().join("a.exr")).unwrap();
         assert_eq!((img.width, img.height), (3, 2));
         assert_eq!(img.rgb("").unwrap(), px);
-        write_rgb(&dir.path().join("a.png"), 3, 2, &px, &opts).unwrap();
+        write_rgb(&dir.path().join("a.png"), &image, &opts).unwrap();
         let png = image::open(dir.path().join("a.png")).unwrap().to_rgb8();
         assert_eq!(png.dimensions(), (3, 2));
         assert_eq!(png.get_pixel(2, 1).0, [255, 188, 255]);
-        assert!(write_rgb(&dir.path().join("b.png"), 4, 2, &px, &opts).is_err());
-        assert!(write_rgb(&dir.path().join("b.tga"), 3, 2, &px, &opts).is_err());
+        assert!(write_rgb(&dir.path().join("b.tga"), &image, &opts).is_err());
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
     }
 }

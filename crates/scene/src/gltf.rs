@@ -22,7 +22,7 @@
 
 use crate::error::{Result, SceneError};
 use crate::geometry::Mesh;
-use crate::image_io::{texture_from_image, Textures};
+use crate::image_io::{texture_from_bytes, Textures};
 use ::gltf::mesh::Mode;
 use glam::{Mat4, Vec2, Vec3};
 use rt_core::transform::Transform;
@@ -316,9 +316,9 @@ impl Loader<'_> {
                 }
             }
         };
-        let img = image::load_from_memory(&bytes)
-            .map_err(|e| self.error(format!("image {index}: cannot decode: {e}")))?;
-        let t = self.textures.add(texture_from_image(img));
+        let texture =
+            texture_from_bytes(&bytes).map_err(|e| self.error(format!("image {index}: {e}")))?;
+        let t = self.textures.add(texture);
         self.images.insert(index, t);
         Ok(t)
     }

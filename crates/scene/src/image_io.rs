@@ -1,7 +1,7 @@
 //! Image files: textures (PNG, JPEG; sRGB decoded to linear) and EXR environment maps.
 
 use crate::error::{Result, SceneError};
-use rt_core::{color::srgb_to_linear, texture::Texture, Rgb};
+use rt_core::{texture::Texture, Rgb};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -37,48 +37,22 @@ impl Textures {
     }
 }
 
-/// Reads a PNG or JPEG texture. Colour values are sRGB-encoded in the file and decoded to
-/// linear RGB; alpha is ignored.
+/// Reads a PNG or JPEG texture (`rt_film::decode_srgb`: sRGB decoded to linear, alpha
+/// ignored).
 pub(crate) fn read_texture(path: &Path) -> Result<Texture> {
     let bytes =
         std::fs::read(path).map_err(|e| SceneError::file(path, format!("cannot open: {e}")))?;
-    let img = image::load_from_memory(&bytes)
-        .map_err(|e| SceneError::file(path, format!("cannot decode image: {e}")))?;
-    Ok(texture_from_image(img))
+    texture_from_bytes(&bytes).map_err(|e| SceneError::file(path, e))
 }
 
-/// Converts a decoded image (sRGB-encoded) to a linear texture.
-pub(crate) fn texture_from_image(img: image::DynamicImage) -> Texture {
-    let (width, height) = (img.width(), img.height());
-    let texels = match img {
-        // 8-bit images: decode through a table (exact and fast).
-        image::DynamicImage::ImageLuma8(_)
-        | image::DynamicImage::ImageLumaA8(_)
-        | image::DynamicImage::ImageRgb8(_)
-        | image::DynamicImage::ImageRgba8(_) => {
-            let lut: Vec<f32> = (0..256).map(|i| srgb_to_linear(i as f32 / 255.0)).collect();
-            img.to_rgb8()
-                .pixels()
-                .map(|p| Rgb::new(lut[p[0] as usize], lut[p[1] as usize], lut[p[2] as usize]))
-                .collect()
-        }
-        _ => img
-            .to_rgb32f()
-            .pixels()
-            .map(|p| {
-                Rgb::new(
-                    srgb_to_linear(p[0].clamp(0.0, 1.0)),
-                    srgb_to_linear(p[1].clamp(0.0, 1.0)),
-                    srgb_to_linear(p[2].clamp(0.0, 1.0)),
-                )
-            })
-            .collect(),
-    };
-    Texture {
-        width,
-        height,
-        texels,
-    }
+/// Decodes an encoded PNG or JPEG (a file's bytes, or an image inside a glTF file).
+pub(crate) fn texture_from_bytes(bytes: &[u8]) -> std::result::Result<Texture, String> {
+    let img = rt_film::decode_srgb(bytes)?;
+    Ok(Texture {
+        width: img.width() as u32,
+        height: img.height() as u32,
+        texels: img.into_pixels(),
+    })
 }
 
 /// Reads the first RGB(A) layer of an EXR file as row-major linear radiance (row 0 at the
@@ -87,27 +61,26 @@ pub(crate) fn read_env_map(path: &Path) -> Result<(u32, u32, Vec<Rgb>)> {
     if let Err(e) = std::fs::File::open(path) {
         return Err(SceneError::file(path, format!("cannot open: {e}")));
     }
-    struct Pixels {
-        width: usize,
-        texels: Vec<Rgb>,
+    if !path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+    {
+        return Err(SceneError::file(
+            path,
+            "an environment map must be an .exr file",
+        ));
     }
-    let img = exr::prelude::read_first_rgba_layer_from_file(
-        path,
-        |size, _| Pixels {
-            width: size.width(),
-            texels: vec![Rgb::ZERO; size.width() * size.height()],
-        },
-        |px: &mut Pixels, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
-            px.texels[pos.y() * px.width + pos.x()] = Rgb::new(r, g, b);
-        },
-    )
-    .map_err(|e| SceneError::file(path, format!("cannot read as an RGB EXR image: {e}")))?;
-    let size = img.layer_data.size;
-    let (w, h) = (size.width(), size.height());
+    let img = rt_film::read_rgb(path).map_err(|e| {
+        let text = e.to_string();
+        let prefix = format!("{}: ", path.display());
+        let why = text.strip_prefix(&prefix).unwrap_or(&text);
+        SceneError::file(path, format!("cannot read as an RGB EXR image: {why}"))
+    })?;
+    let (w, h) = (img.width(), img.height());
     if w == 0 || h == 0 {
         return Err(SceneError::file(path, "the image is empty"));
     }
-    let texels = img.layer_data.channel_data.pixels.texels;
+    let texels = img.into_pixels();
     if let Some(i) = texels
         .iter()
         .position(|t| !t.is_finite() || t.min_element() < 0.0)
