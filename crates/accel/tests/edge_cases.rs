@@ -264,7 +264,10 @@ fn sah_cost_of_a_row_is_near_optimal() {
         2.0 * (2.0 * l * e + e * e)
     };
     let weight = |i: usize, j: usize| area(i, j) / area(0, N - 1);
-    let (ct, ci) = (params.traversal_cost as f64, params.intersection_cost as f64);
+    let (ct, ci) = (
+        params.traversal_cost as f64,
+        params.intersection_cost as f64,
+    );
     // best[i][j]: cheapest subtree over the run i..=j.
     let mut best = vec![vec![f64::INFINITY; N]; N];
     for len in 1..=N {
