@@ -6,6 +6,7 @@
 pub use rt_validate::stress::compare::{
     compare, image_mean, normal_quantile_upper, Comparison, ALPHA,
 };
+pub use rt_validate::stress::invalid_values;
 
 use rt_core::Rgb;
 use rt_film::PixelStats;
