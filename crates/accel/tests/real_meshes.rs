@@ -50,10 +50,10 @@ fn check_specs(
     oracle: &dyn Accel,
     rays: &[(rt_core::Ray, f32)],
 ) {
-    let (tris, n_rays) = (tris, rays.len());
+    let n_rays = rays.len();
     let oracle_name = oracle.name();
     for spec in SPECS {
-        let accel = spec.parse::<AccelSpec>().unwrap().build(&tris);
+        let accel = spec.parse::<AccelSpec>().unwrap().build(tris);
         let (mut hits, mut outside_box) = (0, 0);
         for (i, (ray, t_max)) in rays.iter().enumerate() {
             match check_ray(accel.as_ref(), oracle, ray, *t_max, tris) {
