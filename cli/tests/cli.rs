@@ -425,6 +425,8 @@ fn procedural_scene_names() {
         String::from_utf8_lossy(&out.stderr)
     );
     let obj = std::fs::read_to_string(r.path("wc.obj")).unwrap();
+    // 4,100 triangles: the size `rt_scene::procedural` documents for gen:worst-case (a
+    // specification: benchmark results are reported for that size).
     assert_eq!(obj.lines().filter(|l| l.starts_with("f ")).count(), 4_100);
     assert_eq!(
         obj.lines().filter(|l| l.starts_with("v ")).count(),

@@ -10,7 +10,7 @@ use rt_core::glam::Vec3;
 use rt_core::material::Bsdf;
 use rt_core::Rgb;
 use rt_integrators::PathIntegrator;
-use rt_testkit::furnace::{scene_toml as furnace, L};
+use rt_testkit::furnace::{one_bounce_plane_toml, scene_toml as furnace, L};
 use rt_testkit::stats::{image_mean, variance_of_mean};
 use rt_testkit::{render, scene_from_toml};
 
@@ -89,38 +89,6 @@ fn energy_conserving_presets_render_as_the_environment() {
     }
 }
 
-/// The plane `z = 0` (normal +z) under the furnace's environment, seen from polar angle
-/// `theta` through a 4 × 4 camera of 1° field of view (so `wo` is within 0.5° of that angle).
-fn one_bounce_plane(material: &str, theta: f32) -> String {
-    let (s, c) = theta.sin_cos();
-    format!(
-        r#"
-[environment]
-color = [{L}, {L}, {L}]
-
-[[camera]]
-name = "c"
-position = [{px}, 0.0, {pz}]
-look_at = [0.0, 0.0, 0.0]
-up = [0.0, 0.0, 1.0]
-fov = 1.0
-resolution = [4, 4]
-
-[[material]]
-name = "m"
-{material}
-
-[[geometry]]
-name = "plane"
-shape = "quad"
-vertices = [[-100.0, -100.0, 0.0], [100.0, -100.0, 0.0], [100.0, 100.0, 0.0], [-100.0, 100.0, 0.0]]
-material = "m"
-"#,
-        px = 3.0 * s,
-        pz = 3.0 * c,
-    )
-}
-
 /// `A(wo)` (the largest channel) by the midpoint rule on the (θ, φ) grid of
 /// `rt_testkit::chi2` with `sub²` points per bin.
 fn directional_albedo(bsdf: &Bsdf, sub: usize) -> f64 {
@@ -135,7 +103,7 @@ fn directional_albedo(bsdf: &Bsdf, sub: usize) -> f64 {
 fn one_bounce_lossy_materials_reflect_their_directional_albedo() {
     for m in LOSSY {
         for theta_deg in [25.0f32, 65.0] {
-            let scene = scene_from_toml(&one_bounce_plane(m, theta_deg.to_radians()));
+            let scene = scene_from_toml(&one_bounce_plane_toml(m, theta_deg.to_radians()));
             let material = &scene.materials[0];
             assert!(
                 material.layers.iter().all(|l| !l.is_delta()),

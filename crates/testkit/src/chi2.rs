@@ -42,7 +42,7 @@ pub fn expected(pdf: impl Fn(Vec3) -> f64, sub: usize) -> Vec<f64> {
     out
 }
 
-/// The result of [`test`].
+/// The result of [`test()`].
 #[derive(Clone, Copy, Debug)]
 pub struct ChiSquare {
     /// The statistic.
