@@ -1,4 +1,4 @@
-//! `render stress`: the numerical stress suite (`rt_e2e::stress`) with a large budget.
+//! `render stress`: the numerical stress suite (`rt_validate::stress`) with a large budget.
 //!
 //! The cases are the ones `cargo test` runs with a small budget (`tests/tests/stress.rs`):
 //! transformed scenes compared within noise, self-intersection counts, bad geometry. One line
@@ -6,7 +6,7 @@
 //! stress tests".
 
 use anyhow::{bail, Result};
-use rt_e2e::stress::{cases_named, Budget};
+use rt_validate::stress::{cases_named, Budget};
 use std::path::PathBuf;
 use std::time::Instant;
 

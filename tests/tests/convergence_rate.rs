@@ -9,9 +9,9 @@
 //! samples do not remove.
 
 use rt_core::{SampleStream, Scene};
-use rt_e2e::scene_from_toml;
 use rt_film::{AovSet, Film};
-use rt_integrators::{Ctx, PathIntegrator, SamplePass};
+use rt_integrators::{PathIntegrator, SamplePass};
+use rt_testkit::{shipped_scene, Renderer, SceneExt};
 
 /// Image side, reference samples, test sample counts.
 const SIDE: u32 = 48;
@@ -19,26 +19,13 @@ const REFERENCE_SPP: u32 = 2048;
 const TEST_SPP: [u32; 6] = [4, 8, 16, 32, 64, 128];
 
 fn render(scene: &Scene, seed: u32, spp: u32, stream: SampleStream) -> Film {
-    let accel = rt_accel::Bvh2::build(&scene.triangles, &rt_accel::BuildParams::default());
-    let camera = &scene.cameras[0];
-    let mut film = Film::new(camera.width, camera.height, AovSet::default());
-    let ctx = Ctx {
-        scene,
-        accel: &accel,
-        camera,
-    };
+    let renderer = Renderer::new(scene);
+    let mut film = renderer.film(AovSet::default());
     let pass = SamplePass {
         indices: 0..spp,
         stream,
     };
-    rt_integrators::render_samples(
-        &ctx,
-        &PathIntegrator::new(4),
-        &mut film,
-        seed,
-        &pass,
-        &|_| {},
-    );
+    renderer.render_pass(&PathIntegrator::new(4), &mut film, seed, &pass);
     film
 }
 
@@ -52,14 +39,7 @@ fn mean_sd(v: &[f64]) -> (f64, f64) {
 
 #[test]
 fn path_tracer_mse_falls_at_least_as_fast_as_one_over_spp() {
-    let toml = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../scenes/cornell-box.toml"
-    ))
-    .unwrap();
-    let mut scene = scene_from_toml(&toml);
-    scene.cameras[0].width = SIDE;
-    scene.cameras[0].height = SIDE;
+    let scene = shipped_scene("cornell-box.toml").with_resolution(SIDE, SIDE);
     // The reference is the average of two independent halves (two seeds of the reference
     // stream), so its own error can be measured rather than bounded: E[(r1 − r2)²] = 2 F_half
     // per value, and the average's error is F = F_half / 2 = E[(r1 − r2)²] / 4. (The film's

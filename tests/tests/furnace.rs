@@ -1,63 +1,24 @@
 //! White furnace: objects of albedo 1 under a constant environment of radiance L must render as
 //! L everywhere for the energy-conserving presets (diffuse, mirror, glass), and never brighter
-//! than L for any material. The objects are placed so that light inter-reflects between them
-//! (a single convex object would be too easy). The sphere is faceted: interpolated shading
-//! normals make any renderer lose (or gain) energy, which is a different question.
+//! than L for any material (scene: `rt_testkit::furnace`). The lossy materials are also bounded
+//! from below, by a one-bounce furnace: a plane seen through a narrow camera, rendered with one
+//! bounce, is `L · A(wo)` where `A(wo) = ∫ f(wo, wi) |cos θi| dωi` is the directional albedo,
+//! integrated here by quadrature from `Bsdf::eval` (not from the sampler the renderer uses). A
+//! black or half-energy renderer fails it.
 
-use rt_e2e::{image_mean, render, scene_from_toml, variance_of_mean};
+use rt_core::glam::Vec3;
+use rt_core::material::Bsdf;
+use rt_core::Rgb;
 use rt_integrators::PathIntegrator;
-
-const L: f32 = 0.5;
-
-fn furnace(material: &str) -> String {
-    format!(
-        r#"
-[environment]
-color = [{L}, {L}, {L}]
-
-[[camera]]
-name = "c"
-position = [0.0, 1.2, 4.0]
-look_at = [0.0, 0.5, 0.0]
-up = [0.0, 1.0, 0.0]
-fov = 40.0
-resolution = [24, 24]
-
-[[material]]
-name = "m"
-{material}
-
-[[geometry]]
-name = "slab"
-shape = "box"
-min = [-1.5, -0.2, -1.5]
-max = [1.5, 0.0, 1.5]
-material = "m"
-
-[[geometry]]
-name = "ball"
-shape = "sphere"
-center = [-0.45, 0.45, 0.0]
-radius = 0.45
-subdivisions = 2
-smooth = false
-material = "m"
-
-[[geometry]]
-name = "block"
-shape = "box"
-min = [0.05, 0.0, -0.5]
-max = [0.85, 1.2, 0.3]
-material = "m"
-"#
-    )
-}
+use rt_testkit::furnace::{one_bounce_plane_toml, scene_toml as furnace, L};
+use rt_testkit::stats::{image_mean, variance_of_mean};
+use rt_testkit::{render, scene_from_toml};
 
 /// Checks the image mean against L with a tolerance of 4 standard errors (estimated from the
 /// per-pixel variances), and every pixel against L with 6 of its own standard errors.
 fn check(material: &str, equal: bool, integrator: &PathIntegrator, spp: u32) {
     let scene = scene_from_toml(&furnace(material));
-    let film = render(&scene, integrator, spp, 1, 2);
+    let film = render(&scene, integrator, spp, 1);
     let (mean, se) = image_mean(&film);
     let tol = 4.0 * se + 1e-4;
     if equal {
@@ -125,6 +86,51 @@ fn energy_conserving_presets_render_as_the_environment() {
     for m in ENERGY_CONSERVING {
         check(m, true, &PathIntegrator::new(1000), 64);
         check(m, true, &PathIntegrator::bsdf_only(1000), 64);
+    }
+}
+
+/// `A(wo)` (the largest channel) by the midpoint rule on the (θ, φ) grid of
+/// `rt_testkit::chi2` with `sub²` points per bin.
+fn directional_albedo(bsdf: &Bsdf, sub: usize) -> f64 {
+    let f = |d: Vec3| bsdf.eval(d).max_element() as f64 * d.z.abs() as f64;
+    rt_testkit::chi2::expected(f, sub).iter().sum()
+}
+
+/// One-bounce furnace: the image mean must be `L · A(wo)` within four standard errors, plus the
+/// change of `A` over the camera's ±0.5° and the quadrature's own error (the difference of two
+/// grid resolutions).
+#[test]
+fn one_bounce_lossy_materials_reflect_their_directional_albedo() {
+    for m in LOSSY {
+        for theta_deg in [25.0f32, 65.0] {
+            let scene = scene_from_toml(&one_bounce_plane_toml(m, theta_deg.to_radians()));
+            let material = &scene.materials[0];
+            assert!(
+                material.layers.iter().all(|l| !l.is_delta()),
+                "{m}: a delta lobe escapes the quadrature"
+            );
+            let albedo_at = |deg: f32, sub: usize| {
+                let t = deg.to_radians();
+                let wo = Vec3::new(t.sin(), 0.0, t.cos());
+                directional_albedo(&Bsdf::new(material, Rgb::ONE, Vec3::Z, Vec3::Z, wo), sub)
+            };
+            let a = albedo_at(theta_deg, 8);
+            let quadrature = (albedo_at(theta_deg, 16) - a).abs();
+            let spread = [theta_deg - 0.5, theta_deg + 0.5]
+                .map(|d| (albedo_at(d, 8) - a).abs())
+                .into_iter()
+                .fold(0.0, f64::max);
+            let film = render(&scene, &PathIntegrator::new(1), 2048, 3);
+            let (mean, se) = image_mean(&film);
+            let expected = L as f64 * a;
+            let tol = 4.0 * se + L as f64 * (spread + quadrature);
+            assert!(
+                (mean - expected).abs() <= tol,
+                "{m} at {theta_deg}°: image mean {mean} vs L·A = {expected} (A {a:.4}, tol {tol:.2e})"
+            );
+            // The test must be able to tell a half-energy renderer from the right one.
+            assert!(tol < 0.25 * expected, "{m}: tolerance {tol} too loose");
+        }
     }
 }
 

@@ -3,46 +3,26 @@
 //! seed is a different image of the same scene.
 
 use rt_core::{SampleStream, Scene};
-use rt_e2e::scene_from_toml;
 use rt_film::{AovSet, Film};
-use rt_integrators::{Ctx, PathIntegrator, RenderOptions, SamplePass};
+use rt_integrators::{PathIntegrator, SamplePass};
+use rt_testkit::{shipped_scene, Renderer, SceneExt};
 
 fn cornell_24() -> Scene {
-    let toml = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../scenes/cornell-box.toml"
-    ))
-    .unwrap();
-    let mut scene = scene_from_toml(&toml);
-    scene.cameras[0].width = 24;
-    scene.cameras[0].height = 24;
-    scene
+    shipped_scene("cornell-box.toml").with_resolution(24, 24)
 }
 
 /// Renders the passes one after the other into one film, on two threads.
 fn render_passes(scene: &Scene, seed: u32, passes: &[SamplePass]) -> Film {
-    let accel = rt_accel::Bvh2::build(&scene.triangles, &rt_accel::BuildParams::default());
-    let camera = &scene.cameras[0];
+    let renderer = Renderer::new(scene).threads(2);
     // The variance buffer is kept: the independence test below weighs differences by it.
     let aovs = AovSet {
         variance: true,
         ..AovSet::default()
     };
-    let mut film = Film::new(camera.width, camera.height, aovs);
-    let ctx = Ctx {
-        scene,
-        accel: &accel,
-        camera,
-    };
+    let mut film = renderer.film(aovs);
     let integrator = PathIntegrator::new(6);
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
-        .unwrap();
     for pass in passes {
-        let stats = pool.install(|| {
-            rt_integrators::render_samples(&ctx, &integrator, &mut film, seed, pass, &|_| {})
-        });
+        let stats = renderer.render_pass(&integrator, &mut film, seed, pass);
         assert_eq!(stats.samples, 24 * 24 * pass.indices.len() as u64);
     }
     film
@@ -62,15 +42,7 @@ fn passes_add_up_to_one_render_bit_for_bit() {
     assert_eq!(split.variance_image(), whole.variance_image());
     assert_eq!(split.half_image(1), whole.half_image(1));
     // And the plain driver entry point is the single pass 0..spp of the render stream.
-    let accel = rt_accel::Bvh2::build(&scene.triangles, &rt_accel::BuildParams::default());
-    let mut film = Film::new(24, 24, AovSet::default());
-    let ctx = Ctx {
-        scene: &scene,
-        accel: &accel,
-        camera: &scene.cameras[0],
-    };
-    let opts = RenderOptions { spp: 16, seed: 3 };
-    rt_integrators::render(&ctx, &PathIntegrator::new(6), &mut film, &opts, &|_| {});
+    let (film, _) = Renderer::new(&scene).render(&PathIntegrator::new(6), AovSet::default(), 16, 3);
     assert_eq!(film.mean_image(), whole.mean_image());
 }
 

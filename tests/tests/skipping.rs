@@ -4,13 +4,12 @@
 //! image is the same bit for bit whichever optional buffers the film keeps.
 
 use rt_core::{Camera, Rgb, Sampler, Scene};
-use rt_e2e::scene_from_toml;
 use rt_film::{AovSet, Film, FilmBuffers};
-use rt_integrators::{Ctx, Integrator, PathIntegrator, RayCounters, RenderOptions, SampleAux};
+use rt_integrators::{Integrator, PathIntegrator, RayCounters, SampleAux};
+use rt_testkit::{shipped_scene, Renderer};
 
 fn shipped(name: &str) -> Scene {
-    let path = format!("{}/../scenes/{name}", env!("CARGO_MANIFEST_DIR"));
-    scene_from_toml(&std::fs::read_to_string(path).unwrap())
+    shipped_scene(name)
 }
 
 /// `scene`'s first camera at 16×12 pixels, keeping its lens.
@@ -31,17 +30,8 @@ fn small_camera(scene: &Scene) -> Camera {
 
 /// Renders into a film that keeps `buffers`.
 fn render(scene: &Scene, integrator: &dyn Integrator, buffers: FilmBuffers) -> Film {
-    let camera = small_camera(scene);
-    let accel = rt_accel::Bvh2::build(&scene.triangles, &rt_accel::BuildParams::default());
-    let mut film = Film::new(camera.width, camera.height, buffers);
-    let ctx = Ctx {
-        scene,
-        accel: &accel,
-        camera: &camera,
-    };
-    let opts = RenderOptions { spp: 8, seed: 3 };
-    rt_integrators::render(&ctx, integrator, &mut film, &opts, &|_| {});
-    film
+    let renderer = Renderer::new(scene).with_camera(small_camera(scene));
+    renderer.render(integrator, buffers, 8, 3).0
 }
 
 fn bits(img: &[Rgb]) -> Vec<[u32; 3]> {
@@ -157,10 +147,12 @@ fn beauty_is_bit_identical_with_and_without_optional_buffers() {
     }
 }
 
-/// The depth-of-field scene's main camera has a lens; its second camera is a pinhole. With a
-/// lens the image depends on the lens sample, so both the blur and the draw are really there.
+/// The depth-of-field scene's main camera has a lens and its second camera is a pinhole; with a
+/// lens the image depends on the aperture, so the blur is really there. (That a pinhole draws
+/// no lens sample is checked where the draw happens: `only_thin_lens_cameras_draw_a_lens_sample`
+/// in `crates/integrators/src/driver.rs`.)
 #[test]
-fn depth_of_field_uses_lens_samples_and_its_pinhole_camera_does_not() {
+fn depth_of_field_image_depends_on_the_aperture_and_the_scene_has_a_pinhole() {
     let mut scene = shipped("depth-of-field.toml");
     assert!(!scene.cameras[0].is_pinhole());
     assert_eq!(scene.cameras[1].name, "pinhole");
@@ -177,12 +169,8 @@ fn depth_of_field_uses_lens_samples_and_its_pinhole_camera_does_not() {
 fn integrators_compute_first_hits_only_when_wanted() {
     let scene = shipped("cornell-box.toml");
     let camera = small_camera(&scene);
-    let accel = rt_accel::Bvh2::build(&scene.triangles, &rt_accel::BuildParams::default());
-    let ctx = Ctx {
-        scene: &scene,
-        accel: &accel,
-        camera: &camera,
-    };
+    let renderer = Renderer::new(&scene).with_camera(camera.clone());
+    let ctx = renderer.ctx();
     let ao = rt_integrators::AoIntegrator {
         max_distance: f32::INFINITY,
     };

@@ -1,13 +1,13 @@
-//! The numerical stress suite's short run (`rt_e2e::stress`, `Budget::ci`); `render stress
+//! The numerical stress suite's short run (`rt_validate::stress`, `Budget::ci`); `render stress
 //! --long` runs the same cases with a larger budget. One test per group, so the groups run in
 //! parallel and a failure names its group; each prints its cases' report lines.
 
-use rt_e2e::stress::{cases_named, Budget};
+use rt_validate::stress::{cases_named, Budget};
 
 fn run_group(prefix: &str) {
-    let mut budget = Budget::ci();
-    budget.data_dir =
-        Some(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data"));
+    // The shared meshes are found in `rt_validate::data::default_dir()`; under
+    // RT_REQUIRE_DATA=1 a missing one fails its case.
+    let budget = Budget::ci();
     let cases = cases_named(prefix);
     assert!(!cases.is_empty(), "no case named {prefix}*");
     let reports: Vec<_> = cases.iter().map(|c| c.run(&budget, 1)).collect();

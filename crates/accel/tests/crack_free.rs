@@ -232,8 +232,19 @@ fn report_leaks(name: &str, mesh: &Mesh, seed: u64, n_rays: usize, axis_rays: bo
             .collect::<Vec<_>>()
             .join(", ")
     );
-    // Guaranteed for the watertight test and both crack-free ones; Möller–Trumbore is only
-    // reported.
+    // Guaranteed for the watertight test and both crack-free ones. Möller–Trumbore is the
+    // control: it does leak through shared edges and vertices, so each family of rays (at
+    // vertices, at edge midpoints, at other edge points) must find some of its cracks, or these
+    // rays could not see a crack at all.
+    for (k, family) in ["vertices", "edge midpoints", "other edge points"]
+        .iter()
+        .enumerate()
+    {
+        assert!(
+            missed[1][k] > 0,
+            "{name}: control: Möller–Trumbore never leaks at {family}, so the rays there cannot find cracks"
+        );
+    }
     assert_eq!(missed[0], [0; 3], "{name}: watertight");
     assert_eq!(missed[2], [0; 3], "{name}: subdivision");
     assert_eq!(missed[3], [0; 3], "{name}: hybrid");
@@ -274,9 +285,10 @@ fn axis_aligned_box_does_not_leak() {
 }
 
 /// Every result of the three tests of `crack_free` on this pair is either a miss or a hit with
-/// finite values and `t ∈ (0, t_max]`. The watertight test of `rt-core`, documented as valid up
-/// to coordinates of about `1e12`, is not held to this: its non-finite hits are only counted in
-/// `watertight_non_finite`.
+/// finite values and `t ∈ (0, t_max]`. The watertight test of `rt-core` is documented as valid
+/// up to coordinates of about `1e12` only, so its non-finite hits are counted in
+/// `watertight_non_finite`, and the callers assert that count to be zero for inputs within
+/// that range ([`within_watertight_range`]).
 fn assert_sane(
     ray: &Ray,
     tri: &[Vec3; 3],
@@ -297,6 +309,19 @@ fn assert_sane(
         }
     }
     got
+}
+
+/// The magnitude up to which `rt_core::triangle` documents the watertight test as valid.
+const WATERTIGHT_RANGE: f32 = 1e12;
+
+/// True if every coordinate of `ray`, `tri` and a finite `t_max` is within
+/// [`WATERTIGHT_RANGE`] (non-finite coordinates are not).
+fn within_watertight_range(ray: &Ray, tri: &[Vec3; 3], t_max: f32) -> bool {
+    let points = tri.iter().chain([&ray.origin, &ray.dir]);
+    points
+        .flat_map(|p| p.to_array())
+        .chain((t_max != f32::INFINITY).then_some(t_max))
+        .all(|x| x.abs() <= WATERTIGHT_RANGE)
 }
 
 #[test]
@@ -392,6 +417,14 @@ fn extreme_scales_never_give_nan_and_the_subdivision_test_still_hits() {
              watertight returned {watertight_non_finite} hits with non-finite values",
             METHODS[0], analytic_hits[0], METHODS[1], analytic_hits[1]
         );
+        if scale <= WATERTIGHT_RANGE / 100.0 {
+            // Coordinates here reach about 100 × scale (rays from up to 3 × scale, t_max up to
+            // 10 × scale): within the documented range, so no non-finite hit.
+            assert_eq!(
+                watertight_non_finite, 0,
+                "scale {scale:e}: watertight gave non-finite hits"
+            );
+        }
     }
 }
 
@@ -401,6 +434,7 @@ fn mixed_magnitude_triangles_and_rays_never_give_nan() {
     let mut watertight_non_finite = 0;
     let mut worst = SubdivStats::default();
     let (mut cases, mut gave_up) = (0, 0);
+    let (mut in_range, mut in_range_non_finite) = (0, 0);
     while cases < 20_000 {
         let mag = |rng: &mut Rng| 10f32.powf(rng.range(-38.0, 38.0));
         let tri = [0; 3].map(|_| rng.vec_in(-1.0, 1.0) * mag(&mut rng));
@@ -420,7 +454,12 @@ fn mixed_magnitude_triangles_and_rays_never_give_nan() {
             mag(&mut rng)
         };
         let ray = Ray::new(origin, dir);
+        let before = watertight_non_finite;
         assert_sane(&ray, &tri, t_max, &mut watertight_non_finite);
+        if within_watertight_range(&ray, &tri, t_max) {
+            in_range += 1;
+            in_range_non_finite += watertight_non_finite - before;
+        }
         let mut stats = SubdivStats::default();
         intersect_subdivision_counted(&SubdivRay::new(&ray), &tri, t_max, &mut stats);
         gave_up += usize::from(stats.gave_up);
@@ -429,8 +468,17 @@ fn mixed_magnitude_triangles_and_rays_never_give_nan() {
         }
     }
     println!(
-        "{cases} cases: watertight returned {watertight_non_finite} hits with non-finite values; \
+        "{cases} cases: watertight returned {watertight_non_finite} hits with non-finite values \
+         ({in_range_non_finite} of them among the {in_range} cases within {WATERTIGHT_RANGE:e}); \
          subdivision ran out of budget {gave_up} times, most expensive query {worst:?}"
+    );
+    assert!(
+        in_range > 1000,
+        "too few cases within the watertight test's range"
+    );
+    assert_eq!(
+        in_range_non_finite, 0,
+        "watertight gave non-finite hits within its documented range"
     );
 }
 

@@ -15,7 +15,9 @@ use std::time::Instant;
 #[ignore = "timing, not a check"]
 fn structures_and_options() {
     let tris = match std::env::var("RT_TIMING_OBJ") {
-        Ok(path) => common::read_obj(std::path::Path::new(&path)).expect("RT_TIMING_OBJ readable"),
+        Ok(path) => {
+            rt_testkit::obj::read(std::path::Path::new(&path)).expect("RT_TIMING_OBJ readable")
+        }
         Err(_) => common::icosphere(6).triangles(),
     };
     let bounds = tris.iter().fold(rt_core::Aabb::EMPTY, |b, t| {

@@ -328,16 +328,17 @@ fn no_split_params_build_the_same_tree() {
 #[ignore]
 fn reference_counts_of_real_meshes() {
     let paths = std::env::var("RT_SPLIT_OBJS").unwrap_or_else(|_| {
-        "../../../shared/data/models/stanford-bunny.obj:\
-         ../../../shared/data/scenes/sibenik/sibenik.obj"
-            .into()
+        let dir = rt_testkit::data::default_dir();
+        ["models/stanford-bunny.obj", "scenes/sibenik/sibenik.obj"]
+            .map(|m| dir.join(m).display().to_string())
+            .join(":")
     });
     for path in paths.split(':') {
         let Ok(text) = std::fs::read_to_string(path) else {
             println!("{path}: not found");
             continue;
         };
-        let tris = read_obj(&text);
+        let tris = rt_testkit::obj::parse(&text);
         let splits = [
             Split::None,
             Split::Evh { t: 14 },
@@ -360,36 +361,4 @@ fn reference_counts_of_real_meshes() {
             }
         }
     }
-}
-
-/// Positions and faces of an OBJ file, polygons fanned into triangles.
-fn read_obj(text: &str) -> Vec<[Vec3; 3]> {
-    let mut positions = Vec::new();
-    let mut tris = Vec::new();
-    for line in text.lines() {
-        let mut words = line.split_whitespace();
-        match words.next() {
-            Some("v") => {
-                let c: Vec<f32> = words.take(3).map(|w| w.parse().unwrap()).collect();
-                positions.push(Vec3::new(c[0], c[1], c[2]));
-            }
-            Some("f") => {
-                let idx: Vec<usize> = words
-                    .map(|w| {
-                        let i: i64 = w.split('/').next().unwrap().parse().unwrap();
-                        if i < 0 {
-                            (positions.len() as i64 + i) as usize
-                        } else {
-                            i as usize - 1
-                        }
-                    })
-                    .collect();
-                for k in 1..idx.len().saturating_sub(1) {
-                    tris.push([idx[0], idx[k], idx[k + 1]].map(|i| positions[i]));
-                }
-            }
-            _ => {}
-        }
-    }
-    tris
 }

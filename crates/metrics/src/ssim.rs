@@ -144,9 +144,12 @@ fn band_sum(
             for (wt, &[a, b]) in weights.iter().zip(&padded[x..x + WINDOW]) {
                 m[0] += wt * a;
                 m[1] += wt * b;
-                m[2] += wt * a * a;
-                m[3] += wt * b * b;
-                m[4] += wt * a * b;
+                // Products of the signals first (`wt * (a * b)`, not `wt * a * b`): swapping the
+                // images then gives the same bits (SSIM is symmetric), and identical images
+                // give E[xy] = E[x²] = E[y²] bit for bit (SSIM exactly 1).
+                m[2] += wt * (a * a);
+                m[3] += wt * (b * b);
+                m[4] += wt * (a * b);
             }
             *o = m;
         }
@@ -174,13 +177,10 @@ fn band_sum(
 mod tests {
     use super::*;
 
-    /// A deterministic pseudo-random value in [-1, 1) for pixel `i` (a 64-bit mix; no crate).
+    /// A deterministic pseudo-random value in [-1, 1) for index `i` (the workspace's test RNG,
+    /// seeded by the index).
     fn noise(i: u64) -> f32 {
-        let mut z = i.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        ((z >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
+        rt_testkit::Rng::new(i).f32() * 2.0 - 1.0
     }
 
     fn smooth(w: usize, h: usize) -> RgbImage {

@@ -389,4 +389,121 @@ mod tests {
         .unwrap_err();
         assert!(e.message().contains("-1"), "{e}");
     }
+
+    /// The field names serde's derive gives a struct: its `Deserialize` impl passes them to
+    /// `deserialize_struct`, where this deserializer records them and stops.
+    fn fields_of<'de, T: Deserialize<'de>>() -> Vec<&'static str> {
+        struct Fields(Vec<&'static str>);
+        #[derive(Debug)]
+        struct Stop;
+        impl std::fmt::Display for Stop {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("stop")
+            }
+        }
+        impl std::error::Error for Stop {}
+        impl de::Error for Stop {
+            fn custom<M: std::fmt::Display>(_: M) -> Self {
+                Stop
+            }
+        }
+        impl<'de> de::Deserializer<'de> for &mut Fields {
+            type Error = Stop;
+            fn deserialize_any<V: de::Visitor<'de>>(self, _: V) -> Result<V::Value, Stop> {
+                Err(Stop)
+            }
+            fn deserialize_struct<V: de::Visitor<'de>>(
+                self,
+                _: &'static str,
+                fields: &'static [&'static str],
+                _: V,
+            ) -> Result<V::Value, Stop> {
+                self.0.extend_from_slice(fields);
+                Err(Stop)
+            }
+            serde::forward_to_deserialize_any! {
+                bool i8 i16 i32 i64 i128 u8 u16 u32 u64 u128 f32 f64 char str string bytes
+                byte_buf option unit unit_struct newtype_struct seq tuple tuple_struct map enum
+                identifier ignored_any
+            }
+        }
+        let mut f = Fields(Vec::new());
+        let _ = T::deserialize(&mut f);
+        assert!(
+            !f.0.is_empty(),
+            "{} has no fields",
+            std::any::type_name::<T>()
+        );
+        f.0
+    }
+
+    /// `docs/scene-format.md` has a table row naming every key of every `*Desc` type (in
+    /// backticks), the key list taken from the types themselves, so a key added without
+    /// documentation fails here; so does every value of `shape`.
+    #[test]
+    fn every_desc_field_is_documented_in_a_table_row() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/scene-format.md");
+        let doc = std::fs::read_to_string(path).unwrap();
+        let rows: Vec<&str> = doc.lines().filter(|l| l.starts_with('|')).collect();
+        let types: [(&str, Vec<&str>); 9] = [
+            ("SceneDesc", fields_of::<SceneDesc>()),
+            ("EnvironmentDesc", fields_of::<EnvironmentDesc>()),
+            ("CameraDesc", fields_of::<CameraDesc>()),
+            ("MaterialDesc", fields_of::<MaterialDesc>()),
+            ("LayerDesc", fields_of::<LayerDesc>()),
+            ("GeometryDesc", fields_of::<GeometryDesc>()),
+            ("TransformDesc", fields_of::<TransformDesc>()),
+            ("AssignDesc", fields_of::<AssignDesc>()),
+            ("RenderTableDesc", fields_of::<RenderTableDesc>()),
+        ];
+        // The top level's fields are the tables; each must be one of the types above.
+        assert_eq!(
+            types[0].1,
+            [
+                "environment",
+                "camera",
+                "material",
+                "geometry",
+                "assign",
+                "render"
+            ],
+            "a new top-level table needs its *Desc type in this list"
+        );
+        let mut missing = Vec::new();
+        for (ty, fields) in &types[1..] {
+            for k in fields {
+                let tick = format!("`{k}`");
+                if !rows.iter().any(|r| r.contains(&tick)) {
+                    missing.push(format!("{ty}.{k}"));
+                }
+            }
+        }
+        assert!(
+            missing.is_empty(),
+            "docs/scene-format.md has no table row for: {}",
+            missing.join(", ")
+        );
+        // The shapes (values of `shape`) have rows too.
+        for shape in crate::geometry::SHAPES {
+            let tick = format!("| `{shape}`");
+            assert!(
+                doc.contains(&tick),
+                "docs/scene-format.md has no row for shape {shape}"
+            );
+        }
+        // And the tables themselves are documented (as headings).
+        for table in [
+            "[environment]",
+            "[[camera]]",
+            "[[material]]",
+            "[[geometry]]",
+            "[[assign]]",
+            "[render]",
+        ] {
+            assert!(
+                doc.contains(table),
+                "docs/scene-format.md does not document {table}"
+            );
+        }
+    }
 }

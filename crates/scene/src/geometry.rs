@@ -16,6 +16,9 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use toml::Spanned;
 
+/// The values of a geometry's `shape` key.
+pub(crate) const SHAPES: [&str; 4] = ["quad", "box", "sphere", "disk"];
+
 /// Most subdivisions of an icosphere (20·4^7 = 327,680 triangles).
 pub(crate) const MAX_SUBDIVISIONS: u32 = 7;
 /// Default icosphere subdivisions (1,280 triangles).
@@ -234,7 +237,7 @@ fn kind<'a>(ctx: &Ctx, d: &'a GeometryDesc) -> Result<Kind<'a>> {
             Kind::File(f)
         } else if let Some(s) = &d.shape {
             let shape = s.get_ref().as_str();
-            if !["quad", "box", "sphere", "disk"].contains(&shape) {
+            if !SHAPES.contains(&shape) {
                 return Err(ctx.src.error_at(
                     s.span(),
                     format!(

@@ -423,6 +423,10 @@ fn million() -> Scene {
 mod tests {
     use super::*;
 
+    /// Generates `name` and checks its arrays. `triangles` is the count the module's table
+    /// documents: a specification, not a measurement, because the `gen:` scenes are benchmark
+    /// inputs whose sizes `docs/benchmarks.md` reports results for, so a generator that changes
+    /// them must change the table (and invalidate those results) deliberately.
     fn check(name: &str, triangles: usize) -> Scene {
         let scene = generate(name).unwrap();
         assert_eq!(scene.triangle_count(), triangles, "{name}");

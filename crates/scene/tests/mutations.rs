@@ -1,19 +1,13 @@
 //! Robustness: thousands of corrupted versions of the shipped scenes (lines deleted, files
 //! truncated, numbers replaced by NaN, infinities, negatives, huge values or strings, brackets
-//! dropped) must each load or fail with a one-line error — never panic.
+//! dropped) must each load or fail with a one-line error — never panic. A mutant that loads is
+//! a scene like any other, the case of a silently wrong image: it must render (8 × 8 pixels,
+//! 2 samples, the default acceleration structure) without a panic, without a discarded sample
+//! and without an invalid value in the film. The scenes are taken in name order and the
+//! mutations from a fixed stream (`rt_testkit::Rng`), so every run tries the same mutants.
 
+use rt_testkit::{stats::invalid_values, Renderer, Rng, SceneExt};
 use std::path::Path;
-
-/// xorshift64*: a fixed stream, so every run tries the same mutations.
-struct Rng(u64);
-impl Rng {
-    fn below(&mut self, n: usize) -> usize {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 33) as usize % n.max(1)
-    }
-}
 
 const REPLACEMENTS: [&str; 10] = [
     "nan",
@@ -27,6 +21,29 @@ const REPLACEMENTS: [&str; 10] = [
     "true",
     "4294967296",
 ];
+
+/// Renders a mutant that loaded: no panic, no discarded sample, no invalid value.
+fn render_mutant(scene: rt_core::Scene, text: &str, original: &Path) {
+    let scene = scene.with_resolution(8, 8);
+    let result = std::panic::catch_unwind(|| {
+        let integrator = rt_integrators::PathIntegrator::new(4);
+        let buffers = rt_film::FilmBuffers::from(rt_film::AovSet::default()).with_variance();
+        let (film, stats) = Renderer::new(&scene).render(&integrator, buffers, 2, 1);
+        (invalid_values(&film), stats.discarded)
+    });
+    match result {
+        Ok((0, 0)) => {}
+        Ok((invalid, discarded)) => panic!(
+            "a mutant of {} loads but renders {invalid} invalid values and discards {discarded} \
+             samples:\n{text}",
+            original.display()
+        ),
+        Err(_) => panic!(
+            "a mutant of {} loads but its render panics:\n{text}",
+            original.display()
+        ),
+    }
+}
 
 fn mutate(text: &str, rng: &mut Rng) -> String {
     let lines: Vec<&str> = text.lines().collect();
@@ -90,14 +107,17 @@ fn mutate(text: &str, rng: &mut Rng) -> String {
 #[test]
 fn corrupted_scenes_never_panic() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
-    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
-    let mut errors = 0;
-    let mut tried = 0;
-    for entry in std::fs::read_dir(&dir).unwrap() {
-        let path = entry.unwrap().path();
-        if path.extension().is_none_or(|e| e != "toml") {
-            continue;
-        }
+    let mut rng = Rng::new(0x9e37_79b9_7f4a_7c15);
+    let (mut errors, mut tried, mut rendered) = (0, 0, 0);
+    let mut paths: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    // read_dir's order is the file system's; the mutants must not depend on it.
+    paths.sort();
+    assert!(paths.len() >= 5, "the shipped scenes: {paths:?}");
+    for path in paths {
         let text = std::fs::read_to_string(&path).unwrap();
         for _ in 0..300 {
             let bad = mutate(&text, &mut rng);
@@ -111,22 +131,32 @@ fn corrupted_scenes_never_panic() {
                 );
             };
             tried += 1;
-            if let Err(e) = result {
-                errors += 1;
-                let msg = e.to_string();
-                assert!(!msg.contains('\n'), "multi-line error: {msg}");
-                assert!(
-                    msg.contains("mutant.toml")
-                        || msg.contains(&*dir.to_string_lossy())
-                        || msg.contains("scenes"),
-                    "error names no file: {msg}"
-                );
+            match result {
+                Ok(loaded) => {
+                    rendered += 1;
+                    render_mutant(loaded.scene, &bad, &path);
+                }
+                Err(e) => {
+                    errors += 1;
+                    let msg = e.to_string();
+                    assert!(!msg.contains('\n'), "multi-line error: {msg}");
+                    assert!(
+                        msg.contains("mutant.toml")
+                            || msg.contains(&*dir.to_string_lossy())
+                            || msg.contains("scenes"),
+                        "error names no file: {msg}"
+                    );
+                }
             }
         }
     }
-    // The mutations must actually exercise the error paths.
+    // The mutations must actually exercise the error paths, and the render of loading ones.
     assert!(
         errors > tried / 3,
         "only {errors} of {tried} mutants were rejected"
+    );
+    assert!(
+        rendered > tried / 10,
+        "only {rendered} of {tried} mutants loaded"
     );
 }

@@ -554,6 +554,11 @@ mod tests {
     fn default_group_size_is_bounded_below_and_grows() {
         assert_eq!(default_group_size(0), MIN_GROUP_SIZE);
         assert_eq!(default_group_size(10_000), MIN_GROUP_SIZE);
-        assert_eq!(default_group_size(2_000_000), 3907);
+        // Above the minimum, groups of ⌈n / TARGET_GROUPS⌉ triangles.
+        assert_eq!(
+            default_group_size(2_000_000),
+            2_000_000usize.div_ceil(TARGET_GROUPS)
+        );
+        assert!(2_000_000usize.div_ceil(TARGET_GROUPS) > MIN_GROUP_SIZE);
     }
 }

@@ -1,4 +1,5 @@
-//! Shared test helpers: a seeded RNG, triangle soups, ray sets, closed meshes and the hit
+//! Shared test helpers of the acceleration-structure tests (the seeded RNG and the OBJ reader
+//! come from `rt-testkit`): triangle soups, ray sets, closed meshes and the hit
 //! comparison against the brute-force oracle.
 #![allow(dead_code)] // each test binary uses a different subset
 
@@ -8,66 +9,8 @@ use rt_accel::{BruteForce, BuildParams, Bvh2, WideBvh, WideNode};
 use rt_core::triangle::{intersect_triangle, RayPrecomp};
 use rt_core::{Accel, Hit, Ray, TraversalCounters};
 
-/// PCG32 (O'Neill), so tests are reproducible without the `rand` crate.
-pub struct Rng(u64);
-
-impl Rng {
-    pub fn new(seed: u64) -> Self {
-        let mut r = Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xDA3E_39CB_94B9_5BDB);
-        r.u32();
-        r
-    }
-
-    pub fn u32(&mut self) -> u32 {
-        let old = self.0;
-        self.0 = old
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
-        xorshifted.rotate_right((old >> 59) as u32)
-    }
-
-    /// Uniform in [0, 1).
-    pub fn f32(&mut self) -> f32 {
-        (self.u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
-    }
-
-    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.f32()
-    }
-
-    pub fn below(&mut self, n: usize) -> usize {
-        ((self.u32() as u64 * n as u64) >> 32) as usize
-    }
-
-    pub fn chance(&mut self, p: f32) -> bool {
-        self.f32() < p
-    }
-
-    pub fn vec_in(&mut self, lo: f32, hi: f32) -> Vec3 {
-        Vec3::new(self.range(lo, hi), self.range(lo, hi), self.range(lo, hi))
-    }
-
-    pub fn unit_vec(&mut self) -> Vec3 {
-        loop {
-            let v = self.vec_in(-1.0, 1.0);
-            let l = v.length_squared();
-            if l > 1e-4 && l <= 1.0 {
-                return v / l.sqrt();
-            }
-        }
-    }
-
-    /// Barycentric weights (b1, b2) uniform over the triangle.
-    pub fn barycentric(&mut self) -> (f32, f32) {
-        let (u, v) = (self.f32(), self.f32());
-        if u + v > 1.0 {
-            (1.0 - u, 1.0 - v)
-        } else {
-            (u, v)
-        }
-    }
-}
+/// The workspace's one seeded test RNG.
+pub use rt_testkit::Rng;
 
 /// Planes that axis-aligned soup triangles lie in; rays start on them too.
 pub const PLANES: [f32; 4] = [-0.5, 0.0, 0.25, 0.5];
@@ -272,7 +215,7 @@ pub enum Agreement {
 ///   closer than the oracle's and no farther than the closest hit that does lie in its box.
 pub fn check_ray(
     accel: &dyn Accel,
-    oracle: &BruteForce,
+    oracle: &dyn Accel,
     ray: &Ray,
     t_max: f32,
     tris: &[[Vec3; 3]],
@@ -712,49 +655,7 @@ pub fn rays_at_edges_and_vertices(mesh: &Mesh, rng: &mut Rng, n: usize) -> Vec<R
     out
 }
 
-/// Triangles of an OBJ file (`v` and `f` lines only, polygons as fans), or `None` if it cannot
-/// be read. Enough for the meshes in `../shared/data`, without a dependency.
-pub fn read_obj(path: &std::path::Path) -> Option<Vec<[Vec3; 3]>> {
-    let text = std::fs::read_to_string(path).ok()?;
-    let mut v = Vec::new();
-    let mut tris = Vec::new();
-    for line in text.lines() {
-        let mut it = line.split_whitespace();
-        match it.next() {
-            Some("v") => {
-                let c: Vec<f32> = it.take(3).map(|x| x.parse().unwrap()).collect();
-                v.push(Vec3::new(c[0], c[1], c[2]));
-            }
-            Some("f") => {
-                let idx: Vec<usize> = it
-                    .map(|f| {
-                        let i: i64 = f.split('/').next().unwrap().parse().unwrap();
-                        if i < 0 {
-                            (v.len() as i64 + i) as usize
-                        } else {
-                            i as usize - 1
-                        }
-                    })
-                    .collect();
-                for k in 1..idx.len().saturating_sub(1) {
-                    tris.push([v[idx[0]], v[idx[k]], v[idx[k + 1]]]);
-                }
-            }
-            _ => {}
-        }
-    }
-    Some(tris)
-}
-
-/// A mesh from `../shared/data` (relative to the workspace root), or `None` with a message
-/// when it is absent: the meshes are not part of the repository.
-pub fn shared_mesh(relative: &str) -> Option<Vec<[Vec3; 3]>> {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data")
-        .join(relative);
-    let tris = read_obj(&path);
-    if tris.is_none() {
-        eprintln!("skipping {}: not found", path.display());
-    }
-    tris
-}
+/// A mesh of `../shared/data` (a visible skip when absent, a
+/// failure under `RT_REQUIRE_DATA=1`).
+#[allow(unused_imports)] // only real_meshes.rs reads shared meshes
+pub use rt_testkit::obj::shared_mesh;

@@ -66,14 +66,3 @@ pub fn base64(bytes: &[u8]) -> String {
     }
     out
 }
-
-/// Directory of the shared test data (`../shared/data` beside the workspace), if present.
-pub fn shared_data() -> Option<std::path::PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data");
-    if p.is_dir() {
-        Some(p)
-    } else {
-        println!("skipped: {} is absent", p.display());
-        None
-    }
-}

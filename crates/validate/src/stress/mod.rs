@@ -16,7 +16,8 @@
 //!   overlapping triangles, zero-area and sliver triangles, huge and tiny triangles together,
 //!   shading normals pointing the wrong way, NaN texels, emitters of zero and of the largest
 //!   allowed radiance, rendered by every integrator: no NaN or infinity anywhere in the film
-//!   and no discarded sample.
+//!   and no discarded sample; lit scenes must be lit (a positive mean within the bound of
+//!   their sources), and a box open to the sky must be as bright as its one-bounce light.
 //!
 //! Each case returns a [`CaseReport`] whose `Display` is the one line `render stress` prints.
 //! A case that panics is caught and reported as failed, so one bad case does not hide the rest.
@@ -28,7 +29,7 @@ pub mod transform;
 use crate::{self_hit, LoadError};
 use rt_core::{Accel, Scene};
 use rt_film::{AovSet, Film, FilmBuffers};
-use rt_integrators::{Ctx, Integrator, RenderOptions};
+use rt_integrators::Integrator;
 use std::fmt;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -47,7 +48,8 @@ pub struct Budget {
     pub bounce_grid: (u32, u32),
     /// Also run the extreme transformations (10⁻⁶, 10⁶, 10⁶ from the origin).
     pub extreme: bool,
-    /// Where to look for `scenes/conference/conference.obj` (the shared test meshes).
+    /// Where to look for `scenes/conference/conference.obj` (the shared test meshes; `None`:
+    /// [`crate::data::default_dir`]).
     pub data_dir: Option<PathBuf>,
 }
 
@@ -150,7 +152,8 @@ pub struct Outcome {
     /// Samples the film discarded as NaN, infinite or negative (for cases that render); the
     /// case fails unless it is zero.
     pub discarded: Option<u64>,
-    /// Why the case did not run (missing optional data); a skipped case passes.
+    /// Why the case did not run (missing optional data); a skipped case passes, but under
+    /// `RT_REQUIRE_DATA=1` missing data is an error instead of a skip.
     pub skipped: Option<String>,
 }
 
@@ -278,19 +281,17 @@ fn self_hit_cases() -> Vec<Case> {
         Case {
             name: "self-hit/conference-bounces",
             run: |b, seed| {
-                let Some(dir) = &b.data_dir else {
+                let dir = b.data_dir.clone().unwrap_or_else(crate::data::default_dir);
+                let rel = "scenes/conference/conference.obj";
+                // Under RT_REQUIRE_DATA=1 a missing mesh is an error, so the case fails.
+                let path = crate::data::locate(&dir, rel)
+                    .map_err(|e| LoadError::new("the conference room", e))?;
+                let Some(path) = path else {
                     return Ok(Outcome {
-                        skipped: Some("no data directory given".into()),
+                        skipped: Some(format!("{} not found", dir.join(rel).display())),
                         ..Outcome::default()
                     });
                 };
-                let path = dir.join("scenes/conference/conference.obj");
-                if !path.exists() {
-                    return Ok(Outcome {
-                        skipped: Some(format!("{} not found", path.display())),
-                        ..Outcome::default()
-                    });
-                }
                 let scene = crate::mesh_scene(&path)?;
                 Ok(bounce_outcome(&scene, b, seed))
             },
@@ -347,7 +348,6 @@ pub fn render_film(
     spp: u32,
     seed: u32,
 ) -> (Film, rt_integrators::RenderStats) {
-    let camera = &scene.cameras[0];
     let aovs = AovSet {
         albedo: true,
         normal: true,
@@ -357,20 +357,9 @@ pub fn render_film(
     };
     // Every buffer a film can keep, so that every one is checked for invalid values.
     let buffers = FilmBuffers::for_outputs(aovs).with_variance().with_halves();
-    let mut film = Film::new(camera.width, camera.height, buffers);
-    let ctx = Ctx {
-        scene,
-        accel,
-        camera,
-    };
-    let stats = rt_integrators::render(
-        &ctx,
-        integrator,
-        &mut film,
-        &RenderOptions { spp, seed },
-        &|_| {},
-    );
-    (film, stats)
+    crate::Renderer::new(scene)
+        .with_accel(accel)
+        .render(integrator, buffers, spp, seed)
 }
 
 /// Number of NaN, infinite or negative values anywhere in the film's outputs: means,

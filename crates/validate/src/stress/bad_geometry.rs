@@ -1,5 +1,9 @@
 //! Scenes of bad geometry and bad values, rendered by every integrator: no NaN or infinity in
-//! any output, no discarded sample, no panic.
+//! any output, no discarded sample, no panic. Finite is not enough (an all-black image is
+//! finite): the closed boxes must be exactly black, every lit scene must have a positive image
+//! mean no brighter than its sources allow, and the open box, lit by the sky through its
+//! missing face, must match `albedo · AO` under direct lighting and lie between that and the
+//! sky under path tracing (a half-energy renderer fails there).
 //!
 //! Invalid radiance is stopped where it would arise rather than in the film: texture lookups
 //! clamp texels to [0, 1] (NaN counts as 0; `rt_core::texture`), emission and environment
@@ -8,7 +12,7 @@
 //! shading normals that are NaN or zero fall back to the geometric normal. The film's count
 //! of discarded samples is the last line of defence and must stay zero on every scene here.
 
-use super::{render_film, Budget, Case, Check, Outcome};
+use super::{compare::image_mean, render_film, Budget, Case, Check, Outcome};
 use crate::LoadError;
 use rt_core::{
     environment::Environment,
@@ -452,11 +456,45 @@ fn integrators() -> Vec<Box<dyn Integrator>> {
     ]
 }
 
+/// What a bad-geometry scene must look like besides finite.
+#[derive(Clone, Copy, PartialEq)]
+enum Light {
+    /// Sealed from every light: the path tracers' brightest pixel must be exactly zero.
+    None,
+    /// Lit: the light-transporting integrators' image means must be positive and at most
+    /// [`brightest_possible`] (a black renderer fails).
+    Some,
+    /// [`open_box`]: lit by the sky of radiance 1 through the missing face onto Lambertian walls
+    /// of albedo [`OPEN_BOX_ALBEDO`], seen only where walls are. Direct lighting must equal
+    /// `albedo · AO` (the AO image is the cosine-weighted open fraction of the hemisphere)
+    /// within noise, and the path tracers, which add inter-reflections, lie between that and
+    /// the sky's 1 (a half-energy renderer fails).
+    OpenBox,
+}
+
+/// The radiance no image mean may exceed: twice the brightest emitter or sky. By the maximum
+/// principle no surface leaves more radiance than its emission plus its albedo times the
+/// brightest radiance arriving; the emitters here reflect with albedo 0.5 and every other
+/// material at most 1, so no radiance exceeds twice the brightest source.
+fn brightest_possible(scene: &Scene) -> f64 {
+    let sky = match &scene.environment {
+        Environment::Constant(c) => c.max_element(),
+        Environment::Map(_) => f32::INFINITY,
+    };
+    let emitted = scene
+        .materials
+        .iter()
+        .map(|m| m.emission.max_element())
+        .fold(sky, f32::max);
+    2.0 * emitted as f64
+}
+
 /// Renders `scene` with every integrator: invalid values in the film and discarded samples,
-/// summed; with `black`, also the brightest pixel of the path tracers, which must be zero.
-fn render_checks(scene: &Scene, b: &Budget, seed: u64, black: bool) -> Outcome {
+/// summed, and the checks of its [`Light`].
+fn render_checks(scene: &Scene, b: &Budget, seed: u64, light: Light) -> Outcome {
     let accel = crate::default_accel(scene);
     let (mut invalid, mut discarded, mut brightest) = (0u64, 0u64, 0.0f32);
+    let mut means = Vec::new();
     // Finite values and leaks need many paths, not converged pixels: a quarter of the samples
     // of the comparisons, on four integrators.
     let spp = b.spp.div_ceil(4);
@@ -470,23 +508,106 @@ fn render_checks(scene: &Scene, b: &Budget, seed: u64, black: bool) -> Outcome {
                 brightest = brightest.max(p.mean().max_element());
             }
         }
+        means.push((integrator.name().to_string(), image_mean(&film)));
     }
     let mut checks = vec![Check::at_most(
         "invalid values in the films",
         invalid as f64,
         0.0,
     )];
-    if black {
-        checks.insert(
+    match light {
+        Light::None => checks.insert(
             0,
             Check::at_most("brightest pixel inside", brightest as f64, 0.0),
-        );
+        ),
+        Light::Some => {
+            let bound = brightest_possible(scene);
+            for (name, (mean, _)) in means.iter().filter(|(n, _)| n != "ao") {
+                checks.push(Check::at_least(
+                    format!("{name} image mean"),
+                    *mean,
+                    f64::MIN_POSITIVE,
+                ));
+                checks.push(Check::at_most(
+                    format!("{name} image mean / brightest possible"),
+                    mean / bound,
+                    1.0,
+                ));
+            }
+        }
+        Light::OpenBox => checks.extend(open_box_checks(&means)),
     }
     Outcome {
         checks,
         discarded: Some(discarded),
         skipped: None,
     }
+}
+
+/// Albedo of the walls of [`open_box`].
+const OPEN_BOX_ALBEDO: f32 = 0.5;
+
+/// The [`Light::OpenBox`] checks on `(integrator, (image mean, standard error))`: z-scores
+/// against the normal quantile at the suite's false-alarm rate split over the checks.
+fn open_box_checks(means: &[(String, (f64, f64))]) -> Vec<Check> {
+    let get = |name: &str| means.iter().find(|(n, _)| n == name).expect("rendered").1;
+    let (ao, ao_se) = get("ao");
+    let rho = OPEN_BOX_ALBEDO as f64;
+    let one_bounce = rho * ao;
+    let tracers: Vec<&(String, (f64, f64))> = means
+        .iter()
+        .filter(|(n, _)| n != "ao" && n != "direct")
+        .collect();
+    let crit = super::compare::normal_quantile_upper(
+        super::compare::ALPHA / 2.0 / (1 + 2 * tracers.len()) as f64,
+    );
+    let z = |d: f64, se_a: f64, se_b: f64| d / (se_a * se_a + se_b * se_b).sqrt().max(1e-30);
+    let (direct, direct_se) = get("direct");
+    let mut checks = vec![Check::at_most(
+        format!("|z| of direct {direct:.4} - albedo x ao {one_bounce:.4}"),
+        z(direct - one_bounce, direct_se, rho * ao_se).abs(),
+        crit,
+    )];
+    for (name, (mean, se)) in tracers {
+        checks.push(Check::at_least(
+            format!("z of {name} {mean:.4} - albedo x ao"),
+            z(mean - one_bounce, *se, rho * ao_se),
+            -crit,
+        ));
+        checks.push(Check::at_most(
+            format!("z of {name} - sky"),
+            z(mean - 1.0, *se, 0.0),
+            crit,
+        ));
+    }
+    checks
+}
+
+/// The box `[-1, 1]³` of [`closed_box`] without its top face and without a lamp, walls of
+/// albedo [`OPEN_BOX_ALBEDO`] under a sky of radiance 1; the camera looks down at the floor and
+/// the back wall and sees no sky.
+fn open_box(resolution: u32) -> Scene {
+    const N: u32 = 6;
+    let mut b = Builder::new(1.0);
+    let wall = b.material(Material::diffuse("wall", Rgb::splat(OPEN_BOX_ALBEDO)));
+    let o = Vec3::splat(-1.0);
+    // Origins and edges with e1 × e2 pointing inward: floor, back, front, left, right.
+    let faces = [
+        (o, Vec3::Z, Vec3::X),
+        (o, Vec3::X, Vec3::Y),
+        (Vec3::new(-1.0, -1.0, 1.0), Vec3::Y, Vec3::X),
+        (o, Vec3::Y, Vec3::Z),
+        (Vec3::new(1.0, -1.0, -1.0), Vec3::Z, Vec3::Y),
+    ];
+    for (origin, e1, e2) in faces {
+        b.grid(origin, e1 * 2.0, e2 * 2.0, N, wall);
+    }
+    b.finish(camera(
+        Vec3::new(0.0, 0.2, 0.9),
+        Vec3::new(0.0, -0.5, -1.0),
+        60.0,
+        resolution,
+    ))
 }
 
 /// The bad-geometry cases.
@@ -499,7 +620,7 @@ pub fn cases() -> Vec<Case> {
                     &closed_box(b.resolution, 1.0, Vec3::ZERO),
                     b,
                     seed,
-                    true,
+                    Light::None,
                 ))
             },
         },
@@ -511,13 +632,24 @@ pub fn cases() -> Vec<Case> {
                     &closed_box(b.resolution, 100.0, t),
                     b,
                     seed,
-                    true,
+                    Light::None,
+                ))
+            },
+        },
+        Case {
+            name: "bad/open-box-lit",
+            run: |b, seed| {
+                Ok(render_checks(
+                    &open_box(b.resolution),
+                    b,
+                    seed,
+                    Light::OpenBox,
                 ))
             },
         },
         Case {
             name: "bad/grazing",
-            run: |b, seed| Ok(render_checks(&grazing(b.resolution), b, seed, false)),
+            run: |b, seed| Ok(render_checks(&grazing(b.resolution), b, seed, Light::Some)),
         },
         Case {
             name: "bad/coplanar-overlapping",
@@ -526,13 +658,20 @@ pub fn cases() -> Vec<Case> {
                     &coplanar_overlap(b.resolution),
                     b,
                     seed,
-                    false,
+                    Light::Some,
                 ))
             },
         },
         Case {
             name: "bad/zero-area-and-slivers",
-            run: |b, seed| Ok(render_checks(&degenerate(b.resolution), b, seed, false)),
+            run: |b, seed| {
+                Ok(render_checks(
+                    &degenerate(b.resolution),
+                    b,
+                    seed,
+                    Light::Some,
+                ))
+            },
         },
         Case {
             name: "bad/huge-and-tiny (gen:mixed)",
@@ -551,7 +690,7 @@ pub fn cases() -> Vec<Case> {
                     0.0,
                     1.0,
                 );
-                Ok(render_checks(&scene, b, seed, false))
+                Ok(render_checks(&scene, b, seed, Light::Some))
             },
         },
         Case {
@@ -561,17 +700,24 @@ pub fn cases() -> Vec<Case> {
                     &flipped_normals(b.resolution),
                     b,
                     seed,
-                    false,
+                    Light::Some,
                 ))
             },
         },
         Case {
             name: "bad/nan-texels",
-            run: |b, seed| Ok(render_checks(&nan_texels(b.resolution), b, seed, false)),
+            run: |b, seed| {
+                Ok(render_checks(
+                    &nan_texels(b.resolution),
+                    b,
+                    seed,
+                    Light::Some,
+                ))
+            },
         },
         Case {
             name: "bad/emitters-zero-and-max",
-            run: |b, seed| Ok(render_checks(&emitters(b.resolution), b, seed, false)),
+            run: |b, seed| Ok(render_checks(&emitters(b.resolution), b, seed, Light::Some)),
         },
     ]
 }

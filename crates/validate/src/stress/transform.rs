@@ -14,7 +14,7 @@ use rt_integrators::PathIntegrator;
 
 /// The Cornell box of `scenes/cornell-box.toml` with a `resolution²` camera.
 pub fn cornell_box(resolution: u32) -> Result<Scene, LoadError> {
-    let toml = include_str!("../../../scenes/cornell-box.toml");
+    let toml = include_str!("../../../../scenes/cornell-box.toml");
     let loaded = rt_scene::load_str(
         toml,
         std::path::Path::new("."),
@@ -100,18 +100,24 @@ impl Acne<'_> {
     /// The pulled-back ray and how much longer its parameter range must be, or `None` if this
     /// ray is left alone. Chosen by a hash of the ray, so renders stay deterministic.
     fn sabotage(&self, ray: &Ray) -> Option<(Ray, f32)> {
-        let mut h = 0xcbf2_9ce4_8422_2325u64;
-        for x in ray.origin.to_array().into_iter().chain(ray.dir.to_array()) {
-            h = (h ^ x.to_bits() as u64).wrapping_mul(0x0100_0000_01b3);
-        }
-        let h = (h ^ (h >> 29)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        if ((h >> 11) as f64 / (1u64 << 53) as f64) >= self.fraction {
+        if ray_uniform(ray) >= self.fraction {
             return None;
         }
         let len = ray.dir.length();
         let dt = self.depth / len;
         Some((Ray::new(ray.origin - ray.dir * dt, ray.dir), dt))
     }
+}
+
+/// A uniform number in [0, 1) that is a hash of the ray's bits: lets a sabotaged structure pick
+/// a fraction of the rays deterministically (the same rays for any thread count).
+pub fn ray_uniform(ray: &Ray) -> f64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    for x in ray.origin.to_array().into_iter().chain(ray.dir.to_array()) {
+        h = (h ^ x.to_bits() as u64).wrapping_mul(0x0100_0000_01b3);
+    }
+    let h = (h ^ (h >> 29)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    (h >> 11) as f64 / (1u64 << 53) as f64
 }
 
 impl Accel for Acne<'_> {

@@ -115,6 +115,25 @@ pub fn compare(a: &Film, b: &Film, block: u32, alpha: f64) -> Comparison {
     }
 }
 
+/// Mean over all pixels and channels of a film that keeps its variance buffer, and its standard
+/// error (from the per-pixel variances of the mean; pixels are independent).
+///
+/// # Panics
+/// If the film keeps no variance buffer.
+pub fn image_mean(film: &Film) -> (f64, f64) {
+    let n = film.pixels().len() as f64 * 3.0;
+    let (mut sum, mut var) = (0.0, 0.0);
+    for p in film.pixels() {
+        let (m, v) = (
+            p.mean(),
+            p.variance_of_mean().expect("the film keeps its variance"),
+        );
+        sum += (m.x + m.y + m.z) as f64;
+        var += (v.x + v.y + v.z) as f64;
+    }
+    (sum / n, var.sqrt() / n)
+}
+
 /// Complementary error function, `erfc(x)`, with relative error below 1.2·10⁻⁷ everywhere
 /// (Numerical Recipes' Chebyshev fit).
 pub fn erfc(x: f64) -> f64 {
