@@ -174,6 +174,11 @@ fn load(path: &Path) -> Result<Api> {
     Ok(api)
 }
 
+/// Loads the library now (not inside the first timed build) and checks its version.
+pub fn preload() -> Result<()> {
+    api().map(|_| ())
+}
+
 /// The Embree version of the loaded library, e.g. `4.4.0`.
 pub fn version() -> Option<String> {
     let v = api().ok()?.version;
