@@ -42,11 +42,11 @@ if python3 -c "import mitsuba" 2>/dev/null; then
     echo "| ours (\`$(sed -E 's/^[^:]+: [0-9]+x[0-9]+ [0-9]+ spp [a-z]+ ([^ ]+) \(.*/\1/' <<<"$line")\`, 1 thread) | ${ours} s ($(sed -E 's/.* ([0-9.]+ Msamples\/s), ([0-9.]+ Mrays\/s).*/\1, \2/' <<<"$line")) | 1.00 |"
     for variant in scalar_rgb llvm_ad_rgb; do
         if m=$(python3 tools/reference/toml_to_mitsuba.py "$cornell" -o "$out/m64-$variant.exr" --spp 64 \
-            --max-depth 16 --threads 1 --variant "$variant" 2>"$out/mitsuba-$variant.log" | head -1); then
-            secs=$(sed -E 's/.* render=([0-9.]+)s.*/\1/' <<<"$m")
+            --max-depth 16 --threads 1 --variant "$variant" 2>"$out/mitsuba-$variant.log"); then
+            secs=$(grep -m1 'render=' <<<"$m" | sed -E 's/.* render=([0-9.]+)s.*/\1/')
             echo "| Mitsuba $(python3 -c 'import mitsuba; print(mitsuba.__version__)') \`$variant\` | ${secs} s | $(python3 -c "print(f'{$secs / $ours:.2f}')") |"
         else
-            echo "| Mitsuba \`$variant\` | not available here ($(tail -1 "$out/mitsuba-$variant.log")) | |"
+            echo "| Mitsuba \`$variant\` | failed here: $(grep -m1 -E 'Error|ERROR' "$out/mitsuba-$variant.log" | cut -c1-80) | |"
         fi
     done
 else
