@@ -2,8 +2,9 @@
 //!
 //! The steps, each in its own file:
 //! 1. `input`: the scene (TOML, a bare mesh with an automatic camera and light, or `gen:NAME`).
-//! 2. `rays`: the ray sets, generated once with the binary BVH (primary, incoherent diffuse
-//!    bounces, shadow segments) or read from `--ray-file`; optionally dumped to files.
+//! 2. the ray sets of `rt_accel::bench`, generated once with the binary BVH (primary,
+//!    incoherent diffuse bounces, shadow segments, uniform random rays) or read from
+//!    `--ray-file`; optionally dumped to files.
 //! 3. `run`: per structure, build it, check its answers against the binary BVH on the first
 //!    `--check` rays of every set, then time every set on 1 and N threads and count traversal
 //!    work.
@@ -12,12 +13,11 @@
 //! Progress goes to stderr (silenced by `-q`); the table is the only thing on stdout.
 
 pub mod input;
-mod rays;
 mod report;
 mod run;
 
 use anyhow::{bail, Context, Result};
-use rays::RaySet;
+use rt_accel::bench::{self as rays, Query, RaySet};
 use rt_accel::AccelSpec;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -46,8 +46,9 @@ pub struct BenchArgs {
 
     /// Ray sets, comma separated: primary (one jittered camera ray per pixel), incoherent (a
     /// cosine-distributed diffuse bounce from each primary hit), shadow (a segment from each
-    /// primary hit to a point on a light, occlusion query). [default: all three, or none
-    /// when --ray-file is given]
+    /// primary hit to a point on a light, occlusion query), uniform (as many rays as pixels,
+    /// origins uniform in the scene's bounding box, directions uniform on the sphere).
+    /// [default: primary, incoherent and shadow, or none when --ray-file is given]
     #[arg(long, value_delimiter = ',')]
     pub rays: Option<Vec<String>>,
 
@@ -92,9 +93,9 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
 
-    /// Write the generated rays to DIR/primary.bin and DIR/incoherent.bin (closest hit over
-    /// (0, infinity)) and DIR/shadow.bin (occlusion over (0, 1): the direction reaches the
-    /// light point), six little-endian f32 per ray.
+    /// Write the generated rays to DIR/primary.bin, DIR/incoherent.bin and DIR/uniform.bin
+    /// (closest hit over (0, infinity)) and DIR/shadow.bin (occlusion over (0, 1): the
+    /// direction reaches the light point), six little-endian f32 per ray.
     #[arg(long, value_name = "DIR")]
     pub dump_rays: Option<PathBuf>,
 
@@ -118,11 +119,12 @@ struct Wanted {
     primary: bool,
     incoherent: bool,
     shadow: bool,
+    uniform: bool,
 }
 
 impl Wanted {
     fn any(&self) -> bool {
-        self.primary || self.incoherent || self.shadow
+        self.primary || self.incoherent || self.shadow || self.uniform
     }
 }
 
@@ -135,6 +137,7 @@ fn parse_sets(args: &BenchArgs) -> Result<Wanted> {
                 primary: true,
                 incoherent: true,
                 shadow: true,
+                uniform: false,
             }
         });
     };
@@ -144,10 +147,11 @@ fn parse_sets(args: &BenchArgs) -> Result<Wanted> {
             "primary" => w.primary = true,
             "incoherent" => w.incoherent = true,
             "shadow" => w.shadow = true,
+            "uniform" => w.uniform = true,
             "file" if args.ray_file.is_some() => {}
             "file" => bail!("--rays file needs --ray-file"),
             other => bail!(
-                "--rays: unknown ray set \"{other}\" (expected primary, incoherent, shadow or file)"
+                "--rays: unknown ray set \"{other}\" (expected primary, incoherent, shadow, uniform or file)"
             ),
         }
     }
@@ -193,7 +197,14 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     };
     // Cheap checks of the ray file before the (possibly slow) scene.
     let file_rays = match &args.ray_file {
-        Some(path) => Some(rays::read_file(path, args.ray_file_occlusion)?),
+        Some(path) => {
+            let query = if args.ray_file_occlusion {
+                Query::Occluded
+            } else {
+                Query::Closest
+            };
+            Some(rays::read_set(path, "file", query)?)
+        }
         None => None,
     };
 
@@ -243,21 +254,25 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let generated =
             pool.install(|| rays::generate(scene, &camera, reference.as_ref(), &lights, args.seed));
         info(&format!(
-            "rays: {} primary ({width}x{height}), {} incoherent, {} shadow, generated in {:.2} s",
+            "rays: {} primary ({width}x{height}), {} incoherent, {} shadow, {} uniform, generated \
+             in {:.2} s",
             generated.primary.rays.len(),
             generated.incoherent.rays.len(),
             generated.shadow.rays.len(),
+            generated.uniform.rays.len(),
             t.elapsed().as_secs_f64()
         ));
         if let Some(dir) = &args.dump_rays {
             rays::dump(dir, &generated)?;
             info(&format!("rays written to {}", dir.display()));
         }
-        for (set, on) in [
-            (generated.primary, wanted.primary),
-            (generated.incoherent, wanted.incoherent),
-            (generated.shadow, wanted.shadow),
-        ] {
+        let on = [
+            wanted.primary,
+            wanted.incoherent,
+            wanted.shadow,
+            wanted.uniform,
+        ];
+        for (set, on) in generated.into_sets().into_iter().zip(on) {
             if on {
                 sets.push(set);
             }

@@ -1,8 +1,8 @@
 //! Checking a structure against the reference, timing it and counting its traversal work.
 
-use super::rays::{Query, RaySet};
 use super::CHUNK;
 use rayon::prelude::*;
+use rt_accel::bench::{Query, RaySet};
 use rt_core::{Accel, Hit, TraversalCounters};
 use std::time::Instant;
 

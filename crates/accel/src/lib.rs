@@ -54,6 +54,7 @@
 #![deny(unsafe_code)]
 #![deny(missing_docs)]
 
+pub mod bench;
 pub mod brute_force;
 pub mod bvh2;
 pub mod crack_free;

@@ -2,83 +2,71 @@
 //! `Accel` trait) and other Rust BVH crates (obvhs, bvh) on the same ray files. See README.md.
 
 mod bvh_peer;
+mod embree_peer;
 mod mesh;
 mod obvhs_peer;
 mod ours;
 mod peer;
-mod rays;
 
 use anyhow::{Context, Result};
 use clap::Parser;
 use peer::{Peer, Work};
 use rayon::prelude::*;
+use rt_accel::bench::{read_rays, Query, SET_NAMES};
 use rt_core::Ray;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Benchmark rt-accel's structures against obvhs and the bvh crate on identical rays.
+/// A structure fails the check when more than this fraction of its checked rays disagree with
+/// our `bvh` (as in `render bench-accel`).
+const MAX_MISMATCH_FRACTION: f64 = 1e-3;
+
+/// Benchmark rt-accel's structures against obvhs, the bvh crate and Embree on identical rays.
 #[derive(Parser, Debug)]
 #[command(name = "accel-peers")]
 struct Args {
     /// Wavefront OBJ mesh (triangles in the order our loader reads them).
     mesh: PathBuf,
-    /// Directory of primary.bin, incoherent.bin, shadow.bin (written there with --gen-rays).
+    /// Directory of primary.bin, incoherent.bin, shadow.bin, uniform.bin, as written by
+    /// `render bench-accel MESH --dump-rays DIR` (missing sets are skipped).
     #[arg(long)]
     rays: PathBuf,
-    /// Our structures: AccelSpec strings (`qbvh`, `bvh`, `qbvh:order=distance`, ...).
-    #[arg(long, value_delimiter = ',', default_value = "qbvh,bvh")]
+    /// Our structures: AccelSpec strings (`bvh8`, `qbvh`, `bvh`, `qbvh:order=distance`, ...).
+    #[arg(long, value_delimiter = ',', default_value = "bvh8,qbvh,bvh")]
     accel: Vec<String>,
     /// Peer structures: obvhs-bvh2, obvhs-cwbvh (optionally `:fastest|fast|medium|slow`
-    /// build preset, default medium), bvh-crate, bvh-crate-flat. `none` for none.
+    /// build preset, default medium), bvh-crate, bvh-crate-flat, embree, embree:high (needs
+    /// --embree-lib). `none` for none.
     #[arg(
         long,
         value_delimiter = ',',
         default_value = "obvhs-bvh2,obvhs-cwbvh,bvh-crate,bvh-crate-flat"
     )]
     peers: Vec<String>,
+    /// Embree 4's shared library for the `embree` peers (default: $EMBREE_LIB). The embreex
+    /// wheel carries one: `pip install embreex`, then site-packages/embreex.libs/libembree4*.
+    #[arg(long, value_name = "PATH")]
+    embree_lib: Option<PathBuf>,
     /// Threads of the multi-threaded runs (default: all cores). Builds and traces run once
-    /// with 1 thread and once with N.
+    /// with 1 thread and, if N > 1, once with N.
     #[arg(long)]
     threads: Option<usize>,
     /// Write the results as CSV here.
     #[arg(long)]
     csv: Option<PathBuf>,
-    /// Check every structure's answers against ours (`bvh`) on this many rays of each set.
+    /// Check every structure's answers against ours (`bvh`) on this many rays of each set
+    /// before timing; more than 0.1 % disagreeing stops the benchmark.
     #[arg(long, default_value_t = 10_000)]
     check: usize,
-    /// Timed runs per measurement; the best is reported.
-    #[arg(long, default_value_t = 3)]
+    /// Timed rounds: each round traces every set once with every structure, in turn, so that
+    /// load drift hits all of them alike. The median round is reported (and the best).
+    #[arg(long, default_value_t = 5)]
     runs: usize,
     /// Write our `bvh`'s answers for every ray to this directory: NAME.t.f32 (closest t,
     /// +inf on a miss), NAME.prim.u32 (u32::MAX on a miss) and shadow.occluded.u8.
     #[arg(long)]
     dump_hits: Option<PathBuf>,
-    /// Generate the ray files into --rays instead of benchmarking (fallback until
-    /// `render bench-accel --dump-rays` exists).
-    #[arg(long)]
-    gen_rays: bool,
-    /// --gen-rays: image width.
-    #[arg(long, default_value_t = 512)]
-    width: u32,
-    /// --gen-rays: image height.
-    #[arg(long, default_value_t = 384)]
-    height: u32,
-    /// --gen-rays: camera placement.
-    #[arg(long, value_enum, default_value = "outside")]
-    view: rays::View,
-    /// --gen-rays: camera position `x,y,z` instead of the view's (needs --look-at).
-    #[arg(long, value_delimiter = ',', requires = "look_at")]
-    eye: Option<Vec<f32>>,
-    /// --gen-rays: camera target `x,y,z` (with --eye).
-    #[arg(long, value_delimiter = ',', requires = "eye")]
-    look_at: Option<Vec<f32>>,
-    /// --gen-rays: incoherent and shadow rays per primary hit.
-    #[arg(long, default_value_t = 2)]
-    per_hit: u32,
-    /// --gen-rays: random seed.
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
 }
 
 /// One ray set read from the ray directory.
@@ -97,8 +85,11 @@ struct Row {
     /// CPU time of the build (1-thread rows).
     build_cpu_ms: Option<f64>,
     bytes: Option<usize>,
+    /// Median round.
     mrays_per_s: f64,
-    /// Rays per CPU-second of the tracing thread (1-thread rows).
+    /// Fastest round.
+    mrays_best: f64,
+    /// Rays per CPU-second of the tracing thread, median round (1-thread rows).
     mrays_per_cpu_s: Option<f64>,
     hits: usize,
     work: [Option<f64>; 3],
@@ -111,8 +102,16 @@ enum Answer {
     Occluded(bool),
 }
 
+fn t_max(shadow: bool) -> f32 {
+    if shadow {
+        Query::Occluded.t_max()
+    } else {
+        Query::Closest.t_max()
+    }
+}
+
 fn answer(p: &dyn Peer, ray: &Ray, shadow: bool) -> Answer {
-    let t_max = rays::t_max(shadow);
+    let t_max = t_max(shadow);
     if shadow {
         Answer::Occluded(p.occluded(ray, t_max))
     } else {
@@ -120,8 +119,19 @@ fn answer(p: &dyn Peer, ray: &Ray, shadow: bool) -> Answer {
     }
 }
 
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
 fn main() -> Result<()> {
     let args = Args::parse();
+    embree_peer::set_library(args.embree_lib.clone());
     let threads = args
         .threads
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
@@ -133,9 +143,6 @@ fn main() -> Result<()> {
         tris.len(),
         t0.elapsed().as_secs_f64()
     );
-    if args.gen_rays {
-        return generate(&args, &tris);
-    }
     let sets = read_sets(&args.rays)?;
     let pool = |n| rayon::ThreadPoolBuilder::new().num_threads(n).build();
     let pools = if threads > 1 {
@@ -163,52 +170,97 @@ fn main() -> Result<()> {
     }
     drop(reference);
 
-    let mut rows = Vec::new();
-    let mut checks = String::new();
-    let names = args
+    let names: Vec<&String> = args
         .accel
         .iter()
-        .chain(args.peers.iter().filter(|p| *p != "none"));
-    for name in names {
-        // Checked and counted once, on the first (1-thread) build.
-        let mut work: Option<Vec<[Option<f64>; 3]>> = None;
-        for (n, pool) in &pools {
+        .chain(args.peers.iter().filter(|p| *p != "none"))
+        .collect();
+    if names.iter().any(|n| n.starts_with("embree")) {
+        // Opening the library (and starting TBB) is not part of any build time.
+        embree_peer::preload()?;
+    }
+    let mut rows = Vec::new();
+    let mut checks = String::new();
+    let mut work: Vec<Vec<[Option<f64>; 3]>> = Vec::new();
+    for (n, pool) in &pools {
+        // Build everything on this pool.
+        let mut built = Vec::new();
+        for name in &names {
             let (start, cpu) = (Instant::now(), pool.install(thread_cpu_seconds));
             let p = pool.install(|| peer::build(name, &tris))?;
             let build_ms = start.elapsed().as_secs_f64() * 1e3;
-            // On one thread the whole build ran on the pool's one worker.
-            let build_cpu_ms = (*n == 1).then(|| (pool.install(thread_cpu_seconds) - cpu) * 1e3);
+            // On one thread the whole build ran on the pool's one worker (Embree: its own
+            // single TBB thread, so the CPU time is not seen here).
+            let build_cpu_ms = (*n == 1 && !name.starts_with("embree"))
+                .then(|| (pool.install(thread_cpu_seconds) - cpu) * 1e3);
             eprintln!("{name}: built in {build_ms:.1} ms on {n} thread(s)");
-            let work = work.get_or_insert_with(|| {
+            built.push((p, build_ms, build_cpu_ms));
+        }
+        // Checked and counted once, on the first (1-thread) builds, before any timing.
+        if work.is_empty() {
+            for (p, ..) in &built {
                 for (s, exp) in sets.iter().zip(&expected) {
-                    let _ = writeln!(checks, "{}", check(&*p, s, exp));
+                    let (line, wrong) = check(&**p, s, exp);
+                    eprintln!("{line}");
+                    let _ = writeln!(checks, "{line}");
+                    anyhow::ensure!(
+                        wrong as f64 <= MAX_MISMATCH_FRACTION * exp.len().max(1) as f64,
+                        "{}: {wrong} of {} {} rays disagree with our bvh",
+                        p.name(),
+                        exp.len(),
+                        s.name
+                    );
                 }
-                all.install(|| sets.iter().map(|s| mean_work(&*p, s)).collect())
-            });
-            for (s, w) in sets.iter().zip(work.iter()) {
-                let runs: Vec<Timing> = (0..args.runs.max(1))
-                    .map(|_| pool.install(|| trace(&*p, s, *n)))
-                    .collect();
-                let wall = runs.iter().map(|r| r.wall).fold(f64::INFINITY, f64::min);
-                let cpu = runs.iter().filter_map(|r| r.cpu).reduce(f64::min);
+                work.push(all.install(|| sets.iter().map(|s| mean_work(&**p, s)).collect()));
+            }
+        }
+        // Interleaved rounds: every structure on every set, in turn.
+        let mut timings: Vec<Vec<Vec<Timing>>> = vec![vec![Vec::new(); sets.len()]; built.len()];
+        for round in 0..args.runs.max(1) {
+            for (i, (p, ..)) in built.iter().enumerate() {
+                for (k, s) in sets.iter().enumerate() {
+                    timings[i][k].push(pool.install(|| trace(&**p, s, *n)));
+                }
+            }
+            eprintln!(
+                "{n} thread(s): round {} of {} done",
+                round + 1,
+                args.runs.max(1)
+            );
+        }
+        for (i, (p, build_ms, build_cpu_ms)) in built.iter().enumerate() {
+            for (k, s) in sets.iter().enumerate() {
+                let runs = &timings[i][k];
                 let mrays = |secs: f64| s.rays.len() as f64 / secs / 1e6;
+                let wall = median(runs.iter().map(|r| r.wall).collect());
+                let best = runs.iter().map(|r| r.wall).fold(f64::INFINITY, f64::min);
+                let cpu: Vec<f64> = runs.iter().filter_map(|r| r.cpu).collect();
                 rows.push(Row {
-                    accel: name.clone(),
+                    accel: names[i].clone(),
                     rays: s.name,
                     threads: *n,
-                    build_ms,
-                    build_cpu_ms,
+                    build_ms: *build_ms,
+                    build_cpu_ms: *build_cpu_ms,
                     bytes: p.bytes(),
                     mrays_per_s: mrays(wall),
-                    mrays_per_cpu_s: cpu.map(mrays),
+                    mrays_best: mrays(best),
+                    mrays_per_cpu_s: (!cpu.is_empty()).then(|| mrays(median(cpu))),
                     hits: runs[0].hits,
-                    work: *w,
+                    work: work[i][k],
                 });
             }
         }
     }
 
     print!("{}", table(&args, &tris, &sets, &rows));
+    if let Some(v) = names
+        .iter()
+        .any(|n| n.starts_with("embree"))
+        .then(embree_peer::version)
+        .flatten()
+    {
+        println!("embree: Embree {v}, single-ray API (rtcIntersect1 / rtcOccluded1)");
+    }
     println!(
         "\nCheck against ours (bvh), first {} rays of each set:",
         args.check
@@ -222,40 +274,15 @@ fn main() -> Result<()> {
     Ok(())
 }
 
-fn generate(args: &Args, tris: &[[rt_core::glam::Vec3; 3]]) -> Result<()> {
-    for v in [&args.eye, &args.look_at].into_iter().flatten() {
-        anyhow::ensure!(v.len() == 3, "--eye and --look-at take x,y,z");
-    }
-    let opts = rays::GenOptions {
-        width: args.width,
-        height: args.height,
-        view: args.view,
-        per_hit: args.per_hit,
-        eye: args.eye.as_ref().zip(args.look_at.as_ref()).map(|(e, t)| {
-            let v = |a: &[f32]| rt_core::glam::Vec3::new(a[0], a[1], a[2]);
-            (v(e), v(t))
-        }),
-        seed: args.seed,
-    };
-    let generated = rays::generate(tris, &opts)?;
-    std::fs::create_dir_all(&args.rays)?;
-    for ((name, _), set) in rays::SETS.iter().zip(&generated) {
-        let path = args.rays.join(format!("{name}.bin"));
-        rays::write(&path, set)?;
-        eprintln!("wrote {} ({} rays)", path.display(), set.len());
-    }
-    Ok(())
-}
-
 fn read_sets(dir: &Path) -> Result<Vec<RaySet>> {
     let mut sets = Vec::new();
-    for (name, shadow) in rays::SETS {
+    for name in SET_NAMES {
         let path = dir.join(format!("{name}.bin"));
         if path.exists() {
             sets.push(RaySet {
                 name,
-                shadow,
-                rays: rays::read(&path)?,
+                shadow: Query::of_set(name) == Query::Occluded,
+                rays: read_rays(&path)?,
             });
         } else {
             eprintln!("note: {} is missing, skipping that set", path.display());
@@ -279,6 +306,7 @@ fn thread_cpu_seconds() -> f64 {
 }
 
 /// One timed pass over a set.
+#[derive(Clone)]
 struct Timing {
     /// Wall-clock seconds.
     wall: f64,
@@ -290,7 +318,7 @@ struct Timing {
 
 /// Traces a whole set on the current pool.
 fn trace(p: &dyn Peer, s: &RaySet, threads: usize) -> Timing {
-    let t_max = rays::t_max(s.shadow);
+    let t_max = t_max(s.shadow);
     let one = |r: &Ray| -> usize {
         if s.shadow {
             p.occluded(r, t_max) as usize
@@ -323,7 +351,7 @@ fn trace(p: &dyn Peer, s: &RaySet, threads: usize) -> Timing {
 
 /// Mean work per ray over the whole set (boxes, leaves, triangles), where the structure counts.
 fn mean_work(p: &dyn Peer, s: &RaySet) -> [Option<f64>; 3] {
-    let t_max = rays::t_max(s.shadow);
+    let t_max = t_max(s.shadow);
     let add = |a: Option<u64>, b: Option<u64>| a.zip(b).map(|(a, b)| a + b);
     let total = s
         .rays
@@ -346,7 +374,7 @@ fn mean_work(p: &dyn Peer, s: &RaySet) -> [Option<f64>; 3] {
 }
 
 /// Compares a structure's answers with the reference's; one report line.
-fn check(p: &dyn Peer, s: &RaySet, expected: &[Answer]) -> String {
+fn check(p: &dyn Peer, s: &RaySet, expected: &[Answer]) -> (String, usize) {
     let (mut wrong, mut other_prim) = (0, 0);
     for (r, exp) in s.rays.iter().zip(expected) {
         match (answer(p, r, s.shadow), *exp) {
@@ -361,7 +389,7 @@ fn check(p: &dyn Peer, s: &RaySet, expected: &[Answer]) -> String {
             _ => {}
         }
     }
-    format!(
+    let line = format!(
         "  {:<28} {:<10} {:>6} of {:>6} differ (hit/miss or t beyond 1e-4 relative){}",
         p.name(),
         s.name,
@@ -372,7 +400,8 @@ fn check(p: &dyn Peer, s: &RaySet, expected: &[Answer]) -> String {
         } else {
             String::new()
         }
-    )
+    );
+    (line, wrong)
 }
 
 fn dump_hits(dir: &Path, reference: &dyn Peer, sets: &[RaySet]) -> Result<()> {
@@ -416,7 +445,7 @@ fn table(args: &Args, tris: &[[rt_core::glam::Vec3; 3]], sets: &[RaySet], rows: 
     }
     let _ = writeln!(
         out,
-        "\n{:<28} {:<10} {:>3} {:>9} {:>9} {:>11} {:>7} {:>9} {:>9} {:>8} {:>7} {:>7} {:>7}",
+        "\n{:<28} {:<10} {:>3} {:>9} {:>9} {:>11} {:>7} {:>9} {:>9} {:>9} {:>8} {:>7} {:>7} {:>7}",
         "accel",
         "rays",
         "thr",
@@ -425,6 +454,7 @@ fn table(args: &Args, tris: &[[rt_core::glam::Vec3; 3]], sets: &[RaySet], rows: 
         "bytes",
         "B/tri",
         "Mrays/s",
+        "(best)",
         "(CPU)",
         "hits",
         "boxes",
@@ -434,7 +464,7 @@ fn table(args: &Args, tris: &[[rt_core::glam::Vec3; 3]], sets: &[RaySet], rows: 
     for r in rows {
         let _ = writeln!(
             out,
-            "{:<28} {:<10} {:>3} {:>9.1} {:>9} {:>11} {:>7} {:>9.3} {:>9} {:>8} {:>7} {:>7} {:>7}",
+            "{:<28} {:<10} {:>3} {:>9.1} {:>9} {:>11} {:>7} {:>9.3} {:>9.3} {:>9} {:>8} {:>7} {:>7} {:>7}",
             r.accel,
             r.rays,
             r.threads,
@@ -443,6 +473,7 @@ fn table(args: &Args, tris: &[[rt_core::glam::Vec3; 3]], sets: &[RaySet], rows: 
             r.bytes.map_or(String::new(), |b| b.to_string()),
             opt(r.bytes.map(|b| b as f64 / tris.len() as f64), 1),
             r.mrays_per_s,
+            r.mrays_best,
             opt(r.mrays_per_cpu_s, 3),
             r.hits,
             opt(r.work[0], 1),
@@ -455,12 +486,12 @@ fn table(args: &Args, tris: &[[rt_core::glam::Vec3; 3]], sets: &[RaySet], rows: 
 
 fn csv(rows: &[Row]) -> String {
     let mut out = String::from(
-        "accel,rays,threads,build_ms,bytes,mrays_per_s,hits,boxes_per_ray,leaves_per_ray,tris_per_ray,mrays_per_cpu_s,build_cpu_ms\n",
+        "accel,rays,threads,build_ms,bytes,mrays_per_s,hits,boxes_per_ray,leaves_per_ray,tris_per_ray,mrays_per_cpu_s,build_cpu_ms,mrays_best\n",
     );
     for r in rows {
         let _ = writeln!(
             out,
-            "{},{},{},{:.2},{},{:.4},{},{},{},{},{},{}",
+            "{},{},{},{:.2},{},{:.4},{},{},{},{},{},{},{:.4}",
             r.accel,
             r.rays,
             r.threads,
@@ -473,6 +504,7 @@ fn csv(rows: &[Row]) -> String {
             opt(r.work[2], 2),
             opt(r.mrays_per_cpu_s, 4),
             opt(r.build_cpu_ms, 2),
+            r.mrays_best,
         );
     }
     out

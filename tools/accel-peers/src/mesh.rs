@@ -31,11 +31,3 @@ pub fn load_obj(path: &Path) -> Result<Vec<[Vec3; 3]>> {
     anyhow::ensure!(!tris.is_empty(), "{} has no triangles", path.display());
     Ok(tris)
 }
-
-/// Bounds of all vertices.
-pub fn bounds(tris: &[[Vec3; 3]]) -> (Vec3, Vec3) {
-    tris.iter().flatten().fold(
-        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-        |(lo, hi), &v| (lo.min(v), hi.max(v)),
-    )
-}

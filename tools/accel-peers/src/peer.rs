@@ -38,6 +38,8 @@ pub trait Peer: Send + Sync {
 pub fn build(name: &str, tris: &[[rt_core::glam::Vec3; 3]]) -> anyhow::Result<Box<dyn Peer>> {
     if let Some(rest) = name.strip_prefix("obvhs-") {
         crate::obvhs_peer::build(name, rest, tris)
+    } else if name.starts_with("embree") {
+        crate::embree_peer::build(name, tris)
     } else if name == "bvh-crate" || name == "bvh-crate-flat" {
         crate::bvh_peer::build(name, tris)
     } else {
