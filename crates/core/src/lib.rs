@@ -33,6 +33,7 @@ pub mod image;
 pub mod lights;
 pub mod material;
 pub mod ray;
+pub mod rng;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;

@@ -44,51 +44,12 @@ pub fn generate(name: &str) -> Result<Scene, UnknownScene> {
     }
 }
 
-/// Deterministic pseudo-random numbers: SplitMix64.
-struct Rng(u64);
+/// The generators' random numbers: rt-core's SplitMix64 started at the seed itself (so the
+/// scenes stay what they were when their sizes were specified).
+type Rng = rt_core::rng::SplitMix64;
 
-impl Rng {
-    fn new(seed: u64) -> Self {
-        Self(seed)
-    }
-
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1).
-    fn f32(&mut self) -> f32 {
-        (self.next_u64() >> 40) as f32 / (1u64 << 24) as f32
-    }
-
-    /// Uniform in [lo, hi).
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.f32()
-    }
-
-    /// Uniform in the cube [-1, 1)³.
-    fn cube(&mut self) -> Vec3 {
-        Vec3::new(
-            self.range(-1.0, 1.0),
-            self.range(-1.0, 1.0),
-            self.range(-1.0, 1.0),
-        )
-    }
-
-    /// A unit vector (not exactly uniform on the sphere; it does not need to be).
-    fn direction(&mut self) -> Vec3 {
-        loop {
-            let v = self.cube();
-            let l = v.length_squared();
-            if l > 1e-4 && l <= 1.0 {
-                return v / l.sqrt();
-            }
-        }
-    }
+fn rng(seed: u64) -> Rng {
+    Rng::from_state(seed)
 }
 
 /// Collects triangles into named objects.
@@ -230,7 +191,7 @@ fn rotated() -> Scene {
         ground,
     );
     b.end_object("ground");
-    let mut rng = Rng::new(0x5eed_0002);
+    let mut rng = rng(0x5eed_0002);
     let cell = 2.0 * W / CELLS as f32;
     for j in 0..CELLS {
         for i in 0..CELLS {
@@ -280,7 +241,7 @@ fn mixed() -> Scene {
     let green = b.material(Material::diffuse("green", Rgb::new(0.2, 0.5, 0.15)));
     let dust = b.material(Material::diffuse("dust", Rgb::new(0.8, 0.6, 0.4)));
     let lamp = b.emitter("lamp", 6.0);
-    let mut rng = Rng::new(0x5eed_0003);
+    let mut rng = rng(0x5eed_0003);
     // Two ground triangles and two backdrop triangles, 2·10⁵ wide.
     b.quad(
         Vec3::new(-HUGE, 0.0, HUGE),
@@ -326,7 +287,7 @@ fn mixed() -> Scene {
         let size = radius / 50.0;
         for _ in 0..4096 {
             let p = centre + rng.cube() * radius;
-            let (u, v) = (rng.direction() * size, rng.direction() * size);
+            let (u, v) = (rng.unit_vec() * size, rng.unit_vec() * size);
             b.tri([p, p + u, p + v], dust);
         }
     }

@@ -39,5 +39,5 @@ mod sets;
 pub use file::{
     decode, dump, encode, read_rays, read_set, write_rays, FormatError, RayFileError, RAY_BYTES,
 };
-pub use rng::RayRng;
+pub use rng::{ray_rng, RayRng};
 pub use sets::{generate, uniform, Generated, Lights, Query, RaySet, SET_NAMES};

@@ -4,7 +4,7 @@
 //! barycentrics, offset along the geometric normal by its error bound
 //! (`rt_core::ray::spawn_ray`, `shadow_segment`).
 
-use super::rng::RayRng;
+use super::rng::ray_rng;
 use rayon::prelude::*;
 use rt_core::{
     color::luminance,
@@ -169,7 +169,7 @@ pub fn uniform(bounds: &Aabb, count: usize, seed: u64) -> RaySet {
     let rays = (0..count as u64)
         .into_par_iter()
         .map(|k| {
-            let mut rng = RayRng::new(seed, UNIFORM, k);
+            let mut rng = ray_rng(seed, UNIFORM, k);
             let u = Vec3::new(rng.f32(), rng.f32(), rng.f32());
             // lerp, clamped so that rounding cannot leave the box.
             let origin = (bounds.min + (bounds.max - bounds.min) * u).clamp(bounds.min, bounds.max);
@@ -201,7 +201,7 @@ pub fn generate(
     let primary: Vec<Ray> = (0..n)
         .into_par_iter()
         .map(|k| {
-            let mut rng = RayRng::new(seed, PRIMARY, k);
+            let mut rng = ray_rng(seed, PRIMARY, k);
             let pixel = Vec2::new((k % w) as f32, (k / w) as f32);
             let film = pixel + rng.vec2();
             camera.generate_ray(film, rng.vec2())
@@ -218,7 +218,7 @@ pub fn generate(
         .filter_map(|(k, (hit, ray))| {
             let si = scene.surface(hit.as_ref()?);
             let n = facing(si.ng, ray.dir);
-            let mut rng = RayRng::new(seed, INCOHERENT, k as u64);
+            let mut rng = ray_rng(seed, INCOHERENT, k as u64);
             let wi = Frame::from_normal(n).to_world(cosine_hemisphere(rng.vec2()));
             Some(spawn_ray(si.p, si.p_error, n, wi))
         })
@@ -229,7 +229,7 @@ pub fn generate(
         .enumerate()
         .filter_map(|(k, (hit, ray))| {
             let si = scene.surface(hit.as_ref()?);
-            let mut rng = RayRng::new(seed, SHADOW, k as u64);
+            let mut rng = ray_rng(seed, SHADOW, k as u64);
             let (q, q_error, nq) = lights.sample(scene, rng.f32(), rng.vec2());
             if facing(si.ng, ray.dir).dot(q - si.p) <= 0.0 {
                 return None;
