@@ -1,7 +1,7 @@
 //! The benchmark's geometry: a TOML scene, a bare mesh file, or a procedural scene.
 
 use anyhow::{bail, Context, Result};
-use rt_core::{glam::Vec3, Aabb, Accel, Camera, Ray, Scene};
+use rt_core::{glam::Vec3, Aabb, Camera, Scene};
 use std::io::Write;
 use std::path::Path;
 
@@ -51,7 +51,10 @@ pub fn load(input: &str, camera: Option<&str>) -> Result<Input> {
     let (loaded, is_mesh) = if input.starts_with("gen:") || ext == "toml" {
         (crate::job::load_scene(path)?, false)
     } else if MESH_EXTENSIONS.contains(&ext.as_str()) {
-        (load_mesh(path)?, true)
+        (
+            rt_scene::load_mesh(path).map_err(|e| anyhow::anyhow!("{e}"))?,
+            true,
+        )
     } else {
         bail!(
             "{input}: unknown input type (expected a .toml scene, a .obj, .gltf, .glb or .ra2 \
@@ -69,7 +72,7 @@ pub fn load(input: &str, camera: Option<&str>) -> Result<Input> {
         if let Some(name) = camera {
             bail!("--camera {name}: a mesh file has no cameras (an automatic one is used)");
         }
-        auto_camera(&scene.triangles, &bounds)
+        rt_scene::views::outside_view(&scene.triangles, &bounds)
     } else {
         match camera {
             Some(name) => scene
@@ -100,85 +103,6 @@ pub fn load(input: &str, camera: Option<&str>) -> Result<Input> {
         is_mesh,
         bounds,
     })
-}
-
-/// Reads a mesh through the scene loader: a generated TOML scene that references the mesh's
-/// absolute path with one grey material (the mesh's own materials do not matter here).
-fn load_mesh(path: &Path) -> Result<rt_scene::LoadedScene> {
-    std::fs::metadata(path).map_err(|e| anyhow::anyhow!("{}: cannot open: {e}", path.display()))?;
-    let abs = std::fs::canonicalize(path)
-        .map_err(|e| anyhow::anyhow!("{}: cannot open: {e}", path.display()))?;
-    let Some(abs_text) = abs.to_str() else {
-        bail!("{}: the path is not valid UTF-8", path.display());
-    };
-    let quoted = abs_text.replace('\\', "\\\\").replace('"', "\\\"");
-    let toml = format!(
-        "[environment]\ncolor = [1, 1, 1]\n\n\
-         [[camera]]\nname = \"auto\"\nposition = [0, 0, 1]\nlook_at = [0, 0, 0]\n\n\
-         [[material]]\nname = \"grey\"\n\n\
-         [[geometry]]\nname = \"mesh\"\nfile = \"{quoted}\"\nmaterial = \"grey\"\n"
-    );
-    let base = abs.parent().unwrap_or(Path::new("/"));
-    rt_scene::load_str(&toml, base, path).map_err(|e| anyhow::anyhow!("{e}"))
-}
-
-/// A camera looking at the centre of the triangles' bounding box from the fixed diagonal
-/// (1, 0.7, 1.3), just far enough for every vertex to be in its 40° field of view.
-fn auto_camera(triangles: &[[Vec3; 3]], bounds: &Aabb) -> Camera {
-    let centre = bounds.center();
-    let fov = 40.0f32;
-    let tan_half = (0.5 * fov).to_radians().tan();
-    let back = Vec3::new(1.0, 0.7, 1.3).normalize();
-    let right = (-back).cross(Vec3::Y).normalize();
-    let up = right.cross(-back);
-    let dist = triangles
-        .iter()
-        .flatten()
-        .map(|&p| {
-            let v = p - centre;
-            let lateral = v.dot(right).abs().max(v.dot(up).abs());
-            v.dot(back) + lateral / tan_half
-        })
-        .fold(f32::MIN_POSITIVE, f32::max)
-        * 1.05;
-    Camera::look_at(
-        "auto",
-        centre + back * dist,
-        centre,
-        Vec3::Y,
-        fov,
-        DEFAULT_WIDTH,
-        DEFAULT_WIDTH,
-        0.0,
-        dist,
-    )
-}
-
-/// The automatic camera and light of a room: from the middle of the bounds at 60 % of the
-/// height, backed off along the long horizontal axis by 70 % of the free distance behind
-/// (measured with `reference`), looking down that axis and a little down, 60° field of view;
-/// the light under the middle of the ceiling (90 % of the height).
-pub fn inside_view(bounds: &Aabb, reference: &dyn Accel) -> (Camera, Vec3) {
-    let (lo, centre, ext) = (bounds.min, bounds.center(), bounds.extent());
-    let axis = if ext.x >= ext.z { Vec3::X } else { Vec3::Z };
-    let mid = Vec3::new(centre.x, lo.y + 0.6 * ext.y, centre.z);
-    let behind = reference
-        .intersect(&Ray::new(mid, -axis), f32::INFINITY)
-        .map_or(0.5 * ext.dot(axis), |h| h.t);
-    let eye = mid - axis * (0.7 * behind);
-    let target = Vec3::new(centre.x, lo.y + 0.3 * ext.y, centre.z) + axis * (0.5 * behind);
-    let camera = Camera::look_at(
-        "inside",
-        eye,
-        target,
-        Vec3::Y,
-        60.0,
-        DEFAULT_WIDTH,
-        DEFAULT_WIDTH,
-        0.0,
-        (target - eye).length(),
-    );
-    (camera, Vec3::new(centre.x, lo.y + 0.9 * ext.y, centre.z))
 }
 
 /// The primary ray grid: as given, or derived from the camera's aspect ratio.

@@ -14,10 +14,9 @@
 
 pub mod input;
 mod report;
-mod run;
 
 use anyhow::{bail, Context, Result};
-use rt_accel::bench::{self as rays, Query, RaySet};
+use rt_accel::bench::{self as rays, measure, Query, RaySet};
 use rt_accel::AccelSpec;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -28,8 +27,6 @@ const MAX_THREADS: usize = 1024;
 /// the binary BVH (a handful may differ legitimately: a ray grazing a shared edge in the
 /// crack-free test modes, or a nearly degenerate triangle whose `t` is noisy).
 const MAX_MISMATCH_FRACTION: f64 = 1e-3;
-/// Chunk of rays handed to one rayon task.
-const CHUNK: usize = 4096;
 
 /// Arguments of `render bench-accel`.
 #[derive(clap::Args, Debug)]
@@ -239,7 +236,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
 
     let (camera, fallback_light) = match args.view {
         Some(input::View::Inside) if input.is_mesh => {
-            input::inside_view(&input.bounds, reference.as_ref())
+            rt_scene::views::inside_view(&input.bounds, reference.as_ref())
         }
         _ => (input.camera.clone(), input.fallback_light),
     };
@@ -303,9 +300,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let accel = fresh.as_deref().unwrap_or(reference.as_ref());
         info(&format!("{name}: built in {build_ms:.1} ms"));
         let check = if reuse {
-            run::CheckResult::default()
+            measure::CheckResult::default()
         } else {
-            let c = pool.install(|| run::check(accel, reference.as_ref(), &sets, args.check));
+            let c = pool.install(|| measure::check(accel, reference.as_ref(), &sets, args.check));
             info(&format!("{name}: {}", c.summary()));
             if !args.quiet {
                 for line in c.examples.iter().take(3) {
@@ -326,7 +323,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             let thread_counts: &[usize] = if threads == 1 { &[1] } else { &[1, threads] };
             let first_row = rows.len();
             for &n in thread_counts {
-                let timing = run::time(accel, set, (n > 1).then_some(&pool), args.repeat);
+                let timing = measure::time(accel, set, (n > 1).then_some(&pool), args.repeat);
                 info(&format!(
                     "{name}: {} rays, {n} thread{}: {:.2} Mrays/s",
                     set.name,
@@ -352,7 +349,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             // Counted after the timed runs, so that with `--check 0 --repeat 1` the first
             // timed run is the structure's first pass (the on-demand QBVH builds its groups in
             // it rather than in the counting pass).
-            let counted = pool.install(|| run::count(accel, set));
+            let counted = pool.install(|| measure::count(accel, set));
             for r in &mut rows[first_row..] {
                 r.counters = counted;
             }

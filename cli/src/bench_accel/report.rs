@@ -179,7 +179,7 @@ pub fn write_csv(path: &Path, rows: &[Row]) -> Result<()> {
         out.push_str(&line.join(","));
         out.push('\n');
     }
-    std::fs::write(path, out).map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))
+    rt_film::write_bytes_atomic(path, out.as_bytes()).map_err(|e| anyhow::anyhow!("{e}"))
 }
 
 #[cfg(test)]

@@ -63,6 +63,7 @@ mod obj;
 pub mod procedural;
 pub mod raw;
 mod shapes;
+pub mod views;
 
 pub use error::{LineCol, SceneError};
 
@@ -119,6 +120,31 @@ pub fn load_any(path: &Path) -> Result<LoadedScene, SceneError> {
         });
     }
     load(path)
+}
+
+/// Loads a bare mesh file (OBJ, glTF, .ra2) as a scene through the scene format: one grey
+/// material, a white sky and a placeholder camera named `auto` (see [`views`] for real ones);
+/// the mesh's own materials do not matter to the callers (benchmarks, stress cases).
+pub fn load_mesh(path: &Path) -> Result<LoadedScene, SceneError> {
+    let cannot = |e: std::io::Error| SceneError::File {
+        file: path.to_path_buf(),
+        message: format!("cannot open: {e}"),
+    };
+    let abs = std::fs::canonicalize(path).map_err(cannot)?;
+    let Some(text) = abs.to_str() else {
+        return Err(SceneError::File {
+            file: path.to_path_buf(),
+            message: "the path is not valid UTF-8".into(),
+        });
+    };
+    let quoted = text.replace('\\', "\\\\").replace('"', "\\\"");
+    let toml = format!(
+        "[environment]\ncolor = [1, 1, 1]\n\n\
+         [[camera]]\nname = \"auto\"\nposition = [0, 0, 1]\nlook_at = [0, 0, 0]\n\n\
+         [[material]]\nname = \"grey\"\n\n\
+         [[geometry]]\nname = \"mesh\"\nfile = \"{quoted}\"\nmaterial = \"grey\"\n"
+    );
+    load_str(&toml, abs.parent().unwrap_or(Path::new("/")), path)
 }
 
 /// Loads the scene file at `path`. Relative paths inside it (meshes, textures, environment

@@ -33,7 +33,7 @@ pub mod stress;
 
 pub use render::Renderer;
 
-use rt_core::{glam::Vec3, Scene};
+use rt_core::Scene;
 use std::path::Path;
 
 /// A scene that did not load or generate.
@@ -64,46 +64,20 @@ pub fn default_accel(scene: &Scene) -> Box<dyn rt_core::Accel> {
     rt_accel::AccelSpec::default().build(&scene.triangles)
 }
 
-/// A bare mesh file as a scene: one grey material, a white sky, no camera.
+/// A bare mesh file as a scene ([`rt_scene::load_mesh`]), without its placeholder camera.
 pub fn mesh_scene(path: &Path) -> Result<Scene, LoadError> {
-    let err = |e: &dyn std::fmt::Display| LoadError::new(path.display().to_string(), e);
-    let abs = std::fs::canonicalize(path).map_err(|e| err(&e))?;
-    let text = abs.to_str().ok_or_else(|| err(&"the path is not UTF-8"))?;
-    let toml = mesh_scene_toml(text);
-    let base = abs.parent().unwrap_or(Path::new("/"));
-    let mut scene = rt_scene::load_str(&toml, base, path)
-        .map_err(|e| err(&e))?
+    let mut scene = rt_scene::load_mesh(path)
+        .map_err(|e| LoadError::new(path.display().to_string(), &e))?
         .scene;
     scene.cameras.clear();
     Ok(scene)
 }
 
-/// The TOML of a scene made of one mesh file (absolute path `file`): a white sky, one grey
-/// material, a placeholder camera (callers replace it).
-pub fn mesh_scene_toml(file: &str) -> String {
-    let quoted = file.replace('\\', "\\\\").replace('"', "\\\"");
-    format!(
-        "[environment]\ncolor = [1, 1, 1]\n\n\
-         [[camera]]\nname = \"auto\"\nposition = [0, 0, 1]\nlook_at = [0, 0, 0]\n\n\
-         [[material]]\nname = \"grey\"\n\n\
-         [[geometry]]\nname = \"mesh\"\nfile = \"{quoted}\"\nmaterial = \"grey\"\n"
-    )
-}
-
-/// A camera inside a room-like scene: from the middle of its bounds at 60 % of the height,
-/// looking along the longer horizontal axis and a little down (the view `render bench-accel`
-/// uses for rooms), 512 × 512.
+/// The view into a room-like scene that `render bench-accel --view inside` uses
+/// ([`rt_scene::views::inside_view`]).
 pub fn inside_camera(scene: &Scene, accel: &dyn rt_core::Accel) -> rt_core::Camera {
-    let b = rt_core::Aabb::from_points(scene.triangles.iter().flatten());
-    let (lo, c, e) = (b.min, b.center(), b.extent());
-    let axis = if e.x >= e.z { Vec3::X } else { Vec3::Z };
-    let mid = Vec3::new(c.x, lo.y + 0.6 * e.y, c.z);
-    let behind = accel
-        .intersect(&rt_core::Ray::new(mid, -axis), f32::INFINITY)
-        .map_or(0.5 * e.dot(axis), |h| h.t);
-    let eye = mid - axis * (0.7 * behind);
-    let target = Vec3::new(c.x, lo.y + 0.3 * e.y, c.z) + axis * (0.5 * behind);
-    rt_core::Camera::look_at("inside", eye, target, Vec3::Y, 60.0, 512, 512, 0.0, 1.0)
+    let bounds = rt_core::Aabb::from_points(scene.triangles.iter().flatten());
+    rt_scene::views::inside_view(&bounds, accel).0
 }
 
 /// The one seeded stream of the workspace's tests (`rt-testkit` re-exports it).

@@ -33,6 +33,7 @@
 //! ```
 
 mod file;
+pub mod measure;
 mod rng;
 mod sets;
 

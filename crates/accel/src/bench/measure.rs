@@ -1,10 +1,12 @@
 //! Checking a structure against the reference, timing it and counting its traversal work.
 
-use super::CHUNK;
+use super::{Query, RaySet};
 use rayon::prelude::*;
-use rt_accel::bench::{Query, RaySet};
 use rt_core::{Accel, Hit, TraversalCounters};
 use std::time::Instant;
+
+/// Rays per parallel work item when timing or counting on several threads.
+pub const CHUNK: usize = 4096;
 
 /// Relative tolerance of `t` between two structures' closest hits.
 const T_TOLERANCE: f32 = 1e-5;
