@@ -119,7 +119,7 @@ impl ReferenceRequest<'_> {
             self.camera.height,
             content_digest(self.camera),
             e.kind,
-            e.max_depth,
+            e.depth(),
             e.ao_distance,
             self.spp,
             self.seed,
@@ -254,7 +254,7 @@ material = "lamp"
         assert_ne!(base.hex, key_of(d, SCENE, |r| r.seed = 1).hex);
         assert_ne!(
             base.hex,
-            key_of(d, SCENE, |r| r.estimator.max_depth = 4).hex
+            key_of(d, SCENE, |r| r.estimator.max_depth = Some(4)).hex
         );
         assert_ne!(
             base.hex,

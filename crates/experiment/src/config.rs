@@ -590,7 +590,7 @@ seconds = [0.5, 0.1]
         assert_eq!(p.methods[1].budgets, Budgets::Seconds(vec![0.1, 0.5]));
         assert_eq!(p.pairs.len(), 2);
         // max_depth comes from the scene's [render] table for both method and reference.
-        assert_eq!(p.pairs[0].estimator.max_depth, 5);
+        assert_eq!(p.pairs[0].estimator.depth(), 5);
         assert_eq!(
             p.pairs[1].estimator.kind,
             rt_integrators::IntegratorKind::PathBsdf
@@ -599,7 +599,7 @@ seconds = [0.5, 0.1]
         let ReferencePlan::Render { estimator, spp, .. } = &p.scenes[0].reference else {
             panic!()
         };
-        assert_eq!((estimator.max_depth, *spp), (5, 16));
+        assert_eq!((estimator.depth(), *spp), (5, 16));
         assert!(p.warnings.is_empty(), "{:?}", p.warnings);
     }
 

@@ -85,7 +85,7 @@ pub fn results_csv(plan: &Plan, results: &Results) -> String {
             m.psnr,
             m.ssim,
             row.budget,
-            pair.estimator.max_depth,
+            pair.estimator.depth(),
             pair.seed,
             f.as_ref().map_or(String::new(), |f| num(f.mse)),
             f.as_ref().map_or(String::new(), |f| num(f.relmse)),

@@ -4,8 +4,8 @@
 //! `--integrator`, the scene's `[render] integrator` and an experiment's `methods` all take the
 //! same text: a kind followed by `:`-separated options, e.g. `path`, `path:max-depth=4`,
 //! `path-bsdf`, `direct`, `ao:distance=0.5`. [`IntegratorSpec`] parses it
-//! ([`std::str::FromStr`]), prints it back in a canonical form ([`std::fmt::Display`]: options
-//! at their default are left out), builds the integrator ([`IntegratorSpec::build`]) and says
+//! ([`std::str::FromStr`]), prints it back in a canonical form ([`std::fmt::Display`]: the
+//! options it sets), builds the integrator ([`IntegratorSpec::build`]) and says
 //! what it converges to ([`IntegratorSpec::target`]).
 //!
 //! | option | kinds | meaning |
@@ -89,8 +89,10 @@ impl fmt::Display for IntegratorKind {
 pub struct IntegratorSpec {
     /// Which integrator.
     pub kind: IntegratorKind,
-    /// Bounce limit (path tracers; `direct` is always one bounce, `ao` ignores it).
-    pub max_depth: u32,
+    /// Bounce limit (path tracers; `direct` is always one bounce, `ao` ignores it), if the spec
+    /// sets one; `None` leaves it to the caller's settings, else [`DEFAULT_MAX_DEPTH`]
+    /// ([`IntegratorSpec::depth`]).
+    pub max_depth: Option<u32>,
     /// Occluder distance of `ao` (infinite: unlimited).
     pub ao_distance: f32,
 }
@@ -150,7 +152,7 @@ impl IntegratorSpec {
     pub fn new(kind: IntegratorKind) -> Self {
         Self {
             kind,
-            max_depth: DEFAULT_MAX_DEPTH,
+            max_depth: None,
             ao_distance: f32::INFINITY,
         }
     }
@@ -160,7 +162,7 @@ impl IntegratorSpec {
         if depth > MAX_DEPTH {
             return Err(IntegratorSpecError::BadDepth(depth.to_string()));
         }
-        self.max_depth = depth;
+        self.max_depth = Some(depth);
         Ok(self)
     }
 
@@ -173,11 +175,16 @@ impl IntegratorSpec {
         Ok(self)
     }
 
+    /// The bounce limit in effect.
+    pub fn depth(&self) -> u32 {
+        self.max_depth.unwrap_or(DEFAULT_MAX_DEPTH)
+    }
+
     /// Builds the integrator.
     pub fn build(&self) -> Box<dyn Integrator> {
         match self.kind {
-            IntegratorKind::Path => Box::new(PathIntegrator::new(self.max_depth)),
-            IntegratorKind::PathBsdf => Box::new(PathIntegrator::bsdf_only(self.max_depth)),
+            IntegratorKind::Path => Box::new(PathIntegrator::new(self.depth())),
+            IntegratorKind::PathBsdf => Box::new(PathIntegrator::bsdf_only(self.depth())),
             IntegratorKind::Direct => Box::new(PathIntegrator::direct()),
             IntegratorKind::Ao => Box::new(AoIntegrator {
                 max_distance: self.ao_distance,
@@ -189,7 +196,7 @@ impl IntegratorSpec {
     pub fn target(&self) -> Target {
         match self.kind {
             IntegratorKind::Path | IntegratorKind::PathBsdf => Target::Radiance {
-                bounces: self.max_depth,
+                bounces: self.depth(),
             },
             IntegratorKind::Direct => Target::Radiance { bounces: 1 },
             IntegratorKind::Ao => Target::Occlusion {
@@ -245,8 +252,8 @@ impl FromStr for IntegratorSpec {
 impl fmt::Display for IntegratorSpec {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.kind.name())?;
-        if self.kind.has_depth() && self.max_depth != DEFAULT_MAX_DEPTH {
-            write!(f, ":max-depth={}", self.max_depth)?;
+        if let (true, Some(depth)) = (self.kind.has_depth(), self.max_depth) {
+            write!(f, ":max-depth={depth}")?;
         }
         if self.kind == IntegratorKind::Ao && self.ao_distance.is_finite() {
             write!(f, ":distance={}", self.ao_distance)?;
@@ -278,17 +285,20 @@ mod tests {
     #[test]
     fn options_parse_print_and_validate() {
         let s: IntegratorSpec = "path:max-depth=4".parse().unwrap();
-        assert_eq!((s.kind, s.max_depth), (IntegratorKind::Path, 4));
+        assert_eq!((s.kind, s.max_depth), (IntegratorKind::Path, Some(4)));
         assert_eq!(s.to_string(), "path:max-depth=4");
         let a: IntegratorSpec = "ao:distance=0.5".parse().unwrap();
         assert_eq!(a.ao_distance, 0.5);
         assert_eq!(a.to_string().parse::<IntegratorSpec>(), Ok(a));
+        // What the text says is kept, even the default: it wins over the caller's settings.
+        let d: IntegratorSpec = "path:max-depth=16".parse().unwrap();
         assert_eq!(
-            "path:max-depth=16"
-                .parse::<IntegratorSpec>()
-                .unwrap()
-                .to_string(),
-            "path"
+            (d.to_string().as_str(), d.depth()),
+            ("path:max-depth=16", 16)
+        );
+        assert_eq!(
+            IntegratorSpec::new(IntegratorKind::Path).depth(),
+            DEFAULT_MAX_DEPTH
         );
         for bad in [
             "direct:max-depth=3",

@@ -5,7 +5,7 @@
 
 use rt_accel::AccelSpec;
 use rt_film::AovSet;
-use rt_integrators::{IntegratorSpec, IntegratorSpecError, DEFAULT_MAX_DEPTH, MAX_DEPTH};
+use rt_integrators::{IntegratorSpec, IntegratorSpecError, MAX_DEPTH};
 use rt_scene::RenderDesc;
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -23,7 +23,8 @@ pub const DEFAULT_SPP: u32 = 64;
 /// then to the default.
 #[derive(Clone, Debug, Default)]
 pub struct Overrides {
-    /// Integrator and its options. An explicit `max-depth=` in it wins over [`Self::max_depth`].
+    /// Integrator and its options. A `max-depth=` in it wins over [`Self::max_depth`] and the
+    /// table's `max_depth`.
     pub integrator: Option<IntegratorSpec>,
     /// Bounce limit (`--max-depth`).
     pub max_depth: Option<u32>,
@@ -236,20 +237,15 @@ impl Overrides {
             file: scene_path.to_path_buf(),
             key,
         };
-        let (spec, explicit_depth) = match (&self.integrator, &desc.integrator) {
-            (Some(spec), _) => (*spec, spec.max_depth != DEFAULT_MAX_DEPTH),
-            (None, Some(text)) => {
-                let spec: IntegratorSpec =
-                    text.parse().map_err(|source| SettingsError::Integrator {
-                        origin: table("integrator"),
-                        source,
-                    })?;
-                (spec, spec.max_depth != DEFAULT_MAX_DEPTH)
-            }
-            (None, None) => (IntegratorSpec::default(), false),
+        let mut spec = match (&self.integrator, &desc.integrator) {
+            (Some(spec), _) => *spec,
+            (None, Some(text)) => text.parse().map_err(|source| SettingsError::Integrator {
+                origin: table("integrator"),
+                source,
+            })?,
+            (None, None) => IntegratorSpec::default(),
         };
-        let mut spec = spec;
-        if !explicit_depth {
+        if spec.max_depth.is_none() {
             let depth = self.max_depth.or(desc.max_depth);
             if let Some(d) = depth {
                 let at = if self.max_depth.is_some() {
@@ -258,9 +254,10 @@ impl Overrides {
                     table("max_depth")
                 };
                 in_range(|| at, "max depth", d.into(), 0, MAX_DEPTH.into())?;
-                spec.max_depth = d;
+                spec.max_depth = Some(d);
             }
         }
+        spec.max_depth = Some(spec.depth());
         if let Some(d) = self.ao_distance {
             spec = spec
                 .with_ao_distance(d)
@@ -327,7 +324,7 @@ mod tests {
             d.seed = Some(1 << 32);
         });
         let t = Overrides::default().resolve(&desc, path).unwrap();
-        assert_eq!((t.spp, t.integrator.max_depth), (8, 3));
+        assert_eq!((t.spp, t.integrator.depth()), (8, 3));
         assert_eq!(t.integrator.kind, IntegratorKind::PathBsdf);
         assert_eq!(t.seed, 1);
         let o = Overrides {
@@ -336,14 +333,21 @@ mod tests {
             ..Overrides::default()
         };
         let g = o.resolve(&desc, path).unwrap();
-        assert_eq!((g.spp, g.integrator.max_depth), (2, 5));
+        assert_eq!((g.spp, g.integrator.depth()), (2, 5));
         // An explicit option in the spec text is the most specific setting.
         let o = Overrides {
             integrator: Some("path:max-depth=2".parse().unwrap()),
             max_depth: Some(5),
             ..Overrides::default()
         };
-        assert_eq!(o.resolve(&desc, path).unwrap().integrator.max_depth, 2);
+        assert_eq!(o.resolve(&desc, path).unwrap().integrator.depth(), 2);
+        // Even when the spec names the default.
+        let o = Overrides {
+            integrator: Some("path:max-depth=16".parse().unwrap()),
+            max_depth: Some(5),
+            ..Overrides::default()
+        };
+        assert_eq!(o.resolve(&desc, path).unwrap().integrator.depth(), 16);
     }
 
     #[test]
