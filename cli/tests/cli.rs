@@ -566,13 +566,15 @@ fn bench_accel_on_a_procedural_scene_writes_the_csv() {
         .iter()
         .map(|r| (r[0].clone(), r[1].clone(), r[2].clone()))
         .collect();
-    assert_eq!(keys.len(), 4 * 3 * 2);
+    // Four structures, four ray sets (the default sets: primary, incoherent, shadow, uniform),
+    // one and two threads.
+    assert_eq!(keys.len(), 4 * 4 * 2);
     keys.sort();
     keys.dedup();
-    assert_eq!(keys.len(), 4 * 3 * 2);
+    assert_eq!(keys.len(), 4 * 4 * 2);
     for row in &rows {
         assert!(["bvh", "qbvh", "bvh8", "brute-force"].contains(&row[0].as_str()));
-        assert!(["primary", "incoherent", "shadow"].contains(&row[1].as_str()));
+        assert!(["primary", "incoherent", "shadow", "uniform"].contains(&row[1].as_str()));
         assert!(["1", "2"].contains(&row[2].as_str()));
         assert!(row[5].parse::<f64>().unwrap() > 0.0, "{row:?}");
         assert_eq!(row[15], "0", "check mismatches: {row:?}");
@@ -583,7 +585,7 @@ fn bench_accel_on_a_procedural_scene_writes_the_csv() {
     let hits = |accel: &str, rays: &str| -> String {
         rows.iter().find(|r| r[0] == accel && r[1] == rays).unwrap()[6].clone()
     };
-    for rays in ["primary", "incoherent", "shadow"] {
+    for rays in ["primary", "incoherent", "shadow", "uniform"] {
         assert_eq!(hits("qbvh", rays), hits("bvh", rays));
         assert_eq!(hits("bvh8", rays), hits("bvh", rays));
         assert_eq!(hits("brute-force", rays), hits("bvh", rays));
@@ -658,8 +660,8 @@ fn bench_accel_on_a_mesh_and_a_scene() {
     let rows = csv_rows(&r.path("o.csv"));
     assert_eq!(
         rows.len(),
-        3 * 3,
-        "three structures, three sets, one thread count"
+        3 * 4,
+        "three structures, four sets, one thread count"
     );
     // The automatic camera sees the mesh.
     let primary = rows.iter().find(|r| r[1] == "primary").unwrap();

@@ -45,7 +45,7 @@ pub struct BenchArgs {
     /// cosine-distributed diffuse bounce from each primary hit), shadow (a segment from each
     /// primary hit to a point on a light, occlusion query), uniform (as many rays as pixels,
     /// origins uniform in the scene's bounding box, directions uniform on the sphere).
-    /// [default: primary, incoherent and shadow, or none when --ray-file is given]
+    /// [default: all four, or none when --ray-file is given]
     #[arg(long, value_delimiter = ',')]
     pub rays: Option<Vec<String>>,
 
@@ -134,7 +134,7 @@ fn parse_sets(args: &BenchArgs) -> Result<Wanted> {
                 primary: true,
                 incoherent: true,
                 shadow: true,
-                uniform: false,
+                uniform: true,
             }
         });
     };
