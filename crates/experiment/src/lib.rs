@@ -3,7 +3,7 @@
 //!
 //! - [`config`]: the experiment file (TOML; docs/experiments.md) read and validated into a
 //!   [`Plan`] before the first sample: scenes load, cameras exist, budgets are sane.
-//! - [`reference`] and [`cache`]: high-sample references from their own random streams, stored
+//! - [`reference`](mod@reference) and [`cache`]: high-sample references from their own random streams, stored
 //!   on disk under a key that changes with anything that changes the image.
 //! - [`grid`]: every method on every scene, rendered progressively to its budgets and measured
 //!   against the reference.

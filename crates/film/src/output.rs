@@ -93,8 +93,9 @@ pub fn write_rgb(path: &Path, image: &RgbImage, opts: &OutputOptions) -> Result<
     }
 }
 
-/// Writes `bytes` to `path` atomically (as [`write_atomic`]): for CSVs, reports and sidecars,
-/// so every file the renderer writes is either whole or absent.
+/// Writes `bytes` to `path` atomically (a temporary file in the same directory, synced, then
+/// renamed over `path`): for CSVs, reports and sidecars, so every file the renderer writes is
+/// either whole or absent.
 pub fn write_bytes_atomic(path: &Path, bytes: &[u8]) -> Result<(), FilmError> {
     write_atomic(path, |w| w.write_all(bytes).map_err(|e| e.to_string()))
 }

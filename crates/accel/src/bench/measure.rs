@@ -9,7 +9,7 @@ use std::time::Instant;
 pub const CHUNK: usize = 4096;
 
 /// Relative tolerance of `t` between two structures' closest hits.
-const T_TOLERANCE: f32 = 1e-5;
+pub const T_TOLERANCE: f32 = 1e-5;
 
 /// The outcome of [`check`].
 #[derive(Clone, Debug, Default)]
