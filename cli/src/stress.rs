@@ -53,16 +53,7 @@ pub fn run(args: &StressArgs) -> Result<()> {
     if cases.is_empty() {
         bail!("--only {}: no stress case has that prefix", args.only);
     }
-    let mut pool = rayon::ThreadPoolBuilder::new();
-    if let Some(t) = args.threads {
-        if t == 0 || t > 1024 {
-            bail!("--threads: thread count must be between 1 and 1024, got {t}");
-        }
-        pool = pool.num_threads(t);
-    }
-    let pool = pool
-        .build()
-        .map_err(|e| anyhow::anyhow!("cannot start worker threads: {e}"))?;
+    let pool = crate::experiment::thread_pool(args.threads)?;
     println!(
         "stress ({}): {} spp, {}x{} images, {} rays per surface, seed {}",
         if args.long { "long" } else { "short" },

@@ -315,7 +315,13 @@ mod tests {
             .resolve(&RenderDesc::default(), path)
             .unwrap();
         assert_eq!(none.spp, DEFAULT_SPP);
-        assert_eq!(none.integrator, IntegratorSpec::default());
+        // The resolved spec states its bounce limit: the default one.
+        assert_eq!(
+            none.integrator,
+            IntegratorSpec::default()
+                .with_max_depth(rt_integrators::DEFAULT_MAX_DEPTH)
+                .unwrap()
+        );
         assert_eq!(none.accel, AccelSpec::default());
         let desc = table(|d| {
             d.spp = Some(8);
