@@ -83,8 +83,7 @@ pub fn run(args: &ExperimentArgs) -> Result<()> {
         progress.message(&format!("warning: {w}"));
     }
     let cache = Cache::new(&args.cache);
-    let outcome =
-        pool.install(|| rt_experiment::run(&plan, &args.config, &out, &cache, &progress))?;
+    let outcome = pool.install(|| rt_experiment::run(&plan, &out, &cache, &progress))?;
     progress.finish();
     for e in &outcome.equal_time {
         if let Some((p, wins)) = e.overall() {

@@ -26,13 +26,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let plan = config::load(&file)?;
     let out = dir.path().join("out");
     prepare_out(&out)?;
-    let outcome = run(
-        &plan,
-        &file,
-        &out,
-        &Cache::new(&dir.path().join("cache")),
-        &Silent,
-    )?;
+    let outcome = run(&plan, &out, &Cache::new(&dir.path().join("cache")), &Silent)?;
     for row in &outcome.results.rows {
         let method = &plan.methods[plan.pairs[row.pair].method].name;
         println!(

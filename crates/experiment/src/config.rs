@@ -6,7 +6,8 @@ use crate::{ExperimentError, Result as CrateResult};
 use rt_accel::AccelSpec;
 use rt_core::Camera;
 use rt_film::read_rgb;
-use rt_integrators::{IntegratorSpec, MAX_DEPTH};
+use rt_integrators::spec::{check_ao_distance, check_max_depth};
+use rt_integrators::IntegratorSpec;
 use rt_metrics::RgbImage;
 use rt_scene::LoadedScene;
 use rt_session::{pick_camera, Budgets, ImageSize, Overrides, MAX_SPP};
@@ -213,17 +214,15 @@ fn parse_integrator(s: &str) -> Result<IntegratorSpec, String> {
 }
 
 fn check_depth(d: Option<u32>) -> Result<Option<u32>, String> {
-    match d {
-        Some(d) if d > MAX_DEPTH => Err(format!("max_depth must be at most {MAX_DEPTH}, got {d}")),
-        _ => Ok(d),
-    }
+    d.map(check_max_depth)
+        .transpose()
+        .map_err(|e| format!("max_depth: {e}"))
 }
 
 fn check_ao(d: Option<f32>) -> Result<Option<f32>, String> {
-    match d {
-        Some(d) if d.is_nan() || d <= 0.0 => Err(format!("ao_distance must be positive, got {d}")),
-        _ => Ok(d),
-    }
+    d.map(check_ao_distance)
+        .transpose()
+        .map_err(|e| format!("ao_distance: {e}"))
 }
 
 /// Reads and validates the experiment file at `path`. Every error is one line that starts with

@@ -56,6 +56,12 @@ impl From<rt_session::SettingsError> for ExperimentError {
     }
 }
 
+impl From<rt_core::PixelCountError> for ExperimentError {
+    fn from(e: rt_core::PixelCountError) -> Self {
+        Self::Metrics(e.into())
+    }
+}
+
 /// Results of this crate.
 pub type Result<T, E = ExperimentError> = std::result::Result<T, E>;
 

@@ -22,7 +22,7 @@
 //! let cache = rt_experiment::Cache::new(rt_experiment::DEFAULT_CACHE_DIR.as_ref());
 //! let out = std::path::Path::new("experiments/mine");
 //! rt_experiment::prepare_out(out)?;
-//! let outcome = rt_experiment::run(&plan, &"configs/convergence.toml".as_ref(), out, &cache, &rt_experiment::Silent)?;
+//! let outcome = rt_experiment::run(&plan, out, &cache, &rt_experiment::Silent)?;
 //! println!("{}", outcome.report.display());
 //! # Ok::<(), rt_experiment::ExperimentError>(())
 //! ```
@@ -62,12 +62,6 @@ pub trait Progress: Sync {
 pub struct Silent;
 
 impl Progress for Silent {}
-
-impl From<rt_core::PixelCountError> for ExperimentError {
-    fn from(e: rt_core::PixelCountError) -> Self {
-        Self::Metrics(e.into())
-    }
-}
 
 /// The UTC calendar date and time of `secs` since the Unix epoch (Howard Hinnant's
 /// civil-from-days), so that no date crate is needed for a time stamp.
@@ -133,16 +127,10 @@ pub struct Outcome {
     pub report: PathBuf,
 }
 
-/// Runs `plan` (read from `config`, which is copied beside the results) into the folder `out`
+/// Runs `plan` (its file is copied beside the results) into the folder `out`
 /// (see [`prepare_out`]): references, the grid, images, results.csv, slopes.csv, plots, crops
 /// and report.md. Call it inside the thread pool that should do the work.
-pub fn run(
-    plan: &Plan,
-    config: &Path,
-    out: &Path,
-    cache: &Cache,
-    progress: &dyn Progress,
-) -> Result<Outcome> {
+pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> Result<Outcome> {
     let wall = Instant::now();
     let (y, mo, d, h, mi, _) = utc(now_secs());
     let results = grid::run(plan, out, cache, progress)?;
@@ -158,7 +146,7 @@ pub fn run(
         &out.join("slopes.csv"),
         report::slopes_csv(plan, &slopes).as_bytes(),
     )?;
-    rt_film::copy_atomic(config, &out.join("config.toml"))?;
+    rt_film::copy_atomic(&plan.path, &out.join("config.toml"))?;
     let info = report::RunInfo {
         started: format!("{y:04}-{mo:02}-{d:02} {h:02}:{mi:02}"),
         threads: rayon::current_num_threads(),

@@ -147,6 +147,22 @@ pub enum IntegratorSpecError {
     BadDistance(String),
 }
 
+/// A bounce limit, checked against [`MAX_DEPTH`]: the one check, wherever the value comes from.
+pub fn check_max_depth(depth: u32) -> Result<u32, IntegratorSpecError> {
+    if depth > MAX_DEPTH {
+        return Err(IntegratorSpecError::BadDepth(depth.to_string()));
+    }
+    Ok(depth)
+}
+
+/// An `ao` occluder distance: positive (infinite is unlimited).
+pub fn check_ao_distance(distance: f32) -> Result<f32, IntegratorSpecError> {
+    if distance.is_nan() || distance <= 0.0 {
+        return Err(IntegratorSpecError::BadDistance(distance.to_string()));
+    }
+    Ok(distance)
+}
+
 impl IntegratorSpec {
     /// The default spec of `kind`.
     pub fn new(kind: IntegratorKind) -> Self {
@@ -157,21 +173,15 @@ impl IntegratorSpec {
         }
     }
 
-    /// This spec with bounce limit `depth`, checked against [`MAX_DEPTH`].
+    /// This spec with bounce limit `depth` ([`check_max_depth`]).
     pub fn with_max_depth(mut self, depth: u32) -> Result<Self, IntegratorSpecError> {
-        if depth > MAX_DEPTH {
-            return Err(IntegratorSpecError::BadDepth(depth.to_string()));
-        }
-        self.max_depth = Some(depth);
+        self.max_depth = Some(check_max_depth(depth)?);
         Ok(self)
     }
 
-    /// This spec with `ao` occluder distance `distance` (positive; infinite is unlimited).
+    /// This spec with `ao` occluder distance `distance` ([`check_ao_distance`]).
     pub fn with_ao_distance(mut self, distance: f32) -> Result<Self, IntegratorSpecError> {
-        if distance.is_nan() || distance <= 0.0 {
-            return Err(IntegratorSpecError::BadDistance(distance.to_string()));
-        }
-        self.ao_distance = distance;
+        self.ao_distance = check_ao_distance(distance)?;
         Ok(self)
     }
 

@@ -58,9 +58,6 @@ pub(crate) fn texture_from_bytes(bytes: &[u8]) -> std::result::Result<Texture, S
 /// Reads the first RGB(A) layer of an EXR file as row-major linear radiance (row 0 at the
 /// top). Rejects empty images and NaN, infinite or negative texels, naming the first bad one.
 pub(crate) fn read_env_map(path: &Path) -> Result<(u32, u32, Vec<Rgb>)> {
-    if let Err(e) = std::fs::File::open(path) {
-        return Err(SceneError::file(path, format!("cannot open: {e}")));
-    }
     if !path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
@@ -71,10 +68,14 @@ pub(crate) fn read_env_map(path: &Path) -> Result<(u32, u32, Vec<Rgb>)> {
         ));
     }
     let img = rt_film::read_rgb(path).map_err(|e| {
-        let text = e.to_string();
-        let prefix = format!("{}: ", path.display());
-        let why = text.strip_prefix(&prefix).unwrap_or(&text);
-        SceneError::file(path, format!("cannot read as an RGB EXR image: {why}"))
+        let why = match e {
+            rt_film::FilmError::Io { source, .. } => format!("cannot open: {source}"),
+            rt_film::FilmError::Codec { message, .. } => {
+                format!("cannot read as an RGB EXR image: {message}")
+            }
+            other => format!("cannot read as an RGB EXR image: {other}"),
+        };
+        SceneError::file(path, why)
     })?;
     let (w, h) = (img.width(), img.height());
     if w == 0 || h == 0 {

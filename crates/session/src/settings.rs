@@ -5,7 +5,8 @@
 
 use rt_accel::AccelSpec;
 use rt_film::AovSet;
-use rt_integrators::{IntegratorSpec, IntegratorSpecError, MAX_DEPTH};
+use rt_integrators::spec::check_max_depth;
+use rt_integrators::{IntegratorSpec, IntegratorSpecError};
 use rt_scene::RenderDesc;
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -157,18 +158,6 @@ fn in_range(
     })
 }
 
-/// Checks a sample count against `1..=MAX_SPP`; `flag` names it in the error.
-pub fn check_spp(spp: u32, flag: &'static str) -> Result<u32, SettingsError> {
-    in_range(
-        || Origin::Given(flag),
-        "samples per pixel",
-        spp.into(),
-        1,
-        MAX_SPP.into(),
-    )?;
-    Ok(spp)
-}
-
 impl Overrides {
     /// Resolves every setting for the scene at `scene_path` with `[render]` table `desc`.
     pub fn resolve(&self, desc: &RenderDesc, scene_path: &Path) -> Result<Settings, SettingsError> {
@@ -218,7 +207,7 @@ impl Overrides {
             accel: self.accel_spec(desc, scene_path)?,
             spp,
             threads,
-            seed: fold_seed(self.seed.or(desc.seed).unwrap_or(0)),
+            seed: self.seed(desc),
             aovs,
             output: self
                 .output
@@ -253,8 +242,10 @@ impl Overrides {
                 } else {
                     table("max_depth")
                 };
-                in_range(|| at, "max depth", d.into(), 0, MAX_DEPTH.into())?;
-                spec.max_depth = Some(d);
+                spec.max_depth = Some(
+                    check_max_depth(d)
+                        .map_err(|source| SettingsError::Integrator { origin: at, source })?,
+                );
             }
         }
         spec.max_depth = Some(spec.depth());
@@ -382,7 +373,10 @@ mod tests {
             .unwrap_err();
         assert!(e.to_string().contains("[render] accel = \"kd\""), "{e}");
         let e = Overrides::default()
-            .resolve(&table(|d| d.max_depth = Some(MAX_DEPTH + 1)), path)
+            .resolve(
+                &table(|d| d.max_depth = Some(rt_integrators::MAX_DEPTH + 1)),
+                path,
+            )
             .unwrap_err();
         assert!(e.to_string().contains("max_depth"), "{e}");
         let e = Overrides {
