@@ -3,9 +3,10 @@
 //! environment map, no lens samples for a pinhole. And skipping changes no image: the beauty
 //! image is the same bit for bit whichever optional buffers the film keeps.
 
+use rt_core::lights::Emitter;
 use rt_core::{Camera, Rgb, Sampler, Scene};
 use rt_film::{AovSet, Film, FilmBuffers};
-use rt_integrators::{Integrator, PathIntegrator, RayCounters, SampleAux};
+use rt_integrators::{AoIntegrator, Integrator, PathIntegrator, RayCounters, SampleAux};
 use rt_testkit::{shipped_scene, Renderer};
 
 fn shipped(name: &str) -> Scene {
@@ -56,9 +57,16 @@ fn no_environment_map_and_no_aovs_allocate_none_of_their_buffers() {
     assert_eq!(film.memory_bytes(), m.mean);
     assert!(film.variance_image().is_none() && film.half_image(0).is_none());
     assert!(film.albedo_image().is_none() && film.depth_image().is_none());
-    // Its two emitting triangles are all the light sampler holds: 2 ids, 2 powers, 3 cdf entries.
-    assert_eq!(scene.lights.emitter_count(), 2);
-    assert_eq!(scene.lights.memory_bytes(), (2 + 2 + 3) * 4);
+    // Its two emitting triangles are all the light sampler holds: 2 records, 2 powers, 3 cdf
+    // entries.
+    let lights = scene
+        .lights_if_built()
+        .expect("the path tracer sampled lights");
+    assert_eq!(lights.emitter_count(), 2);
+    assert_eq!(
+        lights.memory_bytes(),
+        2 * std::mem::size_of::<Emitter>() + (2 + 3) * 4
+    );
     assert!(film.mean_image().iter().any(|p| p.max_element() > 0.0));
 }
 
@@ -69,12 +77,45 @@ fn an_environment_map_builds_its_importance_map_and_no_emitter_table() {
     let scene = shipped("environment.toml");
     let map = scene.environment.map().expect("environment.toml has a map");
     assert_eq!(map.size(), (256, 128));
-    assert!(map.importance_map_bytes() > 256 * 128 * 4);
-    assert_eq!(scene.lights.emitter_count(), 0);
-    assert_eq!(scene.lights.memory_bytes(), 0, "nothing built for emitters");
-    assert!(!scene.lights.is_empty(), "the sky is still sampled");
+    assert!(map.importance().memory_bytes() > 256 * 128 * 4);
+    assert_eq!(scene.lights().emitter_count(), 0);
+    assert_eq!(
+        scene.lights().memory_bytes(),
+        0,
+        "nothing built for emitters"
+    );
+    assert!(!scene.lights().is_empty(), "the sky is still sampled");
     let nee = render(&scene, &PathIntegrator::direct(), AovSet::default().into());
     assert!(nee.mean_image().iter().any(|p| p.max_element() > 0.0));
+}
+
+/// Integrators that never sample lights (`ao`, `path-bsdf`) build neither the light sampler nor
+/// the importance map; the path tracer, the control, builds both.
+#[test]
+fn integrators_without_light_sampling_build_no_light_structures() {
+    let built = |integrator: &dyn Integrator| {
+        let scene = shipped("environment.toml");
+        let image = render(&scene, integrator, AovSet::default().into()).mean_image();
+        assert!(image.iter().any(|p| p.max_element() > 0.0));
+        let map = scene.environment.map().expect("environment.toml has a map");
+        (
+            scene.lights_if_built().is_some(),
+            map.importance_if_built().is_some(),
+        )
+    };
+    assert_eq!(
+        built(&AoIntegrator {
+            max_distance: f32::INFINITY
+        }),
+        (false, false),
+        "ao"
+    );
+    assert_eq!(
+        built(&PathIntegrator::bsdf_only(3)),
+        (false, false),
+        "path-bsdf"
+    );
+    assert_eq!(built(&PathIntegrator::new(3)), (true, true), "path");
 }
 
 /// A constant-colour sky is sampled uniformly: no importance map.

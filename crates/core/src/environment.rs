@@ -9,6 +9,7 @@ use crate::stage_time::StageTime;
 use crate::{color::luminance, distribution::Distribution2D, Rgb};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
+use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
 /// Radiance arriving from infinitely far away. Only a map has an importance map: a constant
@@ -21,40 +22,80 @@ pub enum Environment {
     Map(EnvMap),
 }
 
-/// An equirectangular environment map with its sampling distribution.
+/// An equirectangular environment map. Its sampling distribution (the importance map) is built
+/// the first time something samples the map or asks for a sampling pdf, so a render whose
+/// integrator never samples lights never builds it.
 #[derive(Clone, Debug)]
 pub struct EnvMap {
     width: u32,
     height: u32,
     texels: Vec<Rgb>,
-    dist: Distribution2D,
-    /// How long building `dist` took, for `render --stats`: the map is built while a scene
-    /// loads, where the caller cannot time this step on its own.
-    dist_build_time: StageTime,
+    /// Some texel has positive luminance: the map emits and light sampling should see it.
+    emits: bool,
+    importance: OnceLock<Importance>,
 }
 
-impl EnvMap {
-    /// Builds from row-major linear radiance (already multiplied by any strength). Non-finite and
-    /// negative texels must have been rejected by the caller.
-    pub fn new(width: u32, height: u32, texels: Vec<Rgb>) -> Self {
+/// The luminance × sinθ distribution of an [`EnvMap`] and how long building it took (for
+/// `render --stats`, since it is built inside the render).
+#[derive(Clone, Debug)]
+pub struct Importance {
+    dist: Distribution2D,
+    build_time: StageTime,
+}
+
+impl Importance {
+    fn build(width: u32, height: u32, texels: &[Rgb]) -> Self {
         let start = Instant::now();
         let (w, h) = (width as usize, height as usize);
         // Weight by sinθ: rows near the poles cover less solid angle.
         let weights: Vec<f32> = (0..h)
             .flat_map(|y| {
                 let sin_t = (PI * (y as f32 + 0.5) / h as f32).sin();
-                let texels = &texels;
                 (0..w).map(move |x| luminance(texels[y * w + x]).max(0.0) * sin_t)
             })
             .collect();
         let dist = Distribution2D::new(&weights, w, h);
         Self {
+            dist,
+            build_time: StageTime(start.elapsed()),
+        }
+    }
+
+    /// Bytes of the distribution.
+    pub fn memory_bytes(&self) -> usize {
+        self.dist.memory_bytes()
+    }
+
+    /// How long building it took.
+    pub fn build_time(&self) -> Duration {
+        self.build_time.0
+    }
+}
+
+impl EnvMap {
+    /// Builds from row-major linear radiance (already multiplied by any strength). Non-finite and
+    /// negative texels must have been rejected by the caller.
+    pub fn new(width: u32, height: u32, texels: Vec<Rgb>) -> Self {
+        let emits = texels.iter().any(|&t| luminance(t).max(0.0) > 0.0);
+        Self {
             width,
             height,
             texels,
-            dist,
-            dist_build_time: StageTime(start.elapsed()),
+            emits,
+            importance: OnceLock::new(),
         }
+    }
+
+    /// The importance map, built on first use.
+    #[inline]
+    pub fn importance(&self) -> &Importance {
+        self.importance
+            .get_or_init(|| Importance::build(self.width, self.height, &self.texels))
+    }
+
+    /// The importance map if something has sampled the map, else `None`.
+    pub fn importance_if_built(&self) -> Option<&Importance> {
+        self.importance.get()
     }
 
     /// Width and height in texels.
@@ -65,16 +106,6 @@ impl EnvMap {
     /// Bytes of the texels (length × element size).
     pub fn texel_bytes(&self) -> usize {
         std::mem::size_of_val(self.texels.as_slice())
-    }
-
-    /// Bytes of the importance map (the luminance × sinθ distribution).
-    pub fn importance_map_bytes(&self) -> usize {
-        self.dist.memory_bytes()
-    }
-
-    /// How long building the importance map took.
-    pub fn importance_build_time(&self) -> Duration {
-        self.dist_build_time.0
     }
 
     fn texel(&self, uv: Vec2) -> Rgb {
@@ -137,7 +168,7 @@ impl Environment {
     pub fn is_black(&self) -> bool {
         match self {
             Environment::Constant(c) => c.max_element() <= 0.0,
-            Environment::Map(m) => m.dist.integral() <= 0.0,
+            Environment::Map(m) => !m.emits,
         }
     }
 
@@ -155,7 +186,7 @@ impl Environment {
                 })
             }
             Environment::Map(m) => {
-                let (uv, pdf_uv) = m.dist.sample(u);
+                let (uv, pdf_uv) = m.importance().dist.sample(u);
                 let sin_t = (uv.y * PI).sin();
                 if pdf_uv <= 0.0 || sin_t <= 0.0 {
                     return None;
@@ -180,7 +211,7 @@ impl Environment {
                 if sin_t <= 0.0 {
                     return 0.0;
                 }
-                m.dist.pdf(uv) / (2.0 * PI * PI * sin_t)
+                m.importance().dist.pdf(uv) / (2.0 * PI * PI * sin_t)
             }
         }
     }
@@ -198,8 +229,8 @@ impl crate::content_hash::ContentHash for Environment {
                 width,
                 height,
                 texels,
-                dist: _,
-                dist_build_time: _,
+                emits: _,
+                importance: _,
             }) => {
                 out(b"map");
                 width.content_hash(out);
@@ -237,7 +268,7 @@ mod tests {
         assert_eq!(map.texel_bytes(), 16 * 8 * 12);
         // Eight rows of 16 bins (16 weights + 17 cdf entries each) and an 8-bin marginal.
         let rows = 8 * std::mem::size_of::<crate::distribution::Distribution1D>();
-        assert_eq!(map.importance_map_bytes(), rows + 8 * 33 * 4 + 17 * 4);
+        assert_eq!(map.importance().memory_bytes(), rows + 8 * 33 * 4 + 17 * 4);
         assert!(Environment::Constant(Rgb::ONE).map().is_none());
         for i in 0..64 {
             let u = Vec2::new(

@@ -13,7 +13,9 @@ use std::time::{Duration, Instant};
 /// table and no power distribution (nothing is allocated); it may still sample the environment.
 #[derive(Clone, Debug, Default)]
 pub struct LightSampler {
-    emitters: Vec<u32>,
+    /// What sampling needs of each emissive triangle, so that a sample reads one record instead
+    /// of the triangle, its material and a normal recomputed every time.
+    records: Vec<Emitter>,
     dist: Option<Distribution1D>,
     total_power: f32,
     env_prob: f32,
@@ -42,12 +44,53 @@ pub struct LightSample {
     pub pdf: f32,
 }
 
+/// An emissive triangle as light sampling uses it: a copy of what sampling reads, next to each
+/// other in memory.
+#[derive(Clone, Copy, Debug)]
+pub struct Emitter {
+    /// The triangle's corners.
+    pub vertices: [Vec3; 3],
+    /// Unit front normal.
+    pub normal: Vec3,
+    /// Area.
+    pub area: f32,
+    /// Emitted radiance.
+    pub emission: Rgb,
+    /// Emits from both faces.
+    pub two_sided: bool,
+}
+
+impl Emitter {
+    fn new(scene: &Scene, prim: u32) -> Self {
+        let v = scene.triangles[prim as usize];
+        let n_raw = triangle::geometric_normal(&v);
+        let area = 0.5 * n_raw.length();
+        let m = scene.material_of(prim);
+        Self {
+            vertices: v,
+            normal: n_raw / (2.0 * area),
+            area,
+            emission: m.emission,
+            two_sided: m.two_sided,
+        }
+    }
+}
+
 fn triangle_power(scene: &Scene, prim: u32) -> f32 {
     let m = scene.material_of(prim);
     triangle::area(&scene.triangles[prim as usize]) * luminance(m.emission) * m.emitting_faces()
 }
 
 impl LightSampler {
+    /// A sampler with nothing to sample, for integrators that do not sample lights.
+    pub const NONE: LightSampler = LightSampler {
+        records: Vec::new(),
+        dist: None,
+        total_power: 0.0,
+        env_prob: 0.0,
+        build_time: StageTime(Duration::ZERO),
+    };
+
     /// Collects the emissive triangles of `scene` and weighs them by power.
     pub fn build(scene: &Scene) -> Self {
         let start = Instant::now();
@@ -66,7 +109,7 @@ impl LightSampler {
         };
         Self {
             dist: has_tris.then(|| Distribution1D::new(&powers)),
-            emitters,
+            records: emitters.iter().map(|&i| Emitter::new(scene, i)).collect(),
             total_power,
             env_prob,
             build_time: StageTime(start.elapsed()),
@@ -75,7 +118,7 @@ impl LightSampler {
 
     /// Bytes of the emitter table and power distribution (zero without emissive triangles).
     pub fn memory_bytes(&self) -> usize {
-        std::mem::size_of_val(self.emitters.as_slice())
+        std::mem::size_of_val(self.records.as_slice())
             + self.dist.as_ref().map_or(0, Distribution1D::memory_bytes)
     }
 
@@ -91,7 +134,7 @@ impl LightSampler {
 
     /// Number of emissive triangles.
     pub fn emitter_count(&self) -> usize {
-        self.emitters.len()
+        self.records.len()
     }
 
     /// Samples a light as seen from `x`. `None` if the chosen point cannot contribute (back face
@@ -112,13 +155,10 @@ impl LightSampler {
         let dist = self.dist.as_ref()?;
         let u_tri = ((u_sel - self.env_prob) / (1.0 - self.env_prob)).clamp(0.0, 0.999_999_94);
         let (k, pmf, _) = dist.sample_discrete(u_tri);
-        let prim = self.emitters[k];
-        let v = &scene.triangles[prim as usize];
+        let e = &self.records[k];
         let (b1, b2) = uniform_triangle(u);
-        let (p, point_error) = triangle::point_with_error(v, b1, b2);
-        let n_raw = triangle::geometric_normal(v);
-        let area = 0.5 * n_raw.length();
-        let n = n_raw / (2.0 * area);
+        let (p, point_error) = triangle::point_with_error(&e.vertices, b1, b2);
+        let (n, area) = (e.normal, e.area);
         let d = p - x;
         let dist2 = d.length_squared();
         if dist2 <= 0.0 || !dist2.is_finite() {
@@ -126,7 +166,13 @@ impl LightSampler {
         }
         let r = dist2.sqrt();
         let wi = d / r;
-        let le = scene.material_of(prim).emitted(n, -wi);
+        // `Material::emitted` for the front normal `n` and the outgoing direction `-wi`.
+        let front = n.dot(-wi) > 0.0;
+        let le = if e.two_sided || front {
+            e.emission
+        } else {
+            Rgb::ZERO
+        };
         let cos_l = n.dot(wi).abs();
         if cos_l <= 0.0 || le.max_element() <= 0.0 {
             return None;
@@ -186,10 +232,10 @@ mod tests {
         scene.push_triangle([Vec3::ZERO, Vec3::X, Vec3::Z], 0);
         scene.build_lights();
         let p = Vec3::new(0.25, 0.0, 0.25);
-        let pdf = scene.lights.pdf_triangle(&scene, 0, p, p, Vec3::Y);
+        let pdf = scene.lights().pdf_triangle(&scene, 0, p, p, Vec3::Y);
         assert_eq!(pdf, 0.0);
         let pdf = scene
-            .lights
+            .lights()
             .pdf_triangle(&scene, 0, p + Vec3::Y, p, Vec3::Y);
         assert!(pdf > 0.0 && pdf.is_finite());
     }

@@ -309,6 +309,11 @@ pub struct Bsdf<'a> {
     weights: [f32; MAX_LAYERS],
     total: f32,
     has_non_delta: bool,
+    /// `Some(colour · tint · weight / π)` for a material that is one Lambertian layer of one
+    /// colour at all angles (most surfaces of most scenes): its value and pdf need no layer
+    /// loop, and sampling it needs no evaluation. The arithmetic is the general path's,
+    /// operation for operation, so both give the same bits.
+    lambert: Option<Rgb>,
 }
 
 impl<'a> Bsdf<'a> {
@@ -319,6 +324,25 @@ impl<'a> Bsdf<'a> {
         let frame = Frame::from_normal(ns);
         let wo_local = frame.to_local(wo);
         let mut weights = [0.0f32; MAX_LAYERS];
+        if let [l] = material.layers.as_slice() {
+            if is_plain_lambert(l) && l.weight > 0.0 {
+                // The general loop's values for this case: `1 · w`, a sum of `w` and zeros, and
+                // `color_at`, which is `color · tint` at every angle.
+                weights[0] = l.weight;
+                return Self {
+                    layers: &material.layers,
+                    tint,
+                    frame,
+                    ng,
+                    wo,
+                    wo_local,
+                    weights,
+                    total: l.weight,
+                    has_non_delta: true,
+                    lambert: Some(l.color * tint * FRAC_1_PI * l.weight),
+                };
+            }
+        }
         let mut passed = 1.0f32;
         let cos_o = wo_local.z.abs();
         let mut has_non_delta = false;
@@ -344,6 +368,7 @@ impl<'a> Bsdf<'a> {
             weights,
             total,
             has_non_delta,
+            lambert: None,
         }
     }
 
@@ -394,6 +419,9 @@ impl<'a> Bsdf<'a> {
         let Some(reflect) = self.sides(wi, wi_local) else {
             return (Rgb::ZERO, 0.0);
         };
+        if let Some(f) = self.lambert {
+            return lambert_eval_pdf(f, wi_local, reflect);
+        }
         let mut f = Rgb::ZERO;
         let mut pdf = 0.0;
         for (l, &w) in self.layers.iter().zip(&self.weights) {
@@ -412,6 +440,9 @@ impl<'a> Bsdf<'a> {
     pub fn sample(&self, u_layer: f32, u: Vec2) -> Option<BsdfSample> {
         if self.total <= 0.0 {
             return None;
+        }
+        if self.lambert.is_some() {
+            return self.sample_lambert(u);
         }
         // Pick a layer in proportion to its weight; rounding past the end lands on the last
         // layer with weight.
@@ -462,6 +493,48 @@ impl<'a> Bsdf<'a> {
             transmitted: !reflect,
         })
     }
+}
+
+impl Bsdf<'_> {
+    /// [`Bsdf::sample`] for a plain Lambertian material: the steps of the general path for
+    /// that case, without the layer choice.
+    #[inline]
+    fn sample_lambert(&self, u: Vec2) -> Option<BsdfSample> {
+        let side = if self.wo_local.z >= 0.0 { 1.0 } else { -1.0 };
+        let d = cosine_hemisphere(u);
+        let wi_local = Vec3::new(d.x, d.y, d.z * side);
+        let wi = self.frame.to_world(wi_local).normalize();
+        let reflect = self.sides(wi, wi_local)?;
+        // Evaluated at the world direction, as the general path does, so the bits agree.
+        let (f, pdf) = self.eval_pdf(wi);
+        if pdf <= 0.0 || !pdf.is_finite() {
+            return None;
+        }
+        Some(BsdfSample {
+            wi,
+            weight: f * (wi_local.z.abs() / pdf),
+            pdf,
+            delta: false,
+            transmitted: !reflect,
+        })
+    }
+}
+
+/// A single layer that is Lambertian with one colour at every angle: `color_at` is then
+/// `color · tint` whatever the cosine.
+#[inline]
+fn is_plain_lambert(l: &Layer) -> bool {
+    l.hardness <= 0.0 && !l.transmission && !l.coat && l.color == l.color90
+}
+
+/// `(f, pdf)` of a plain Lambertian layer whose `f` is already known, as [`eval_layer`] and the
+/// layer sum in [`Bsdf::eval_pdf`] compute them (the pdf's layer share `w / total` is exactly 1).
+#[inline]
+fn lambert_eval_pdf(f: Rgb, wi_local: Vec3, reflect: bool) -> (Rgb, f32) {
+    if !reflect {
+        return (Rgb::ZERO, 0.0);
+    }
+    (f, wi_local.z.abs() * FRAC_1_PI)
 }
 
 /// Dielectric Fresnel reflectance for cosine `cos_i ≥ 0` on the incident side and relative index

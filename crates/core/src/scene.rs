@@ -9,6 +9,7 @@ use crate::{
     Material, Rgb,
 };
 use glam::{Vec2, Vec3};
+use std::sync::OnceLock;
 
 /// A named group of consecutive triangles (one `[[geometry]]` entry).
 #[derive(Clone, Debug, PartialEq)]
@@ -42,9 +43,10 @@ pub struct Scene {
     pub cameras: Vec<Camera>,
     /// Named triangle ranges.
     pub objects: Vec<Object>,
-    /// Emitter sampling structure; rebuild with [`Scene::build_lights`] after changing geometry
-    /// or materials.
-    pub lights: LightSampler,
+    /// Emitter sampling structure, built on first use ([`Scene::lights`]), so integrators that
+    /// never sample lights never pay for it. Reset with [`Scene::build_lights`] after changing
+    /// geometry, materials or the environment.
+    lights: OnceLock<LightSampler>,
 }
 
 /// Shading information at a ray hit.
@@ -81,7 +83,7 @@ impl Scene {
             environment: Environment::Constant(Rgb::ZERO),
             cameras: Vec::new(),
             objects: Vec::new(),
-            lights: LightSampler::default(),
+            lights: OnceLock::new(),
         }
     }
 
@@ -93,9 +95,29 @@ impl Scene {
         self.material_ids.push(material);
     }
 
-    /// Rebuilds the light sampler from the emissive triangles and the environment.
+    /// Rebuilds the light sampler from the emissive triangles and the environment now.
     pub fn build_lights(&mut self) {
-        self.lights = LightSampler::build(self);
+        self.lights = OnceLock::from(LightSampler::build(self));
+    }
+
+    /// The light sampler, built from the emissive triangles and the environment on first use.
+    #[inline]
+    pub fn lights(&self) -> &LightSampler {
+        self.lights.get_or_init(|| LightSampler::build(self))
+    }
+
+    /// The light sampler if something has used (or [`Scene::build_lights`] built) it.
+    pub fn lights_if_built(&self) -> Option<&LightSampler> {
+        self.lights.get()
+    }
+
+    /// True if something emits: an emissive material on some triangle, or a non-black
+    /// environment. Cheap (no light sampler is built), for warnings about black images.
+    pub fn has_light_sources(&self) -> bool {
+        !self.environment.is_black()
+            || self.material_ids.iter().enumerate().any(|(i, &m)| {
+                self.materials[m as usize].is_emissive() && triangle::area(&self.triangles[i]) > 0.0
+            })
     }
 
     /// Number of triangles.

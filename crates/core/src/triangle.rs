@@ -225,14 +225,18 @@ pub const MAX_CONDITIONING: f32 = 1e4;
 /// origin offset from it stays on the inner side of the neighbouring triangles' planes too.
 #[inline]
 pub fn point_with_error(v: &[Vec3; 3], b1: f32, b2: f32) -> (Vec3, Vec3) {
-    let (p, err) = point_and_bound(v, b1, b2);
+    let twice_area = geometric_normal(v).length();
+    let (p, err) = point_and_bound(v, b1, b2, twice_area);
     // Pull the point in from the edges by twice its error bound (which also covers the normal
     // offset, `dot(|n|, err) ≤ |err|`): reconstructed near an edge, it may otherwise lie beyond
     // the plane of the neighbouring triangle, and a ray offset along this triangle's own normal
     // stays beyond it. Far from the origin that lets rays escape closed meshes at their edges
     // (a box 200 across at 10⁵: the error is 6 ULPs of 10⁵, 0.05). The point moves by at most
     // a few error bounds, within its own uncertainty; shading keeps the original barycentrics.
-    let twice_area = geometric_normal(v).length();
+    let b = [1.0 - b1 - b2, b1, b2];
+    if clear_of_edges(v, b, err, twice_area) {
+        return (p, err);
+    }
     let e = 2.0 * err.length();
     let edge = [
         (v[2] - v[1]).length(),
@@ -241,7 +245,6 @@ pub fn point_with_error(v: &[Vec3; 3], b1: f32, b2: f32) -> (Vec3, Vec3) {
     ];
     // Barycentric weight of vertex i at distance e from the opposite edge: e / altitude.
     let b_min = edge.map(|l| e * l / twice_area);
-    let b = [1.0 - b1 - b2, b1, b2];
     let room = 1.0 - (b_min[0] + b_min[1] + b_min[2]);
     // Without an interior point that far from every edge (a sliver about as thin as the
     // error, or a degenerate triangle), leave the point where it is.
@@ -258,12 +261,31 @@ pub fn point_with_error(v: &[Vec3; 3], b1: f32, b2: f32) -> (Vec3, Vec3) {
             b_min[i] + room / 3.0
         }
     });
-    point_and_bound(v, pulled[1], pulled[2])
+    point_and_bound(v, pulled[1], pulled[2], twice_area)
 }
 
-/// [`point_at`] and its error bound (the two parts of [`point_with_error`]'s documentation).
+/// True if every barycentric weight clearly exceeds its `b_min` in [`point_with_error`], decided
+/// without square roots (squared, with a relative margin of 10⁻⁵ that is far above the few ULPs
+/// by which the two forms may round apart). Almost every point is clear; the rest take the exact
+/// test, so the result is bit for bit the one of the exact test alone.
 #[inline]
-fn point_and_bound(v: &[Vec3; 3], b1: f32, b2: f32) -> (Vec3, Vec3) {
+fn clear_of_edges(v: &[Vec3; 3], b: [f32; 3], err: Vec3, twice_area: f32) -> bool {
+    let e2 = 4.0 * err.length_squared() * (1.0 + 1e-5);
+    let edge2 = [
+        (v[2] - v[1]).length_squared(),
+        (v[0] - v[2]).length_squared(),
+        (v[1] - v[0]).length_squared(),
+    ];
+    (0..3).all(|i| {
+        let lhs = b[i] * twice_area;
+        b[i] >= 0.0 && lhs * lhs >= e2 * edge2[i]
+    })
+}
+
+/// [`point_at`] and its error bound (the two parts of [`point_with_error`]'s documentation);
+/// `twice_area` is `|(v1 − v0) × (v2 − v0)|`.
+#[inline]
+fn point_and_bound(v: &[Vec3; 3], b1: f32, b2: f32, twice_area: f32) -> (Vec3, Vec3) {
     let p = point_at(v, b1, b2);
     let reconstruction =
         ((1.0 - b1).abs() + b2.abs()) * v[0].abs() + b1.abs() * v[1].abs() + b2.abs() * v[2].abs();
@@ -272,7 +294,6 @@ fn point_and_bound(v: &[Vec3; 3], b1: f32, b2: f32) -> (Vec3, Vec3) {
         .max((v[1] - p).abs())
         .max((v[2] - p).abs())
         .max_element();
-    let twice_area = geometric_normal(v).length();
     // Zero area gives κ = ∞, or NaN from 0/0, which `f32::min` also turns into the cap.
     let kappa = (l * l / twice_area).min(MAX_CONDITIONING);
     let test = gamma(8) * l * (1.0 + kappa);

@@ -93,7 +93,7 @@ fn emitters() -> Scene {
 fn emitter_area_sampling_matches_its_pdf_chi_square() {
     let scene = emitters();
     let x = Vec3::ZERO;
-    let lights = &scene.lights;
+    let lights = scene.lights();
     let pdf = |d: Vec3| {
         let pre = RayPrecomp::new(&Ray::new(x, d));
         (0..scene.triangles.len())

@@ -12,6 +12,7 @@
 
 use crate::{Ctx, Integrator, RayCounters, SampleAux};
 use rt_core::{
+    lights::LightSampler,
     material::Bsdf,
     ray::{shadow_segment, spawn_ray},
     sampling::power_heuristic,
@@ -78,8 +79,14 @@ impl Integrator for PathIntegrator {
         counters: &mut RayCounters,
     ) -> Rgb {
         let scene = ctx.scene;
-        let lights = &scene.lights;
-        let use_nee = self.next_event && !lights.is_empty();
+        // Only a path tracer that samples lights asks for (and so builds) the light sampler.
+        static NO_LIGHTS: LightSampler = LightSampler::NONE;
+        let lights = if self.next_event {
+            scene.lights()
+        } else {
+            &NO_LIGHTS
+        };
+        let use_nee = !lights.is_empty();
         let mut l = Rgb::ZERO;
         let mut beta = Rgb::ONE;
         // MIS state of the previous vertex: was the bounce a delta lobe, its pdf, its position.

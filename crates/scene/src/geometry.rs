@@ -1010,7 +1010,7 @@ mod tests {
         let names: Vec<&str> = s.scene.materials.iter().map(|m| m.name.as_str()).collect();
         assert_eq!(names, ["light", "a/red", "a/lamp"]);
         assert_eq!(s.scene.material_ids[2..], [1, 2]);
-        assert_eq!(s.scene.lights.emitter_count(), 3);
+        assert_eq!(s.scene.lights().emitter_count(), 3);
         // [[assign]] can use them, and `material` overrides them.
         let s = load_in(
             dir.path(),

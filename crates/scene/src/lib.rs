@@ -47,7 +47,7 @@
 //! let fixed = toml.replace("\"white\"", "\"light\"");
 //! let loaded = rt_scene::load_str(&fixed, Path::new("."), Path::new("demo.toml")).unwrap();
 //! assert_eq!(loaded.scene.triangle_count(), 4);
-//! assert_eq!(loaded.scene.lights.emitter_count(), 4);
+//! assert_eq!(loaded.scene.lights().emitter_count(), 4);
 //! ```
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
@@ -72,7 +72,7 @@ use std::path::Path;
 /// A loaded scene: the runtime scene, the `[render]` defaults and non-fatal remarks.
 #[derive(Debug)]
 pub struct LoadedScene {
-    /// The runtime scene, ready to render: `build_lights()` has been called.
+    /// The runtime scene, ready to render (its light sampler is built on first use).
     pub scene: rt_core::Scene,
     /// Defaults from the optional `[render]` table; command-line flags take precedence.
     pub render: RenderDesc,

@@ -15,7 +15,7 @@
 //! ```
 //! let scene = rt_scene::procedural::generate("worst-case").unwrap();
 //! assert_eq!(scene.triangle_count(), 4_100);
-//! assert!(!scene.lights.is_empty() && !scene.cameras.is_empty());
+//! assert!(!scene.lights().is_empty() && !scene.cameras.is_empty());
 //! assert!(rt_scene::procedural::generate("teapot").is_err());
 //! ```
 
@@ -113,7 +113,6 @@ impl Builder {
 
     fn finish(mut self, camera: Camera) -> Scene {
         self.scene.cameras.push(camera);
-        self.scene.build_lights();
         self.scene
     }
 }
@@ -407,7 +406,7 @@ mod tests {
         }
         let covered: u32 = scene.objects.iter().map(|o| o.count).sum();
         assert_eq!(covered as usize, triangles);
-        assert!(scene.lights.emitter_count() > 0, "{name}: no lights");
+        assert!(scene.lights().emitter_count() > 0, "{name}: no lights");
         assert_eq!(scene.cameras.len(), 1);
         for m in &scene.materials {
             m.validate().unwrap();

@@ -281,7 +281,7 @@ fn gltf_materials_map_onto_the_layered_model() {
         names,
         ["t/steel", "t/glass", "t/material2", "t/painted", "t/steel"]
     );
-    assert!(s.scene.lights.emitter_count() >= 3);
+    assert!(s.scene.lights().emitter_count() >= 3);
     for m in &s.scene.materials {
         assert_eq!(m.validate(), Ok(()), "{}", m.name);
     }

@@ -41,7 +41,7 @@ fn every_shipped_scene_loads_without_warnings() {
         let s = rt_scene::load(p).unwrap_or_else(|e| panic!("{e}"));
         assert!(s.warnings.is_empty(), "{}: {:?}", p.display(), s.warnings);
         assert!(!s.scene.cameras.is_empty() && s.scene.triangle_count() > 0);
-        assert!(!s.scene.lights.is_empty(), "{} has no light", p.display());
+        assert!(!s.scene.lights().is_empty(), "{} has no light", p.display());
         for c in &s.scene.cameras {
             assert!(
                 c.width <= 512 && c.height <= 512,
@@ -118,7 +118,7 @@ fn cornell_box_matches_the_published_data() {
             assert!(ok, "{} faces the wrong way: {t:?}", o.name);
         }
     }
-    assert_eq!(sc.lights.emitter_count(), 2);
+    assert_eq!(sc.lights().emitter_count(), 2);
     assert_eq!(s.render.spp, Some(256));
     assert_eq!(s.render.max_depth, Some(16));
     assert_eq!(s.render.integrator.as_deref(), Some("path"));
@@ -147,7 +147,7 @@ fn environment_scene_is_lit_by_the_generated_sky() {
     let env = &s.scene.environment;
     assert!(matches!(env, rt_core::environment::Environment::Map(_)));
     assert_eq!(
-        s.scene.lights.emitter_count(),
+        s.scene.lights().emitter_count(),
         0,
         "the map is the only light"
     );

@@ -12,6 +12,9 @@ use std::fmt;
 use std::path::Path;
 use std::time::Duration;
 
+/// Why the light sampler or the importance map was not built: nothing in the render asked.
+const NOT_SAMPLED: &str = "the integrator samples no lights";
+
 /// Whether a stage ran, and if not, why not.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Status {
@@ -134,38 +137,39 @@ impl RenderReport {
             }),
         );
 
-        let lights = &scene.lights;
         let env_sampled = !scene.environment.is_black();
         let light_stage = "light sampling structure";
-        stages.push(if lights.emitter_count() > 0 {
-            Stage::ran(
+        stages.push(match scene.lights_if_built() {
+            Some(lights) if lights.emitter_count() > 0 => Stage::ran(
                 light_stage,
                 "built",
                 Some(lights.build_time()),
                 Some(lights.memory_bytes()),
             )
-            .details(format!("{} emissive triangles", lights.emitter_count()))
-        } else if env_sampled {
-            Stage::skipped(
+            .details(format!("{} emissive triangles", lights.emitter_count())),
+            Some(_) if env_sampled => Stage::skipped(
                 light_stage,
                 "no emitters (light samples go to the environment)",
-            )
-        } else {
-            Stage::skipped(light_stage, "no emitters")
+            ),
+            Some(_) => Stage::skipped(light_stage, "no emitters"),
+            None => Stage::skipped(light_stage, NOT_SAMPLED),
         });
 
         let env_stage = "environment importance map";
         stages.push(match &scene.environment {
-            Environment::Map(m) => {
-                let (w, h) = m.size();
-                Stage::ran(
-                    env_stage,
-                    "built",
-                    Some(m.importance_build_time()),
-                    Some(m.importance_map_bytes()),
-                )
-                .details(format!("{w}x{h} map"))
-            }
+            Environment::Map(m) => match m.importance_if_built() {
+                Some(imp) => {
+                    let (w, h) = m.size();
+                    Stage::ran(
+                        env_stage,
+                        "built",
+                        Some(imp.build_time()),
+                        Some(imp.memory_bytes()),
+                    )
+                    .details(format!("{w}x{h} map"))
+                }
+                None => Stage::skipped(env_stage, NOT_SAMPLED),
+            },
             Environment::Constant(_) if env_sampled => {
                 Stage::skipped(env_stage, "constant environment")
             }
@@ -223,11 +227,12 @@ impl RenderReport {
 
         let held = mem.total()
             + accel_bytes
-            + lights.memory_bytes()
+            + scene.lights_if_built().map_or(0, |l| l.memory_bytes())
             + scene
                 .environment
                 .map()
-                .map_or(0, |m| m.importance_map_bytes())
+                .and_then(|m| m.importance_if_built())
+                .map_or(0, |imp| imp.memory_bytes())
             + fm.total();
         RenderReport {
             stages,
