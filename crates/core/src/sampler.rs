@@ -43,7 +43,9 @@ impl SampleStream {
 pub struct Sampler {
     seed: u32,
     pixel_hash: u32,
-    index: u32,
+    /// The sample index with its bits reversed: the first step of every draw's index shuffle
+    /// ([`nested_uniform_scramble`]), done once per sample instead of once per draw.
+    index_reversed: u32,
     dim: u32,
     first_dim: u32,
 }
@@ -60,7 +62,7 @@ impl Sampler {
         Self {
             seed,
             pixel_hash: 0,
-            index: 0,
+            index_reversed: 0,
             dim: first_dim,
             first_dim,
         }
@@ -70,7 +72,7 @@ impl Sampler {
     #[inline]
     pub fn start(&mut self, x: u32, y: u32, index: u32) {
         self.pixel_hash = hash3(x, y, self.seed);
-        self.index = index;
+        self.index_reversed = index.reverse_bits();
         self.dim = self.first_dim;
     }
 
@@ -78,7 +80,7 @@ impl Sampler {
     #[inline]
     pub fn next_1d(&mut self) -> f32 {
         let h = self.dim_hash();
-        let i = nested_uniform_scramble(self.index, h);
+        let i = laine_karras_permutation(self.index_reversed, h).reverse_bits();
         // nested_uniform_scramble(sobol_dim0(i)) with the two bit reversals that cancel removed.
         to_unit_float(laine_karras_permutation(i, hash_u32(h ^ 0x68bc_21eb)).reverse_bits())
     }
@@ -87,7 +89,7 @@ impl Sampler {
     #[inline]
     pub fn next_2d(&mut self) -> Vec2 {
         let h = self.dim_hash();
-        let i = nested_uniform_scramble(self.index, h);
+        let i = laine_karras_permutation(self.index_reversed, h).reverse_bits();
         let x = laine_karras_permutation(i, hash_u32(h ^ 0x68bc_21eb)).reverse_bits();
         let y = nested_uniform_scramble(sobol_dim1(i), hash_u32(h ^ 0x02e5_be93));
         Vec2::new(to_unit_float(x), to_unit_float(y))
