@@ -27,9 +27,12 @@ pub struct Object {
 pub struct Scene {
     /// World-space vertex positions, three per triangle.
     pub triangles: Vec<[Vec3; 3]>,
-    /// Optional per-vertex shading normals (world space, unit), per triangle.
+    /// Optional per-vertex shading normals (world space, unit), per triangle: one entry per
+    /// triangle, or none at all when no triangle has normals ([`Scene::compact_attributes`]).
+    /// Read them with [`Scene::normals_of`].
     pub normals: Vec<Option<[Vec3; 3]>>,
-    /// Optional per-vertex texture coordinates, per triangle.
+    /// Optional per-vertex texture coordinates, per triangle; one entry per triangle or none at
+    /// all, like `normals`. Read them with [`Scene::uvs_of`].
     pub uvs: Vec<Option<[Vec2; 3]>>,
     /// Material index of every triangle.
     pub material_ids: Vec<u32>,
@@ -89,10 +92,39 @@ impl Scene {
 
     /// Appends a triangle with material `material` and no shading normals or uvs.
     pub fn push_triangle(&mut self, v: [Vec3; 3], material: u32) {
+        // A full attribute list stays full; a compacted (empty) one stays empty.
+        if self.normals.len() == self.triangles.len() {
+            self.normals.push(None);
+        }
+        if self.uvs.len() == self.triangles.len() {
+            self.uvs.push(None);
+        }
         self.triangles.push(v);
-        self.normals.push(None);
-        self.uvs.push(None);
         self.material_ids.push(material);
+    }
+
+    /// Drops the per-triangle normal and uv lists when no triangle has any, so a mesh without
+    /// them holds 68 bytes less per triangle and shading reads nothing for them (on the
+    /// dragon, the load of an absent normal was a cache miss on every hit).
+    pub fn compact_attributes(&mut self) {
+        if self.normals.iter().all(Option::is_none) {
+            self.normals = Vec::new();
+        }
+        if self.uvs.iter().all(Option::is_none) {
+            self.uvs = Vec::new();
+        }
+    }
+
+    /// Shading normals of triangle `i`, if it has them.
+    #[inline]
+    pub fn normals_of(&self, i: usize) -> Option<&[Vec3; 3]> {
+        self.normals.get(i).and_then(Option::as_ref)
+    }
+
+    /// Texture coordinates of triangle `i`, if it has them.
+    #[inline]
+    pub fn uvs_of(&self, i: usize) -> Option<&[Vec2; 3]> {
+        self.uvs.get(i).and_then(Option::as_ref)
     }
 
     /// Rebuilds the light sampler from the emissive triangles and the environment now.
@@ -140,7 +172,7 @@ impl Scene {
         let b0 = 1.0 - b1 - b2;
         let (p, p_error) = triangle::point_with_error(v, b1, b2);
         let ng = triangle::geometric_normal(v).normalize_or(Vec3::Z);
-        let ns = match &self.normals[i] {
+        let ns = match self.normals_of(i) {
             Some(n) => {
                 let n = (n[0] * b0 + n[1] * b1 + n[2] * b2).normalize_or(ng);
                 if n.dot(ng) < 0.0 {
@@ -151,7 +183,7 @@ impl Scene {
             }
             None => ng,
         };
-        let uv = match &self.uvs[i] {
+        let uv = match self.uvs_of(i) {
             Some(t) => t[0] * b0 + t[1] * b1 + t[2] * b2,
             None => Vec2::new(b1, b2),
         };

@@ -842,7 +842,7 @@ mod tests {
             s.warnings
         );
         let s = ok(&geom("positions = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]\nindices = [[0, 1, 2]]\nnormals = [[0, 0, 0], [0, 0, 1], [0, 0, 1]]"));
-        assert_eq!(s.scene.normals[2], None);
+        assert_eq!(s.scene.normals_of(2), None);
         assert!(
             s.warnings
                 .iter()

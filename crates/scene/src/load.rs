@@ -78,6 +78,7 @@ pub(crate) fn load(text: &str, base: &Path, name: &Path) -> Result<LoadedScene> 
     }
     scene.materials = mats.into_vec();
     scene.textures = std::mem::take(&mut ctx.textures).into_vec();
+    scene.compact_attributes();
     if !scene.has_light_sources() {
         ctx.warnings.push(
             "the scene has no light: no emissive material is used and the environment is black, \
