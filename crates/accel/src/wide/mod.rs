@@ -86,9 +86,12 @@ impl<N: WideNode> WideBvh<N> {
         &self.options
     }
 
-    /// Collapses `bvh`: every node takes the two children of its binary node and then
-    /// repeatedly replaces the inner child of largest surface area by that child's two
-    /// children, until it has `N::WIDTH` children or only leaves. Triangles and prim ids are copied.
+    /// Collapses `bvh`. A [`Bvh8`] takes the collapse of least SAH cost, in which a slot may
+    /// also be a whole binary subtree of up to [`MAX_LEAF_TRIANGLES`] triangles made one leaf
+    /// (Ylitie et al. 2017, see `collapse.rs`). A [`Qbvh`] keeps Dammertz's greedy collapse:
+    /// every node takes the two children of its binary node and then repeatedly replaces the
+    /// inner child of largest surface area by that child's two children, until it has
+    /// `N::WIDTH` children or only leaves. Triangles and prim ids are copied.
     ///
     /// # Panics
     ///
@@ -99,7 +102,8 @@ impl<N: WideNode> WideBvh<N> {
             "Qbvh supports fewer than 2^27 triangles, got {}",
             bvh.triangles().len()
         );
-        let c = collapse::collapse::<N>(bvh.nodes(), bvh.triangles(), bvh.prim_ids());
+        let sah = N::PLANNED_COLLAPSE.then_some(collapse::PLAN_COSTS);
+        let c = collapse::collapse::<N>(bvh.nodes(), bvh.triangles(), bvh.prim_ids(), sah);
         Self {
             nodes: c.nodes,
             packets: c.packets,
