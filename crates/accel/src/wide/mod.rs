@@ -185,7 +185,9 @@ impl<N: WideNode> WideBvh<N> {
         isa: I,
         c: &mut C,
     ) -> Option<Hit> {
-        match (self.options.order, self.options.t_stack) {
+        // An any-hit query stops at its first hit, so the culling distance never shrinks and
+        // entry distances on the stack would cull nothing.
+        match (self.options.order, self.options.t_stack && !ANY_HIT) {
             (Order::SplitPlane, false) => {
                 self.traverse::<ANY_HIT, SPLIT_PLANE, false, I, C>(ray, t_max, isa, c)
             }

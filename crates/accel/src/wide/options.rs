@@ -54,10 +54,12 @@ pub struct WideOptions {
 }
 
 impl WideOptions {
-    /// The default options of a wide BVH with nodes `N`: they differ only in the child order.
+    /// The default options of a wide BVH with nodes `N`: they differ only in the child order
+    /// and the t-stack.
     pub fn defaults_for<N: super::WideNode>() -> Self {
         Self {
             order: N::DEFAULT_ORDER,
+            t_stack: N::DEFAULT_TSTACK,
             ..Self::default()
         }
     }
