@@ -322,8 +322,12 @@ impl<N: WideNode> WideBvh<N> {
             return None;
         }
         let slab = Slab::new(ray);
-        counter.boxes(1);
-        slab.hit_box(&self.bounds, t_max)?;
+        // The eight boxes of the root node are tested next anyway, as cheaply as the scene's
+        // box; the four-wide node keeps the test (and its count).
+        if N::WIDTH < 8 {
+            counter.boxes(1);
+            slab.hit_box(&self.bounds, t_max)?;
+        }
         let pre = RayPrecomp4::new(ray);
         let oct = octant(ray);
 
@@ -355,27 +359,42 @@ impl<N: WideNode> WideBvh<N> {
                         }
                         cur = keys[0] as u32;
                     } else if ORDER == DISTANCE {
-                        // Usually two or three of the eight slots are hit: insertion-sort those.
-                        let mut keys = [MISS; 8];
-                        let mut n = 0;
-                        let mut rest = mask;
-                        while rest != 0 {
-                            let lane = rest.trailing_zeros() as usize;
-                            rest &= rest - 1;
-                            let k = key(t[lane], node.code(lane));
-                            let mut i = n;
-                            while i > 0 && keys[i - 1] > k {
-                                keys[i] = keys[i - 1];
-                                i -= 1;
+                        // Most nodes have one or two hit slots (Embree's traverser has the
+                        // same two fast paths); more are insertion-sorted.
+                        let first = mask.trailing_zeros() as usize;
+                        let rest = mask & (mask - 1);
+                        if rest == 0 {
+                            cur = node.code(first);
+                        } else if rest & (rest - 1) == 0 {
+                            let second = rest.trailing_zeros() as usize;
+                            let a = key(t[first], node.code(first));
+                            let b = key(t[second], node.code(second));
+                            let (near, far) = if a < b { (a, b) } else { (b, a) };
+                            self.prefetch(far as u32);
+                            stack.push(far as u32, key_t(far));
+                            cur = near as u32;
+                        } else {
+                            let mut keys = [MISS; 8];
+                            let mut n = 0;
+                            let mut rest = mask;
+                            while rest != 0 {
+                                let lane = rest.trailing_zeros() as usize;
+                                rest &= rest - 1;
+                                let k = key(t[lane], node.code(lane));
+                                let mut i = n;
+                                while i > 0 && keys[i - 1] > k {
+                                    keys[i] = keys[i - 1];
+                                    i -= 1;
+                                }
+                                keys[i] = k;
+                                n += 1;
                             }
-                            keys[i] = k;
-                            n += 1;
+                            for &k in keys[1..n].iter().rev() {
+                                self.prefetch(k as u32);
+                                stack.push(k as u32, key_t(k));
+                            }
+                            cur = keys[0] as u32;
                         }
-                        for &k in keys[1..n].iter().rev() {
-                            self.prefetch(k as u32);
-                            stack.push(k as u32, key_t(k));
-                        }
-                        cur = keys[0] as u32;
                     } else {
                         let order = if ORDER == SPLIT_PLANE {
                             node.order(oct)
