@@ -365,6 +365,17 @@ impl<N: WideNode> WideBvh<N> {
                         let rest = mask & (mask - 1);
                         if rest == 0 {
                             cur = node.code(first);
+                        } else if ANY_HIT {
+                            // Any occluder will do, so the order is not worth sorting for
+                            // (Embree's any-hit traverser does not sort either).
+                            let mut rest = rest;
+                            while rest != 0 {
+                                let lane = rest.trailing_zeros() as usize;
+                                rest &= rest - 1;
+                                self.prefetch(node.code(lane));
+                                stack.push(node.code(lane), t[lane]);
+                            }
+                            cur = node.code(first);
                         } else if rest & (rest - 1) == 0 {
                             let second = rest.trailing_zeros() as usize;
                             let a = key(t[first], node.code(first));
