@@ -155,6 +155,18 @@ impl<N: WideNode> WideBvh<N> {
             #[allow(unsafe_code)]
             return unsafe { self.query_avx2::<ANY_HIT, C>(ray, t_max, avx2, c) };
         }
+        self.query_baseline::<ANY_HIT, C>(ray, t_max, c)
+    }
+
+    /// [`WideBvh::query_any`] without AVX2. Kept out of line so that [`WideBvh::query`] stays a
+    /// branch, not a second 6 KB stack frame set up for every ray.
+    #[inline(never)]
+    fn query_baseline<const ANY_HIT: bool, C: Counter>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        c: &mut C,
+    ) -> Option<Hit> {
         self.query_any::<ANY_HIT, _, C>(ray, t_max, Baseline, c)
     }
 

@@ -328,7 +328,9 @@ impl<N: WideNode> WideBvh<N> {
             counter.boxes(1);
             slab.hit_box(&self.bounds, t_max)?;
         }
-        let pre = RayPrecomp4::new(ray);
+        // Made at the first leaf: many rays (most camera rays past the silhouette) never reach
+        // one, and the shear costs a division and a dozen data-dependent selections.
+        let mut pre: Option<RayPrecomp4> = None;
         let oct = octant(ray);
 
         let mut closest = Closest::new(t_max);
@@ -336,7 +338,8 @@ impl<N: WideNode> WideBvh<N> {
         let mut cur: u32 = 0;
         loop {
             if cur & LEAF_BIT != 0 {
-                if self.test_leaf::<ANY_HIT, I, C>(&pre, cur, t_max, &mut closest, isa, counter) {
+                let pre = pre.get_or_insert_with(|| RayPrecomp4::new(ray));
+                if self.test_leaf::<ANY_HIT, I, C>(pre, cur, t_max, &mut closest, isa, counter) {
                     return closest.hit;
                 }
             } else {
