@@ -14,7 +14,9 @@ pub const DEFAULT_INTERSECTION_COST: f32 = 0.2;
 pub enum Order {
     /// Slot order, whatever the ray: the cheapest per node, the most boxes per ray.
     Unsorted,
-    /// Nearest entry distance first (a sorting network over the four hit slots).
+    /// Nearest entry distance first (a sorting network over the four hit slots). The
+    /// eight-wide node sorts for closest-hit queries only: any-hit queries take its hit slots
+    /// in slot order.
     Distance,
     /// The order of the binary splits the node was collapsed from, near side first according to
     /// the sign of the ray direction along each split axis. Needs no distances at all; the
