@@ -15,7 +15,7 @@
 //! | `evh=T` / `bbah=T` | bvh, qbvh, bvh8 | triangle splitting with threshold exponent T |
 //! | `compact` | bvh, qbvh, bvh8 | remove duplicate references per leaf |
 //! | `order=unsorted\|distance\|split` | qbvh, bvh8 | child order (default `split`) |
-//! | `tstack` | qbvh, bvh8 | keep entry distances on the stack and skip stale entries |
+//! | `tstack` / `no-tstack` | qbvh, bvh8 | keep entry distances on the stack and skip stale entries, or not (default: on for bvh8, off for qbvh) |
 //! | `shadow-cache` | qbvh, bvh8 | start occlusion queries at the last occluder's node |
 //! | `isect=watertight\|subdivision\|hybrid` | qbvh, bvh8 | triangle test (default watertight) |
 //! | `lazy` | qbvh | build subtrees the first time a ray reaches them |
@@ -179,7 +179,7 @@ impl AccelSpec {
         let wide = self.kind.is_wide();
         let applies = match key {
             "leaf" | "bins" | "icost" | "evh" | "bbah" | "compact" => tree,
-            "order" | "tstack" | "shadow-cache" | "isect" => wide,
+            "order" | "tstack" | "no-tstack" | "shadow-cache" | "isect" => wide,
             "lazy" => self.kind == AccelKind::Qbvh,
             _ => {
                 return Err(SpecError::UnknownOption {
@@ -239,9 +239,9 @@ impl AccelSpec {
                     _ => return Err(bad("expected unsorted, distance or split")),
                 }
             }
-            "tstack" => {
+            "tstack" | "no-tstack" => {
                 flag()?;
-                self.wide.t_stack = true;
+                self.wide.t_stack = key == "tstack";
             }
             "shadow-cache" => {
                 flag()?;
@@ -315,8 +315,8 @@ impl fmt::Display for AccelSpec {
             };
             write!(f, ":order={o}")?;
         }
-        if q.t_stack {
-            f.write_str(":tstack")?;
+        if q.t_stack != dq.t_stack {
+            f.write_str(if q.t_stack { ":tstack" } else { ":no-tstack" })?;
         }
         if q.shadow_cache {
             f.write_str(":shadow-cache")?;
@@ -361,14 +361,18 @@ mod tests {
             "bvh:icost=0.3",
             "qbvh:leaf=8:order=unsorted:shadow-cache:isect=hybrid:lazy",
             "bvh8",
-            "bvh8:leaf=8:evh=14:tstack:shadow-cache",
+            "bvh8:leaf=8:evh=14:no-tstack:shadow-cache",
             "bvh8:order=split",
         ] {
             let spec: AccelSpec = s.parse().unwrap();
             assert_eq!(spec.to_string(), s);
         }
-        let spec: AccelSpec = "qbvh:order=split:isect=watertight".parse().unwrap();
+        let spec: AccelSpec = "qbvh:order=split:isect=watertight:no-tstack"
+            .parse()
+            .unwrap();
         assert_eq!(spec, AccelSpec::new(AccelKind::Qbvh));
+        let spec: AccelSpec = "bvh8:tstack:order=distance".parse().unwrap();
+        assert_eq!(spec, AccelSpec::new(AccelKind::Bvh8));
     }
 
     #[test]

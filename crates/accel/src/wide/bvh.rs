@@ -57,6 +57,13 @@ pub trait WideNode: Copy + Debug + PartialEq + Send + Sync + sealed::Sealed + 's
     /// The child order traversal uses unless told otherwise: the fastest measured
     /// (`docs/benchmarks.md`).
     const DEFAULT_ORDER: Order;
+    /// Whether traversal keeps entry distances on the stack unless told otherwise
+    /// ([`WideOptions::t_stack`](super::WideOptions::t_stack)).
+    const DEFAULT_TSTACK: bool;
+    /// Collapse with the SAH-optimal plan rather than greedily by area (see
+    /// [`WideBvh::from_bvh2`](super::WideBvh::from_bvh2)).
+    #[doc(hidden)]
+    const PLANNED_COLLAPSE: bool;
     /// Bits per slot in an order word.
     #[doc(hidden)]
     const ORDER_BITS: u32;

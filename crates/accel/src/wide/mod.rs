@@ -86,9 +86,12 @@ impl<N: WideNode> WideBvh<N> {
         &self.options
     }
 
-    /// Collapses `bvh`: every node takes the two children of its binary node and then
-    /// repeatedly replaces the inner child of largest surface area by that child's two
-    /// children, until it has `N::WIDTH` children or only leaves. Triangles and prim ids are copied.
+    /// Collapses `bvh`. A [`Bvh8`] takes the collapse of least SAH cost, in which a slot may
+    /// also be a whole binary subtree of up to [`MAX_LEAF_TRIANGLES`] triangles made one leaf
+    /// (Ylitie et al. 2017, see `collapse.rs`). A [`Qbvh`] keeps Dammertz's greedy collapse:
+    /// every node takes the two children of its binary node and then repeatedly replaces the
+    /// inner child of largest surface area by that child's two children, until it has
+    /// `N::WIDTH` children or only leaves. Triangles and prim ids are copied.
     ///
     /// # Panics
     ///
@@ -99,7 +102,8 @@ impl<N: WideNode> WideBvh<N> {
             "Qbvh supports fewer than 2^27 triangles, got {}",
             bvh.triangles().len()
         );
-        let c = collapse::collapse::<N>(bvh.nodes(), bvh.triangles(), bvh.prim_ids());
+        let sah = N::PLANNED_COLLAPSE.then_some(collapse::PLAN_COSTS);
+        let c = collapse::collapse::<N>(bvh.nodes(), bvh.triangles(), bvh.prim_ids(), sah);
         Self {
             nodes: c.nodes,
             packets: c.packets,
@@ -151,6 +155,18 @@ impl<N: WideNode> WideBvh<N> {
             #[allow(unsafe_code)]
             return unsafe { self.query_avx2::<ANY_HIT, C>(ray, t_max, avx2, c) };
         }
+        self.query_baseline::<ANY_HIT, C>(ray, t_max, c)
+    }
+
+    /// [`WideBvh::query_any`] without AVX2. Kept out of line so that [`WideBvh::query`] stays a
+    /// branch, not a second 6 KB stack frame set up for every ray.
+    #[inline(never)]
+    fn query_baseline<const ANY_HIT: bool, C: Counter>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        c: &mut C,
+    ) -> Option<Hit> {
         self.query_any::<ANY_HIT, _, C>(ray, t_max, Baseline, c)
     }
 
@@ -181,7 +197,9 @@ impl<N: WideNode> WideBvh<N> {
         isa: I,
         c: &mut C,
     ) -> Option<Hit> {
-        match (self.options.order, self.options.t_stack) {
+        // An any-hit query stops at its first hit, so the culling distance never shrinks and
+        // entry distances on the stack would cull nothing.
+        match (self.options.order, self.options.t_stack && !ANY_HIT) {
             (Order::SplitPlane, false) => {
                 self.traverse::<ANY_HIT, SPLIT_PLANE, false, I, C>(ray, t_max, isa, c)
             }

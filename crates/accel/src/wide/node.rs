@@ -172,6 +172,9 @@ impl WideNode for QNode {
     const WIDTH: usize = 4;
     const NAME: &'static str = "qbvh";
     const DEFAULT_ORDER: Order = Order::SplitPlane;
+    // The QBVH stays Dammertz's (its benchmarks and the on-demand build compare with it).
+    const PLANNED_COLLAPSE: bool = false;
+    const DEFAULT_TSTACK: bool = false;
     const ORDER_BITS: u32 = 2;
     const IDENTITY_ORDER: u32 = IDENTITY_ORDER as u32;
     type Dists = [f32; 4];

@@ -14,7 +14,9 @@ pub const DEFAULT_INTERSECTION_COST: f32 = 0.2;
 pub enum Order {
     /// Slot order, whatever the ray: the cheapest per node, the most boxes per ray.
     Unsorted,
-    /// Nearest entry distance first (a sorting network over the four hit slots).
+    /// Nearest entry distance first (a sorting network over the four hit slots). The
+    /// eight-wide node sorts for closest-hit queries only: any-hit queries take its hit slots
+    /// in slot order.
     Distance,
     /// The order of the binary splits the node was collapsed from, near side first according to
     /// the sign of the ray direction along each split axis. Needs no distances at all; the
@@ -54,10 +56,12 @@ pub struct WideOptions {
 }
 
 impl WideOptions {
-    /// The default options of a wide BVH with nodes `N`: they differ only in the child order.
+    /// The default options of a wide BVH with nodes `N`: they differ only in the child order
+    /// and the t-stack.
     pub fn defaults_for<N: super::WideNode>() -> Self {
         Self {
             order: N::DEFAULT_ORDER,
+            t_stack: N::DEFAULT_TSTACK,
             ..Self::default()
         }
     }

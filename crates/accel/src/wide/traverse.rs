@@ -322,9 +322,15 @@ impl<N: WideNode> WideBvh<N> {
             return None;
         }
         let slab = Slab::new(ray);
-        counter.boxes(1);
-        slab.hit_box(&self.bounds, t_max)?;
-        let pre = RayPrecomp4::new(ray);
+        // The eight boxes of the root node are tested next anyway, as cheaply as the scene's
+        // box; the four-wide node keeps the test (and its count).
+        if N::WIDTH < 8 {
+            counter.boxes(1);
+            slab.hit_box(&self.bounds, t_max)?;
+        }
+        // Made at the first leaf: many rays (most camera rays past the silhouette) never reach
+        // one, and the shear costs a division and a dozen data-dependent selections.
+        let mut pre: Option<RayPrecomp4> = None;
         let oct = octant(ray);
 
         let mut closest = Closest::new(t_max);
@@ -332,7 +338,8 @@ impl<N: WideNode> WideBvh<N> {
         let mut cur: u32 = 0;
         loop {
             if cur & LEAF_BIT != 0 {
-                if self.test_leaf::<ANY_HIT, I, C>(&pre, cur, t_max, &mut closest, isa, counter) {
+                let pre = pre.get_or_insert_with(|| RayPrecomp4::new(ray));
+                if self.test_leaf::<ANY_HIT, I, C>(pre, cur, t_max, &mut closest, isa, counter) {
                     return closest.hit;
                 }
             } else {
@@ -355,26 +362,53 @@ impl<N: WideNode> WideBvh<N> {
                         }
                         cur = keys[0] as u32;
                     } else if ORDER == DISTANCE {
-                        // Usually two or three of the eight slots are hit: insertion-sort those.
-                        let mut keys = [MISS; 8];
-                        let mut n = 0;
-                        let mut rest = mask;
-                        while rest != 0 {
-                            let lane = rest.trailing_zeros() as usize;
-                            rest &= rest - 1;
-                            let k = key(t[lane], node.code(lane));
-                            let mut i = n;
-                            while i > 0 && keys[i - 1] > k {
-                                keys[i] = keys[i - 1];
-                                i -= 1;
+                        // Most nodes have one or two hit slots (Embree's traverser has the
+                        // same two fast paths); more are insertion-sorted.
+                        let first = mask.trailing_zeros() as usize;
+                        let rest = mask & (mask - 1);
+                        if rest == 0 {
+                            cur = node.code(first);
+                        } else if ANY_HIT {
+                            // Any occluder will do, so the order is not worth sorting for
+                            // (Embree's any-hit traverser does not sort either).
+                            let mut rest = rest;
+                            while rest != 0 {
+                                let lane = rest.trailing_zeros() as usize;
+                                rest &= rest - 1;
+                                self.prefetch(node.code(lane));
+                                stack.push(node.code(lane), t[lane]);
                             }
-                            keys[i] = k;
-                            n += 1;
+                            cur = node.code(first);
+                        } else if rest & (rest - 1) == 0 {
+                            let second = rest.trailing_zeros() as usize;
+                            let a = key(t[first], node.code(first));
+                            let b = key(t[second], node.code(second));
+                            let (near, far) = if a < b { (a, b) } else { (b, a) };
+                            self.prefetch(far as u32);
+                            stack.push(far as u32, key_t(far));
+                            cur = near as u32;
+                        } else {
+                            let mut keys = [MISS; 8];
+                            let mut n = 0;
+                            let mut rest = mask;
+                            while rest != 0 {
+                                let lane = rest.trailing_zeros() as usize;
+                                rest &= rest - 1;
+                                let k = key(t[lane], node.code(lane));
+                                let mut i = n;
+                                while i > 0 && keys[i - 1] > k {
+                                    keys[i] = keys[i - 1];
+                                    i -= 1;
+                                }
+                                keys[i] = k;
+                                n += 1;
+                            }
+                            for &k in keys[1..n].iter().rev() {
+                                self.prefetch(k as u32);
+                                stack.push(k as u32, key_t(k));
+                            }
+                            cur = keys[0] as u32;
                         }
-                        for &k in keys[1..n].iter().rev() {
-                            stack.push(k as u32, key_t(k));
-                        }
-                        cur = keys[0] as u32;
                     } else {
                         let order = if ORDER == SPLIT_PLANE {
                             node.order(oct)
@@ -406,6 +440,41 @@ impl<N: WideNode> WideBvh<N> {
                 None => return closest.hit,
             }
         }
+    }
+
+    /// Starts fetching the memory of child `code` (its node, or its leaf's packets) into the
+    /// cache, so that a child pushed now is there when it is popped: the loads of the nodes on
+    /// one path depend on each other, the fetches of pushed siblings need not wait (Embree
+    /// prefetches hit children likewise).
+    #[inline(always)]
+    fn prefetch(&self, code: u32) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+            let (ptr, bytes) = if code & LEAF_BIT != 0 {
+                let (first, count) = leaf_parts(code);
+                let p = self.packets.as_ptr().wrapping_add(first);
+                (
+                    p.cast::<i8>(),
+                    count.div_ceil(4) * std::mem::size_of::<super::Tri4>(),
+                )
+            } else {
+                let p = self.nodes.as_ptr().wrapping_add(code as usize);
+                (p.cast::<i8>(), std::mem::size_of::<N>())
+            };
+            let mut off = 0;
+            while off < bytes.min(256) {
+                // SAFETY: prefetching has no architectural effect and never faults, whatever
+                // the address; SSE is part of the x86_64 baseline.
+                #[allow(unsafe_code)]
+                unsafe {
+                    _mm_prefetch::<_MM_HINT_T0>(ptr.wrapping_add(off))
+                };
+                off += 64;
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = code;
     }
 
     /// Tests the triangles of leaf `code`; returns true when an any-hit query has its answer.
