@@ -110,10 +110,31 @@ fn stats_show_skipped_stages_for_a_scene_without_environment_map_or_aovs() {
 
     assert_holds(&table, "scene load", "done");
     assert_holds(&table, "acceleration structure", "built");
-    // Two emitting triangles: ids, powers and a three-entry cdf, four bytes each.
+    // Two emitting triangles: their records, two powers and a three-entry cdf.
     assert_eq!(
         assert_holds(&table, "light sampling structure", "built"),
-        28
+        2 * std::mem::size_of::<rt_core::lights::Emitter>() as u64 + (2 + 3) * 4
+    );
+
+    // Ambient occlusion samples no light: the light sampler is not built.
+    let ao = render(
+        dir.path(),
+        &[
+            "lamp.toml",
+            "--spp",
+            "1",
+            "-q",
+            "--stats",
+            "--integrator",
+            "ao",
+            "-o",
+            "ao.exr",
+        ],
+    );
+    assert_skipped(
+        &ao,
+        "light sampling structure",
+        "the integrator samples no lights",
     );
     assert_eq!(
         assert_holds(&table, "film mean + count", "allocated"),

@@ -26,7 +26,8 @@ pub struct Hit {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct TraversalCounters {
     /// Boxes tested: every child box of every inner node visited (a four-wide node counts its
-    /// occupied slots), plus the root's bounds.
+    /// occupied slots), plus the root's bounds where the structure tests them apart (`bvh8`
+    /// does not: its root node's child boxes already bound the scene).
     pub nodes_visited: u64,
     /// Leaves entered (their triangles then tested).
     pub leaves_visited: u64,
