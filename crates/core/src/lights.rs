@@ -81,6 +81,11 @@ fn triangle_power(scene: &Scene, prim: u32) -> f32 {
     triangle::area(&scene.triangles[prim as usize]) * luminance(m.emission) * m.emitting_faces()
 }
 
+/// True if triangle `prim` is one the sampler samples: emissive with positive power.
+pub(crate) fn is_emitter(scene: &Scene, prim: u32) -> bool {
+    scene.material_of(prim).is_emissive() && triangle_power(scene, prim) > 0.0
+}
+
 impl LightSampler {
     /// A sampler with nothing to sample, for integrators that do not sample lights.
     pub const NONE: LightSampler = LightSampler {
@@ -95,7 +100,7 @@ impl LightSampler {
     pub fn build(scene: &Scene) -> Self {
         let start = Instant::now();
         let emitters: Vec<u32> = (0..scene.triangles.len() as u32)
-            .filter(|&i| scene.material_of(i).is_emissive() && triangle_power(scene, i) > 0.0)
+            .filter(|&i| is_emitter(scene, i))
             .collect();
         let powers: Vec<f32> = emitters.iter().map(|&i| triangle_power(scene, i)).collect();
         let total_power: f32 = powers.iter().map(|&p| p as f64).sum::<f64>() as f32;

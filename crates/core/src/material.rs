@@ -310,9 +310,9 @@ pub struct Bsdf<'a> {
     total: f32,
     has_non_delta: bool,
     /// `Some(colour · tint · weight / π)` for a material that is one Lambertian layer of one
-    /// colour at all angles (most surfaces of most scenes): its value and pdf need no layer
-    /// loop, and sampling it needs no evaluation. The arithmetic is the general path's,
-    /// operation for operation, so both give the same bits.
+    /// colour at all angles (most surfaces of most scenes): its value and pdf, here and inside
+    /// [`Bsdf::sample`], need no layer loop. The arithmetic is the general path's, operation
+    /// for operation, so both give the same bits.
     lambert: Option<Rgb>,
 }
 
@@ -324,25 +324,6 @@ impl<'a> Bsdf<'a> {
         let frame = Frame::from_normal(ns);
         let wo_local = frame.to_local(wo);
         let mut weights = [0.0f32; MAX_LAYERS];
-        if let [l] = material.layers.as_slice() {
-            if is_plain_lambert(l) && l.weight > 0.0 {
-                // The general loop's values for this case: `1 · w`, a sum of `w` and zeros, and
-                // `color_at`, which is `color · tint` at every angle.
-                weights[0] = l.weight;
-                return Self {
-                    layers: &material.layers,
-                    tint,
-                    frame,
-                    ng,
-                    wo,
-                    wo_local,
-                    weights,
-                    total: l.weight,
-                    has_non_delta: true,
-                    lambert: Some(l.color * tint * FRAC_1_PI * l.weight),
-                };
-            }
-        }
         let mut passed = 1.0f32;
         let cos_o = wo_local.z.abs();
         let mut has_non_delta = false;
@@ -358,6 +339,13 @@ impl<'a> Bsdf<'a> {
             has_non_delta |= *w > 0.0 && !l.is_delta();
         }
         let total = weights.iter().sum();
+        // `color_at` of a plain Lambertian layer is `color · tint` at every angle.
+        let lambert = match material.layers.as_slice() {
+            [l] if is_plain_lambert(l) && weights[0] > 0.0 => {
+                Some(l.color * tint * FRAC_1_PI * weights[0])
+            }
+            _ => None,
+        };
         Self {
             layers: &material.layers,
             tint,
@@ -368,7 +356,7 @@ impl<'a> Bsdf<'a> {
             weights,
             total,
             has_non_delta,
-            lambert: None,
+            lambert,
         }
     }
 
@@ -441,9 +429,6 @@ impl<'a> Bsdf<'a> {
         if self.total <= 0.0 {
             return None;
         }
-        if self.lambert.is_some() {
-            return self.sample_lambert(u);
-        }
         // Pick a layer in proportion to its weight; rounding past the end lands on the last
         // layer with weight.
         let mut target = u_layer * self.total;
@@ -481,31 +466,6 @@ impl<'a> Bsdf<'a> {
                 transmitted: !reflect,
             });
         }
-        let (f, pdf) = self.eval_pdf(wi);
-        if pdf <= 0.0 || !pdf.is_finite() {
-            return None;
-        }
-        Some(BsdfSample {
-            wi,
-            weight: f * (wi_local.z.abs() / pdf),
-            pdf,
-            delta: false,
-            transmitted: !reflect,
-        })
-    }
-}
-
-impl Bsdf<'_> {
-    /// [`Bsdf::sample`] for a plain Lambertian material: the steps of the general path for
-    /// that case, without the layer choice.
-    #[inline]
-    fn sample_lambert(&self, u: Vec2) -> Option<BsdfSample> {
-        let side = if self.wo_local.z >= 0.0 { 1.0 } else { -1.0 };
-        let d = cosine_hemisphere(u);
-        let wi_local = Vec3::new(d.x, d.y, d.z * side);
-        let wi = self.frame.to_world(wi_local).normalize();
-        let reflect = self.sides(wi, wi_local)?;
-        // Evaluated at the world direction, as the general path does, so the bits agree.
         let (f, pdf) = self.eval_pdf(wi);
         if pdf <= 0.0 || !pdf.is_finite() {
             return None;

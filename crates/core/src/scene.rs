@@ -143,13 +143,11 @@ impl Scene {
         self.lights.get()
     }
 
-    /// True if something emits: an emissive material on some triangle, or a non-black
+    /// True if something emits: a triangle the light sampler would sample, or a non-black
     /// environment. Cheap (no light sampler is built), for warnings about black images.
     pub fn has_light_sources(&self) -> bool {
         !self.environment.is_black()
-            || self.material_ids.iter().enumerate().any(|(i, &m)| {
-                self.materials[m as usize].is_emissive() && triangle::area(&self.triangles[i]) > 0.0
-            })
+            || (0..self.triangles.len() as u32).any(|i| crate::lights::is_emitter(self, i))
     }
 
     /// Number of triangles.
