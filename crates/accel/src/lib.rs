@@ -78,4 +78,7 @@ pub struct ValidationError {
 pub use bvh2::{BuildParams, Bvh2, BvhStats, Node, Split, MAX_BINS};
 pub use on_demand::OnDemandQbvh;
 pub use spec::{AccelKind, AccelSpec, SpecError, DEFAULT_ACCEL};
-pub use wide::{Bvh8, Node8, Order, QNode, Qbvh, TriangleTest, WideBvh, WideNode, WideOptions};
+pub use wide::{
+    Bvh8, Node8, Order, QNode, Qbvh, TriangleTest, WideBvh, WideNode, WideOptions,
+    FINE_LEAVES_MAX_TRIANGLES,
+};
