@@ -32,6 +32,7 @@ fn rays_inside_a_small_room_test_few_triangles() {
         assert_eq!(hit.map(|h| h.t), want.map(|h| h.t), "{ray:?}");
     }
     let per_ray = counters.prims_tested as f64 / rays as f64;
-    // Leaves of 16 give 13 to 16 tests per ray here; single-triangle binary leaves give about 5; 17 before this rule.
+    // Leaves of up to 16 (the SAH's choice) test 17.4 triangles per ray here, one-triangle
+    // binary leaves 3.2.
     assert!(per_ray < 8.0, "{per_ray:.2} triangle tests per ray");
 }
