@@ -6,7 +6,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rt_accel::AccelSpec;
 use rt_core::{Accel, Scene};
 use rt_film::{AovSet, Film, FilmBuffers, OutputOptions};
-use rt_integrators::{Ctx, Integrator, RenderOptions, RenderStats};
+use rt_integrators::{Ctx, RenderStats, SamplePass, Technique};
 use rt_scene::{LoadedScene, RenderDesc};
 use rt_session::{pick_camera, Overrides, RenderReport, ReportInputs, Settings};
 use std::io::IsTerminal;
@@ -134,9 +134,9 @@ pub fn run(args: &Args) -> Result<()> {
         accel: accel.as_ref(),
         camera,
     };
-    let opts = RenderOptions {
-        spp: job.settings.spp,
-        seed: job.settings.seed,
+    let pass = SamplePass {
+        indices: 0..job.settings.spp,
+        stream: rt_core::SampleStream::Render,
     };
 
     let bar = if job.quiet || !std::io::stderr().is_terminal() {
@@ -153,7 +153,7 @@ pub fn run(args: &Args) -> Result<()> {
         b
     };
     let stats: RenderStats = pool.install(|| {
-        rt_integrators::render(&ctx, integrator.as_ref(), &mut film, &opts, &|rows| {
+        integrator.render_pass(&ctx, &mut film, job.settings.seed, &pass, &|rows| {
             bar.set_position(rows as u64)
         })
     });
@@ -208,7 +208,7 @@ fn print_summary(
     scene: &Scene,
     camera: &rt_core::Camera,
     accel: &dyn Accel,
-    integrator: &dyn Integrator,
+    integrator: &dyn Technique,
     stats: &RenderStats,
     load_secs: f64,
     build_secs: f64,

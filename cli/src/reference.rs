@@ -117,6 +117,13 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         ..Overrides::default()
     };
     let estimator = overrides.integrator_spec(&loaded.render, &args.scene)?;
+    if estimator.kind.splats() {
+        anyhow::bail!(
+            "{}: integrator `{}` splats light paths and keeps no per-pixel variance; render references with a camera-ray integrator (path, path-bsdf, direct, ao)",
+            args.scene.display(),
+            estimator.kind
+        );
+    }
     let accel_spec = overrides.accel_spec(&loaded.render, &args.scene)?;
     let camera = size.apply(pick_camera(
         &loaded.scene,

@@ -105,6 +105,78 @@ impl Camera {
     }
 }
 
+/// A deterministic connection from a scene point to the camera, for light paths
+/// ([`Camera::connect`]).
+#[derive(Clone, Copy, Debug)]
+pub struct CameraConnection {
+    /// Raster position (x right, y down, in pixels) the point is seen at, inside the image.
+    pub raster: Vec2,
+    /// The point on the lens the connection ends at (the centre of projection for a pinhole).
+    pub lens_point: Vec3,
+    /// Unit direction from the scene point towards `lens_point`.
+    pub wi: Vec3,
+    /// Distance from the scene point to `lens_point`.
+    pub dist: f32,
+    /// The camera's importance over the solid-angle pdf of the connection, per pixel:
+    /// `1 / (dist² · A_pixel · cos³θ)`, with `A_pixel` one pixel's area on the image plane at
+    /// distance 1 and `θ` the angle between the view direction and the ray at the lens. A light
+    /// path's contribution to pixel `raster` is `β · f · |cos| · importance`, averaged over
+    /// the light paths: that is the box-filtered pixel mean the camera-ray driver estimates.
+    pub importance: f32,
+}
+
+impl Camera {
+    /// Connects world point `p` to the camera through lens sample `lens` in [0,1)² (ignored by a
+    /// pinhole), for light tracing. `None` if `p` is behind the lens or projects outside the
+    /// image.
+    ///
+    /// Why `importance` is what it is: the driver averages radiance over a pixel's area `s` on
+    /// the image plane at distance 1 and over the lens; through a lens point the solid angle
+    /// of `ds` is `cos³θ ds` (for a thin lens too: the focus plane is at a fixed depth), so a
+    /// pixel's value is `∫ L dω / (A_pixel cos³θ)`, and `dω = cos_p dA / dist²` at the scene
+    /// point. The uniform lens sample's pdf cancels the lens average.
+    pub fn connect(&self, p: Vec3, lens: Vec2) -> Option<CameraConnection> {
+        let lens_point = if self.is_pinhole() {
+            self.position
+        } else {
+            let l = concentric_disk(lens) * self.aperture;
+            self.position + self.right * l.x + self.up * l.y
+        };
+        let v = p - lens_point;
+        let z = v.dot(self.forward);
+        let dist2 = v.length_squared();
+        if z <= 0.0 || dist2.is_nan() || dist2 <= 0.0 || !dist2.is_finite() {
+            return None;
+        }
+        // The point of the focus plane on the line from the lens point through `p` is what the
+        // pinhole at the lens centre images at the raster position.
+        let q = if self.is_pinhole() {
+            p
+        } else {
+            lens_point + v * (self.focus_distance / z)
+        };
+        let raster = self.project(q)?;
+        let inside = (0.0..self.width as f32).contains(&raster.x)
+            && (0.0..self.height as f32).contains(&raster.y);
+        if !inside {
+            return None;
+        }
+        let dist = dist2.sqrt();
+        let cos = z / dist;
+        let aspect = self.width as f32 / self.height as f32;
+        let pixel_area = (2.0 * self.tan_half * aspect / self.width as f32)
+            * (2.0 * self.tan_half / self.height as f32);
+        let importance = 1.0 / (dist2 * pixel_area * cos * cos * cos);
+        Some(CameraConnection {
+            raster,
+            lens_point,
+            wi: -v / dist,
+            dist,
+            importance,
+        })
+    }
+}
+
 impl crate::content_hash::ContentHash for Camera {
     /// Everything but `tan_half`, which follows from the field of view.
     fn content_hash(&self, out: &mut crate::content_hash::Sink<'_>) {

@@ -27,6 +27,7 @@ pub mod camera;
 pub mod color;
 pub mod content_hash;
 pub mod distribution;
+pub mod emission;
 pub mod environment;
 pub mod frame;
 pub mod image;

@@ -15,10 +15,10 @@ use std::time::{Duration, Instant};
 pub struct LightSampler {
     /// What sampling needs of each emissive triangle, so that a sample reads one record instead
     /// of the triangle, its material and a normal recomputed every time.
-    records: Vec<Emitter>,
-    dist: Option<Distribution1D>,
+    pub(crate) records: Vec<Emitter>,
+    pub(crate) dist: Option<Distribution1D>,
     total_power: f32,
-    env_prob: f32,
+    pub(crate) env_prob: f32,
     /// How long [`LightSampler::build`] took, for `render --stats` (it runs while a scene
     /// loads, where the caller cannot time it on its own).
     build_time: StageTime,

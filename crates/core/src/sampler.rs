@@ -76,6 +76,15 @@ impl Sampler {
         self.dim = self.first_dim;
     }
 
+    /// Begins light path number `path` of sample index `index` (light-path techniques take
+    /// one set of light paths per sample index). Light paths are keyed as pixels of a row no
+    /// image has (`y = u32::MAX`), so their streams never coincide with a camera sample's, and
+    /// path `k` of successive indices walks one scrambled sequence, as a pixel's samples do.
+    #[inline]
+    pub fn start_light_path(&mut self, path: u32, index: u32) {
+        self.start(path, u32::MAX, index);
+    }
+
     /// The next 1D value in [0, 1).
     #[inline]
     pub fn next_1d(&mut self) -> f32 {

@@ -353,11 +353,19 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
                         .map_err(at)?,
                     ..Overrides::default()
                 };
+                let estimator = overrides
+                    .integrator_spec(&loaded.render, &scene_path)
+                    .map_err(|e| e.to_string())?;
+                if estimator.kind.splats() {
+                    // A reference keeps per-pixel variances, which splatted light paths lack.
+                    return Err(format!(
+                        "reference integrator `{}` splats light paths; references come from a camera-ray integrator (path, path-bsdf, direct, ao)",
+                        estimator.kind
+                    ));
+                }
                 ReferencePlan::Render {
                     spp: r.spp,
-                    estimator: overrides
-                        .integrator_spec(&loaded.render, &scene_path)
-                        .map_err(|e| e.to_string())?,
+                    estimator,
                     seed: overrides.seed(&loaded.render),
                     accel: overrides
                         .accel_spec(&loaded.render, &scene_path)

@@ -1,6 +1,7 @@
 //! The film: a grid of pixel statistics plus optional first-hit AOVs.
 
 use crate::pixel::{add_m2, FirstHit, HalfSums, MeanCount, PixelStats};
+use crate::splat::{Splat, SplatSums};
 use rt_core::glam::Vec3;
 use rt_core::Rgb;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -113,6 +114,8 @@ pub struct FilmMemory {
     pub depth: Option<usize>,
     /// Position sums.
     pub position: Option<usize>,
+    /// Light-path splat sums (allocated by the first splat).
+    pub splats: Option<usize>,
 }
 
 impl FilmMemory {
@@ -127,6 +130,7 @@ impl FilmMemory {
                 self.normal,
                 self.depth,
                 self.position,
+                self.splats,
             ]
             .iter()
             .flatten()
@@ -165,6 +169,7 @@ pub struct Film {
     m2: Vec<Rgb>,
     halves: Vec<HalfSums>,
     aov: AovBuffers,
+    splats: SplatSums,
     discarded: AtomicU64,
 }
 
@@ -301,6 +306,7 @@ impl Film {
                 depth: buffer(a.depth, n),
                 position: buffer(a.position, n),
             },
+            splats: SplatSums::default(),
             discarded: AtomicU64::new(0),
         }
     }
@@ -336,6 +342,7 @@ impl Film {
             normal: bytes(&self.aov.normal),
             depth: bytes(&self.aov.depth),
             position: bytes(&self.aov.position),
+            splats: self.splats.bytes(),
         }
     }
 
@@ -422,9 +429,36 @@ impl Film {
         self.bands(rows).collect()
     }
 
-    /// The pixel estimates, row-major.
+    /// Adds `paths` light paths of sample index `index` (light-path techniques take one set of
+    /// light paths per sample index) and their splats, summed in the order given: callers that
+    /// render in parallel hand them over in a fixed order, so the sums do not depend on the
+    /// thread count. Non-finite, negative or out-of-image splats are dropped and counted.
+    pub fn add_splats(&mut self, index: u32, paths: u64, splats: &[Splat]) {
+        let n = self.mean.len();
+        let dropped = self
+            .splats
+            .add(n, self.buffers.halves, index, paths, splats);
+        self.discarded.fetch_add(dropped, Ordering::Relaxed);
+    }
+
+    /// Light paths taken so far (the splats' divisor).
+    pub fn light_paths(&self) -> u64 {
+        self.splats.paths()
+    }
+
+    /// True if the film holds light-path splats, whose per-pixel variance it does not know.
+    pub fn has_splats(&self) -> bool {
+        self.splats.paths() > 0
+    }
+
+    /// The pixel estimates, row-major: the mean of the camera samples plus the light paths'
+    /// splats over the number of light paths.
     pub fn mean_image(&self) -> Vec<Rgb> {
-        self.mean.iter().map(|p| p.mean).collect()
+        self.mean
+            .iter()
+            .enumerate()
+            .map(|(i, p)| p.mean + self.splats.mean(i))
+            .collect()
     }
 
     /// Variance of each pixel estimate, row-major; `None` without a variance buffer.
@@ -444,7 +478,13 @@ impl Film {
         if self.halves.is_empty() {
             return None;
         }
-        Some(self.halves.iter().map(|h| h.mean(half)).collect())
+        Some(
+            self.halves
+                .iter()
+                .enumerate()
+                .map(|(i, h)| h.mean(half) + self.splats.half_mean(i, half))
+                .collect(),
+        )
     }
 
     /// Average first-hit albedo, row-major (zero where no sample hit); `None` unless kept.

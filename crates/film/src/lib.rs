@@ -8,6 +8,10 @@
 //! normal, depth, world position) and their shared hit count. [`Film::memory`] reports what is
 //! held. Nothing non-finite ever enters a buffer: such samples are counted and dropped.
 //!
+//! Light paths land on any pixel: their [`Splat`]s are summed apart (in `f64`, allocated at the
+//! first splat) and divided by the number of light paths taken; the image is the camera
+//! samples' mean plus that ([`Film::mean_image`]).
+//!
 //! [`input`] reads any image (EXR, PNG, JPEG) as a linear [`rt_core::RgbImage`]. [`output`]
 //! writes EXR (linear float, AOVs as extra channel groups) and PNG (tone mapped
 //! sRGB), always atomically: a temporary file in the target directory renamed into place.
@@ -33,6 +37,7 @@ mod film;
 pub mod input;
 pub mod output;
 mod pixel;
+mod splat;
 
 pub use film::{AovSet, Film, FilmBuffers, FilmMemory, FilmStripe, UnknownAov};
 pub use input::{decode_srgb, read_rgb};
@@ -40,3 +45,4 @@ pub use output::{
     copy_atomic, read_exr, write_bytes_atomic, write_image, write_rgb, FilmError, OutputOptions,
 };
 pub use pixel::{FirstHit, HalfSums, PixelStats};
+pub use splat::Splat;

@@ -1,8 +1,8 @@
-//! Ambient occlusion of a procedural scene at 4 spp through `IntegratorSpec` and the driver,
+//! Ambient occlusion of a procedural scene at 4 spp through `IntegratorSpec` and its technique's passes,
 //! printing the image mean: the integrators crate used on its own.
 //! `cargo run --release -p rt-integrators --example ao_mean [SPEC]` (default `ao:distance=2`).
 use rt_film::{Film, FilmBuffers};
-use rt_integrators::{Ctx, IntegratorSpec, RenderOptions};
+use rt_integrators::{Ctx, IntegratorSpec, SamplePass};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let spec: IntegratorSpec = std::env::args()
@@ -19,13 +19,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         camera: &camera,
     };
     let mut film = Film::new(camera.width, camera.height, FilmBuffers::default());
-    let stats = rt_integrators::render(
-        &ctx,
-        spec.build().as_ref(),
-        &mut film,
-        &RenderOptions { spp: 4, seed: 0 },
-        &|_| {},
-    );
+    let pass = SamplePass {
+        indices: 0..4,
+        stream: rt_core::SampleStream::Render,
+    };
+    let stats = spec.build().render_pass(&ctx, &mut film, 0, &pass, &|_| {});
     let mean = film.mean_image().iter().sum::<rt_core::Rgb>() / (64.0 * 48.0);
     println!("{spec}: mean {mean:?}, {} rays", stats.rays.rays);
     Ok(())

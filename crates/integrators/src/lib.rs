@@ -8,9 +8,11 @@
 //! Provided: [`PathIntegrator`] (unidirectional path tracing with next-event estimation and
 //! multiple importance sampling, Russian roulette and a bounce limit; also usable with BSDF
 //! sampling only), direct lighting (the same estimator stopped after one bounce) and
-//! [`AoIntegrator`] (ambient occlusion).
+//! [`AoIntegrator`] (ambient occlusion); and [`LightTracer`] (particles from the lights, splatted
+//! through the camera). Every one is a [`Technique`], the pass-based seam: camera-ray
+//! integrators through [`CameraRays`], light-path techniques on their own.
 //!
-//! [`IntegratorSpec`] is the one place integrators are named, parsed from text such as
+//! [`IntegratorSpec`] is the one place techniques are named, parsed from text such as
 //! `path:max-depth=8` and built, so a program using this crate offers the same choice as
 //! `render --integrator`.
 //!
@@ -19,15 +21,19 @@
 
 mod ao;
 pub mod driver;
+mod light;
 mod path;
 pub mod spec;
+pub mod technique;
 
 pub use ao::AoIntegrator;
 pub use driver::{render, render_samples, RenderOptions, RenderStats, SamplePass};
+pub use light::LightTracer;
 pub use path::PathIntegrator;
 pub use spec::{
     IntegratorKind, IntegratorSpec, IntegratorSpecError, Target, DEFAULT_MAX_DEPTH, MAX_DEPTH,
 };
+pub use technique::{CameraRays, Technique};
 
 use rt_core::{Accel, Camera, Rgb, Sampler, Scene};
 use rt_film::FirstHit;

@@ -10,10 +10,10 @@
 //!
 //! | option | kinds | meaning |
 //! |---|---|---|
-//! | `max-depth=N` | path, path-bsdf | bounce limit (default [`DEFAULT_MAX_DEPTH`], at most [`MAX_DEPTH`]) |
+//! | `max-depth=N` | path, path-bsdf, light | bounce limit (default [`DEFAULT_MAX_DEPTH`], at most [`MAX_DEPTH`]) |
 //! | `distance=F` | ao | occluder distance (default unlimited) |
 
-use crate::{AoIntegrator, Integrator, PathIntegrator};
+use crate::{AoIntegrator, CameraRays, LightTracer, PathIntegrator, Technique};
 use std::fmt;
 use std::str::FromStr;
 
@@ -36,15 +36,19 @@ pub enum IntegratorKind {
     Direct,
     /// Ambient occlusion ([`AoIntegrator`]).
     Ao,
+    /// Light tracing: particles from the lights splatted through the camera
+    /// ([`LightTracer`]).
+    Light,
 }
 
 impl IntegratorKind {
     /// Every kind, in the order help texts list them.
-    pub const ALL: [IntegratorKind; 4] = [
+    pub const ALL: [IntegratorKind; 5] = [
         IntegratorKind::Path,
         IntegratorKind::PathBsdf,
         IntegratorKind::Direct,
         IntegratorKind::Ao,
+        IntegratorKind::Light,
     ];
 
     /// The name used in specs and reports.
@@ -54,12 +58,22 @@ impl IntegratorKind {
             IntegratorKind::PathBsdf => "path-bsdf",
             IntegratorKind::Direct => "direct",
             IntegratorKind::Ao => "ao",
+            IntegratorKind::Light => "light",
         }
     }
 
     /// True for the kinds whose bounce limit is an option.
     pub fn has_depth(self) -> bool {
-        matches!(self, IntegratorKind::Path | IntegratorKind::PathBsdf)
+        matches!(
+            self,
+            IntegratorKind::Path | IntegratorKind::PathBsdf | IntegratorKind::Light
+        )
+    }
+
+    /// True for the techniques whose light paths splat onto any pixel (their films know no
+    /// per-pixel variance and no first hits).
+    pub fn splats(self) -> bool {
+        matches!(self, IntegratorKind::Light)
     }
 
     fn names() -> String {
@@ -132,7 +146,7 @@ pub enum IntegratorSpecError {
     #[error("\"{0}\" is not one of {names}", names = IntegratorKind::names())]
     UnknownKind(String),
     /// An option this crate does not know, or one that does not apply to the kind.
-    #[error("option `{option}` does not apply to `{kind}` (options: max-depth=N for path and path-bsdf, distance=F for ao)")]
+    #[error("option `{option}` does not apply to `{kind}` (options: max-depth=N for path, path-bsdf and light, distance=F for ao)")]
     UnknownOption {
         /// The integrator.
         kind: IntegratorKind,
@@ -190,24 +204,31 @@ impl IntegratorSpec {
         self.max_depth.unwrap_or(DEFAULT_MAX_DEPTH)
     }
 
-    /// Builds the integrator.
-    pub fn build(&self) -> Box<dyn Integrator> {
+    /// Builds the technique.
+    pub fn build(&self) -> Box<dyn Technique> {
+        let camera =
+            |i: Box<dyn crate::Integrator>| -> Box<dyn Technique> { Box::new(CameraRays(i)) };
         match self.kind {
-            IntegratorKind::Path => Box::new(PathIntegrator::new(self.depth())),
-            IntegratorKind::PathBsdf => Box::new(PathIntegrator::bsdf_only(self.depth())),
-            IntegratorKind::Direct => Box::new(PathIntegrator::direct()),
-            IntegratorKind::Ao => Box::new(AoIntegrator {
+            IntegratorKind::Path => camera(Box::new(PathIntegrator::new(self.depth()))),
+            IntegratorKind::PathBsdf => camera(Box::new(PathIntegrator::bsdf_only(self.depth()))),
+            IntegratorKind::Direct => camera(Box::new(PathIntegrator::direct())),
+            IntegratorKind::Ao => camera(Box::new(AoIntegrator {
                 max_distance: self.ao_distance,
-            }),
+            })),
+            IntegratorKind::Light => Box::new(LightTracer::new(self.depth())),
         }
     }
 
     /// What the integrator converges to.
     pub fn target(&self) -> Target {
         match self.kind {
-            IntegratorKind::Path | IntegratorKind::PathBsdf => Target::Radiance {
-                bounces: self.depth(),
-            },
+            // Light tracing misses paths ending in a delta bounce and the environment seen
+            // directly; where a scene has neither, it converges to the path tracer's image.
+            IntegratorKind::Path | IntegratorKind::PathBsdf | IntegratorKind::Light => {
+                Target::Radiance {
+                    bounces: self.depth(),
+                }
+            }
             IntegratorKind::Direct => Target::Radiance { bounces: 1 },
             IntegratorKind::Ao => Target::Occlusion {
                 distance: self.ao_distance,
@@ -288,7 +309,7 @@ mod tests {
         let e = "bdpt".parse::<IntegratorSpec>().unwrap_err();
         assert_eq!(
             e.to_string(),
-            "\"bdpt\" is not one of path, path-bsdf, direct, ao"
+            "\"bdpt\" is not one of path, path-bsdf, direct, ao, light"
         );
     }
 

@@ -6,7 +6,7 @@
 use crate::MAX_SPP;
 use rt_core::SampleStream;
 use rt_film::{AovSet, Film};
-use rt_integrators::{Ctx, Integrator, SamplePass};
+use rt_integrators::{Ctx, SamplePass, Technique};
 
 /// How much to render: samples per pixel, or a time.
 #[derive(Clone, Debug, PartialEq)]
@@ -55,7 +55,7 @@ pub struct Session<'a> {
     /// Scene, acceleration structure and camera (already resized).
     pub ctx: Ctx<'a>,
     /// The estimator.
-    pub integrator: &'a dyn Integrator,
+    pub integrator: &'a dyn Technique,
     /// Seed of the sample streams.
     pub seed: u32,
     /// Normal or reference streams.
@@ -94,14 +94,11 @@ impl Session<'_> {
                 indices: at.spp..at.spp + n,
                 stream: self.stream,
             };
-            let stats = rt_integrators::render_samples(
-                &self.ctx,
-                self.integrator,
-                film,
-                self.seed,
-                &pass,
-                &|r| progress(done_fraction(r as f64 / rows)),
-            );
+            let stats = self
+                .integrator
+                .render_pass(&self.ctx, film, self.seed, &pass, &|r| {
+                    progress(done_fraction(r as f64 / rows))
+                });
             at.spp += n;
             at.seconds += stats.elapsed.as_secs_f64();
             at.samples += stats.samples;

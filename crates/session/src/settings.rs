@@ -123,6 +123,15 @@ pub enum SettingsError {
         /// As given.
         value: u64,
     },
+    /// AOVs asked of a technique that cannot write them: a light tracer's splats have no
+    /// per-pixel variance and its light paths no first camera hit.
+    #[error("{origin}: the {technique} technique writes no AOVs (its light paths land on any pixel, so there is no first hit or per-pixel variance); drop the AOV list or use a camera-ray integrator")]
+    AovUnsupported {
+        /// Where the AOVs were asked for.
+        origin: Origin,
+        /// The technique's name.
+        technique: &'static str,
+    },
     /// An unknown AOV name.
     #[error("{origin}: {source}")]
     Aov {
@@ -202,8 +211,15 @@ impl Overrides {
                 })?
             }
         };
+        let integrator = self.integrator_spec(desc, scene_path)?;
+        if integrator.kind.splats() && aovs != AovSet::default() {
+            return Err(SettingsError::AovUnsupported {
+                origin: origin(self.aovs.is_some(), "aov", "aov"),
+                technique: integrator.kind.name(),
+            });
+        }
         Ok(Settings {
-            integrator: self.integrator_spec(desc, scene_path)?,
+            integrator,
             accel: self.accel_spec(desc, scene_path)?,
             spp,
             threads,

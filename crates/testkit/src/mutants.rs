@@ -47,3 +47,49 @@ impl Accel for DroppedShadowRays<'_> {
         self.inner.memory_bytes()
     }
 }
+
+/// An acceleration structure that reports its bounds shrunk about their centre by `scale` (and
+/// answers every query like `inner`): light paths from the environment, started on a
+/// rectangle covering the reported box, then miss part of the scene, the bias plane sampling
+/// must not have.
+pub struct ShrunkBounds<'a> {
+    /// The real structure.
+    pub inner: &'a dyn Accel,
+    /// Factor applied to the box's extent.
+    pub scale: f32,
+}
+
+impl Accel for ShrunkBounds<'_> {
+    fn name(&self) -> &str {
+        "shrunk-bounds"
+    }
+
+    fn closest_hit(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        counters: Option<&mut TraversalCounters>,
+    ) -> Option<Hit> {
+        self.inner.closest_hit(ray, t_max, counters)
+    }
+
+    fn any_hit(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        toward: Option<Vec3>,
+        counters: Option<&mut TraversalCounters>,
+    ) -> bool {
+        self.inner.any_hit(ray, t_max, toward, counters)
+    }
+
+    fn bounds(&self) -> Aabb {
+        let b = self.inner.bounds();
+        let (c, h) = (b.center(), b.extent() * (0.5 * self.scale));
+        Aabb::new(c - h, c + h)
+    }
+
+    fn memory_bytes(&self) -> usize {
+        self.inner.memory_bytes()
+    }
+}

@@ -4,7 +4,7 @@
 //! re-exported here.
 
 pub use rt_validate::stress::compare::{
-    compare, image_mean, normal_quantile_upper, Comparison, ALPHA,
+    compare, compare_estimates, image_mean, normal_quantile_upper, Comparison, Estimate, ALPHA,
 };
 pub use rt_validate::stress::invalid_values;
 

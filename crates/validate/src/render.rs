@@ -4,7 +4,7 @@
 
 use rt_core::{Accel, Camera, Scene};
 use rt_film::{Film, FilmBuffers};
-use rt_integrators::{Ctx, Integrator, RenderOptions, RenderStats, SamplePass};
+use rt_integrators::{Ctx, Integrator, RenderOptions, RenderStats, SamplePass, Technique};
 use std::sync::OnceLock;
 
 /// A scene ready to render: a camera, an acceleration structure and a thread count.
@@ -93,6 +93,40 @@ impl<'a> Renderer<'a> {
             )
         });
         (film, stats)
+    }
+
+    /// Renders sample indices `0..spp` of any technique (light tracing too) with `seed` into
+    /// a fresh film keeping `buffers`.
+    pub fn render_technique(
+        &self,
+        technique: &dyn Technique,
+        buffers: impl Into<FilmBuffers>,
+        spp: u32,
+        seed: u32,
+    ) -> (Film, RenderStats) {
+        let mut film = self.film(buffers);
+        let stats = self.technique_pass(
+            technique,
+            &mut film,
+            seed,
+            &SamplePass {
+                indices: 0..spp,
+                stream: rt_core::SampleStream::Render,
+            },
+        );
+        (film, stats)
+    }
+
+    /// Renders the sample pass `pass` of any technique with `seed` into `film`.
+    pub fn technique_pass(
+        &self,
+        technique: &dyn Technique,
+        film: &mut Film,
+        seed: u32,
+        pass: &SamplePass,
+    ) -> RenderStats {
+        let ctx = self.ctx();
+        self.install(|| technique.render_pass(&ctx, film, seed, pass, &|_| {}))
     }
 
     /// Renders the sample pass `pass` with `seed` into `film` (progressive rendering).

@@ -61,7 +61,64 @@ pub const ALPHA: f64 = 1e-3;
 /// If the films differ in size (a bug in the caller).
 pub fn compare(a: &Film, b: &Film, block: u32, alpha: f64) -> Comparison {
     assert_eq!((a.width(), a.height()), (b.width(), b.height()));
-    let (w, h) = (a.width(), a.height());
+    let estimate = |f: &Film| Estimate {
+        mean: f.mean_image(),
+        variance: f
+            .variance_image()
+            .expect("compared films keep the variance buffer"),
+    };
+    compare_estimates(&estimate(a), &estimate(b), a.width(), block, alpha)
+}
+
+/// Per-pixel estimates and the variances of those estimates, row-major: what [`compare`] reads
+/// from a film, or what independent renders give for a technique whose film knows no
+/// per-pixel variance (a light tracer's splats: [`Estimate::from_runs`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Estimate {
+    /// Pixel estimates.
+    pub mean: Vec<rt_core::Rgb>,
+    /// Variance of each pixel estimate.
+    pub variance: Vec<rt_core::Rgb>,
+}
+
+impl Estimate {
+    /// The average of independent images of one estimator (at least 2) and, per pixel, the
+    /// variance of that average from their spread.
+    ///
+    /// # Panics
+    /// With fewer than two images or images of different sizes.
+    pub fn from_runs(runs: &[Vec<rt_core::Rgb>]) -> Self {
+        assert!(runs.len() >= 2, "the spread needs two runs at least");
+        let n = runs[0].len();
+        assert!(runs.iter().all(|r| r.len() == n));
+        let k = runs.len() as f32;
+        let mean: Vec<rt_core::Rgb> = (0..n)
+            .map(|i| runs.iter().map(|r| r[i]).sum::<rt_core::Rgb>() / k)
+            .collect();
+        let variance = (0..n)
+            .map(|i| {
+                let ss: rt_core::Rgb = runs.iter().map(|r| (r[i] - mean[i]).powf(2.0)).sum();
+                ss / ((k - 1.0) * k)
+            })
+            .collect();
+        Self { mean, variance }
+    }
+}
+
+/// [`compare`] on two estimates of an image `width` pixels wide.
+///
+/// # Panics
+/// If the estimates differ in size (a bug in the caller).
+pub fn compare_estimates(
+    a: &Estimate,
+    b: &Estimate,
+    width: u32,
+    block: u32,
+    alpha: f64,
+) -> Comparison {
+    assert_eq!(a.mean.len(), b.mean.len());
+    let w = width.max(1);
+    let h = a.mean.len() as u32 / w;
     let block = block.max(1);
     let (bw, bh) = (w.div_ceil(block), h.div_ceil(block));
     // Per block and channel: sum of differences and sum of variances.
@@ -69,13 +126,9 @@ pub fn compare(a: &Film, b: &Film, block: u32, alpha: f64) -> Comparison {
     let mut image = [(0.0f64, 0.0f64); 3];
     for y in 0..h {
         for x in 0..w {
-            let (pa, pb) = (a.pixel(x, y), b.pixel(x, y));
-            let (ma, mb) = (pa.mean(), pb.mean());
-            let variance = |p: &rt_film::PixelStats| {
-                p.variance_of_mean()
-                    .expect("compared films keep the variance buffer")
-            };
-            let (va, vb) = (variance(&pa), variance(&pb));
+            let i = (y * w + x) as usize;
+            let (ma, mb) = (a.mean[i], b.mean[i]);
+            let (va, vb) = (a.variance[i], b.variance[i]);
             let k = ((y / block) * bw + x / block) as usize;
             for c in 0..3 {
                 let floor = |m: f32| (f32::EPSILON as f64 * m as f64).powi(2);

@@ -1,0 +1,276 @@
+//! Light tracing (Dammertz 2011, §6.1.2; Veach 1997, §10.3.3 and Arvo & Kirk's particle
+//! tracing): particles leave the lights, and every vertex with a non-delta BSDF is connected
+//! to the camera deterministically and splatted onto the pixel it is seen in.
+//!
+//! It estimates the same image as the path tracer, less what it cannot sample: paths whose
+//! last bounce before the camera is a delta lobe (mirrors and smooth glass seen by the
+//! camera, and whatever is seen through them, are black) and the environment seen directly.
+//! Caustics on diffuse surfaces are its strength. Particles from the environment start by
+//! plane sampling ([`rt_core::emission`]).
+//!
+//! Deviations and choices: `max_depth = D` connects vertices 1 to `D` (the path tracer's
+//! bounce count: a path of `D` scattering events), and the emitter itself is connected too
+//! (emitters seen directly). Shading normals use Veach's adjoint correction (§5.3), so light
+//! tracing and path tracing agree on smooth-shaded meshes; the layered material's Fresnel
+//! weights depend on the outgoing direction only, which is not reciprocal, so on coated
+//! materials the two converge to slightly different images (the partitioned renderer of §6.3
+//! tolerates this by construction; light tracing simply estimates the adjoint). Russian
+//! roulette is the path tracer's. A pass takes one light path per pixel per sample index.
+
+use crate::driver::{RenderStats, SamplePass};
+use crate::technique::Technique;
+use crate::{Ctx, RayCounters};
+use rayon::prelude::*;
+use rt_core::{
+    camera::CameraConnection,
+    glam::{Vec2, Vec3},
+    material::Bsdf,
+    ray::{shadow_segment, spawn_ray},
+    Ray, Rgb, Sampler,
+};
+use rt_film::{Film, Splat};
+use std::time::Instant;
+
+/// Light paths per work item: enough that scheduling is noise, few enough that a pass of a
+/// small image still spreads over the threads.
+const CHUNK_PATHS: u32 = 4096;
+
+/// Work items rendered between two merges into the film; bounds the memory of splats in
+/// flight (a few splats per light path) whatever the image size.
+const BATCH_ITEMS: usize = 64;
+
+/// The light tracer.
+#[derive(Clone, Debug)]
+pub struct LightTracer {
+    /// Maximum number of bounces (scattering events) of a path, as for the path tracer.
+    pub max_depth: u32,
+    /// Bounce after which Russian roulette may end paths.
+    pub rr_depth: u32,
+}
+
+impl LightTracer {
+    /// A light tracer allowing `max_depth` bounces.
+    pub fn new(max_depth: u32) -> Self {
+        Self {
+            max_depth,
+            rr_depth: 3,
+        }
+    }
+}
+
+/// One work item: light paths `first..first + count` of sample index `index`.
+#[derive(Clone, Copy)]
+struct Item {
+    index: u32,
+    first: u32,
+    count: u32,
+}
+
+impl Technique for LightTracer {
+    fn name(&self) -> &str {
+        "light"
+    }
+
+    fn splats(&self) -> bool {
+        true
+    }
+
+    fn render_pass(
+        &self,
+        ctx: &Ctx<'_>,
+        film: &mut Film,
+        seed: u32,
+        pass: &SamplePass,
+        progress: &(dyn Fn(u32) + Sync),
+    ) -> RenderStats {
+        let start = Instant::now();
+        let discarded_before = film.discarded();
+        let paths = film.width().saturating_mul(film.height());
+        let items: Vec<Item> = pass
+            .indices
+            .clone()
+            .flat_map(|index| {
+                (0..paths.div_ceil(CHUNK_PATHS)).map(move |c| Item {
+                    index,
+                    first: c * CHUNK_PATHS,
+                    count: CHUNK_PATHS.min(paths - c * CHUNK_PATHS),
+                })
+            })
+            .collect();
+        let mut buffers: Vec<(Vec<Splat>, RayCounters)> = (0..BATCH_ITEMS.min(items.len()))
+            .map(|_| (Vec::new(), RayCounters::default()))
+            .collect();
+        let mut rays = RayCounters::default();
+        let rows = film.height() as u64;
+        for (b, batch) in items.chunks(BATCH_ITEMS).enumerate() {
+            buffers[..batch.len()]
+                .par_iter_mut()
+                .zip(batch.par_iter())
+                .for_each(|((splats, counters), item)| {
+                    splats.clear();
+                    *counters = RayCounters::default();
+                    let mut sampler = Sampler::with_stream(seed, pass.stream);
+                    for k in item.first..item.first + item.count {
+                        sampler.start_light_path(k, item.index);
+                        self.trace(ctx, &mut sampler, splats, counters);
+                    }
+                });
+            for (item, (splats, counters)) in batch.iter().zip(&buffers) {
+                film.add_splats(item.index, u64::from(item.count), splats);
+                rays += *counters;
+            }
+            let done = (b * BATCH_ITEMS + batch.len()) as u64;
+            progress((done * rows / items.len().max(1) as u64) as u32);
+        }
+        RenderStats {
+            elapsed: start.elapsed(),
+            samples: u64::from(paths) * pass.indices.len() as u64,
+            rays,
+            discarded: film.discarded() - discarded_before,
+        }
+    }
+}
+
+impl LightTracer {
+    /// Traces one light path, pushing its camera connections onto `splats`. Random numbers are
+    /// drawn in a fixed order per vertex, used or not, so a vertex's dimensions do not depend
+    /// on the branches earlier vertices took.
+    fn trace(
+        &self,
+        ctx: &Ctx<'_>,
+        sampler: &mut Sampler,
+        splats: &mut Vec<Splat>,
+        counters: &mut RayCounters,
+    ) {
+        let (scene, camera) = (ctx.scene, ctx.camera);
+        let thin_lens = !camera.is_pinhole();
+        let lens = |s: &mut Sampler| {
+            if thin_lens {
+                s.next_2d()
+            } else {
+                Vec2::ZERO
+            }
+        };
+        let u_sel = sampler.next_1d();
+        let u_pos = sampler.next_2d();
+        let u_dir = sampler.next_2d();
+        let u_lens = lens(sampler);
+        let bounds = ctx.accel.bounds();
+        let Some(e) = scene
+            .lights()
+            .sample_emission(scene, &bounds, u_sel, u_pos, u_dir)
+        else {
+            return;
+        };
+        // The emitter seen directly: Le · cos / pdf_area, through the camera's importance.
+        if let Some(pt) = e.point {
+            if let Some(c) = camera.connect(pt.point, u_lens) {
+                let le = pt.radiance_toward(c.wi);
+                let cos = pt.normal.dot(c.wi).abs();
+                let value = le * (cos * c.importance / pt.pdf_area);
+                splat(
+                    ctx, splats, counters, &c, value, pt.point, pt.error, pt.normal,
+                );
+            }
+        }
+        let mut beta = e.beta;
+        let mut ray = if e.point.is_some() {
+            spawn_ray(e.origin, e.origin_error, e.normal, e.dir)
+        } else {
+            Ray::new(e.origin, e.dir)
+        };
+        let mut depth = 0u32;
+        while depth < self.max_depth {
+            counters.rays += 1;
+            let Some(hit) = ctx.accel.intersect(&ray, f32::INFINITY) else {
+                break;
+            };
+            depth += 1;
+            let si = scene.surface(&hit);
+            let material = &scene.materials[si.material as usize];
+            let wo = -ray.dir;
+            let tint = scene.tint(material, si.uv);
+            let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo);
+            let u_lens = lens(sampler);
+            let u_layer = sampler.next_1d();
+            let u_bsdf = sampler.next_2d();
+            let u_rr = sampler.next_1d();
+            if bsdf.has_non_delta() {
+                if let Some(c) = camera.connect(si.p, u_lens) {
+                    let f = bsdf.eval(c.wi);
+                    if f.max_element() > 0.0 {
+                        let value = beta * f * (adjoint_cos(wo, c.wi, si.ns, si.ng) * c.importance);
+                        splat(ctx, splats, counters, &c, value, si.p, si.p_error, si.ng);
+                    }
+                }
+            }
+            if depth >= self.max_depth {
+                break;
+            }
+            let Some(s) = bsdf.sample(u_layer, u_bsdf) else {
+                break;
+            };
+            // `s.weight` holds |cos(wi, ns)|; importance transport wants the adjoint's.
+            let cos_ns = s.wi.dot(si.ns).abs();
+            let correction = if cos_ns > 0.0 {
+                adjoint_cos(wo, s.wi, si.ns, si.ng) / cos_ns
+            } else {
+                0.0
+            };
+            beta *= s.weight * correction;
+            if beta.max_element() <= 0.0 || !beta.is_finite() {
+                break;
+            }
+            ray = spawn_ray(si.p, si.p_error, si.ng, s.wi);
+            if depth > self.rr_depth {
+                let q = beta.max_element().min(0.95);
+                if u_rr >= q {
+                    break;
+                }
+                beta /= q;
+            }
+        }
+    }
+}
+
+/// The cosine factor of importance transport with shading normals (Veach 1997, eq. 5.17):
+/// `|wo·ns| |wi·ng| / |wo·ng|` in place of the radiance transport's `|wi·ns|`, where `wo`
+/// points to the light side and `wi` onward (to the camera for a connection). Equal to
+/// `|wi·n|` when the normals agree.
+#[inline]
+fn adjoint_cos(wo: Vec3, wi: Vec3, ns: Vec3, ng: Vec3) -> f32 {
+    let wo_ng = wo.dot(ng).abs();
+    if wo_ng <= 0.0 {
+        return 0.0;
+    }
+    wo.dot(ns).abs() * wi.dot(ng).abs() / wo_ng
+}
+
+/// Pushes `value` for the pixel `c` lands in if the segment from `p` to the lens is clear.
+#[allow(clippy::too_many_arguments)]
+fn splat(
+    ctx: &Ctx<'_>,
+    splats: &mut Vec<Splat>,
+    counters: &mut RayCounters,
+    c: &CameraConnection,
+    value: Rgb,
+    p: Vec3,
+    p_error: Vec3,
+    n: Vec3,
+) {
+    if value.max_element() <= 0.0 {
+        return;
+    }
+    counters.shadow_rays += 1;
+    let (r, t_max) = shadow_segment(p, p_error, n, c.lens_point, Vec3::ZERO, c.wi);
+    if ctx.accel.occluded(&r, t_max) {
+        return;
+    }
+    let cam = ctx.camera;
+    let x = (c.raster.x as u32).min(cam.width - 1);
+    let y = (c.raster.y as u32).min(cam.height - 1);
+    splats.push(Splat {
+        pixel: y * cam.width + x,
+        value,
+    });
+}

@@ -1,0 +1,67 @@
+//! The pass-based seam every light-transport technique implements: add sample indices `a..b`
+//! to a film. Camera-ray estimators ([`Integrator`]) are one kind, driven pixel by pixel by
+//! [`render_samples`]; light-path techniques ([`crate::LightTracer`]) splat anywhere.
+//!
+//! Whatever the technique, a pass is a pure function of (seed, sample indices, scene,
+//! settings): passes `0..a` then `a..b` give the same film as `0..b`, bit for bit, on any
+//! number of threads.
+
+use crate::driver::{render_samples, RenderStats, SamplePass};
+use crate::{Ctx, Integrator};
+use rt_film::Film;
+
+/// A light-transport technique that renders in passes of sample indices.
+pub trait Technique: Send + Sync {
+    /// Short name for reports.
+    fn name(&self) -> &str;
+
+    /// Adds the samples `pass.indices` to `film`. `progress` is called from worker threads with
+    /// the work done so far in this pass, in image rows (a splatting technique converts its own
+    /// units), so one progress bar serves every technique. `samples` in the result counts
+    /// camera samples and light paths alike (a light-path technique takes one light path per
+    /// pixel per sample index).
+    fn render_pass(
+        &self,
+        ctx: &Ctx<'_>,
+        film: &mut Film,
+        seed: u32,
+        pass: &SamplePass,
+        progress: &(dyn Fn(u32) + Sync),
+    ) -> RenderStats;
+
+    /// The per-ray estimator, for a technique that is one (callers that trace single camera
+    /// rays, like tests of an estimator's value, need it).
+    fn camera_integrator(&self) -> Option<&dyn Integrator> {
+        None
+    }
+
+    /// True if the technique splats light paths onto the film, whose per-pixel variance the
+    /// film then does not know.
+    fn splats(&self) -> bool {
+        false
+    }
+}
+
+/// A camera-ray [`Integrator`] as a [`Technique`]: every pixel takes its own samples.
+pub struct CameraRays(pub Box<dyn Integrator>);
+
+impl Technique for CameraRays {
+    fn name(&self) -> &str {
+        self.0.name()
+    }
+
+    fn render_pass(
+        &self,
+        ctx: &Ctx<'_>,
+        film: &mut Film,
+        seed: u32,
+        pass: &SamplePass,
+        progress: &(dyn Fn(u32) + Sync),
+    ) -> RenderStats {
+        render_samples(ctx, self.0.as_ref(), film, seed, pass, progress)
+    }
+
+    fn camera_integrator(&self) -> Option<&dyn Integrator> {
+        Some(self.0.as_ref())
+    }
+}
