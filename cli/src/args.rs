@@ -36,9 +36,20 @@ pub struct Args {
     #[arg(short, long)]
     pub output: Option<PathBuf>,
 
-    /// Samples per pixel. [default: `[render] spp`, else 64]
+    /// Samples per pixel. [default: `[render] spp`, else 64] With --error or --time-limit:
+    /// the most samples any pixel takes [default: no cap below 2^20].
     #[arg(long)]
     pub spp: Option<u32>,
+
+    /// Render until the hierarchical stopping criterion (Dammertz 2009) finds every block of
+    /// the image below error V (the thesis uses 2e-4, for radiance in about [0, 1]); finished
+    /// blocks stop sampling. Works with every integrator.
+    #[arg(long, value_name = "V")]
+    pub error: Option<f32>,
+
+    /// Stop rendering after this many seconds of passes (with or without --error).
+    #[arg(long, value_name = "SECONDS")]
+    pub time_limit: Option<f64>,
 
     /// Light transport algorithm and its options, KIND[:OPTION...]: path (path tracing,
     /// next-event estimation + MIS), path-bsdf (path tracing with BSDF sampling only), direct

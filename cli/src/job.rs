@@ -8,7 +8,10 @@ use rt_core::{Accel, Scene};
 use rt_film::{AovSet, Film, FilmBuffers, OutputOptions};
 use rt_integrators::{Ctx, RenderStats, SamplePass, Technique};
 use rt_scene::{LoadedScene, RenderDesc};
-use rt_session::{pick_camera, Overrides, RenderReport, ReportInputs, Settings};
+use rt_session::{
+    pick_camera, render_adaptive, Overrides, RenderReport, ReportInputs, Settings, StopRule,
+    MAX_SPP,
+};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -23,6 +26,8 @@ pub struct Job {
     pub camera: Option<String>,
     pub exposure: f32,
     pub quiet: bool,
+    /// Adaptive stopping (`--error`, `--time-limit`), if asked for.
+    pub stop: Option<StopRule>,
 }
 
 /// The scene path; clap requires it whenever there is no subcommand.
@@ -86,6 +91,23 @@ impl Job {
         if !args.exposure.is_finite() {
             bail!("--exposure must be a finite number");
         }
+        if let Some(v) = args.error {
+            if v.is_nan() || v <= 0.0 || !v.is_finite() {
+                bail!("--error must be a positive number (the thesis uses 2e-4), got {v}");
+            }
+        }
+        let time_limit = match args.time_limit {
+            Some(t) if t.is_nan() || t <= 0.0 || !t.is_finite() => {
+                bail!("--time-limit must be a positive number of seconds, got {t}")
+            }
+            Some(t) => Some(std::time::Duration::from_secs_f64(t)),
+            None => None,
+        };
+        let stop = (args.error.is_some() || time_limit.is_some()).then(|| StopRule {
+            error: args.error,
+            time_limit,
+            max_spp: args.spp.unwrap_or(MAX_SPP),
+        });
         Ok(Job {
             scene_path: scene.to_path_buf(),
             output,
@@ -93,6 +115,7 @@ impl Job {
             camera: args.camera.clone(),
             exposure: args.exposure,
             quiet: args.quiet,
+            stop,
         })
     }
 }
@@ -124,11 +147,12 @@ pub fn run(args: &Args) -> Result<()> {
     let build_secs = build_time.as_secs_f64();
     let integrator = job.settings.integrator.build();
     // Only the buffers the outputs read: no variance or half-buffers unless asked for.
-    let mut film = Film::new(
-        camera.width,
-        camera.height,
-        FilmBuffers::for_outputs(job.settings.aovs),
-    );
+    // The stopping criterion reads the even samples' half-buffer.
+    let mut buffers = FilmBuffers::for_outputs(job.settings.aovs);
+    if job.stop.is_some_and(|s| s.error.is_some()) {
+        buffers = buffers.with_halves();
+    }
+    let mut film = Film::new(camera.width, camera.height, buffers);
     let ctx = Ctx {
         scene: &scene,
         accel: accel.as_ref(),
@@ -137,6 +161,7 @@ pub fn run(args: &Args) -> Result<()> {
     let pass = SamplePass {
         indices: 0..job.settings.spp,
         stream: rt_core::SampleStream::Render,
+        pixels: None,
     };
 
     let bar = if job.quiet || !std::io::stderr().is_terminal() {
@@ -152,11 +177,30 @@ pub fn run(args: &Args) -> Result<()> {
         );
         b
     };
-    let stats: RenderStats = pool.install(|| {
-        integrator.render_pass(&ctx, &mut film, job.settings.seed, &pass, &|rows| {
-            bar.set_position(rows as u64)
-        })
-    });
+    let mut adaptive = None;
+    let stats: RenderStats = match &job.stop {
+        None => pool.install(|| {
+            integrator.render_pass(&ctx, &mut film, job.settings.seed, &pass, &|rows| {
+                bar.set_position(rows as u64)
+            })
+        }),
+        Some(rule) => {
+            let rows = camera.height as f64;
+            let a = pool.install(|| {
+                render_adaptive(
+                    &ctx,
+                    integrator.as_ref(),
+                    &mut film,
+                    job.settings.seed,
+                    rule,
+                    &|f| bar.set_position((f * rows) as u64),
+                )
+            })?;
+            let stats = a.stats;
+            adaptive = Some(a);
+            stats
+        }
+    };
     bar.finish_and_clear();
 
     let t_write = Instant::now();
@@ -170,12 +214,24 @@ pub fn run(args: &Args) -> Result<()> {
     .map_err(|e| anyhow::anyhow!("{e}"))?;
     let write_time = t_write.elapsed();
     if !job.quiet {
+        let sampling = match &adaptive {
+            None => format!("{} spp", job.settings.spp),
+            Some(a) => format!(
+                "adaptive: {} after {} spp, {} samples, {} blocks left, {:.3} s deciding;",
+                a.reason,
+                a.spp,
+                a.stats.samples,
+                a.active_blocks.len(),
+                a.decisions.as_secs_f64()
+            ),
+        };
         print_summary(
             &job,
             &scene,
             camera,
             accel.as_ref(),
             integrator.as_ref(),
+            &sampling,
             &stats,
             load_secs,
             build_secs,
@@ -209,6 +265,7 @@ fn print_summary(
     camera: &rt_core::Camera,
     accel: &dyn Accel,
     integrator: &dyn Technique,
+    sampling: &str,
     stats: &RenderStats,
     load_secs: f64,
     build_secs: f64,
@@ -217,12 +274,12 @@ fn print_summary(
     // Always printed, zero included: a valid scene must discard nothing, and a reader should
     // not have to know that silence means zero.
     println!(
-        "{}: {}x{} {} spp {} {} ({} tris, {} threads): {:.2} s render ({:.2} s load, {:.2} s {} build), \
+        "{}: {}x{} {} {} {} ({} tris, {} threads): {:.2} s render ({:.2} s load, {:.2} s {} build), \
          {:.2} Msamples/s, {:.2} Mrays/s, {} invalid samples discarded -> {}",
         job.scene_path.display(),
         camera.width,
         camera.height,
-        job.settings.spp,
+        sampling,
         integrator.name(),
         job.settings.accel,
         scene.triangle_count(),

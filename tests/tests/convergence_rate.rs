@@ -24,6 +24,7 @@ fn render(scene: &Scene, seed: u32, spp: u32, stream: SampleStream) -> Film {
     let pass = SamplePass {
         indices: 0..spp,
         stream,
+        pixels: None,
     };
     renderer.render_pass(&PathIntegrator::new(4), &mut film, seed, &pass);
     film

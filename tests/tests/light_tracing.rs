@@ -110,6 +110,7 @@ fn light_tracing_is_deterministic_across_threads_and_passes() {
             let pass = SamplePass {
                 indices: p[0]..p[1],
                 stream: rt_core::SampleStream::Render,
+                pixels: None,
             };
             r.technique_pass(&lt, &mut film, 3, &pass);
         }

@@ -29,7 +29,11 @@ fn render_passes(scene: &Scene, seed: u32, passes: &[SamplePass]) -> Film {
 }
 
 fn pass(indices: std::ops::Range<u32>, stream: SampleStream) -> SamplePass {
-    SamplePass { indices, stream }
+    SamplePass {
+        indices,
+        stream,
+        pixels: None,
+    }
 }
 
 #[test]

@@ -38,6 +38,7 @@ pub mod input;
 pub mod output;
 mod pixel;
 mod splat;
+pub mod stopping;
 
 pub use film::{AovSet, Film, FilmBuffers, FilmMemory, FilmStripe, UnknownAov};
 pub use input::{decode_srgb, read_rgb};

@@ -64,6 +64,10 @@ pub struct SamplePass {
     pub indices: Range<u32>,
     /// The family of streams the samples come from (references use their own).
     pub stream: SampleStream,
+    /// Per pixel (row-major), whether it takes this pass's samples; `None`: every pixel. The
+    /// stopping criterion leaves out the pixels of finished blocks. Light-path techniques
+    /// cannot aim their splats and ignore it.
+    pub pixels: Option<std::sync::Arc<[bool]>>,
 }
 
 /// Renders `opts.spp` samples into every pixel of `film`. `progress` is called with the number
@@ -78,6 +82,7 @@ pub fn render(
     let pass = SamplePass {
         indices: 0..opts.spp,
         stream: SampleStream::Render,
+        pixels: None,
     };
     render_samples(ctx, integrator, film, opts.seed, &pass, progress)
 }
@@ -107,6 +112,11 @@ pub fn render_samples(
             let mut counters = RayCounters::default();
             for y in stripe.y0..stripe.y0 + stripe.rows() {
                 for x in 0..stripe.width {
+                    if let Some(mask) = &pass.pixels {
+                        if !mask[(y * stripe.width + x) as usize] {
+                            continue;
+                        }
+                    }
                     for i in pass.indices.clone() {
                         sampler.start(x, y, i);
                         let film_pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
@@ -130,9 +140,13 @@ pub fn render_samples(
             *totals.lock().unwrap_or_else(|e| e.into_inner()) += counters;
         });
     let rays = totals.into_inner().unwrap_or_else(|e| e.into_inner());
+    let pixels = match &pass.pixels {
+        Some(mask) => mask.iter().filter(|&&m| m).count() as u64,
+        None => film.width() as u64 * film.height() as u64,
+    };
     RenderStats {
         elapsed: start.elapsed(),
-        samples: film.width() as u64 * film.height() as u64 * pass.indices.len() as u64,
+        samples: pixels * pass.indices.len() as u64,
         rays,
         discarded: film.discarded() - discarded_before,
     }

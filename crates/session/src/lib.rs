@@ -43,11 +43,13 @@
 //! ```
 #![forbid(unsafe_code)]
 
+pub mod adaptive;
 pub mod camera;
 pub mod progressive;
 pub mod report;
 pub mod settings;
 
+pub use adaptive::{render_adaptive, Adaptive, StopReason, StopRule};
 pub use camera::{parse_resolution, pick_camera, ImageSize, MAX_SIDE};
 pub use progressive::{Budgets, Checkpoint, Session};
 pub use report::{RenderReport, ReportInputs, Stage, Status};

@@ -93,6 +93,7 @@ impl Session<'_> {
             let pass = SamplePass {
                 indices: at.spp..at.spp + n,
                 stream: self.stream,
+                pixels: None,
             };
             let stats = self
                 .integrator

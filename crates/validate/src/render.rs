@@ -112,6 +112,7 @@ impl<'a> Renderer<'a> {
             &SamplePass {
                 indices: 0..spp,
                 stream: rt_core::SampleStream::Render,
+                pixels: None,
             },
         );
         (film, stats)

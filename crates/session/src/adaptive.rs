@@ -1,0 +1,126 @@
+//! Rendering until an error threshold or a time limit is met (`render --error V`,
+//! `--time-limit S`), with samples per pixel as a cap: passes of two samples (so the film's
+//! even half holds exactly half of every active pixel's samples), each followed by one
+//! decision of the hierarchical stopping criterion ([`rt_film::stopping`]), which takes the
+//! pixels of finished blocks out of the next pass. Light-path techniques cannot aim their
+//! splats, so for them every pass covers the whole image and the criterion only decides when
+//! to stop.
+//!
+//! The image is deterministic for a given threshold: which pixels sample in a pass depends
+//! only on the film, which depends only on the seed and the settings. A time limit makes the
+//! sample count, and so the image, depend on the machine.
+
+use rt_core::SampleStream;
+use rt_film::stopping::{BadThreshold, Block, StoppingCriterion};
+use rt_film::Film;
+use rt_integrators::{Ctx, RenderStats, SamplePass, Technique};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// When an adaptive render stops.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StopRule {
+    /// Error threshold of the stopping criterion (`ε_t`); `None`: no criterion.
+    pub error: Option<f32>,
+    /// Wall-clock limit of the passes; `None`: none.
+    pub time_limit: Option<Duration>,
+    /// Most samples any pixel takes.
+    pub max_spp: u32,
+}
+
+/// Why an adaptive render stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StopReason {
+    /// Every block met the error threshold.
+    Converged,
+    /// The time limit was reached.
+    TimeLimit,
+    /// The cap on samples per pixel was reached.
+    SampleCap,
+}
+
+impl std::fmt::Display for StopReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            StopReason::Converged => "converged",
+            StopReason::TimeLimit => "time limit",
+            StopReason::SampleCap => "sample cap",
+        })
+    }
+}
+
+/// What an adaptive render did.
+#[derive(Clone, Debug)]
+pub struct Adaptive {
+    /// The passes' statistics summed (samples: camera samples and light paths taken).
+    pub stats: RenderStats,
+    /// Samples per pixel of the pixels that sampled longest.
+    pub spp: u32,
+    /// Why it stopped.
+    pub reason: StopReason,
+    /// Time spent in the stopping criterion's decisions.
+    pub decisions: Duration,
+    /// Blocks still sampling when it stopped (empty when converged).
+    pub active_blocks: Vec<Block>,
+}
+
+/// Renders into `film` (which must keep half-buffers when `rule.error` is set) until `rule`
+/// says stop. `progress` is called with the fraction of the cap done so far.
+pub fn render_adaptive(
+    ctx: &Ctx<'_>,
+    technique: &dyn Technique,
+    film: &mut Film,
+    seed: u32,
+    rule: &StopRule,
+    progress: &(dyn Fn(f64) + Sync),
+) -> Result<Adaptive, BadThreshold> {
+    let mut criterion = rule
+        .error
+        .map(|v| StoppingCriterion::new(film.width(), film.height(), v))
+        .transpose()?;
+    let start = Instant::now();
+    let mut stats = RenderStats::default();
+    let mut decisions = Duration::ZERO;
+    let mut spp = 0u32;
+    let cap = rule.max_spp.max(1);
+    let reason = loop {
+        if spp >= cap {
+            break StopReason::SampleCap;
+        }
+        let n = 2.min(cap - spp);
+        let pixels = match &criterion {
+            Some(c) if !technique.splats() => Some(Arc::from(c.mask())),
+            _ => None,
+        };
+        let pass = SamplePass {
+            indices: spp..spp + n,
+            stream: SampleStream::Render,
+            pixels,
+        };
+        let s = technique.render_pass(ctx, film, seed, &pass, &|_| {});
+        stats.samples += s.samples;
+        stats.rays += s.rays;
+        stats.discarded += s.discarded;
+        spp += n;
+        progress(f64::from(spp) / f64::from(cap));
+        if let Some(c) = criterion.as_mut() {
+            let t = Instant::now();
+            c.decide(film);
+            decisions += t.elapsed();
+            if c.converged() {
+                break StopReason::Converged;
+            }
+        }
+        if rule.time_limit.is_some_and(|t| start.elapsed() >= t) {
+            break StopReason::TimeLimit;
+        }
+    };
+    stats.elapsed = start.elapsed();
+    Ok(Adaptive {
+        stats,
+        spp,
+        reason,
+        decisions,
+        active_blocks: criterion.map(|c| c.active().to_vec()).unwrap_or_default(),
+    })
+}
