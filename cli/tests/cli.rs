@@ -715,3 +715,42 @@ fn bench_accel_on_a_mesh_and_a_scene() {
         "{table}"
     );
 }
+
+/// `--error` and `--time-limit` take positive numbers; light tracing takes no AOVs.
+#[test]
+fn bad_stopping_and_technique_arguments_are_one_error_line() {
+    for bad in ["0", "-1", "nan", "inf"] {
+        expect_error(GOOD, &[&format!("--error={bad}")], &["--error"]);
+        expect_error(GOOD, &[&format!("--time-limit={bad}")], &["--time-limit"]);
+    }
+    expect_error(
+        GOOD,
+        &["--integrator", "light", "--aov", "albedo"],
+        &["light", "AOV"],
+    );
+}
+
+/// An adaptive render says why it stopped and how many samples it took.
+#[test]
+fn adaptive_render_reports_its_stop() {
+    let r = Run::new();
+    r.write("scene.toml", GOOD);
+    let out = r.render(&[
+        "scene.toml",
+        "-o",
+        "a.exr",
+        "--error",
+        "1e-1",
+        "--spp",
+        "64",
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(text.contains("adaptive: "), "{text}");
+    assert!(text.contains(" samples, "), "{text}");
+    assert!(r.path("a.exr").exists());
+}
