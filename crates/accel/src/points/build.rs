@@ -33,10 +33,19 @@ pub struct PointKdTree {
     pub(super) nodes: Vec<Node>,
     /// Split axis (0, 1 or 2) of each node.
     pub(super) axes: Vec<u8>,
-    /// Each item's own radius.
-    pub(super) radii: Vec<f32>,
-    /// The largest radius in each node's subtree, itself included.
-    pub(super) subtree_radii: Vec<f32>,
+    /// Each item's radius and its subtree's largest, side by side because the covering
+    /// search reads both.
+    pub(super) radii: Vec<Radii>,
+}
+
+/// The radii of one node.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C)]
+pub(super) struct Radii {
+    /// The item's own.
+    pub(super) own: f32,
+    /// The largest in the node's subtree, its own included.
+    pub(super) subtree: f32,
 }
 
 impl PointKdTree {
@@ -67,20 +76,18 @@ impl PointKdTree {
         self.axes.clear();
         self.axes.resize(n, 0);
         self.radii.clear();
-        self.radii.resize(n, 0.0);
-        self.subtree_radii.clear();
-        self.subtree_radii.resize(n, 0.0);
+        self.radii.resize(n, Radii::default());
         self.place(items, 1);
         // Children come after their parent in heap order, so one backward pass sees every
         // subtree's maximum before its parent needs it.
         for h in (1..=n).rev() {
-            let mut r = self.radii[h - 1];
+            let mut r = self.radii[h - 1].own;
             for child in [2 * h, 2 * h + 1] {
                 if child <= n {
-                    r = r.max(self.subtree_radii[child - 1]);
+                    r = r.max(self.radii[child - 1].subtree);
                 }
             }
-            self.subtree_radii[h - 1] = r;
+            self.radii[h - 1].subtree = r;
         }
         Ok(())
     }
@@ -100,7 +107,7 @@ impl PointKdTree {
             payload: median.payload,
         };
         self.axes[h - 1] = axis as u8;
-        self.radii[h - 1] = median.radius;
+        self.radii[h - 1].own = median.radius;
         let (left, rest) = items.split_at_mut(m);
         self.place(left, 2 * h);
         self.place(&mut rest[1..], 2 * h + 1);
@@ -118,7 +125,7 @@ impl PointKdTree {
 
     /// The largest item radius (0 for an empty tree).
     pub fn max_radius(&self) -> f32 {
-        self.subtree_radii.first().copied().unwrap_or(0.0)
+        self.radii.first().map_or(0.0, |r| r.subtree)
     }
 
     /// The item at heap number `heap_index` (root 1, children of `h` at `2h` and `2h + 1`) and
@@ -127,7 +134,7 @@ impl PointKdTree {
     pub fn node(&self, heap_index: usize) -> Option<(PointItem, usize)> {
         let i = heap_index.checked_sub(1)?;
         let node = self.nodes.get(i)?;
-        let item = PointItem::with_radius(Vec3::from(node.point), node.payload, self.radii[i]);
+        let item = PointItem::with_radius(Vec3::from(node.point), node.payload, self.radii[i].own);
         Some((item, self.axes[i] as usize))
     }
 
@@ -135,7 +142,7 @@ impl PointKdTree {
     pub fn memory_bytes(&self) -> usize {
         self.nodes.capacity() * std::mem::size_of::<Node>()
             + self.axes.capacity()
-            + (self.radii.capacity() + self.subtree_radii.capacity()) * 4
+            + self.radii.capacity() * std::mem::size_of::<Radii>()
     }
 }
 

@@ -31,9 +31,10 @@
 //! # Layout
 //!
 //! Item number `h` of the heap order (root `h = 1`, children `2h` and `2h + 1`, no pointers) is
-//! stored at index `h - 1` of four parallel arrays: the point and payload (16 bytes, all the
-//! k-NN and radius searches read besides the axis), the split axis (1 byte), the item's radius
-//! and the largest radius in its subtree (4 bytes each, read only by the covering search). A
+//! stored at index `h - 1` of three parallel arrays: the point and payload (16 bytes, all the
+//! k-NN and radius searches read besides the axis), the split axis (1 byte), and the item's
+//! radius beside the largest radius in its subtree (8 bytes, read only by the covering
+//! search), 25 bytes per item in all. A
 //! node's split value is its own point's coordinate on its axis: its left subtree lies at or
 //! below it, its right subtree at or above it.
 //!
@@ -136,23 +137,32 @@ pub struct Neighbour {
     pub payload: u32,
 }
 
+impl Neighbour {
+    /// The order as one integer: squared distances are never NaN (queries reject non-finite
+    /// points) and never -0 (a sum of squares), and the bits of non-negative floats sort like
+    /// the floats, so one `u64` comparison replaces two on the searches' hot path.
+    #[inline(always)]
+    pub(crate) fn key(&self) -> u64 {
+        (u64::from(self.dist2.to_bits()) << 32) | u64::from(self.payload)
+    }
+}
+
 impl Ord for Neighbour {
+    #[inline(always)]
     fn cmp(&self, other: &Self) -> Ordering {
-        // Squared distances are never NaN (queries reject non-finite points) and never -0, so
-        // `total_cmp` is the numeric order here.
-        self.dist2
-            .total_cmp(&other.dist2)
-            .then(self.payload.cmp(&other.payload))
+        self.key().cmp(&other.key())
     }
 }
 
 impl PartialOrd for Neighbour {
+    #[inline(always)]
     fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
         Some(self.cmp(other))
     }
 }
 
 impl PartialEq for Neighbour {
+    #[inline(always)]
     fn eq(&self, other: &Self) -> bool {
         self.cmp(other) == Ordering::Equal
     }

@@ -139,7 +139,7 @@ impl PointKdTree {
             return &[];
         }
         self.knn_pass(q, k, bound, query);
-        query.heap.sort_unstable();
+        query.heap.sort_unstable_by_key(Neighbour::key);
         &query.heap
     }
 
@@ -169,14 +169,14 @@ impl PointKdTree {
             self.knn_pass(q, k, first, query);
             // Every item outside the first radius is farther than the k found inside it.
             if query.heap.len() == k || query.heap.len() == self.len() {
-                query.heap.sort_unstable();
+                query.heap.sort_unstable_by_key(Neighbour::key);
                 return &query.heap;
             }
             query.stats.restarts += 1;
             query.heap.clear();
         }
         self.knn_pass(q, k, bound, query);
-        query.heap.sort_unstable();
+        query.heap.sort_unstable_by_key(Neighbour::key);
         &query.heap
     }
 
@@ -374,7 +374,7 @@ impl<const SUBTREE: bool> Visitor for Covering<SUBTREE> {
     #[inline(always)]
     fn subtree_bound(&self, tree: &PointKdTree, h: usize) -> f32 {
         if SUBTREE {
-            let r = tree.subtree_radii[h - 1];
+            let r = tree.radii[h - 1].subtree;
             self.bound().min(r * r)
         } else {
             self.bound()
@@ -383,7 +383,7 @@ impl<const SUBTREE: bool> Visitor for Covering<SUBTREE> {
 
     #[inline(always)]
     fn visit(&mut self, tree: &PointKdTree, h: usize, dist2: f32) {
-        let r = tree.radii[h - 1];
+        let r = tree.radii[h - 1].own;
         if dist2 > r * r {
             return;
         }

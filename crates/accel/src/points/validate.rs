@@ -19,12 +19,11 @@ impl PointKdTree {
 
     fn find_problem(&self) -> Result<(), String> {
         let n = self.nodes.len();
-        if self.axes.len() != n || self.radii.len() != n || self.subtree_radii.len() != n {
+        if self.axes.len() != n || self.radii.len() != n {
             return Err(format!(
-                "{n} nodes but {} axes, {} radii, {} subtree radii",
+                "{n} nodes but {} axes and {} radii",
                 self.axes.len(),
-                self.radii.len(),
-                self.subtree_radii.len()
+                self.radii.len()
             ));
         }
         if n > 0 && n.ilog2() as usize >= MAX_DEPTH {
@@ -36,12 +35,12 @@ impl PointKdTree {
                 return Err(format!("node {h} has axis {axis}"));
             }
             let split = self.nodes[h - 1].point[axis];
-            let mut largest = self.radii[h - 1];
+            let mut largest = self.radii[h - 1].own;
             for (child, left) in [(2 * h, true), (2 * h + 1, false)] {
                 if child > n {
                     continue;
                 }
-                largest = largest.max(self.subtree_radii[child - 1]);
+                largest = largest.max(self.radii[child - 1].subtree);
                 // Walk the child's subtree level by level: heap numbers c·2^d .. c·2^d + 2^d - 1.
                 let (mut first, mut width) = (child, 1usize);
                 while first <= n {
@@ -60,13 +59,58 @@ impl PointKdTree {
                     width *= 2;
                 }
             }
-            if self.subtree_radii[h - 1] != largest {
+            if self.radii[h - 1].subtree != largest {
                 return Err(format!(
                     "node {h} records subtree radius {} but its subtree's largest is {largest}",
-                    self.subtree_radii[h - 1]
+                    self.radii[h - 1].subtree
                 ));
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::PointItem;
+    use super::*;
+    use glam::Vec3;
+
+    fn tree() -> PointKdTree {
+        let items: Vec<PointItem> = (0..20u32)
+            .map(|i| {
+                let p = Vec3::new((i * 7 % 20) as f32, (i * 3 % 5) as f32, 0.0);
+                PointItem::with_radius(p, i, i as f32 * 0.1)
+            })
+            .collect();
+        PointKdTree::build(&items).unwrap()
+    }
+
+    #[test]
+    fn a_built_tree_is_valid() {
+        tree().validate().unwrap();
+    }
+
+    #[test]
+    fn each_broken_invariant_is_found() {
+        let mut t = tree();
+        t.nodes.swap(1, 2); // the root's children: their subtrees now straddle the split
+        assert!(t
+            .validate()
+            .unwrap_err()
+            .problem
+            .contains("subtree of node 1"));
+
+        let mut t = tree();
+        t.axes[3] = 3;
+        assert!(t.validate().unwrap_err().problem.contains("axis 3"));
+
+        let mut t = tree();
+        t.radii[10].own = 5.0; // larger than the subtree maxima recorded above it
+        assert!(t.validate().unwrap_err().problem.contains("subtree radius"));
+
+        let mut t = tree();
+        t.axes.pop();
+        assert!(t.validate().is_err());
     }
 }
