@@ -247,10 +247,11 @@ fn results_do_not_depend_on_input_order() {
     }
 }
 
-/// The same input builds the same tree, item for item.
+/// The same input builds the same tree, item for item (with many equal coordinates, where
+/// the layout is not forced by the values alone).
 #[test]
 fn builds_are_deterministic() {
-    let items = items(Kind::Clustered, 5000, 9);
+    let items = items(Kind::Duplicated, 5000, 9);
     let (a, b) = (
         PointKdTree::build(&items).unwrap(),
         PointKdTree::build(&items).unwrap(),
