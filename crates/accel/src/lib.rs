@@ -13,6 +13,8 @@
 //!   an on-demand variant ([`OnDemandQbvh`]).
 //! - [`crack_free`]: the crack-free intersection tests of Dammertz §3.4.
 //! - [`BruteForce`]: tests every triangle; the reference the others are checked against.
+//! - [`points`]: a balanced point kd-tree ([`PointKdTree`]) for photon maps and the caustic
+//!   histogram's bins (k nearest, within a radius, nearest covering item); not an `Accel`.
 //!
 //! [`AccelSpec`] is the one dispatch point: it parses `bvh8:order=distance` and the like and
 //! builds the structure. Later work adds the implicit IOSP BVH behind the same trait.
@@ -59,6 +61,7 @@ pub mod brute_force;
 pub mod bvh2;
 pub mod crack_free;
 pub mod on_demand;
+pub mod points;
 pub mod spec;
 mod traversal;
 pub mod wide;
@@ -77,6 +80,7 @@ pub struct ValidationError {
 }
 pub use bvh2::{BuildParams, Bvh2, BvhStats, Node, Split, MAX_BINS};
 pub use on_demand::OnDemandQbvh;
+pub use points::PointKdTree;
 pub use spec::{AccelKind, AccelSpec, SpecError, DEFAULT_ACCEL};
 pub use wide::{
     Bvh8, Node8, Order, QNode, Qbvh, TriangleTest, WideBvh, WideNode, WideOptions,
