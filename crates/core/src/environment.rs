@@ -243,6 +243,11 @@ impl EnvMap {
         (self.width, self.height)
     }
 
+    /// The texels, row-major from the zenith row, without the sun.
+    pub fn texels(&self) -> &[Rgb] {
+        &self.texels
+    }
+
     /// Bytes of the texels (length × element size).
     pub fn texel_bytes(&self) -> usize {
         std::mem::size_of_val(self.texels.as_slice())

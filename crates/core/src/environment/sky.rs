@@ -39,8 +39,9 @@
 //!   plane there.
 //! - The sun must be at or above the horizon (the fit covers θ_s ∈ [0, π/2]); within its
 //!   radius of the horizon the disc reaches slightly below it.
-//! - Turbidity is limited to [1.7, 10]: below 1.7 the luminance distribution's gradient term
-//!   `1 + A e^B` turns negative near the zenith, and the paper fits up to 10.
+//! - Turbidity is limited to [1.7, 10]: below about 1.65 the luminance distribution's
+//!   gradient term `1 + A e^(B / cos θ)` is negative at the zenith (a negative sky), and 10 is
+//!   the haziest of the clear skies the model describes.
 
 use super::sun::{self, SolarTime, SUN_ANGULAR_RADIUS_DEG};
 use super::{uv_to_dir, EnvMap, SunDisc};
