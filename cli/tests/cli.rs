@@ -239,6 +239,37 @@ fn nan_and_negative_numbers() {
 }
 
 #[test]
+fn sky_environment_renders_and_bad_sky_values_are_one_line_errors() {
+    // The shipped sky scene renders (one sample per pixel, a PNG) without invalid samples.
+    let r = Run::new();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/sky.toml");
+    let out = r.render(&[scene.to_str().unwrap(), "-o", "sky.png", "--spp", "1"]);
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr),
+    );
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    assert!(stdout.contains(" 0 invalid samples discarded"), "{stdout}");
+    assert!(r.path("sky.png").exists());
+    let sky = |keys: &str| format!("{GOOD}\n[environment]\nsky = {{ {keys} }}\n");
+    expect_error(
+        &sky("sun_direction = [0, 1, 0], turbidity = 20"),
+        &[],
+        &["scene.toml", "turbidity must be in [1.7, 10]", "20"],
+    );
+    expect_error(
+        &sky("latitude = 47.4, day = 172, solar_time = 23"),
+        &[],
+        &["scene.toml", "below the horizon"],
+    );
+    expect_error(
+        &sky("latitude = 47.4, day = 172, hour = 12"),
+        &[],
+        &["scene.toml", "longitude"],
+    );
+}
+
+#[test]
 fn stress_command_reports_one_line_per_case_and_fails_on_bad_arguments() {
     let r = Run::new();
     let out = r.render(&[

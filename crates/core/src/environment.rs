@@ -1,10 +1,30 @@
-//! Distant illumination: a constant colour or an equirectangular (lat-long) map.
+//! Distant illumination: a constant colour or an equirectangular (lat-long) map, optionally
+//! with a sun disc on top of the map (how the analytic daylight sky of [`sky`] reaches the
+//! renderer: tabulated into a map, with its sun as a [`SunDisc`]).
 //!
 //! Orientation of maps: +y is up. Row 0 of the image is the zenith (+y), the last row the nadir.
 //! The centre column looks along -z (where the default camera looks) and `u` increases towards
 //! +x, so `u = 0.5 + atan2(d.x, -d.z) / 2π`, `v = θ / π` with `θ = acos(d.y)` (computed as
 //! `atan2(√(x² + z²), y)`, which keeps its precision at the poles).
+//!
+//! A sun disc is smaller than a texel of any map we would store (at 512 × 256 the sun covers
+//! 0.45 of a texel at 5° elevation, 0.64 at 45°, 0.9 at 60°), so it is not rasterised into the
+//! texels, which would make it a square of the wrong size: it is a uniformly bright cone added
+//! to the map's radiance, and sampling picks the cone (uniformly within it) or the texels (by
+//! luminance) in proportion to their powers, so the mixture's pdf is proportional to luminance
+//! everywhere, as a map's alone is. `radiance`, `sample` and `pdf` all see the same sum, and
+//! `sample` evaluates radiance and pdf at its direction exactly as `radiance` and `pdf` do.
+//! `cargo run --release -p rt-core --example sky_sampling` measures the choice: the per-sample
+//! noise of next-event estimation of a horizontal surface's irradiance equals that of the sun
+//! rasterised into its texel (0.35 relative standard deviation at 45° elevation), and beats
+//! fixed splits of 0.1, 0.5 and 0.9 (1.9, 0.43, 1.0) except at a low sun, where 0.1 is 13 %
+//! better (0.66 against 0.76 at 10°).
 
+pub mod sky;
+pub mod sun;
+
+use crate::distribution::ONE_MINUS_EPS;
+use crate::frame::Frame;
 use crate::stage_time::StageTime;
 use crate::{color::luminance, distribution::Distribution2D, Rgb};
 use glam::{Vec2, Vec3};
@@ -22,9 +42,10 @@ pub enum Environment {
     Map(EnvMap),
 }
 
-/// An equirectangular environment map. Its sampling distribution (the importance map) is built
-/// the first time something samples the map or asks for a sampling pdf, so a render whose
-/// integrator never samples lights never builds it.
+/// An equirectangular environment map, optionally with a [`SunDisc`] added on top. Its
+/// sampling distribution (the importance map) is built the first time something samples the
+/// map or asks for a sampling pdf, so a render whose integrator never samples lights never
+/// builds it.
 #[derive(Clone, Debug)]
 pub struct EnvMap {
     width: u32,
@@ -32,19 +53,110 @@ pub struct EnvMap {
     texels: Vec<Rgb>,
     /// Some texel has positive luminance: the map emits and light sampling should see it.
     emits: bool,
+    /// A small bright disc added to the texels' radiance and sampled on its own.
+    sun: Option<SunDisc>,
     importance: OnceLock<Importance>,
 }
 
-/// The luminance × sinθ distribution of an [`EnvMap`] and how long building it took (for
-/// `render --stats`, since it is built inside the render).
+/// A disc of uniform radiance on the sphere of directions (a cone around `dir`), such as the
+/// sun. Membership is tested with the cross product, `|d × dir|² ≤ sin²r · |d|²` (and
+/// `d · dir > 0`), rather than with a cosine: for a disc of 0.27° the cosine at the rim is
+/// `1 − 1.1e-5`, which f32 resolves only to about half a per cent of the disc's area, while
+/// `sin γ` keeps full relative precision. The test needs no normalised `d`, so `radiance`,
+/// `sample` and `pdf` decide membership from the same bits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SunDisc {
+    dir: Vec3,
+    /// Angular radius in radians.
+    radius: f32,
+    /// `sin² radius`.
+    sin2_radius: f32,
+    /// Solid angle, `2π(1 − cos r) = 4π sin²(r/2)`.
+    solid_angle: f32,
+    radiance: Rgb,
+}
+
+impl SunDisc {
+    /// A disc around `dir` (normalised here) of angular radius `radius` radians, in (0, π/2],
+    /// with uniform `radiance`. Non-finite or negative radiance, a zero direction or a radius
+    /// out of range must have been rejected by the caller.
+    pub fn new(dir: Vec3, radius: f32, radiance: Rgb) -> Self {
+        debug_assert!(
+            radius > 0.0 && radius <= std::f32::consts::FRAC_PI_2,
+            "{radius}"
+        );
+        debug_assert!(radiance.is_finite() && radiance.min_element() >= 0.0);
+        let r = radius as f64;
+        let half = (r / 2.0).sin();
+        Self {
+            dir: dir.normalize(),
+            radius,
+            sin2_radius: (r.sin() * r.sin()) as f32,
+            solid_angle: (4.0 * std::f64::consts::PI * half * half) as f32,
+            radiance,
+        }
+    }
+
+    /// Unit direction of the disc's centre.
+    pub fn dir(&self) -> Vec3 {
+        self.dir
+    }
+
+    /// Radiance of every direction inside the disc.
+    pub fn radiance(&self) -> Rgb {
+        self.radiance
+    }
+
+    /// Solid angle in steradians.
+    pub fn solid_angle(&self) -> f32 {
+        self.solid_angle
+    }
+
+    /// Angular radius in radians.
+    pub fn radius(&self) -> f32 {
+        self.radius
+    }
+
+    /// True if direction `d` (of any non-zero length) lies inside the disc.
+    #[inline]
+    pub fn contains(&self, d: Vec3) -> bool {
+        d.dot(self.dir) > 0.0
+            && d.cross(self.dir).length_squared() <= self.sin2_radius * d.length_squared()
+    }
+
+    /// A direction uniformly distributed over the disc (pdf `1 / solid_angle`). Rounding can put
+    /// a direction from the outermost part of the rim just outside; callers evaluate radiance
+    /// and pdf at the returned direction, so they stay consistent with it.
+    #[inline]
+    fn sample(&self, u: Vec2) -> Vec3 {
+        // 1 − cos θ is uniform on [0, 1 − cos r]; sin θ from it without forming cos θ, which
+        // would cancel.
+        let one_minus_cos = u.x * self.solid_angle / (2.0 * PI);
+        let sin_t = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0).sqrt();
+        let phi = 2.0 * PI * u.y;
+        let local = Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), 1.0 - one_minus_cos);
+        Frame::from_normal(self.dir).to_world(local).normalize()
+    }
+
+    /// Luminance × solid angle: the disc's share of a map's power.
+    fn power(&self) -> f32 {
+        luminance(self.radiance).max(0.0) * self.solid_angle
+    }
+}
+
+/// The luminance × sinθ distribution of an [`EnvMap`], the probability of sampling its sun, and
+/// how long building them took (for `render --stats`, since it is built inside the render).
 #[derive(Clone, Debug)]
 pub struct Importance {
     dist: Distribution2D,
+    /// Probability that [`Environment::sample`] samples the sun rather than the texels: the
+    /// sun's share of the total power (0 without a sun).
+    sun_prob: f32,
     build_time: StageTime,
 }
 
 impl Importance {
-    fn build(width: u32, height: u32, texels: &[Rgb]) -> Self {
+    fn build(width: u32, height: u32, texels: &[Rgb], sun: Option<&SunDisc>) -> Self {
         let start = Instant::now();
         let (w, h) = (width as usize, height as usize);
         // Weight by sinθ: rows near the poles cover less solid angle.
@@ -55,10 +167,24 @@ impl Importance {
             })
             .collect();
         let dist = Distribution2D::new(&weights, w, h);
+        // The distribution's integral is the mean of luminance × sinθ over [0,1)²; dω = 2π² sinθ
+        // du dv turns it into the texels' power. Splitting samples by power makes the mixture's
+        // pdf proportional to luminance everywhere, as it is for a map alone.
+        let map_power = dist.integral() * 2.0 * PI * PI;
+        let sun_prob = match sun {
+            Some(s) if s.power() > 0.0 => s.power() / (s.power() + map_power),
+            _ => 0.0,
+        };
         Self {
             dist,
+            sun_prob,
             build_time: StageTime(start.elapsed()),
         }
+    }
+
+    /// Probability that a sample goes to the sun disc rather than the texels.
+    pub fn sun_probability(&self) -> f32 {
+        self.sun_prob
     }
 
     /// Bytes of the distribution.
@@ -82,15 +208,29 @@ impl EnvMap {
             height,
             texels,
             emits,
+            sun: None,
             importance: OnceLock::new(),
         }
+    }
+
+    /// The same map with `sun` added on top of the texels.
+    pub fn with_sun(mut self, sun: SunDisc) -> Self {
+        self.sun = Some(sun);
+        self.importance = OnceLock::new();
+        self
+    }
+
+    /// The sun disc, if the map has one.
+    pub fn sun(&self) -> Option<&SunDisc> {
+        self.sun.as_ref()
     }
 
     /// The importance map, built on first use.
     #[inline]
     pub fn importance(&self) -> &Importance {
-        self.importance
-            .get_or_init(|| Importance::build(self.width, self.height, &self.texels))
+        self.importance.get_or_init(|| {
+            Importance::build(self.width, self.height, &self.texels, self.sun.as_ref())
+        })
     }
 
     /// The importance map if something has sampled the map, else `None`.
@@ -103,6 +243,11 @@ impl EnvMap {
         (self.width, self.height)
     }
 
+    /// The texels, row-major from the zenith row, without the sun.
+    pub fn texels(&self) -> &[Rgb] {
+        &self.texels
+    }
+
     /// Bytes of the texels (length × element size).
     pub fn texel_bytes(&self) -> usize {
         std::mem::size_of_val(self.texels.as_slice())
@@ -112,6 +257,43 @@ impl EnvMap {
         let x = ((uv.x * self.width as f32) as u32).min(self.width - 1);
         let y = ((uv.y * self.height as f32) as u32).min(self.height - 1);
         self.texels[(y * self.width + x) as usize]
+    }
+
+    /// The sun's radiance along direction `d` (zero outside the disc or without a sun).
+    #[inline]
+    fn sun_radiance(&self, d: Vec3) -> Rgb {
+        match &self.sun {
+            Some(s) if s.contains(d) => s.radiance,
+            _ => Rgb::ZERO,
+        }
+    }
+
+    /// Solid-angle pdf of the mixture at direction `d`, given the texels' pdf there.
+    #[inline]
+    fn mixture_pdf(&self, imp: &Importance, d: Vec3, map_pdf: f32) -> f32 {
+        match &self.sun {
+            None => map_pdf,
+            Some(s) => {
+                let p = imp.sun_prob;
+                let sun = if s.contains(d) {
+                    p / s.solid_angle
+                } else {
+                    0.0
+                };
+                (1.0 - p) * map_pdf + sun
+            }
+        }
+    }
+
+    /// Solid-angle pdf with which the texels' distribution alone gives direction `d`.
+    #[inline]
+    fn map_pdf(imp: &Importance, d: Vec3) -> f32 {
+        let uv = dir_to_uv(d);
+        let sin_t = (uv.y * PI).sin();
+        if sin_t <= 0.0 {
+            return 0.0;
+        }
+        imp.dist.pdf(uv) / (2.0 * PI * PI * sin_t)
     }
 }
 
@@ -152,7 +334,7 @@ impl Environment {
     pub fn radiance(&self, d: Vec3) -> Rgb {
         match self {
             Environment::Constant(c) => *c,
-            Environment::Map(m) => m.texel(dir_to_uv(d)),
+            Environment::Map(m) => m.texel(dir_to_uv(d)) + m.sun_radiance(d),
         }
     }
 
@@ -168,12 +350,13 @@ impl Environment {
     pub fn is_black(&self) -> bool {
         match self {
             Environment::Constant(c) => c.max_element() <= 0.0,
-            Environment::Map(m) => !m.emits,
+            Environment::Map(m) => !m.emits && m.sun.as_ref().is_none_or(|s| s.power() <= 0.0),
         }
     }
 
     /// Samples an incident direction: uniformly over the sphere for a constant colour, by
-    /// luminance for a map.
+    /// luminance for a map (its sun, if any, uniformly within the disc, chosen in proportion
+    /// to its power).
     #[inline]
     pub fn sample(&self, u: Vec2) -> Option<EnvSample> {
         match self {
@@ -186,15 +369,41 @@ impl Environment {
                 })
             }
             Environment::Map(m) => {
-                let (uv, pdf_uv) = m.importance().dist.sample(u);
-                let sin_t = (uv.y * PI).sin();
-                if pdf_uv <= 0.0 || sin_t <= 0.0 {
+                let imp = m.importance();
+                let Some(sun) = &m.sun else {
+                    let (uv, pdf_uv) = imp.dist.sample(u);
+                    let sin_t = (uv.y * PI).sin();
+                    if pdf_uv <= 0.0 || sin_t <= 0.0 {
+                        return None;
+                    }
+                    return Some(EnvSample {
+                        dir: uv_to_dir(uv),
+                        radiance: m.texel(uv),
+                        pdf: pdf_uv / (2.0 * PI * PI * sin_t),
+                    });
+                };
+                let p = imp.sun_prob;
+                let dir = if u.x < p {
+                    sun.sample(Vec2::new(u.x / p, u.y))
+                } else {
+                    let u = Vec2::new(((u.x - p) / (1.0 - p)).min(ONE_MINUS_EPS), u.y);
+                    let (uv, pdf_uv) = imp.dist.sample(u);
+                    if pdf_uv <= 0.0 {
+                        return None;
+                    }
+                    uv_to_dir(uv)
+                };
+                // Radiance and pdf at the direction itself, computed as `radiance` and `pdf`
+                // compute them: a direction from one texel can round into its neighbour, whose
+                // pdf differs by the sky's gradient (up to 12 % at 128 × 64 near the sun).
+                let pdf = m.mixture_pdf(imp, dir, EnvMap::map_pdf(imp, dir));
+                if pdf <= 0.0 {
                     return None;
                 }
                 Some(EnvSample {
-                    dir: uv_to_dir(uv),
-                    radiance: m.texel(uv),
-                    pdf: pdf_uv / (2.0 * PI * PI * sin_t),
+                    dir,
+                    radiance: m.texel(dir_to_uv(dir)) + m.sun_radiance(dir),
+                    pdf,
                 })
             }
         }
@@ -206,12 +415,8 @@ impl Environment {
         match self {
             Environment::Constant(_) => crate::sampling::UNIFORM_SPHERE_PDF,
             Environment::Map(m) => {
-                let uv = dir_to_uv(d);
-                let sin_t = (uv.y * PI).sin();
-                if sin_t <= 0.0 {
-                    return 0.0;
-                }
-                m.importance().dist.pdf(uv) / (2.0 * PI * PI * sin_t)
+                let imp = m.importance();
+                m.mixture_pdf(imp, d, EnvMap::map_pdf(imp, d))
             }
         }
     }
@@ -230,14 +435,32 @@ impl crate::content_hash::ContentHash for Environment {
                 height,
                 texels,
                 emits: _,
+                sun,
                 importance: _,
             }) => {
                 out(b"map");
                 width.content_hash(out);
                 height.content_hash(out);
                 texels.content_hash(out);
+                sun.content_hash(out);
             }
         }
+    }
+}
+
+impl crate::content_hash::ContentHash for SunDisc {
+    /// The disc as the renderer reads it; `sin2_radius` and the solid angle follow from the radius.
+    fn content_hash(&self, out: &mut crate::content_hash::Sink<'_>) {
+        let SunDisc {
+            dir,
+            radius,
+            sin2_radius: _,
+            solid_angle: _,
+            radiance,
+        } = self;
+        dir.content_hash(out);
+        radius.content_hash(out);
+        radiance.content_hash(out);
     }
 }
 
@@ -291,5 +514,74 @@ mod tests {
         }
         let mean = sum / (n * n) as f32;
         assert!((mean - 1.0).abs() < 0.02, "{mean}");
+    }
+
+    #[test]
+    fn sun_disc_membership_is_exact_at_the_rim_for_any_length() {
+        let r = 0.2667f32.to_radians();
+        let dir = Vec3::new(0.3, 0.8, -0.5).normalize();
+        let sun = SunDisc::new(dir * 7.0, r, Rgb::ONE);
+        assert!((sun.dir().length() - 1.0).abs() < 1e-6);
+        let omega = 2.0 * std::f64::consts::PI * (1.0 - (r as f64).cos());
+        assert!((sun.solid_angle() as f64 / omega - 1.0).abs() < 1e-6);
+        let frame = Frame::from_normal(sun.dir());
+        let at = |angle: f32, phi: f32| {
+            frame.to_world(Vec3::new(
+                angle.sin() * phi.cos(),
+                angle.sin() * phi.sin(),
+                angle.cos(),
+            ))
+        };
+        for phi in [0.0f32, 1.0, 2.5, 4.0] {
+            for len in [1.0f32, 3.0, 0.2] {
+                assert!(sun.contains(at(0.999 * r, phi) * len), "{phi} {len}");
+                assert!(!sun.contains(at(1.001 * r, phi) * len), "{phi} {len}");
+            }
+        }
+        assert!(!sun.contains(-sun.dir()));
+        // Samples land inside (rounding allowing) with radiance and pdf from the same test.
+        let env = Environment::Map(EnvMap::new(4, 2, vec![Rgb::splat(1e-3); 8]).with_sun(sun));
+        let p = env.map().unwrap().importance().sun_probability();
+        let mut inside = 0;
+        for i in 0..1000 {
+            let u = Vec2::new(p * (i as f32 + 0.5) / 1000.0, (i as f32 * 0.618_034) % 1.0);
+            let s = env.sample(u).unwrap();
+            inside += usize::from(sun.contains(s.dir));
+            assert_eq!(s.pdf, env.pdf(s.dir));
+        }
+        assert!(inside >= 999, "{inside}");
+    }
+
+    #[test]
+    fn sun_share_of_samples_is_its_share_of_power() {
+        let (w, h) = (16u32, 8u32);
+        let texels: Vec<Rgb> = (0..w * h)
+            .map(|i| Rgb::new(0.2, 0.5, 1.0) * (1 + i % 5) as f32)
+            .collect();
+        // Power of the texels: Σ luminance × solid angle of the texel.
+        let map_power: f64 = (0..h)
+            .map(|y| {
+                let (t0, t1) = (PI * y as f32 / h as f32, PI * (y + 1) as f32 / h as f32);
+                let omega = 2.0 * PI / w as f32 * (t0.cos() - t1.cos());
+                (0..w)
+                    .map(|x| (luminance(texels[(y * w + x) as usize]) * omega) as f64)
+                    .sum::<f64>()
+            })
+            .sum();
+        let sun = SunDisc::new(Vec3::new(0.0, 1.0, 1.0), 0.01, Rgb::splat(3e4));
+        let sun_power = 3e4 * sun.solid_angle() as f64;
+        let map = EnvMap::new(w, h, texels).with_sun(sun);
+        let p = map.importance().sun_probability() as f64;
+        let expected = sun_power / (sun_power + map_power);
+        // sinθ at the row centre against the exact band area: a few 1e-3 at 8 rows.
+        assert!((p / expected - 1.0).abs() < 5e-3, "{p} vs {expected}");
+        let env = Environment::Map(map);
+        assert!(!env.is_black());
+        // A black map with a black sun is black; a black map with a sun is not.
+        let black = EnvMap::new(2, 2, vec![Rgb::ZERO; 4]);
+        assert!(Environment::Map(black.clone()).is_black());
+        assert!(!Environment::Map(black.clone().with_sun(sun)).is_black());
+        let dark_sun = SunDisc::new(Vec3::Y, 0.01, Rgb::ZERO);
+        assert!(Environment::Map(black.with_sun(dark_sun)).is_black());
     }
 }

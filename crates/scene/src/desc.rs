@@ -100,8 +100,34 @@ pub(crate) struct EnvironmentDesc {
     pub color: Option<Spanned<V3>>,
     /// Equirectangular EXR, relative to the TOML file.
     pub map: Option<Spanned<String>>,
-    /// Multiplies `color` or `map`; default 1.
+    /// Multiplies `color`, `map` or `sky`; default 1.
     pub strength: Option<Spanned<f32>>,
+    /// The Preetham daylight sky with a sun.
+    pub sky: Option<Spanned<SkyDesc>>,
+}
+
+/// `[environment] sky = { ... }`: the sun by direction, or by date, time and place.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct SkyDesc {
+    /// Towards the sun, +y up.
+    pub sun_direction: Option<Spanned<V3>>,
+    /// Degrees north.
+    pub latitude: Option<Spanned<f64>>,
+    /// Degrees east; with `hour`.
+    pub longitude: Option<Spanned<f64>>,
+    /// Degrees east of the time zone's meridian; with `hour`.
+    pub standard_meridian: Option<Spanned<f64>>,
+    /// Day of the year, 1–366.
+    pub day: Option<Spanned<u32>>,
+    /// Local standard (clock) time, hours.
+    pub hour: Option<Spanned<f64>>,
+    /// Local apparent solar time, hours (12 = solar noon).
+    pub solar_time: Option<Spanned<f64>>,
+    /// Default 3.
+    pub turbidity: Option<Spanned<f32>>,
+    /// Size of the tabulated sky; default 512 × 256.
+    pub resolution: Option<Spanned<Arr<u32, 2>>>,
 }
 
 /// `[[camera]]`.
@@ -340,6 +366,8 @@ mod tests {
         assert!(e.contains("unknown field `gloss`"), "{e}");
         let e = err("[[geometry]]\nname = \"g\"\ntransform = { translate = [0, 0, 0], turn = 1 }");
         assert!(e.contains("unknown field `turn`"), "{e}");
+        let e = err("[environment]\nsky = { sun_direction = [0, 1, 0], scale = 2 }");
+        assert!(e.contains("unknown field `scale`"), "{e}");
     }
 
     #[test]
@@ -445,9 +473,10 @@ mod tests {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/scene-format.md");
         let doc = std::fs::read_to_string(path).unwrap();
         let rows: Vec<&str> = doc.lines().filter(|l| l.starts_with('|')).collect();
-        let types: [(&str, Vec<&str>); 9] = [
+        let types: [(&str, Vec<&str>); 10] = [
             ("SceneDesc", fields_of::<SceneDesc>()),
             ("EnvironmentDesc", fields_of::<EnvironmentDesc>()),
+            ("SkyDesc", fields_of::<SkyDesc>()),
             ("CameraDesc", fields_of::<CameraDesc>()),
             ("MaterialDesc", fields_of::<MaterialDesc>()),
             ("LayerDesc", fields_of::<LayerDesc>()),

@@ -1,13 +1,17 @@
 //! Turns a parsed scene description into an `rt_core::Scene`, section by section:
 //! environment, cameras, materials, geometry, material assignments, lights.
 
-use crate::desc::{self, AssignDesc, CameraDesc, EnvironmentDesc, RenderTableDesc, SceneDesc, V3};
+use crate::desc::{
+    self, AssignDesc, CameraDesc, EnvironmentDesc, RenderTableDesc, SceneDesc, SkyDesc, V3,
+};
 use crate::error::{Result, Source};
 use crate::geometry;
 use crate::image_io::{self, Textures};
 use crate::material::{self, MaterialTable};
 use crate::{LoadedScene, RenderDesc};
 use glam::Vec3;
+use rt_core::environment::sky::{Sky, SkyError, DEFAULT_RESOLUTION};
+use rt_core::environment::sun::{SolarTime, TimeOfDay};
 use rt_core::environment::{EnvMap, Environment};
 use rt_core::{material::MAX_RADIANCE, Camera, Rgb, Scene};
 use std::collections::HashSet;
@@ -143,6 +147,43 @@ fn environment(ctx: &Ctx, env: &Spanned<EnvironmentDesc>) -> Result<Environment>
             ),
         )
     };
+    if let Some(sky_desc) = &e.sky {
+        if color != Rgb::ZERO {
+            return Err(ctx.src.error_at(
+                e.color.as_ref().map_or(sky_desc.span(), |c| c.span()),
+                "environment has both a non-black `color` and a `sky`; give one of them",
+            ));
+        }
+        if let Some(map) = &e.map {
+            return Err(ctx.src.error_at(
+                map.span(),
+                "environment has both a `map` and a `sky`; give one of them",
+            ));
+        }
+        let map = sky(
+            ctx,
+            sky_desc,
+            strength,
+            e.strength.as_ref().map(|s| s.span()),
+        )?;
+        let brightest = map
+            .texels()
+            .iter()
+            .copied()
+            .chain(map.sun().map(|s| s.radiance()))
+            .fold(Rgb::ZERO, Rgb::max);
+        if brightest.max_element() > MAX_RADIANCE {
+            let span = e.strength.as_ref().map_or(sky_desc.span(), |s| s.span());
+            return Err(ctx.src.error_at(
+                span,
+                format!(
+                    "environment radiance {:?} (sky x strength) exceeds the maximum {MAX_RADIANCE:e}",
+                    brightest.to_array()
+                ),
+            ));
+        }
+        return Ok(Environment::Map(map));
+    }
     let Some(map) = &e.map else {
         let radiance = color * strength;
         if radiance.max_element() > MAX_RADIANCE {
@@ -170,6 +211,157 @@ fn environment(ctx: &Ctx, env: &Spanned<EnvironmentDesc>) -> Result<Environment>
         }
     }
     Ok(Environment::Map(EnvMap::new(w, h, texels)))
+}
+
+/// `[environment] sky`: the sun from `sun_direction` or from a date, time and place; every
+/// value is checked by `rt_core`'s sky, whose errors are placed at the key they concern.
+fn sky(
+    ctx: &Ctx,
+    desc: &Spanned<SkyDesc>,
+    strength: f32,
+    strength_span: Option<std::ops::Range<usize>>,
+) -> Result<EnvMap> {
+    let d = desc.get_ref();
+    let table = desc.span();
+    let span_of = |v: Option<std::ops::Range<usize>>| v.unwrap_or_else(|| table.clone());
+    let time_keys = [
+        ("latitude", d.latitude.as_ref().map(|v| v.span())),
+        ("longitude", d.longitude.as_ref().map(|v| v.span())),
+        (
+            "standard_meridian",
+            d.standard_meridian.as_ref().map(|v| v.span()),
+        ),
+        ("day", d.day.as_ref().map(|v| v.span())),
+        ("hour", d.hour.as_ref().map(|v| v.span())),
+        ("solar_time", d.solar_time.as_ref().map(|v| v.span())),
+    ];
+    let turbidity = d.turbidity.as_ref().map_or(3.0, |t| *t.get_ref());
+    // Where an error of the sky model belongs.
+    let place = |e: SkyError, sun_span: std::ops::Range<usize>| {
+        let span = match &e {
+            SkyError::Turbidity(_) => span_of(d.turbidity.as_ref().map(|v| v.span())),
+            SkyError::SunDirection(_) | SkyError::SunBelowHorizon(_) => sun_span,
+            SkyError::Latitude(_) => span_of(d.latitude.as_ref().map(|v| v.span())),
+            SkyError::Longitude(_) => span_of(d.longitude.as_ref().map(|v| v.span())),
+            SkyError::StandardMeridian(_) => {
+                span_of(d.standard_meridian.as_ref().map(|v| v.span()))
+            }
+            SkyError::Day(_) => span_of(d.day.as_ref().map(|v| v.span())),
+            SkyError::Hour(_) => {
+                span_of(d.hour.as_ref().or(d.solar_time.as_ref()).map(|v| v.span()))
+            }
+            SkyError::Scale(_) => span_of(strength_span.clone()),
+            SkyError::Resolution(..) => span_of(d.resolution.as_ref().map(|v| v.span())),
+            _ => table.clone(),
+        };
+        let message = e.to_string();
+        let message = if message.starts_with("sky") {
+            message
+        } else {
+            format!("sky: {message}")
+        };
+        ctx.src.error_at(span, message)
+    };
+    let model = match &d.sun_direction {
+        Some(dir) => {
+            if let Some((key, Some(span))) = time_keys.iter().find(|(_, s)| s.is_some()) {
+                return Err(ctx.src.error_at(
+                    span.clone(),
+                    format!(
+                        "sky has both `sun_direction` and `{key}`; give the sun's direction or a \
+                         date, time and place, not both"
+                    ),
+                ));
+            }
+            Sky::new(Vec3::from(*dir.get_ref()), turbidity).map_err(|e| place(e, dir.span()))?
+        }
+        None => {
+            let missing = |what: &str| {
+                ctx.src.error_at(
+                    table.clone(),
+                    format!(
+                        "sky needs `sun_direction`, or `latitude`, `day` and `hour` (with \
+                         `longitude` and `standard_meridian`) or `solar_time`; {what}"
+                    ),
+                )
+            };
+            let (Some(latitude), Some(day)) = (&d.latitude, &d.day) else {
+                return Err(missing("`latitude` or `day` is missing"));
+            };
+            let (time, time_span) = match (&d.hour, &d.solar_time) {
+                (Some(_), Some(s)) => {
+                    return Err(ctx.src.error_at(
+                        s.span(),
+                        "sky has both `hour` (clock time) and `solar_time`; give one of them",
+                    ))
+                }
+                (None, None) => return Err(missing("`hour` or `solar_time` is missing")),
+                (None, Some(solar)) => {
+                    for (key, v) in [
+                        ("longitude", &d.longitude),
+                        ("standard_meridian", &d.standard_meridian),
+                    ] {
+                        if let Some(v) = v {
+                            return Err(ctx.src.error_at(
+                                v.span(),
+                                format!(
+                                    "sky `{key}` applies to `hour` (clock time), not to `solar_time`"
+                                ),
+                            ));
+                        }
+                    }
+                    (TimeOfDay::Solar(*solar.get_ref()), solar.span())
+                }
+                (Some(hour), None) => {
+                    let (Some(longitude), Some(meridian)) = (&d.longitude, &d.standard_meridian)
+                    else {
+                        return Err(ctx.src.error_at(
+                            hour.span(),
+                            "sky `hour` is clock time and needs `longitude` and \
+                             `standard_meridian` (degrees east); use `solar_time` for local solar time",
+                        ));
+                    };
+                    let time = TimeOfDay::Standard {
+                        hour: *hour.get_ref(),
+                        longitude: *longitude.get_ref(),
+                        standard_meridian: *meridian.get_ref(),
+                    };
+                    (time, hour.span())
+                }
+            };
+            let when = SolarTime {
+                latitude: *latitude.get_ref(),
+                day: *day.get_ref(),
+                time,
+            };
+            Sky::at(&when, turbidity).map_err(|e| match e {
+                SkyError::SunBelowHorizon(below) => {
+                    let at = match when.time {
+                        TimeOfDay::Solar(h) => format!("at {h} h solar time"),
+                        TimeOfDay::Standard {
+                            hour, longitude, ..
+                        } => format!("at {hour} h clock time at longitude {longitude}"),
+                    };
+                    ctx.src.error_at(
+                        time_span.clone(),
+                        format!(
+                            "sky: {at} on day {} at latitude {}, the sun is {below:.2} degrees \
+                             below the horizon; the Preetham sky needs it at or above the horizon",
+                            when.day, when.latitude
+                        ),
+                    )
+                }
+                e => place(e, time_span.clone()),
+            })?
+        }
+    };
+    let (w, h) = d
+        .resolution
+        .as_ref()
+        .map_or(DEFAULT_RESOLUTION, |r| (r.get_ref().0[0], r.get_ref().0[1]));
+    model
+        .to_env_map(strength, w, h)
+        .map_err(|e| place(e, table.clone()))
 }
 
 /// `[[camera]]`: at least one, unique names, every value in range.
@@ -454,6 +646,246 @@ material = "light"
         assert!(e.contains("both a non-black `color` and a `map`"), "{e}");
         let e = load_in(dir.path(), "[environment]\nmap = \"env/none.exr\"").unwrap_err();
         assert!(e.contains("none.exr: cannot open"), "{e}");
+    }
+
+    fn sky_map(s: &LoadedScene) -> &EnvMap {
+        s.scene.environment.map().expect("a sky is a map")
+    }
+
+    #[test]
+    fn sky_from_a_direction_or_a_time_and_place_scaled_by_strength() {
+        let s = ok("[environment]\nsky = { sun_direction = [1, 1, 0], turbidity = 2.5 }");
+        let map = sky_map(&s);
+        assert_eq!(map.size(), DEFAULT_RESOLUTION);
+        let sun = map.sun().expect("a sun");
+        assert!((sun.dir() - Vec3::new(1.0, 1.0, 0.0).normalize()).length() < 1e-6);
+        let model = Sky::new(Vec3::new(1.0, 1.0, 0.0), 2.5).unwrap();
+        assert_eq!(sun.radiance(), model.sun_radiance());
+        // The zenith texel's centre is 0.35° from the zenith: within a per cent of it.
+        let (zenith, expected) = (
+            s.scene.environment.radiance(Vec3::Y),
+            model.radiance(Vec3::Y),
+        );
+        assert!((zenith - expected).abs().max_element() < 0.01 * expected.max_element());
+
+        // Strength scales sky and sun; turbidity defaults to 3; resolution is the table's.
+        let s = ok("[environment]\nstrength = 0.5\nsky = { sun_direction = [0, 1, 1], resolution = [64, 32] }");
+        let map = sky_map(&s);
+        assert_eq!(map.size(), (64, 32));
+        let model = Sky::new(Vec3::new(0.0, 1.0, 1.0), 3.0).unwrap();
+        assert_eq!(map.sun().unwrap().radiance(), model.sun_radiance() * 0.5);
+
+        // A date, time and place: 14:30 CEST-less clock time (standard time, meridian 15° E)
+        // in Zurich on 21 June, as `SolarTime` computes it.
+        let s = ok("[environment]\nsky = { latitude = 47.4, longitude = 8.5, standard_meridian = 15, day = 172, hour = 14.5, turbidity = 4 }");
+        let when = SolarTime {
+            latitude: 47.4,
+            day: 172,
+            time: TimeOfDay::Standard {
+                hour: 14.5,
+                longitude: 8.5,
+                standard_meridian: 15.0,
+            },
+        };
+        let sun = sky_map(&s).sun().unwrap();
+        assert!((sun.dir() - when.sun_direction()).length() < 1e-6);
+        assert!(
+            sun.dir().x < 0.0 && sun.dir().y > 0.5,
+            "afternoon: west and high"
+        );
+        let s = ok("[environment]\nsky = { latitude = -33.9, day = 355, solar_time = 12 }");
+        let sun = sky_map(&s).sun().unwrap();
+        // Cape Town at its midsummer noon: sun 79.5° high in the north (−z).
+        assert!(
+            (sun.dir().y.asin().to_degrees() - 79.5).abs() < 0.2,
+            "{}",
+            sun.dir()
+        );
+        assert!(sun.dir().z < 0.0 && sun.dir().x.abs() < 1e-5);
+        assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    }
+
+    #[test]
+    fn every_sky_parameter_reaches_the_content_hash() {
+        use rt_core::ContentHash;
+        let content = |sky: &str| {
+            let s = ok(&format!("[environment]\n{sky}\n"));
+            let mut bytes = Vec::new();
+            s.scene
+                .content_hash(&mut |b: &[u8]| bytes.extend_from_slice(b));
+            bytes
+        };
+        let base = "sky = { latitude = 47.4, longitude = 8.5, standard_meridian = 15, day = 172, hour = 14.5 }";
+        let reference = content(base);
+        assert_eq!(content(base), reference, "deterministic");
+        for changed in [
+            base.replace("47.4", "47.5"),
+            base.replace("8.5", "8.6"),
+            base.replace("= 15", "= 0"),
+            base.replace("172", "173"),
+            base.replace("14.5", "14.6"),
+            base.replace(" }", ", turbidity = 3.1 }"),
+            base.replace(" }", ", resolution = [256, 128] }"),
+            format!("strength = 0.5\n{base}"),
+        ] {
+            assert_ne!(content(&changed), reference, "{changed}");
+        }
+        // Stated defaults are the defaults.
+        assert_eq!(content(&base.replace(" }", ", turbidity = 3 }")), reference);
+        assert_eq!(
+            content(&base.replace(" }", ", resolution = [512, 256] }")),
+            reference
+        );
+    }
+
+    #[test]
+    fn sky_errors_name_the_file_the_key_and_the_problem() {
+        let sky = |keys: &str| format!("[environment]\nsky = {{ {keys} }}\n");
+        let cases: [(&str, &str, &str); 21] = [
+            (
+                "sun_direction = [0, 1, 0], turbidity = 1.2",
+                "turbidity = 1.2",
+                "turbidity must be in [1.7, 10]",
+            ),
+            (
+                "sun_direction = [0, 1, 0], turbidity = 11",
+                "turbidity = 11",
+                "turbidity must be in [1.7, 10]",
+            ),
+            (
+                "sun_direction = [0, 0, 0]",
+                "sun_direction = ",
+                "must be finite and non-zero",
+            ),
+            (
+                "sun_direction = [0, nan, 1]",
+                "sun_direction = ",
+                "must be finite and non-zero",
+            ),
+            (
+                "sun_direction = [0, -1, 1]",
+                "sun_direction = ",
+                "sun is 45.00 degrees below the horizon",
+            ),
+            (
+                "sun_direction = [0, 1, 0], day = 3",
+                "day = 3",
+                "both `sun_direction` and `day`",
+            ),
+            ("turbidity = 3", "sky = ", "needs `sun_direction`"),
+            (
+                "latitude = 40, solar_time = 12",
+                "sky = ",
+                "`latitude` or `day` is missing",
+            ),
+            (
+                "latitude = 40, day = 80",
+                "sky = ",
+                "`hour` or `solar_time` is missing",
+            ),
+            (
+                "latitude = 40, day = 80, hour = 12, solar_time = 12",
+                "solar_time = 12",
+                "give one of them",
+            ),
+            (
+                "latitude = 40, day = 80, hour = 12",
+                "hour = 12",
+                "needs `longitude` and `standard_meridian`",
+            ),
+            (
+                "latitude = 40, day = 80, solar_time = 12, longitude = 8",
+                "longitude = 8",
+                "not to `solar_time`",
+            ),
+            (
+                "latitude = 91, day = 80, solar_time = 12",
+                "latitude = 91",
+                "latitude must be in [-90, 90]",
+            ),
+            (
+                "latitude = 40, day = 0, solar_time = 12",
+                "day = 0",
+                "day of the year in [1, 366]",
+            ),
+            (
+                "latitude = 40, day = 400, solar_time = 12",
+                "day = 400",
+                "day of the year in [1, 366]",
+            ),
+            (
+                "latitude = 40, day = 80, solar_time = 25",
+                "solar_time = 25",
+                "in [0, 24] hours",
+            ),
+            (
+                "latitude = 40, day = 80, hour = 12, longitude = 190, standard_meridian = 0",
+                "longitude = 190",
+                "longitude must be in [-180, 180]",
+            ),
+            (
+                "latitude = 40, day = 80, hour = 12, longitude = 0, standard_meridian = -181",
+                "standard_meridian = ",
+                "standard_meridian must be in [-180, 180]",
+            ),
+            (
+                "latitude = 40, day = 172, solar_time = 0.5",
+                "solar_time = ",
+                "at 0.5 h solar time on day 172 at latitude 40, the sun is 26.17 degrees below",
+            ),
+            (
+                "sun_direction = [0, 1, 0], resolution = [1, 4]",
+                "resolution = ",
+                "resolution 1x4",
+            ),
+            (
+                "sun_direction = [0, 1, 0], resolution = [9000, 4]",
+                "resolution = ",
+                "must be in [2, 8192]",
+            ),
+        ];
+        for (keys, at, message) in cases {
+            let extra = sky(keys);
+            let e = err(&extra);
+            assert!(e.contains(message), "{keys}: {e}");
+            let line = line_of(&extra, at);
+            assert!(e.starts_with(&format!("t.toml:{line}:")), "{keys}: {e}");
+            // The column of the value after `at`'s "= ".
+            let text = format!("{BASE}{extra}");
+            let in_line = text.lines().nth(line - 1).unwrap().find(at).unwrap();
+            let col = in_line + at.find("= ").unwrap() + 3;
+            assert!(
+                e.starts_with(&format!("t.toml:{line}:{col}:")),
+                "{keys} (col {col}): {e}"
+            );
+        }
+        // Types and unknown keys come from the TOML layer, also one line.
+        for (keys, message) in [
+            ("latitude = 40, day = -1, solar_time = 12", "-1"),
+            ("latitude = 40, day = 80.5, solar_time = 12", "80.5"),
+            ("sun_direction = [0, 1]", "invalid length 2"),
+            ("sun = [0, 1, 0]", "unknown field `sun`"),
+        ] {
+            let e = err(&sky(keys));
+            assert!(e.contains(message), "{keys}: {e}");
+        }
+        // The sky excludes a colour and a map, and the scaled sun must stay in range.
+        let e = err("[environment]\ncolor = [1, 1, 1]\nsky = { sun_direction = [0, 1, 0] }");
+        assert!(e.contains("both a non-black `color` and a `sky`"), "{e}");
+        let e = err("[environment]\nmap = \"x.exr\"\nsky = { sun_direction = [0, 1, 0] }");
+        assert!(e.contains("both a `map` and a `sky`"), "{e}");
+        let e = err("[environment]\nstrength = 1e10\nsky = { sun_direction = [0, 1, 0] }");
+        assert!(
+            e.contains("(sky x strength) exceeds the maximum 1e15"),
+            "{e}"
+        );
+        assert!(
+            e.starts_with(&format!(
+                "t.toml:{}:",
+                line_of("[environment]\nstrength = 1e10\n", "strength")
+            )),
+            "{e}"
+        );
     }
 
     fn cam(extra: &str) -> std::result::Result<Camera, String> {

@@ -74,3 +74,27 @@ fn the_complete_example_loads() {
     );
     common::load_in(dir.path(), &extra).unwrap();
 }
+
+#[test]
+fn the_sky_examples_load_with_the_sun_where_they_say() {
+    let doc = doc();
+    let examples: Vec<String> = toml_blocks(&doc)
+        .into_iter()
+        .filter(|b| b.contains("sky = {"))
+        .collect();
+    assert_eq!(examples.len(), 2, "the two sky examples");
+    let dir = tempfile::tempdir().unwrap();
+    let sun_of = |text: &str| {
+        let s = common::load_in(dir.path(), text).unwrap_or_else(|e| panic!("{e}"));
+        s.scene.environment.map().unwrap().sun().unwrap().dir()
+    };
+    // "the sun low in the west": west is −x.
+    let zurich = sun_of(&examples[0]);
+    assert!(
+        zurich.x < -0.8 && (0.1..0.35).contains(&zurich.y),
+        "{zurich}"
+    );
+    // "30° above the horizon, towards +x".
+    let direct = sun_of(&examples[1]);
+    assert!((direct.y - 0.5).abs() < 1e-3 && direct.x > 0.86, "{direct}");
+}

@@ -30,6 +30,7 @@ fn every_shipped_scene_loads_without_warnings() {
         "environment.toml",
         "meshes.toml",
         "showcase.toml",
+        "sky.toml",
     ];
     for e in expected {
         assert!(
@@ -165,6 +166,32 @@ fn environment_scene_is_lit_by_the_generated_sky() {
     assert!(env.radiance(Vec3::Y).x < 1.0);
     let exr = std::fs::metadata(scenes_dir().join("sky.exr")).unwrap();
     assert!(exr.len() < 400_000);
+}
+
+#[test]
+fn sky_scene_is_lit_by_the_preetham_sky_at_the_time_it_says() {
+    let s = load_scene("sky.toml");
+    let map = s.scene.environment.map().expect("a sky is a map");
+    assert_eq!(map.size(), (512, 256));
+    let sun = map.sun().expect("with a sun");
+    let d = sun.dir();
+    // The file's comment: 21° high, a little north of west (west −x, north −z).
+    let elevation = d.y.asin().to_degrees();
+    assert!((elevation - 21.0).abs() < 1.0, "{elevation}");
+    assert!(d.x < -0.9 && d.z < 0.0 && d.z > -0.3, "{d}");
+    // Only the sky lights it, and the sun outshines the sky by far.
+    assert!(s.scene.lights().emitter_count() == 0 && !s.scene.environment.is_black());
+    let zenith = s.scene.environment.radiance(Vec3::Y);
+    assert!(
+        sun.radiance().y > 1e4 * zenith.y,
+        "{} vs {zenith}",
+        sun.radiance()
+    );
+    assert_eq!(
+        s.scene.environment.radiance(-Vec3::Y),
+        Rgb::ZERO,
+        "black below the horizon"
+    );
 }
 
 #[test]
