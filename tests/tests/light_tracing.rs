@@ -78,19 +78,9 @@ fn light_tracing_agrees_with_path_tracing_on_the_cornell_box() {
 /// wall), the connection samples the lens.
 #[test]
 fn light_tracing_agrees_with_path_tracing_through_a_thin_lens() {
-    let mut scene = shipped_scene("cornell-box.toml").with_resolution(SIZE, SIZE);
-    let c = &scene.cameras[0];
-    scene.cameras[0] = rt_core::Camera::look_at(
-        &c.name,
-        c.position,
-        c.position + c.forward,
-        c.up,
-        c.fov_y_deg,
-        SIZE,
-        SIZE,
-        150.0,
-        1100.0,
-    );
+    let scene = shipped_scene("cornell-box.toml")
+        .with_resolution(SIZE, SIZE)
+        .with_lens(150.0, 1100.0);
     let (honest, _) = honest_and_biased(&scene);
     assert!(
         honest.same_within_noise(),

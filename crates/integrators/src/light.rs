@@ -102,6 +102,8 @@ impl Technique for LightTracer {
             .collect();
         let mut rays = RayCounters::default();
         let rows = film.height() as u64;
+        // Plane sampling's box, read once per pass rather than once per light path.
+        let bounds = ctx.accel.bounds();
         for (b, batch) in items.chunks(BATCH_ITEMS).enumerate() {
             buffers[..batch.len()]
                 .par_iter_mut()
@@ -112,7 +114,7 @@ impl Technique for LightTracer {
                     let mut sampler = Sampler::with_stream(seed, pass.stream);
                     for k in item.first..item.first + item.count {
                         sampler.start_light_path(k, item.index);
-                        self.trace(ctx, &mut sampler, splats, counters);
+                        self.trace(ctx, &bounds, &mut sampler, splats, counters);
                     }
                 });
             for (item, (splats, counters)) in batch.iter().zip(&buffers) {
@@ -138,6 +140,7 @@ impl LightTracer {
     fn trace(
         &self,
         ctx: &Ctx<'_>,
+        bounds: &rt_core::Aabb,
         sampler: &mut Sampler,
         splats: &mut Vec<Splat>,
         counters: &mut RayCounters,
@@ -155,10 +158,9 @@ impl LightTracer {
         let u_pos = sampler.next_2d();
         let u_dir = sampler.next_2d();
         let u_lens = lens(sampler);
-        let bounds = ctx.accel.bounds();
         let Some(e) = scene
             .lights()
-            .sample_emission(scene, &bounds, u_sel, u_pos, u_dir)
+            .sample_emission(scene, bounds, u_sel, u_pos, u_dir)
         else {
             return;
         };

@@ -67,23 +67,38 @@ pub trait SceneExt {
     /// The scene with its first camera rendering `width × height` pixels (same view, lens
     /// and field of view).
     fn with_resolution(self, width: u32, height: u32) -> Scene;
+
+    /// The scene with its first camera given a thin lens of radius `aperture` focused at
+    /// `focus_distance` (same view, size and field of view).
+    fn with_lens(self, aperture: f32, focus_distance: f32) -> Scene;
+}
+
+/// The first camera of `scene` rebuilt with the given size and lens.
+fn first_camera_as(mut scene: Scene, size: (u32, u32), lens: (f32, f32)) -> Scene {
+    let c = &scene.cameras[0];
+    scene.cameras[0] = rt_core::Camera::look_at(
+        &c.name,
+        c.position,
+        c.position + c.forward,
+        c.up,
+        c.fov_y_deg,
+        size.0,
+        size.1,
+        lens.0,
+        lens.1,
+    );
+    scene
 }
 
 impl SceneExt for Scene {
-    fn with_resolution(mut self, width: u32, height: u32) -> Scene {
-        let c = &self.cameras[0];
-        self.cameras[0] = rt_core::Camera::look_at(
-            &c.name,
-            c.position,
-            c.position + c.forward,
-            c.up,
-            c.fov_y_deg,
-            width,
-            height,
-            c.aperture,
-            c.focus_distance,
-        );
-        self
+    fn with_resolution(self, width: u32, height: u32) -> Scene {
+        let lens = (self.cameras[0].aperture, self.cameras[0].focus_distance);
+        first_camera_as(self, (width, height), lens)
+    }
+
+    fn with_lens(self, aperture: f32, focus_distance: f32) -> Scene {
+        let size = (self.cameras[0].width, self.cameras[0].height);
+        first_camera_as(self, size, (aperture, focus_distance))
     }
 }
 
