@@ -55,8 +55,10 @@ pub struct Args {
     /// next-event estimation + MIS), path-bsdf (path tracing with BSDF sampling only), direct
     /// (direct lighting: one bounce, NEE + MIS), ao (ambient occlusion), light (light tracing:
     /// particles from the lights and the sky splatted through the camera; one light path per
-    /// pixel per spp; no AOVs); options max-depth=N (path, path-bsdf, light) and distance=F
-    /// (ao), e.g. path:max-depth=4 (crates/integrators/src/spec.rs).
+    /// pixel per spp; no AOVs), bdpt (bidirectional path tracing, MIS over all strategies;
+    /// one camera and one light subpath per pixel per spp; no AOVs); options max-depth=N
+    /// (path, path-bsdf, light, bdpt) and distance=F (ao), e.g. path:max-depth=4
+    /// (crates/integrators/src/spec.rs).
     /// [default: `[render] integrator`, else path]
     #[arg(long, value_name = "SPEC", value_parser = parse_integrator)]
     pub integrator: Option<IntegratorSpec>,

@@ -87,6 +87,23 @@ impl Camera {
         Ray::new(o, (focus - o).normalize())
     }
 
+    /// Solid-angle pdf with which [`Camera::generate_ray`], at a raster position uniform over
+    /// the whole image, produces unit direction `dir` (from a pinhole or from the lens point
+    /// the ray leaves): `1 / (A_image · cos³θ)`, `A_image` the image's area on the plane at
+    /// distance 1 and `θ` the angle to the view direction (for a thin lens too: the focus plane
+    /// is at a fixed depth, so the lens point does not change the measure). Zero behind the
+    /// camera. Bidirectional MIS compares camera and light strategies with it; it does not test
+    /// whether `dir` is inside the image (callers only ask about directions that are).
+    pub fn pdf_direction(&self, dir: Vec3) -> f32 {
+        let cos = dir.dot(self.forward);
+        if cos.is_nan() || cos <= 0.0 {
+            return 0.0;
+        }
+        let aspect = self.width as f32 / self.height as f32;
+        let image_area = (2.0 * self.tan_half * aspect) * (2.0 * self.tan_half);
+        1.0 / (image_area * cos * cos * cos)
+    }
+
     /// Raster position (x right, y down) of a world point seen through the pinhole, if it is in
     /// front of the camera. Used by tests and later by splatting integrators.
     pub fn project(&self, p: Vec3) -> Option<Vec2> {

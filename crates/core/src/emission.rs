@@ -63,6 +63,12 @@ pub struct Emission {
     /// The triangle point the path starts at, for connecting it to the camera directly; `None`
     /// for the environment.
     pub point: Option<EmitterPoint>,
+    /// Pdf of the start: the triangle point's area pdf (choice of light included), or for the
+    /// environment the plane point's, `1 / plane area`.
+    pub pdf_position: f32,
+    /// Solid-angle pdf of `dir` given the start (for the environment, of the direction, with
+    /// the choice of the environment included). `beta = Le |cos| / (pdf_position · pdf_direction)`.
+    pub pdf_direction: f32,
 }
 
 impl LightSampler {
@@ -112,6 +118,8 @@ impl LightSampler {
                 dir,
                 beta,
                 point: None,
+                pdf_position: 1.0 / area,
+                pdf_direction: s.pdf * self.env_prob,
             });
         }
         let p = self.sample_emitter_point(u_sel, u_pos)?;
@@ -141,6 +149,8 @@ impl LightSampler {
             dir,
             beta,
             point: Some(p),
+            pdf_position: p.pdf_area,
+            pdf_direction: local.z / (PI * faces),
         })
     }
 }

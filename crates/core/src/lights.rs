@@ -42,6 +42,8 @@ pub struct LightSample {
     pub le: Rgb,
     /// Solid-angle pdf of `wi`, including the probability of choosing this light.
     pub pdf: f32,
+    /// The triangle emits from both faces (false for the environment).
+    pub two_sided: bool,
 }
 
 /// An emissive triangle as light sampling uses it: a copy of what sampling reads, next to each
@@ -155,6 +157,7 @@ impl LightSampler {
                 dist: f32::INFINITY,
                 le: s.radiance,
                 pdf: s.pdf * self.env_prob,
+                two_sided: false,
             });
         }
         let dist = self.dist.as_ref()?;
@@ -191,6 +194,7 @@ impl LightSampler {
             dist: r,
             le,
             pdf,
+            two_sided: e.two_sided,
         })
     }
 
@@ -200,18 +204,35 @@ impl LightSampler {
         if self.total_power <= 0.0 {
             return 0.0;
         }
-        let v = &scene.triangles[prim as usize];
-        let area = triangle::area(v);
         let d = p - x;
         let dist2 = d.length_squared();
         let cos_l = ng.dot(d).abs() / dist2.sqrt();
         // NaN (x = p, hence 0/0) gives 0 too: a NaN pdf would make the MIS
         // weight, and so the sample, NaN.
+        let area = triangle::area(&scene.triangles[prim as usize]);
         if area <= 0.0 || cos_l.is_nan() || cos_l <= 0.0 {
             return 0.0;
         }
+        // The same product as `pdf_emitter_area · dist2 / cos_l`, kept in this order so path
+        // tracing's bits did not change when the area pdf got its own function.
         let pmf = triangle_power(scene, prim) / self.total_power;
         pmf * (1.0 - self.env_prob) * dist2 / (area * cos_l)
+    }
+
+    /// Area pdf of a point on emissive triangle `prim` as [`LightSampler::sample`] and
+    /// [`LightSampler::sample_emitter_point`] choose it (triangle by power, point uniform, the
+    /// choice of the triangles over the environment included); zero for a triangle that does
+    /// not emit.
+    pub fn pdf_emitter_area(&self, scene: &Scene, prim: u32) -> f32 {
+        if self.total_power <= 0.0 {
+            return 0.0;
+        }
+        let area = triangle::area(&scene.triangles[prim as usize]);
+        if area.is_nan() || area <= 0.0 {
+            return 0.0;
+        }
+        let pmf = triangle_power(scene, prim) / self.total_power;
+        pmf * (1.0 - self.env_prob) / area
     }
 
     /// Solid-angle pdf of sampling environment direction `d`.

@@ -20,6 +20,7 @@
 #![forbid(unsafe_code)]
 
 mod ao;
+mod bdpt;
 pub mod driver;
 mod light;
 mod path;
@@ -27,6 +28,7 @@ pub mod spec;
 pub mod technique;
 
 pub use ao::AoIntegrator;
+pub use bdpt::Bdpt;
 pub use driver::{render, render_samples, RenderOptions, RenderStats, SamplePass};
 pub use light::LightTracer;
 pub use path::PathIntegrator;

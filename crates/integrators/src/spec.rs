@@ -10,10 +10,10 @@
 //!
 //! | option | kinds | meaning |
 //! |---|---|---|
-//! | `max-depth=N` | path, path-bsdf, light | bounce limit (default [`DEFAULT_MAX_DEPTH`], at most [`MAX_DEPTH`]) |
+//! | `max-depth=N` | path, path-bsdf, light, bdpt | bounce limit (default [`DEFAULT_MAX_DEPTH`], at most [`MAX_DEPTH`]) |
 //! | `distance=F` | ao | occluder distance (default unlimited) |
 
-use crate::{AoIntegrator, CameraRays, LightTracer, PathIntegrator, Technique};
+use crate::{AoIntegrator, Bdpt, CameraRays, LightTracer, PathIntegrator, Technique};
 use std::fmt;
 use std::str::FromStr;
 
@@ -39,16 +39,19 @@ pub enum IntegratorKind {
     /// Light tracing: particles from the lights splatted through the camera
     /// ([`LightTracer`]).
     Light,
+    /// Bidirectional path tracing with MIS over all strategies ([`Bdpt`]).
+    Bdpt,
 }
 
 impl IntegratorKind {
     /// Every kind, in the order help texts list them.
-    pub const ALL: [IntegratorKind; 5] = [
+    pub const ALL: [IntegratorKind; 6] = [
         IntegratorKind::Path,
         IntegratorKind::PathBsdf,
         IntegratorKind::Direct,
         IntegratorKind::Ao,
         IntegratorKind::Light,
+        IntegratorKind::Bdpt,
     ];
 
     /// The name used in specs and reports.
@@ -59,6 +62,7 @@ impl IntegratorKind {
             IntegratorKind::Direct => "direct",
             IntegratorKind::Ao => "ao",
             IntegratorKind::Light => "light",
+            IntegratorKind::Bdpt => "bdpt",
         }
     }
 
@@ -66,14 +70,17 @@ impl IntegratorKind {
     pub fn has_depth(self) -> bool {
         matches!(
             self,
-            IntegratorKind::Path | IntegratorKind::PathBsdf | IntegratorKind::Light
+            IntegratorKind::Path
+                | IntegratorKind::PathBsdf
+                | IntegratorKind::Light
+                | IntegratorKind::Bdpt
         )
     }
 
     /// True for the techniques whose light paths splat onto any pixel (their films know no
     /// per-pixel variance and no first hits).
     pub fn splats(self) -> bool {
-        matches!(self, IntegratorKind::Light)
+        matches!(self, IntegratorKind::Light | IntegratorKind::Bdpt)
     }
 
     fn names() -> String {
@@ -146,7 +153,7 @@ pub enum IntegratorSpecError {
     #[error("\"{0}\" is not one of {names}", names = IntegratorKind::names())]
     UnknownKind(String),
     /// An option this crate does not know, or one that does not apply to the kind.
-    #[error("option `{option}` does not apply to `{kind}` (options: max-depth=N for path, path-bsdf and light, distance=F for ao)")]
+    #[error("option `{option}` does not apply to `{kind}` (options: max-depth=N for path, path-bsdf, light and bdpt, distance=F for ao)")]
     UnknownOption {
         /// The integrator.
         kind: IntegratorKind,
@@ -216,6 +223,7 @@ impl IntegratorSpec {
                 max_distance: self.ao_distance,
             })),
             IntegratorKind::Light => Box::new(LightTracer::new(self.depth())),
+            IntegratorKind::Bdpt => Box::new(Bdpt::new(self.depth())),
         }
     }
 
@@ -224,11 +232,12 @@ impl IntegratorSpec {
         match self.kind {
             // Light tracing misses paths ending in a delta bounce and the environment seen
             // directly; where a scene has neither, it converges to the path tracer's image.
-            IntegratorKind::Path | IntegratorKind::PathBsdf | IntegratorKind::Light => {
-                Target::Radiance {
-                    bounces: self.depth(),
-                }
-            }
+            IntegratorKind::Path
+            | IntegratorKind::PathBsdf
+            | IntegratorKind::Light
+            | IntegratorKind::Bdpt => Target::Radiance {
+                bounces: self.depth(),
+            },
             IntegratorKind::Direct => Target::Radiance { bounces: 1 },
             IntegratorKind::Ao => Target::Occlusion {
                 distance: self.ao_distance,
@@ -306,10 +315,10 @@ mod tests {
                 Ok(IntegratorSpec::new(k))
             );
         }
-        let e = "bdpt".parse::<IntegratorSpec>().unwrap_err();
+        let e = "vcm".parse::<IntegratorSpec>().unwrap_err();
         assert_eq!(
             e.to_string(),
-            "\"bdpt\" is not one of path, path-bsdf, direct, ao, light"
+            "\"vcm\" is not one of path, path-bsdf, direct, ao, light, bdpt"
         );
     }
 
