@@ -279,6 +279,25 @@ impl Material {
     }
 }
 
+/// The two kinds of layer the path-space partition tells apart (Dammertz 2011, §2.3.4 and
+/// §6.3): diffuse (`κ <` [`DIFFUSE_HARDNESS_THRESHOLD`]) and specular (everything else:
+/// glossy, mirrors, glass).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LayerClass {
+    /// Hardness below the threshold.
+    Diffuse,
+    /// Hardness at or above the threshold.
+    Specular,
+}
+
+impl LayerClass {
+    /// True if layer `l` is of this class.
+    #[inline]
+    pub fn contains(self, l: &Layer) -> bool {
+        l.is_diffuse() == (self == LayerClass::Diffuse)
+    }
+}
+
 /// Result of sampling a BSDF.
 #[derive(Clone, Copy, Debug)]
 pub struct BsdfSample {
@@ -299,6 +318,7 @@ pub struct BsdfSample {
 ///
 /// Built per path vertex; holds the per-layer weights for `wo` in a fixed array, so building
 /// and using it never allocates.
+#[derive(Clone)]
 pub struct Bsdf<'a> {
     layers: &'a [Layer],
     tint: Rgb,
@@ -364,6 +384,43 @@ impl<'a> Bsdf<'a> {
     #[inline]
     pub fn has_non_delta(&self) -> bool {
         self.has_non_delta
+    }
+
+    /// The probability with which [`Bsdf::sample`] picks a layer of `class`: the class's share
+    /// of the layer weights (0 for a BSDF that reflects nothing).
+    pub fn share(&self, class: LayerClass) -> f32 {
+        if self.total <= 0.0 {
+            return 0.0;
+        }
+        let kept: f32 = self
+            .layers
+            .iter()
+            .zip(&self.weights)
+            .filter(|(l, _)| class.contains(l))
+            .map(|(_, &w)| w)
+            .sum();
+        (kept / self.total).min(1.0)
+    }
+
+    /// The part of this BSDF made of the layers of `class`, with their weights unchanged:
+    /// `f = Σ_class wᵢ fᵢ`, and sampling chooses among those layers only. The two classes'
+    /// parts sum to the whole, which is how the path-space partition (Dammertz 2011, §6.3)
+    /// splits a vertex into its diffuse and its specular part.
+    pub fn restricted(&self, class: LayerClass) -> Self {
+        let mut b = self.clone();
+        let mut has_non_delta = false;
+        for (w, l) in b.weights.iter_mut().zip(b.layers) {
+            if !class.contains(l) {
+                *w = 0.0;
+            }
+            has_non_delta |= *w > 0.0 && !l.is_delta();
+        }
+        b.total = b.weights.iter().sum();
+        b.has_non_delta = has_non_delta;
+        if b.total <= 0.0 {
+            b.lambert = None;
+        }
+        b
     }
 
     /// Reflectance at normal incidence summed over layers: the albedo AOV.

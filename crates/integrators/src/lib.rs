@@ -19,10 +19,12 @@
 //! Depends on `rt-core` and `rt-film`.
 #![forbid(unsafe_code)]
 
+mod adjoint;
 mod ao;
 mod bdpt;
 pub mod driver;
 mod light;
+pub mod partitioned;
 mod path;
 pub mod spec;
 pub mod technique;
@@ -31,6 +33,7 @@ pub use ao::AoIntegrator;
 pub use bdpt::Bdpt;
 pub use driver::{render, render_samples, RenderOptions, RenderStats, SamplePass};
 pub use light::LightTracer;
+pub use partitioned::{Culling, PartitionOptions, PartitionStats, Partitioned};
 pub use path::PathIntegrator;
 pub use spec::{
     IntegratorKind, IntegratorSpec, IntegratorSpecError, Target, DEFAULT_MAX_DEPTH, MAX_DEPTH,

@@ -10,10 +10,14 @@
 //!
 //! | option | kinds | meaning |
 //! |---|---|---|
-//! | `max-depth=N` | path, path-bsdf, light, bdpt | bounce limit (default [`DEFAULT_MAX_DEPTH`], at most [`MAX_DEPTH`]) |
+//! | `max-depth=N` | path, path-bsdf, light, bdpt, partitioned |
+//! | `vpls=N`, `photons=N`, `clamp=F`, `cull=off\|unbiased\|biased`, `maps=on\|off` | partitioned | VPL paths and caustic photons per pass (16, 100000), G-clamp distance as a fraction of the scene diagonal (0.001), VPL culling (unbiased), projection maps (on): [`PartitionOptions`] | bounce limit (default [`DEFAULT_MAX_DEPTH`], at most [`MAX_DEPTH`]) |
 //! | `distance=F` | ao | occluder distance (default unlimited) |
 
-use crate::{AoIntegrator, Bdpt, CameraRays, LightTracer, PathIntegrator, Technique};
+use crate::{
+    AoIntegrator, Bdpt, CameraRays, Culling, LightTracer, PartitionOptions, Partitioned,
+    PathIntegrator, Technique,
+};
 use std::fmt;
 use std::str::FromStr;
 
@@ -41,17 +45,21 @@ pub enum IntegratorKind {
     Light,
     /// Bidirectional path tracing with MIS over all strategies ([`Bdpt`]).
     Bdpt,
+    /// The path-space-partitioned progressive renderer: VPLs, caustic histogram, specular
+    /// gathering ([`Partitioned`]).
+    Partitioned,
 }
 
 impl IntegratorKind {
     /// Every kind, in the order help texts list them.
-    pub const ALL: [IntegratorKind; 6] = [
+    pub const ALL: [IntegratorKind; 7] = [
         IntegratorKind::Path,
         IntegratorKind::PathBsdf,
         IntegratorKind::Direct,
         IntegratorKind::Ao,
         IntegratorKind::Light,
         IntegratorKind::Bdpt,
+        IntegratorKind::Partitioned,
     ];
 
     /// The name used in specs and reports.
@@ -63,6 +71,7 @@ impl IntegratorKind {
             IntegratorKind::Ao => "ao",
             IntegratorKind::Light => "light",
             IntegratorKind::Bdpt => "bdpt",
+            IntegratorKind::Partitioned => "partitioned",
         }
     }
 
@@ -74,6 +83,7 @@ impl IntegratorKind {
                 | IntegratorKind::PathBsdf
                 | IntegratorKind::Light
                 | IntegratorKind::Bdpt
+                | IntegratorKind::Partitioned
         )
     }
 
@@ -116,6 +126,8 @@ pub struct IntegratorSpec {
     pub max_depth: Option<u32>,
     /// Occluder distance of `ao` (infinite: unlimited).
     pub ao_distance: f32,
+    /// Parameters of `partitioned`.
+    pub partition: PartitionOptions,
 }
 
 /// What an estimator converges to. Two estimators with the same target can be measured against
@@ -153,7 +165,7 @@ pub enum IntegratorSpecError {
     #[error("\"{0}\" is not one of {names}", names = IntegratorKind::names())]
     UnknownKind(String),
     /// An option this crate does not know, or one that does not apply to the kind.
-    #[error("option `{option}` does not apply to `{kind}` (options: max-depth=N for path, path-bsdf, light and bdpt, distance=F for ao)")]
+    #[error("option `{option}` does not apply to `{kind}` (options: max-depth=N for path, path-bsdf, light, bdpt and partitioned, distance=F for ao, vpls=N, photons=N, clamp=F, cull=off|unbiased|biased and maps=on|off for partitioned)")]
     UnknownOption {
         /// The integrator.
         kind: IntegratorKind,
@@ -166,6 +178,14 @@ pub enum IntegratorSpecError {
     /// An occluder distance that is not positive or does not parse.
     #[error("ao distance must be positive, got {0}")]
     BadDistance(String),
+    /// A `partitioned` option out of range or not parsing.
+    #[error("partitioned option `{option}`: {what}")]
+    BadPartitionOption {
+        /// The option as written.
+        option: String,
+        /// What it must be.
+        what: &'static str,
+    },
 }
 
 /// A bounce limit, checked against [`MAX_DEPTH`]: the one check, wherever the value comes from.
@@ -191,6 +211,7 @@ impl IntegratorSpec {
             kind,
             max_depth: None,
             ao_distance: f32::INFINITY,
+            partition: PartitionOptions::default(),
         }
     }
 
@@ -224,6 +245,9 @@ impl IntegratorSpec {
             })),
             IntegratorKind::Light => Box::new(LightTracer::new(self.depth())),
             IntegratorKind::Bdpt => Box::new(Bdpt::new(self.depth())),
+            IntegratorKind::Partitioned => {
+                Box::new(Partitioned::new(self.depth(), self.partition))
+            }
         }
     }
 
@@ -235,7 +259,8 @@ impl IntegratorSpec {
             IntegratorKind::Path
             | IntegratorKind::PathBsdf
             | IntegratorKind::Light
-            | IntegratorKind::Bdpt => Target::Radiance {
+            | IntegratorKind::Bdpt
+            | IntegratorKind::Partitioned => Target::Radiance {
                 bounces: self.depth(),
             },
             IntegratorKind::Direct => Target::Radiance { bounces: 1 },
@@ -270,6 +295,16 @@ impl FromStr for IntegratorSpec {
                         .map_err(|_| IntegratorSpecError::BadDepth(value.to_string()))?;
                     spec.with_max_depth(depth)?
                 }
+                (key, IntegratorKind::Partitioned)
+                    if matches!(key, "vpls" | "photons" | "clamp" | "cull" | "maps") =>
+                {
+                    spec.partition = parse_partition_option(spec.partition, key, value.trim())
+                        .map_err(|what| IntegratorSpecError::BadPartitionOption {
+                            option: option.to_string(),
+                            what,
+                        })?;
+                    spec
+                }
                 ("distance", IntegratorKind::Ao) => {
                     let d: f32 = value
                         .trim()
@@ -289,6 +324,56 @@ impl FromStr for IntegratorSpec {
     }
 }
 
+/// Most VPL paths per pass a spec may ask for.
+pub const MAX_VPL_PATHS: u32 = 65_536;
+/// Most caustic photons per pass.
+pub const MAX_PHOTONS: u32 = 100_000_000;
+
+/// One `partitioned` option applied to `o`, or what its value must be.
+fn parse_partition_option(
+    mut o: PartitionOptions,
+    key: &str,
+    value: &str,
+) -> Result<PartitionOptions, &'static str> {
+    match key {
+        "vpls" => {
+            o.vpl_paths = value
+                .parse()
+                .ok()
+                .filter(|n| (1..=MAX_VPL_PATHS).contains(n))
+                .ok_or("VPL paths per pass must be an integer from 1 to 65536")?;
+        }
+        "photons" => {
+            o.photons = value
+                .parse()
+                .ok()
+                .filter(|n| (1..=MAX_PHOTONS).contains(n))
+                .ok_or("caustic photons per pass must be an integer from 1 to 100000000")?;
+        }
+        "clamp" => {
+            o.clamp = value
+                .parse()
+                .ok()
+                .filter(|c: &f32| c.is_finite() && *c >= 0.0)
+                .ok_or("the clamp distance (a fraction of the scene's diagonal) must be a number at least 0")?;
+        }
+        "cull" => {
+            o.cull = [Culling::Off, Culling::Unbiased, Culling::Biased]
+                .into_iter()
+                .find(|c| c.name() == value)
+                .ok_or("culling must be off, unbiased or biased")?;
+        }
+        _ => {
+            o.projection_maps = match value {
+                "on" => true,
+                "off" => false,
+                _ => return Err("projection maps must be on or off"),
+            };
+        }
+    }
+    Ok(o)
+}
+
 impl fmt::Display for IntegratorSpec {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.kind.name())?;
@@ -297,6 +382,24 @@ impl fmt::Display for IntegratorSpec {
         }
         if self.kind == IntegratorKind::Ao && self.ao_distance.is_finite() {
             write!(f, ":distance={}", self.ao_distance)?;
+        }
+        if self.kind == IntegratorKind::Partitioned {
+            let (o, d) = (self.partition, PartitionOptions::default());
+            if o.vpl_paths != d.vpl_paths {
+                write!(f, ":vpls={}", o.vpl_paths)?;
+            }
+            if o.photons != d.photons {
+                write!(f, ":photons={}", o.photons)?;
+            }
+            if o.clamp != d.clamp {
+                write!(f, ":clamp={}", o.clamp)?;
+            }
+            if o.cull != d.cull {
+                write!(f, ":cull={}", o.cull.name())?;
+            }
+            if o.projection_maps != d.projection_maps {
+                write!(f, ":maps=off")?;
+            }
         }
         Ok(())
     }
@@ -318,7 +421,7 @@ mod tests {
         let e = "vcm".parse::<IntegratorSpec>().unwrap_err();
         assert_eq!(
             e.to_string(),
-            "\"vcm\" is not one of path, path-bsdf, direct, ao, light, bdpt"
+            "\"vcm\" is not one of path, path-bsdf, direct, ao, light, bdpt, partitioned"
         );
     }
 

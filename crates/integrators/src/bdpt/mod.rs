@@ -32,6 +32,7 @@
 mod vertex;
 
 use crate::driver::{RenderStats, SamplePass};
+use crate::adjoint::adjoint_cos;
 use crate::technique::Technique;
 use crate::{Ctx, RayCounters};
 use rayon::prelude::*;
@@ -687,15 +688,4 @@ fn mis_weight(cam: &[Vertex], light: &[Vertex], s: usize, t: usize, ov: &Overrid
     } else {
         0.0
     }
-}
-
-/// The cosine factor of importance transport with shading normals (Veach 1997, eq. 5.17); see
-/// [`crate::LightTracer`].
-#[inline]
-fn adjoint_cos(wo: Vec3, wi: Vec3, ns: Vec3, ng: Vec3) -> f32 {
-    let wo_ng = wo.dot(ng).abs();
-    if wo_ng <= 0.0 {
-        return 0.0;
-    }
-    wo.dot(ns).abs() * wi.dot(ng).abs() / wo_ng
 }

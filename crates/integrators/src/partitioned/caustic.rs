@@ -1,0 +1,280 @@
+//! The caustic histogram of the partitioned renderer (Dammertz 2011, §6.3.2): the pass's eye
+//! vertices are the bins, in a point kd-tree with a radius each; photons leave the primary
+//! lights, must meet a specular part first, and at every later vertex land in the nearest bin
+//! that covers them (part B, `EDS(S|D)*L`, and behind specular chains part C).
+//!
+//! A photon's contribution to its bin's pixel is `β_eye · f_D(ω_photon) · Φ / (π r²)`, `Φ` the
+//! photon's power over the draws of its light (rejected draws of the projection maps
+//! included). Bias: the density estimate over a disc of half the pixel footprint blurs the
+//! caustic like a reconstruction filter of that size. Deviation: a photon only lands in a bin
+//! whose surface faces the same way (normals within 25°, the eye and the photon on the same
+//! side), which keeps caustics from leaking round corners and through thin walls.
+
+use super::eye::EyeVertex;
+use super::projection::{Occupant, ProjectionMap};
+use super::vpl::PrimaryLight;
+use super::Partitioned;
+use crate::adjoint::adjoint_cos;
+use crate::{Ctx, RayCounters};
+use rayon::prelude::*;
+use rt_accel::points::{PointItem, PointKdTree, PointQuery};
+use rt_core::{
+    emission::plane_sample,
+    frame::Frame,
+    glam::{Vec2, Vec3},
+    material::{Bsdf, LayerClass},
+    ray::spawn_ray,
+    sampling::cosine_hemisphere,
+    Aabb, Ray, Rgb, SampleStream, Sampler,
+};
+use std::f32::consts::PI;
+use std::time::{Duration, Instant};
+
+/// Photons per parallel work item.
+const CHUNK: u32 = 1024;
+
+/// Cosine of the largest angle between a bin's and a photon's surface normals.
+const SAME_SURFACE_COS: f32 = 0.9;
+
+/// What one pass's caustic photons did.
+#[derive(Default)]
+pub(super) struct CausticPass {
+    /// Per pixel, the sum of its bin's photons.
+    pub radiance: Vec<Rgb>,
+    /// Photon draws (the normalisation), traced photons, photons landed in a bin.
+    pub emitted: u64,
+    pub traced: u64,
+    pub landed: u64,
+    /// Sum over the emitter lights of their map's coverage, and how many maps.
+    pub coverage_sum: f64,
+    pub maps: u64,
+    pub map_time: Duration,
+}
+
+/// The specular triangles of a scene, as the projection maps see them.
+pub(super) fn occupants(scene: &rt_core::Scene) -> Vec<Occupant> {
+    let specular = |m: &rt_core::Material| {
+        m.layers
+            .iter()
+            .any(|l| l.weight > 0.0 && LayerClass::Specular.contains(l))
+    };
+    scene
+        .triangles
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| specular(scene.material_of(*i as u32)))
+        .map(|(_, v)| {
+            let b = Aabb::from_points(v.iter());
+            let center = b.center();
+            let radius = v.iter().map(|p| p.distance(center)).fold(0.0, f32::max);
+            Occupant {
+                center,
+                radius: radius * (1.0 + 1e-4) + 1e-6 * center.abs().max_element(),
+            }
+        })
+        .collect()
+}
+
+/// One work item: photons `first..first + count` of primary light `light`.
+#[derive(Clone, Copy)]
+struct Item {
+    light: usize,
+    first: u32,
+    count: u32,
+}
+
+impl Partitioned {
+    /// Traces the pass's caustic photons into the bins at `eyes`.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn caustics(
+        &self,
+        ctx: &Ctx<'_>,
+        bounds: &Aabb,
+        seed: u32,
+        stream: SampleStream,
+        index: u32,
+        eyes: &[EyeVertex],
+        primaries: &[PrimaryLight],
+        occupants: &[Occupant],
+        counters: &mut RayCounters,
+    ) -> CausticPass {
+        let pixels = (ctx.camera.width * ctx.camera.height) as usize;
+        let mut out = CausticPass {
+            radiance: vec![Rgb::ZERO; pixels],
+            ..CausticPass::default()
+        };
+        let per_light = self.options.photons / self.options.vpl_paths.max(1);
+        if occupants.is_empty() || primaries.is_empty() || per_light == 0 {
+            return out;
+        }
+        let items: Vec<PointItem> = eyes
+            .iter()
+            .enumerate()
+            .filter(|(_, e)| e.radius > 0.0 && e.radius.is_finite())
+            .map(|(i, e)| PointItem::with_radius(e.p, i as u32, e.radius))
+            .collect();
+        let Ok(bins) = PointKdTree::build(&items) else {
+            return out;
+        };
+        if bins.is_empty() {
+            return out;
+        }
+        let start = Instant::now();
+        let maps: Vec<Option<ProjectionMap>> = primaries
+            .iter()
+            .map(|l| {
+                (self.options.projection_maps && l.travel == Vec3::ZERO)
+                    .then(|| ProjectionMap::build(l.p, l.n, l.two_sided, occupants))
+            })
+            .collect();
+        out.map_time = start.elapsed();
+        for m in maps.iter().flatten() {
+            out.coverage_sum += f64::from(m.coverage());
+            out.maps += 1;
+        }
+        let work: Vec<Item> = (0..primaries.len())
+            .flat_map(|light| {
+                (0..per_light.div_ceil(CHUNK)).map(move |c| Item {
+                    light,
+                    first: c * CHUNK,
+                    count: CHUNK.min(per_light - c * CHUNK),
+                })
+            })
+            .collect();
+        let vpl_paths = self.options.vpl_paths;
+        let results: Vec<(Vec<(u32, Rgb)>, RayCounters, u64)> = work
+            .par_iter()
+            .map(|item| {
+                let mut sampler = Sampler::with_stream(seed, stream);
+                let mut query = PointQuery::new(1);
+                let mut deposits = Vec::new();
+                let mut rays = RayCounters::default();
+                let mut traced = 0u64;
+                let light = &primaries[item.light];
+                let phi = light.beta / per_light as f32;
+                for m in item.first..item.first + item.count {
+                    let k = vpl_paths + item.light as u32 * per_light + m;
+                    sampler.start_light_path(k, index);
+                    let u = sampler.next_2d();
+                    let Some(ray) = photon_ray(light, maps[item.light].as_ref(), bounds, u) else {
+                        continue;
+                    };
+                    traced += 1;
+                    self.trace_photon(
+                        ctx, ray, phi, &mut sampler, &bins, &mut query, eyes, &mut deposits,
+                        &mut rays,
+                    );
+                }
+                (deposits, rays, traced)
+            })
+            .collect();
+        for (deposits, rays, traced) in results {
+            out.landed += deposits.len() as u64;
+            for (pixel, v) in deposits {
+                out.radiance[pixel as usize] += v;
+            }
+            *counters += rays;
+            out.traced += traced;
+        }
+        out.emitted = u64::from(per_light) * primaries.len() as u64;
+        out
+    }
+
+    /// Follows one photon through specular parts, landing it in a bin at every vertex after
+    /// the first.
+    #[allow(clippy::too_many_arguments)]
+    fn trace_photon(
+        &self,
+        ctx: &Ctx<'_>,
+        mut ray: Ray,
+        mut beta: Rgb,
+        sampler: &mut Sampler,
+        bins: &PointKdTree,
+        query: &mut PointQuery,
+        eyes: &[EyeVertex],
+        deposits: &mut Vec<(u32, Rgb)>,
+        counters: &mut RayCounters,
+    ) {
+        let scene = ctx.scene;
+        for bounce in 0..self.max_depth {
+            counters.rays += 1;
+            let Some(hit) = ctx.accel.intersect(&ray, f32::INFINITY) else {
+                return;
+            };
+            let si = scene.surface(&hit);
+            let wo = -ray.dir;
+            if bounce > 0 {
+                if let Some(n) = bins.nearest_covering(si.p, query) {
+                    let e = &eyes[n.payload as usize];
+                    let same_side = e.wo.dot(si.ng) * wo.dot(si.ng) > 0.0;
+                    if e.depth + bounce <= self.max_depth
+                        && same_side
+                        && e.ng.dot(si.ng) >= SAME_SURFACE_COS
+                    {
+                        let f = e.diffuse_bsdf(ctx).eval(wo);
+                        let v = e.beta * f * beta / (PI * e.radius * e.radius);
+                        if v.max_element() > 0.0 && v.is_finite() {
+                            deposits.push((e.pixel, v));
+                        }
+                    }
+                }
+            }
+            let material = &scene.materials[si.material as usize];
+            let tint = scene.tint(material, si.uv);
+            let u_layer = sampler.next_1d();
+            let u_bsdf = sampler.next_2d();
+            let u_rr = sampler.next_1d();
+            // Only the specular part carries a photon on: its diffuse part is the VPLs'.
+            let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo).restricted(LayerClass::Specular);
+            let Some(s) = bsdf.sample(u_layer, u_bsdf) else {
+                return;
+            };
+            let cos_ns = s.wi.dot(si.ns).abs();
+            let correction = if cos_ns > 0.0 {
+                adjoint_cos(wo, s.wi, si.ns, si.ng) / cos_ns
+            } else {
+                0.0
+            };
+            beta *= s.weight * correction;
+            if beta.max_element() <= 0.0 || !beta.is_finite() {
+                return;
+            }
+            if bounce + 1 > self.rr_depth {
+                let q = beta.max_element().min(0.95);
+                if u_rr >= q {
+                    return;
+                }
+                beta /= q;
+            }
+            ray = spawn_ray(si.p, si.p_error, si.ng, s.wi);
+        }
+    }
+}
+
+/// The ray of a photon from `light` for random numbers `u`, or `None` when the projection map
+/// rejects its direction (it would meet a diffuse surface first).
+fn photon_ray(light: &PrimaryLight, map: Option<&ProjectionMap>, bounds: &Aabb, u: Vec2) -> Option<Ray> {
+    if light.travel != Vec3::ZERO {
+        let (o, _) = plane_sample(bounds, light.travel, u)?;
+        return Some(Ray::new(o, light.travel));
+    }
+    let (side, u) = if light.two_sided {
+        if u.x < 0.5 {
+            (1.0, Vec2::new(u.x * 2.0, u.y))
+        } else {
+            (-1.0, Vec2::new(u.x * 2.0 - 1.0, u.y))
+        }
+    } else {
+        (1.0, u)
+    };
+    let n = light.n * side;
+    let local = cosine_hemisphere(u);
+    if local.z <= 0.0 {
+        return None;
+    }
+    let dir = Frame::from_normal(n).to_world(local).normalize();
+    if map.is_some_and(|m| !m.allows(dir)) {
+        return None;
+    }
+    Some(spawn_ray(light.p, light.p_error, n, dir))
+}
