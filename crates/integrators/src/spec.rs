@@ -245,9 +245,7 @@ impl IntegratorSpec {
             })),
             IntegratorKind::Light => Box::new(LightTracer::new(self.depth())),
             IntegratorKind::Bdpt => Box::new(Bdpt::new(self.depth())),
-            IntegratorKind::Partitioned => {
-                Box::new(Partitioned::new(self.depth(), self.partition))
-            }
+            IntegratorKind::Partitioned => Box::new(Partitioned::new(self.depth(), self.partition)),
         }
     }
 

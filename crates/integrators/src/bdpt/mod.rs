@@ -31,8 +31,8 @@
 
 mod vertex;
 
-use crate::driver::{RenderStats, SamplePass};
 use crate::adjoint::adjoint_cos;
+use crate::driver::{RenderStats, SamplePass};
 use crate::technique::Technique;
 use crate::{Ctx, RayCounters};
 use rayon::prelude::*;

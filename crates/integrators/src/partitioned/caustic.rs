@@ -161,7 +161,14 @@ impl Partitioned {
                     };
                     traced += 1;
                     self.trace_photon(
-                        ctx, ray, phi, &mut sampler, &bins, &mut query, eyes, &mut deposits,
+                        ctx,
+                        ray,
+                        phi,
+                        &mut sampler,
+                        &bins,
+                        &mut query,
+                        eyes,
+                        &mut deposits,
                         &mut rays,
                     );
                 }
@@ -253,7 +260,12 @@ impl Partitioned {
 
 /// The ray of a photon from `light` for random numbers `u`, or `None` when the projection map
 /// rejects its direction (it would meet a diffuse surface first).
-fn photon_ray(light: &PrimaryLight, map: Option<&ProjectionMap>, bounds: &Aabb, u: Vec2) -> Option<Ray> {
+fn photon_ray(
+    light: &PrimaryLight,
+    map: Option<&ProjectionMap>,
+    bounds: &Aabb,
+    u: Vec2,
+) -> Option<Ray> {
     if light.travel != Vec3::ZERO {
         let (o, _) = plane_sample(bounds, light.travel, u)?;
         return Some(Ray::new(o, light.travel));

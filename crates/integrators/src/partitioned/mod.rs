@@ -245,7 +245,13 @@ impl Technique for Partitioned {
                     continue;
                 }
                 let value = e.emitted + l + caustics.radiance[k];
-                film.add_sample(k as u32 % w, k as u32 / w, index, value, e.first_hit.as_ref());
+                film.add_sample(
+                    k as u32 % w,
+                    k as u32 / w,
+                    index,
+                    value,
+                    e.first_hit.as_ref(),
+                );
                 samples += 1;
             }
             let t3 = Instant::now();
@@ -273,7 +279,11 @@ impl Technique for Partitioned {
             total.photons_traced += stats.photons_traced;
             total.photons_landed += stats.photons_landed;
             total.maps = maps;
-            total.mean_coverage = if maps > 0 { coverage / maps as f64 } else { 0.0 };
+            total.mean_coverage = if maps > 0 {
+                coverage / maps as f64
+            } else {
+                0.0
+            };
             total.map_time += stats.map_time;
             total.caustic_time += stats.caustic_time;
             total.other_time += stats.other_time;

@@ -164,7 +164,10 @@ mod tests {
                 let w = (q - p).normalize();
                 let in_hemisphere = case % 2 == 0 || w.dot(n) >= 0.0;
                 if in_hemisphere && (q - p).length() > radius {
-                    assert!(map.allows(w), "case {case}: {w} towards {center} r {radius}");
+                    assert!(
+                        map.allows(w),
+                        "case {case}: {w} towards {center} r {radius}"
+                    );
                 }
             }
         }
@@ -177,7 +180,11 @@ mod tests {
             radius: 0.5,
         };
         let map = ProjectionMap::build(Vec3::ZERO, Vec3::Z, false, &[o]);
-        assert!(map.coverage() > 0.0 && map.coverage() < 0.02, "{}", map.coverage());
+        assert!(
+            map.coverage() > 0.0 && map.coverage() < 0.02,
+            "{}",
+            map.coverage()
+        );
         let behind = Occupant {
             center: Vec3::new(0.0, 0.0, -10.0),
             radius: 0.5,

@@ -132,7 +132,16 @@ impl Partitioned {
             } else {
                 Ray::new(e.origin, e.dir)
             };
-            self.walk(ctx, ray, e.beta * scale, &mut sampler, sentinels, &mut vpls, counters, culled);
+            self.walk(
+                ctx,
+                ray,
+                e.beta * scale,
+                &mut sampler,
+                sentinels,
+                &mut vpls,
+                counters,
+                culled,
+            );
         }
         (vpls, primaries)
     }
@@ -167,7 +176,8 @@ impl Partitioned {
             let u_rr = sampler.next_1d();
             let u_cull = sampler.next_1d();
             if bsdf.share(LayerClass::Diffuse) > 0.0 {
-                let weight = self.cull_weight(ctx, si.p, si.p_error, si.ng, sentinels, u_cull, counters);
+                let weight =
+                    self.cull_weight(ctx, si.p, si.p_error, si.ng, sentinels, u_cull, counters);
                 if weight > 0.0 {
                     vpls.push(Vpl {
                         source: Source::Surface {
