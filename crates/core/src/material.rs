@@ -29,10 +29,21 @@
 //!
 //! Radiance crossing into a medium of relative index η is scaled by `1/η²` (radiance, not
 //! importance, is transported by the camera paths here).
+//!
+//! Dispersion (thesis §6.6, [`crate::spectral`]): a smooth transmitting layer may have a
+//! wavelength-dependent index. When [`Bsdf::sample`] chooses such a layer on a path without a
+//! wavelength, it draws λ from the lobe's 2-D number (which a delta lobe does not otherwise use),
+//! multiplies the sample weight by the RGB weight of λ and reports λ in
+//! [`BsdfSample::wavelength`]; the caller passes it to every later vertex through
+//! [`Bsdf::with_wavelength`], where the same λ picks the index and no new weight is applied.
+//! Both the Fresnel choice and the refraction use `n(λ)`, so reflection off dispersive glass is a
+//! dispersive event too. Dispersion is limited to delta layers: their `eval` is zero, so light
+//! connections never need a wavelength the path does not have yet.
 
 use crate::{
     frame::Frame,
     sampling::{blinn_phong_half, blinn_phong_half_pdf, cosine_hemisphere},
+    spectral::{sample_wavelength, Dispersion},
     Rgb,
 };
 use glam::{Vec2, Vec3};
@@ -64,6 +75,9 @@ pub struct Layer {
     pub ior: f32,
     /// A Fresnel-weighted clear coat over the layers after it.
     pub coat: bool,
+    /// Wavelength-dependent index for a smooth transmitting layer; `ior` then holds `n_d` (the
+    /// index at 587.56 nm), used where no wavelength is known.
+    pub dispersion: Option<Dispersion>,
 }
 
 impl Layer {
@@ -77,6 +91,7 @@ impl Layer {
             transmission: false,
             ior: 1.5,
             coat: false,
+            dispersion: None,
         }
     }
 
@@ -242,6 +257,18 @@ impl Material {
             if l.coat && l.transmission {
                 return bad("a layer cannot be both a coat and transmissive".into());
             }
+            if let Some(d) = &l.dispersion {
+                if !(l.transmission && l.is_delta()) {
+                    return bad(
+                        "dispersion applies to smooth transmitting layers only (transmission \
+                         with hardness 1)"
+                            .into(),
+                    );
+                }
+                if let Err(e) = d.validate() {
+                    return bad(format!("dispersion: {e}"));
+                }
+            }
             check_color(l.color, "color", i)?;
             check_color(l.color90, "color90", i)?;
             if !l.coat {
@@ -293,6 +320,11 @@ pub struct BsdfSample {
     pub delta: bool,
     /// The direction crossed the surface.
     pub transmitted: bool,
+    /// The path's wavelength in nm after this sample: the BSDF's own
+    /// ([`Bsdf::with_wavelength`]), or the one drawn here at a dispersive event of a path that
+    /// had none (its RGB weight is then in `weight`). `None` for an RGB path. Pass it to the
+    /// next vertex's BSDF.
+    pub wavelength: Option<f32>,
 }
 
 /// A material evaluated at one surface point for one outgoing direction.
@@ -314,6 +346,11 @@ pub struct Bsdf<'a> {
     /// [`Bsdf::sample`], need no layer loop. The arithmetic is the general path's, operation
     /// for operation, so both give the same bits.
     lambert: Option<Rgb>,
+    /// The path's wavelength, nm (`None`: an RGB path).
+    wavelength: Option<f32>,
+    /// Dispersive layers use their wavelength-dependent index (false: `ior` = `n_d`, as an RGB
+    /// renderer would; for tests that compare against the renderer without spectral code).
+    spectral: bool,
 }
 
 impl<'a> Bsdf<'a> {
@@ -357,7 +394,25 @@ impl<'a> Bsdf<'a> {
             total,
             has_non_delta,
             lambert,
+            wavelength: None,
+            spectral: true,
         }
+    }
+
+    /// The BSDF for a path that already carries wavelength `lambda` nm (from an earlier
+    /// dispersive event, [`BsdfSample::wavelength`]); `None` leaves the path RGB.
+    #[inline]
+    pub fn with_wavelength(mut self, lambda: Option<f32>) -> Self {
+        self.wavelength = lambda;
+        self
+    }
+
+    /// Treats dispersive layers as plain glass of index `n_d`: the renderer as if it had no
+    /// spectral code. For tests.
+    #[doc(hidden)]
+    pub fn without_dispersion(mut self) -> Self {
+        self.spectral = false;
+        self
     }
 
     /// True if some non-delta lobe has weight, i.e. light sampling can contribute.
@@ -446,7 +501,24 @@ impl<'a> Bsdf<'a> {
         let (i, u_rest) = chosen?;
         let l = &self.layers[i];
         let wo = self.wo_local;
-        let (wi_local, delta_weight) = if l.is_delta() {
+        let mut wavelength = self.wavelength;
+        let (wi_local, delta_weight) = if let (Some(d), true) = (&l.dispersion, self.spectral) {
+            // A dispersive event. A delta lobe leaves `u` unused, so a new wavelength comes
+            // from `u.x`: no sampler dimension is added, and non-dispersive paths are untouched.
+            let (lambda, spectral_weight) = match self.wavelength {
+                Some(lambda) => (lambda, Rgb::ONE),
+                None => {
+                    let s = sample_wavelength(u.x);
+                    (s.lambda, s.weight)
+                }
+            };
+            wavelength = Some(lambda);
+            let (wi, scale) = sample_delta_eta(l, d.ior(lambda), wo, u_rest)?;
+            (
+                wi,
+                Some(l.color_at(wo.z.abs(), self.tint) * spectral_weight * (self.total * scale)),
+            )
+        } else if l.is_delta() {
             let (wi, scale) = sample_delta(l, wo, u_rest)?;
             (
                 wi,
@@ -464,6 +536,7 @@ impl<'a> Bsdf<'a> {
                 pdf: self.weights[i] / self.total,
                 delta: true,
                 transmitted: !reflect,
+                wavelength,
             });
         }
         let (f, pdf) = self.eval_pdf(wi);
@@ -476,6 +549,7 @@ impl<'a> Bsdf<'a> {
             pdf,
             delta: false,
             transmitted: !reflect,
+            wavelength,
         })
     }
 }
@@ -543,6 +617,20 @@ fn sample_delta(l: &Layer, wo: Vec3, u: f32) -> Option<(Vec3, f32)> {
         return Some((mirror, 1.0));
     }
     let eta = relative_eta(l, wo);
+    delta_dielectric(wo, eta, u)
+}
+
+/// [`sample_delta`] of a transmitting layer whose index is `ior` (a dispersive layer's `n(λ)`).
+fn sample_delta_eta(l: &Layer, ior: f32, wo: Vec3, u: f32) -> Option<(Vec3, f32)> {
+    debug_assert!(l.transmission);
+    let eta = if wo.z > 0.0 { ior } else { 1.0 / ior };
+    delta_dielectric(wo, eta, u)
+}
+
+/// Smooth dielectric interface of relative index `eta`: Fresnel chooses with `u`.
+#[inline]
+fn delta_dielectric(wo: Vec3, eta: f32, u: f32) -> Option<(Vec3, f32)> {
+    let mirror = Vec3::new(-wo.x, -wo.y, wo.z);
     let f = fresnel_dielectric(wo.z.abs(), eta);
     if u < f {
         return Some((mirror, 1.0));
@@ -637,6 +725,7 @@ impl crate::content_hash::ContentHash for Layer {
             transmission,
             ior,
             coat,
+            dispersion,
         } = self;
         weight.content_hash(out);
         color.content_hash(out);
@@ -645,6 +734,11 @@ impl crate::content_hash::ContentHash for Layer {
         transmission.content_hash(out);
         ior.content_hash(out);
         coat.content_hash(out);
+        // Only when present, so that every non-dispersive scene keeps the hash (and the cached
+        // experiment results) it had before dispersion existed.
+        if let Some(d) = dispersion {
+            d.content_hash(out);
+        }
     }
 }
 
