@@ -815,4 +815,91 @@ mod tests {
         assert!((s.wi.x.abs() - 0.6 / 1.5).abs() < 1e-5 && s.wi.z < 0.0);
         assert!((s.weight.x - 1.0 / 2.25).abs() < 1e-5);
     }
+
+    fn flint() -> Material {
+        let d = Dispersion::preset("sf11").unwrap();
+        let mut m = Material::glass("g", Rgb::ONE, d.ior(crate::spectral::LAMBDA_D), 1.0);
+        m.layers[0].dispersion = Some(d);
+        m
+    }
+
+    /// A path without a wavelength gets one from `u.x` at a dispersive event, with its RGB
+    /// weight; a path with one refracts by `n(λ)` and gets no new weight.
+    #[test]
+    fn dispersive_glass_draws_a_wavelength_once_and_refracts_by_it() {
+        let m = flint();
+        assert_eq!(m.validate(), Ok(()));
+        let d = m.layers[0].dispersion.unwrap();
+        let wo = Vec3::new(0.6, 0.0, 0.8);
+        let b = Bsdf::new(&m, Rgb::ONE, Vec3::Z, Vec3::Z, wo);
+        for u in [0.1, 0.5, 0.9] {
+            let s = b.sample(0.99, Vec2::new(u, 0.3)).unwrap();
+            let w = crate::spectral::sample_wavelength(u);
+            assert_eq!(s.wavelength, Some(w.lambda));
+            let n = d.ior(w.lambda);
+            assert!(s.transmitted && s.delta);
+            assert!(
+                (s.wi.x.abs() - 0.6 / n).abs() < 1e-5,
+                "Snell at n({})",
+                w.lambda
+            );
+            assert!((s.weight - w.weight / (n * n)).length() < 1e-5);
+            // The same λ given by an earlier event: same direction, no spectral weight.
+            let fixed =
+                Bsdf::new(&m, Rgb::ONE, Vec3::Z, Vec3::Z, wo).with_wavelength(Some(w.lambda));
+            let t = fixed.sample(0.99, Vec2::new(0.77, 0.3)).unwrap();
+            assert_eq!(t.wavelength, Some(w.lambda));
+            assert!((t.wi - s.wi).length() < 1e-6);
+            assert!((t.weight - Rgb::splat(1.0 / (n * n))).length() < 1e-5);
+        }
+        // Blue bends more than red.
+        let at = |lambda| {
+            Bsdf::new(&m, Rgb::ONE, Vec3::Z, Vec3::Z, wo)
+                .with_wavelength(Some(lambda))
+                .sample(0.99, Vec2::ZERO)
+                .unwrap()
+                .wi
+                .x
+                .abs()
+        };
+        assert!(at(420.0) < at(680.0) - 1e-3);
+        // Reflection off dispersive glass is a dispersive event too (Fresnel depends on n(λ)).
+        let r = b.sample(0.0, Vec2::new(0.5, 0.0)).unwrap();
+        assert!(!r.transmitted && r.wavelength.is_some());
+        // A non-dispersive material leaves the path's wavelength as it was.
+        let plain = Material::diffuse("d", Rgb::ONE);
+        let p = Bsdf::new(&plain, Rgb::ONE, Vec3::Z, Vec3::Z, wo).with_wavelength(Some(500.0));
+        assert_eq!(
+            p.sample(0.5, Vec2::new(0.3, 0.3)).unwrap().wavelength,
+            Some(500.0)
+        );
+        let p = Bsdf::new(&plain, Rgb::ONE, Vec3::Z, Vec3::Z, wo);
+        assert_eq!(p.sample(0.5, Vec2::new(0.3, 0.3)).unwrap().wavelength, None);
+        // Without dispersion, the layer is glass of index n_d.
+        let off = b
+            .without_dispersion()
+            .sample(0.99, Vec2::new(0.1, 0.3))
+            .unwrap();
+        assert_eq!(off.wavelength, None);
+        assert!((off.wi.x.abs() - 0.6 / m.layers[0].ior).abs() < 1e-6);
+    }
+
+    #[test]
+    fn dispersion_needs_smooth_glass_and_valid_coefficients() {
+        let mut m = flint();
+        m.layers[0].hardness = 0.7;
+        let e = m.validate().unwrap_err().to_string();
+        assert!(e.contains("smooth transmitting layers only"), "{e}");
+        let mut m = flint();
+        m.layers[0].dispersion = Some(Dispersion::Cauchy {
+            a: 0.5,
+            b: 0.0,
+            c: 0.0,
+        });
+        let e = m.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("layer 0: dispersion: index of refraction must be in (1, 4]"),
+            "{e}"
+        );
+    }
 }

@@ -169,30 +169,31 @@ pub enum Dispersion {
     },
 }
 
-/// Named glasses: `(name, dispersion)`.
+/// Named glasses: `(name, dispersion)`, with the catalogue's digits (f32 keeps about seven).
+#[allow(clippy::excessive_precision)]
 pub const PRESETS: [(&str, Dispersion); 3] = [
     // Schott N-BK7, borosilicate crown: n_d = 1.5168, V_d = 64.17.
     (
         "bk7",
         Dispersion::Sellmeier {
-            b: [1.039_612_1, 0.231_792_34, 1.010_469_5],
-            c: [0.006_000_698_7, 0.020_017_914, 103.560_65],
+            b: [1.03961212, 0.231792344, 1.01046945],
+            c: [0.00600069867, 0.0200179144, 103.560653],
         },
     ),
     // Schott N-SF11, dense flint: n_d = 1.78472, V_d = 25.68.
     (
         "sf11",
         Dispersion::Sellmeier {
-            b: [1.737_597, 0.313_747_35, 1.898_781],
-            c: [0.013_188_707, 0.062_306_814, 155.236_29],
+            b: [1.73759695, 0.313747346, 1.89878101],
+            c: [0.013188707, 0.0623068142, 155.23629],
         },
     ),
-    // Fused silica (Malitson 1965): n_d = 1.4585.
+    // Fused silica (Malitson 1965, C = 0.0684043², 0.1162414², 9.896161² µm²): n_d = 1.4585.
     (
         "fused-silica",
         Dispersion::Sellmeier {
-            b: [0.696_166_3, 0.407_942_6, 0.897_479_4],
-            c: [0.004_679_148, 0.013_512_063, 97.934_0],
+            b: [0.6961663, 0.4079426, 0.8974794],
+            c: [0.004679148, 0.013512063, 97.934003],
         },
     ),
 ];

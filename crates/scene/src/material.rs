@@ -543,6 +543,65 @@ mod tests {
     }
 
     #[test]
+    fn dispersion_presets_tables_and_errors() {
+        let bk7 = Dispersion::preset("bk7").unwrap();
+        let m = ok("type = \"glass\"\ndispersion = \"BK7\"");
+        assert_eq!(m.layers[0].dispersion, Some(bk7));
+        assert!((m.layers[0].ior - 1.5168).abs() < 1e-4, "ior holds n_d");
+        let m = ok("type = \"glass\"\ndispersion = { cauchy = [1.5046, 0.0042] }");
+        assert_eq!(
+            m.layers[0].dispersion,
+            Some(Dispersion::Cauchy {
+                a: 1.5046,
+                b: 0.0042,
+                c: 0.0
+            })
+        );
+        let m = ok("type = \"glass\"\ndispersion = { sellmeier = { b = [1.03961212, 0.231792344, 1.01046945], c = [0.00600069867, 0.0200179144, 103.560653] } }");
+        assert_eq!(m.layers[0].dispersion, Some(bk7));
+        let m = ok("layers = [{ transmission = true, hardness = 1, dispersion = \"sf11\" }]");
+        assert_eq!(m.layers[0].dispersion, Dispersion::preset("sf11"));
+        let e = bad("type = \"glass\"\ndispersion = \"crown\"");
+        assert!(
+            e.contains("m.toml:4:14: material \"m\": unknown dispersion preset \"crown\"; the presets are \"bk7\", \"sf11\", \"fused-silica\""),
+            "{e}"
+        );
+        let e = bad("type = \"glass\"\ndispersion = { sellmeier = { b = [1, 0.2, 1], c = [0.006, 0.25, 100] } }");
+        assert!(
+            e.contains("m.toml:4:14: material \"m\": layer 0: dispersion: Sellmeier c = 0.25")
+                && e.contains("500 nm"),
+            "{e}"
+        );
+        let e = bad("type = \"glass\"\ndispersion = { cauchy = [1.5] }");
+        assert!(e.contains("`cauchy` needs 2 or 3 numbers, got 1"), "{e}");
+        let e = bad("type = \"glass\"\ndispersion = { abbe = 60 }");
+        assert!(e.contains("unknown dispersion model `abbe`"), "{e}");
+        let e = bad("type = \"glass\"\nior = 1.6\ndispersion = \"bk7\"");
+        assert!(
+            e.contains("`ior` and `dispersion` exclude each other"),
+            "{e}"
+        );
+        let e = bad("type = \"glass\"\nhardness = 0.5\ndispersion = \"bk7\"");
+        assert!(e.contains("smooth transmitting layers only"), "{e}");
+        let e = bad("type = \"mirror\"\ndispersion = \"bk7\"");
+        assert!(
+            e.contains("`dispersion` does not apply to type \"mirror\""),
+            "{e}"
+        );
+        let e = bad("layers = [{ dispersion = \"bk7\" }]");
+        assert!(
+            e.contains("m.toml:3:11:") && e.contains("smooth transmitting layers only"),
+            "{e}"
+        );
+        let e = bad("layers = [{ transmission = true, hardness = 1, dispersion = { cauchy = [0.9, 0.01] } }]");
+        assert!(
+            e.contains("m.toml:3:11:")
+                && e.contains("dispersion: index of refraction must be in (1, 4]"),
+            "{e}"
+        );
+    }
+
+    #[test]
     fn names_are_checked() {
         let e = mat("[[material]]\nname = \"a/b\"").unwrap_err();
         assert!(e.contains("must not contain '/'"), "{e}");
