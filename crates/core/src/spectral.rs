@@ -90,8 +90,8 @@ fn table() -> &'static Table {
             cdf: [0.0; BINS + 1],
         };
         let mut acc = 0.0f64;
-        for k in 0..BINS {
-            let c = [rgb[k][0] / sum[0], rgb[k][1] / sum[1], rgb[k][2] / sum[2]];
+        for (k, v) in rgb.iter().enumerate() {
+            let c = [v[0] / sum[0], v[1] / sum[1], v[2] / sum[2]];
             let p = (c[0] + c[1] + c[2]) / 3.0;
             t.prob[k] = p as f32;
             if p > 0.0 {
