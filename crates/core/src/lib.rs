@@ -39,6 +39,7 @@ pub mod sampler;
 pub mod sampling;
 pub mod scene;
 pub mod shapes;
+pub mod spectral;
 pub mod stage_time;
 pub mod texture;
 pub mod transform;

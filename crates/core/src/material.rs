@@ -29,10 +29,21 @@
 //!
 //! Radiance crossing into a medium of relative index η is scaled by `1/η²` (radiance, not
 //! importance, is transported by the camera paths here).
+//!
+//! Dispersion (thesis §6.6, [`crate::spectral`]): a smooth transmitting layer may have a
+//! wavelength-dependent index. When [`Bsdf::sample`] chooses such a layer on a path without a
+//! wavelength, it draws λ from the lobe's 2-D number (which a delta lobe does not otherwise use),
+//! multiplies the sample weight by the RGB weight of λ and reports λ in
+//! [`BsdfSample::wavelength`]; the caller passes it to every later vertex through
+//! [`Bsdf::with_wavelength`], where the same λ picks the index and no new weight is applied.
+//! Both the Fresnel choice and the refraction use `n(λ)`, so reflection off dispersive glass is a
+//! dispersive event too. Dispersion is limited to delta layers: their `eval` is zero, so light
+//! connections never need a wavelength the path does not have yet.
 
 use crate::{
     frame::Frame,
     sampling::{blinn_phong_half, blinn_phong_half_pdf, cosine_hemisphere},
+    spectral::{sample_wavelength, Dispersion},
     Rgb,
 };
 use glam::{Vec2, Vec3};
@@ -64,6 +75,9 @@ pub struct Layer {
     pub ior: f32,
     /// A Fresnel-weighted clear coat over the layers after it.
     pub coat: bool,
+    /// Wavelength-dependent index for a smooth transmitting layer; `ior` then holds `n_d` (the
+    /// index at 587.56 nm), used where no wavelength is known.
+    pub dispersion: Option<Dispersion>,
 }
 
 impl Layer {
@@ -77,6 +91,7 @@ impl Layer {
             transmission: false,
             ior: 1.5,
             coat: false,
+            dispersion: None,
         }
     }
 
@@ -242,6 +257,18 @@ impl Material {
             if l.coat && l.transmission {
                 return bad("a layer cannot be both a coat and transmissive".into());
             }
+            if let Some(d) = &l.dispersion {
+                if !(l.transmission && l.is_delta()) {
+                    return bad(
+                        "dispersion applies to smooth transmitting layers only (transmission \
+                         with hardness 1)"
+                            .into(),
+                    );
+                }
+                if let Err(e) = d.validate() {
+                    return bad(format!("dispersion: {e}"));
+                }
+            }
             check_color(l.color, "color", i)?;
             check_color(l.color90, "color90", i)?;
             if !l.coat {
@@ -312,6 +339,11 @@ pub struct BsdfSample {
     pub delta: bool,
     /// The direction crossed the surface.
     pub transmitted: bool,
+    /// The path's wavelength in nm after this sample: the BSDF's own
+    /// ([`Bsdf::with_wavelength`]), or the one drawn here at a dispersive event of a path that
+    /// had none (its RGB weight is then in `weight`). `None` for an RGB path. Pass it to the
+    /// next vertex's BSDF.
+    pub wavelength: Option<f32>,
 }
 
 /// A material evaluated at one surface point for one outgoing direction.
@@ -334,6 +366,11 @@ pub struct Bsdf<'a> {
     /// [`Bsdf::sample`], need no layer loop. The arithmetic is the general path's, operation
     /// for operation, so both give the same bits.
     lambert: Option<Rgb>,
+    /// The path's wavelength, nm (`None`: an RGB path).
+    wavelength: Option<f32>,
+    /// Dispersive layers use their wavelength-dependent index (false: `ior` = `n_d`, as an RGB
+    /// renderer would; for tests that compare against the renderer without spectral code).
+    spectral: bool,
 }
 
 impl<'a> Bsdf<'a> {
@@ -377,7 +414,25 @@ impl<'a> Bsdf<'a> {
             total,
             has_non_delta,
             lambert,
+            wavelength: None,
+            spectral: true,
         }
+    }
+
+    /// The BSDF for a path that already carries wavelength `lambda` nm (from an earlier
+    /// dispersive event, [`BsdfSample::wavelength`]); `None` leaves the path RGB.
+    #[inline]
+    pub fn with_wavelength(mut self, lambda: Option<f32>) -> Self {
+        self.wavelength = lambda;
+        self
+    }
+
+    /// Treats dispersive layers as plain glass of index `n_d`: the renderer as if it had no
+    /// spectral code. For tests.
+    #[doc(hidden)]
+    pub fn without_dispersion(mut self) -> Self {
+        self.spectral = false;
+        self
     }
 
     /// True if some non-delta lobe has weight, i.e. light sampling can contribute.
@@ -503,7 +558,24 @@ impl<'a> Bsdf<'a> {
         let (i, u_rest) = chosen?;
         let l = &self.layers[i];
         let wo = self.wo_local;
-        let (wi_local, delta_weight) = if l.is_delta() {
+        let mut wavelength = self.wavelength;
+        let (wi_local, delta_weight) = if let (Some(d), true) = (&l.dispersion, self.spectral) {
+            // A dispersive event. A delta lobe leaves `u` unused, so a new wavelength comes
+            // from `u.x`: no sampler dimension is added, and non-dispersive paths are untouched.
+            let (lambda, spectral_weight) = match self.wavelength {
+                Some(lambda) => (lambda, Rgb::ONE),
+                None => {
+                    let s = sample_wavelength(u.x);
+                    (s.lambda, s.weight)
+                }
+            };
+            wavelength = Some(lambda);
+            let (wi, scale) = sample_delta_eta(l, d.ior(lambda), wo, u_rest)?;
+            (
+                wi,
+                Some(l.color_at(wo.z.abs(), self.tint) * spectral_weight * (self.total * scale)),
+            )
+        } else if l.is_delta() {
             let (wi, scale) = sample_delta(l, wo, u_rest)?;
             (
                 wi,
@@ -521,6 +593,7 @@ impl<'a> Bsdf<'a> {
                 pdf: self.weights[i] / self.total,
                 delta: true,
                 transmitted: !reflect,
+                wavelength,
             });
         }
         let (f, pdf) = self.eval_pdf(wi);
@@ -533,6 +606,7 @@ impl<'a> Bsdf<'a> {
             pdf,
             delta: false,
             transmitted: !reflect,
+            wavelength,
         })
     }
 }
@@ -600,6 +674,20 @@ fn sample_delta(l: &Layer, wo: Vec3, u: f32) -> Option<(Vec3, f32)> {
         return Some((mirror, 1.0));
     }
     let eta = relative_eta(l, wo);
+    delta_dielectric(wo, eta, u)
+}
+
+/// [`sample_delta`] of a transmitting layer whose index is `ior` (a dispersive layer's `n(λ)`).
+fn sample_delta_eta(l: &Layer, ior: f32, wo: Vec3, u: f32) -> Option<(Vec3, f32)> {
+    debug_assert!(l.transmission);
+    let eta = if wo.z > 0.0 { ior } else { 1.0 / ior };
+    delta_dielectric(wo, eta, u)
+}
+
+/// Smooth dielectric interface of relative index `eta`: Fresnel chooses with `u`.
+#[inline]
+fn delta_dielectric(wo: Vec3, eta: f32, u: f32) -> Option<(Vec3, f32)> {
+    let mirror = Vec3::new(-wo.x, -wo.y, wo.z);
     let f = fresnel_dielectric(wo.z.abs(), eta);
     if u < f {
         return Some((mirror, 1.0));
@@ -694,6 +782,7 @@ impl crate::content_hash::ContentHash for Layer {
             transmission,
             ior,
             coat,
+            dispersion,
         } = self;
         weight.content_hash(out);
         color.content_hash(out);
@@ -702,6 +791,11 @@ impl crate::content_hash::ContentHash for Layer {
         transmission.content_hash(out);
         ior.content_hash(out);
         coat.content_hash(out);
+        // Only when present, so that every non-dispersive scene keeps the hash (and the cached
+        // experiment results) it had before dispersion existed.
+        if let Some(d) = dispersion {
+            d.content_hash(out);
+        }
     }
 }
 
@@ -777,5 +871,92 @@ mod tests {
         // sin θt = sin θi / 1.5
         assert!((s.wi.x.abs() - 0.6 / 1.5).abs() < 1e-5 && s.wi.z < 0.0);
         assert!((s.weight.x - 1.0 / 2.25).abs() < 1e-5);
+    }
+
+    fn flint() -> Material {
+        let d = Dispersion::preset("sf11").unwrap();
+        let mut m = Material::glass("g", Rgb::ONE, d.ior(crate::spectral::LAMBDA_D), 1.0);
+        m.layers[0].dispersion = Some(d);
+        m
+    }
+
+    /// A path without a wavelength gets one from `u.x` at a dispersive event, with its RGB
+    /// weight; a path with one refracts by `n(λ)` and gets no new weight.
+    #[test]
+    fn dispersive_glass_draws_a_wavelength_once_and_refracts_by_it() {
+        let m = flint();
+        assert_eq!(m.validate(), Ok(()));
+        let d = m.layers[0].dispersion.unwrap();
+        let wo = Vec3::new(0.6, 0.0, 0.8);
+        let b = Bsdf::new(&m, Rgb::ONE, Vec3::Z, Vec3::Z, wo);
+        for u in [0.1, 0.5, 0.9] {
+            let s = b.sample(0.99, Vec2::new(u, 0.3)).unwrap();
+            let w = crate::spectral::sample_wavelength(u);
+            assert_eq!(s.wavelength, Some(w.lambda));
+            let n = d.ior(w.lambda);
+            assert!(s.transmitted && s.delta);
+            assert!(
+                (s.wi.x.abs() - 0.6 / n).abs() < 1e-5,
+                "Snell at n({})",
+                w.lambda
+            );
+            assert!((s.weight - w.weight / (n * n)).length() < 1e-5);
+            // The same λ given by an earlier event: same direction, no spectral weight.
+            let fixed =
+                Bsdf::new(&m, Rgb::ONE, Vec3::Z, Vec3::Z, wo).with_wavelength(Some(w.lambda));
+            let t = fixed.sample(0.99, Vec2::new(0.77, 0.3)).unwrap();
+            assert_eq!(t.wavelength, Some(w.lambda));
+            assert!((t.wi - s.wi).length() < 1e-6);
+            assert!((t.weight - Rgb::splat(1.0 / (n * n))).length() < 1e-5);
+        }
+        // Blue bends more than red.
+        let at = |lambda| {
+            Bsdf::new(&m, Rgb::ONE, Vec3::Z, Vec3::Z, wo)
+                .with_wavelength(Some(lambda))
+                .sample(0.99, Vec2::ZERO)
+                .unwrap()
+                .wi
+                .x
+                .abs()
+        };
+        assert!(at(420.0) < at(680.0) - 1e-3);
+        // Reflection off dispersive glass is a dispersive event too (Fresnel depends on n(λ)).
+        let r = b.sample(0.0, Vec2::new(0.5, 0.0)).unwrap();
+        assert!(!r.transmitted && r.wavelength.is_some());
+        // A non-dispersive material leaves the path's wavelength as it was.
+        let plain = Material::diffuse("d", Rgb::ONE);
+        let p = Bsdf::new(&plain, Rgb::ONE, Vec3::Z, Vec3::Z, wo).with_wavelength(Some(500.0));
+        assert_eq!(
+            p.sample(0.5, Vec2::new(0.3, 0.3)).unwrap().wavelength,
+            Some(500.0)
+        );
+        let p = Bsdf::new(&plain, Rgb::ONE, Vec3::Z, Vec3::Z, wo);
+        assert_eq!(p.sample(0.5, Vec2::new(0.3, 0.3)).unwrap().wavelength, None);
+        // Without dispersion, the layer is glass of index n_d.
+        let off = b
+            .without_dispersion()
+            .sample(0.99, Vec2::new(0.1, 0.3))
+            .unwrap();
+        assert_eq!(off.wavelength, None);
+        assert!((off.wi.x.abs() - 0.6 / m.layers[0].ior).abs() < 1e-6);
+    }
+
+    #[test]
+    fn dispersion_needs_smooth_glass_and_valid_coefficients() {
+        let mut m = flint();
+        m.layers[0].hardness = 0.7;
+        let e = m.validate().unwrap_err().to_string();
+        assert!(e.contains("smooth transmitting layers only"), "{e}");
+        let mut m = flint();
+        m.layers[0].dispersion = Some(Dispersion::Cauchy {
+            a: 0.5,
+            b: 0.0,
+            c: 0.0,
+        });
+        let e = m.validate().unwrap_err().to_string();
+        assert!(
+            e.contains("layer 0: dispersion: index of refraction must be in (1, 4]"),
+            "{e}"
+        );
     }
 }

@@ -16,6 +16,10 @@
 //! materials the two converge to slightly different images (the partitioned renderer of §6.3
 //! tolerates this by construction; light tracing simply estimates the adjoint). Russian
 //! roulette is the path tracer's. A pass takes one light path per pixel per sample index.
+//!
+//! On-demand spectral rendering (§6.6, `rt_core::spectral`): a particle is RGB until its first
+//! dispersive event (a prism), which assigns it a wavelength and its RGB weight; the wavelength
+//! stays with it for the rest of its walk, so a prism casts a coloured caustic.
 
 use crate::driver::{RenderStats, SamplePass};
 use crate::technique::Technique;
@@ -46,6 +50,10 @@ pub struct LightTracer {
     pub max_depth: u32,
     /// Bounce after which Russian roulette may end paths.
     pub rr_depth: u32,
+    /// Dispersive materials use their wavelength-dependent index (false: their `n_d`, as if
+    /// the renderer had no spectral code; for tests).
+    #[doc(hidden)]
+    pub spectral: bool,
 }
 
 impl LightTracer {
@@ -54,6 +62,7 @@ impl LightTracer {
         Self {
             max_depth,
             rr_depth: 3,
+            spectral: true,
         }
     }
 }
@@ -182,6 +191,8 @@ impl LightTracer {
             Ray::new(e.origin, e.dir)
         };
         let mut depth = 0u32;
+        // The particle's wavelength once a dispersive event has drawn one (§6.6).
+        let mut lambda: Option<f32> = None;
         while depth < self.max_depth {
             counters.rays += 1;
             let Some(hit) = ctx.accel.intersect(&ray, f32::INFINITY) else {
@@ -192,7 +203,12 @@ impl LightTracer {
             let material = &scene.materials[si.material as usize];
             let wo = -ray.dir;
             let tint = scene.tint(material, si.uv);
-            let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo);
+            let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo).with_wavelength(lambda);
+            let bsdf = if self.spectral {
+                bsdf
+            } else {
+                bsdf.without_dispersion()
+            };
             let u_lens = lens(sampler);
             let u_layer = sampler.next_1d();
             let u_bsdf = sampler.next_2d();
@@ -223,6 +239,7 @@ impl LightTracer {
             if beta.max_element() <= 0.0 || !beta.is_finite() {
                 break;
             }
+            lambda = s.wavelength;
             ray = spawn_ray(si.p, si.p_error, si.ng, s.wi);
             if depth > self.rr_depth {
                 let q = beta.max_element().min(0.95);

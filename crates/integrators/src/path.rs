@@ -9,6 +9,11 @@
 //! Emission found by BSDF sampling after a delta bounce is always counted fully (light sampling
 //! cannot produce such paths), which keeps caustics through mirrors and glass (the "PTDL cannot
 //! do caustics" pitfall of the thesis, §6.1.1).
+//!
+//! On-demand spectral rendering (§6.6, `rt_core::spectral`): the path is RGB until its first
+//! dispersive event, which assigns it a wavelength (its RGB weight goes into the throughput);
+//! every later vertex's BSDF gets that wavelength. Light sampling needs none: dispersive lobes
+//! are delta lobes, which light sampling skips.
 
 use crate::{Ctx, Integrator, RayCounters, SampleAux};
 use rt_core::{
@@ -30,6 +35,10 @@ pub struct PathIntegrator {
     pub next_event: bool,
     /// Bounce after which Russian roulette may end paths.
     pub rr_depth: u32,
+    /// Dispersive materials use their wavelength-dependent index (false: their `n_d`, as if
+    /// the renderer had no spectral code; for tests).
+    #[doc(hidden)]
+    pub spectral: bool,
     name: &'static str,
 }
 
@@ -40,6 +49,7 @@ impl PathIntegrator {
             max_depth,
             next_event: true,
             rr_depth: 3,
+            spectral: true,
             name: "path",
         }
     }
@@ -50,6 +60,7 @@ impl PathIntegrator {
             max_depth,
             next_event: false,
             rr_depth: 3,
+            spectral: true,
             name: "path-bsdf",
         }
     }
@@ -60,6 +71,7 @@ impl PathIntegrator {
             max_depth: 1,
             next_event: true,
             rr_depth: u32::MAX,
+            spectral: true,
             name: "direct",
         }
     }
@@ -94,6 +106,8 @@ impl Integrator for PathIntegrator {
         let mut prev_pdf = 0.0f32;
         let mut prev_p = ray.origin;
         let mut depth = 0u32;
+        // The path's wavelength once a dispersive event has drawn one (§6.6).
+        let mut lambda: Option<f32> = None;
         loop {
             counters.rays += 1;
             let Some(hit) = ctx.accel.intersect(&ray, f32::INFINITY) else {
@@ -126,7 +140,12 @@ impl Integrator for PathIntegrator {
                 break;
             }
             let tint = scene.tint(material, si.uv);
-            let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo);
+            let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo).with_wavelength(lambda);
+            let bsdf = if self.spectral {
+                bsdf
+            } else {
+                bsdf.without_dispersion()
+            };
             if first_hit_wanted {
                 let n = if si.ns.dot(wo) < 0.0 { -si.ns } else { si.ns };
                 aux.first_hit = Some(FirstHit {
@@ -183,6 +202,7 @@ impl Integrator for PathIntegrator {
             if beta.max_element() <= 0.0 || !beta.is_finite() {
                 break;
             }
+            lambda = s.wavelength;
             prev_delta = s.delta;
             prev_pdf = s.pdf;
             prev_p = si.p;

@@ -164,6 +164,9 @@ pub(crate) struct MaterialDesc {
     pub emission: Option<Spanned<V3>>,
     pub two_sided: Option<bool>,
     pub layers: Option<Spanned<Vec<Spanned<LayerDesc>>>>,
+    /// A preset name or an inline table; `material.rs` reads it (its forms are easier to
+    /// explain in an error there than through an untagged serde enum).
+    pub dispersion: Option<Spanned<toml::Value>>,
 }
 
 /// One entry of a material's `layers` array.
@@ -177,6 +180,7 @@ pub(crate) struct LayerDesc {
     pub transmission: Option<bool>,
     pub ior: Option<f32>,
     pub coat: Option<bool>,
+    pub dispersion: Option<toml::Value>,
 }
 
 /// `[[geometry]]`: a mesh file, an inline shape or an inline triangle mesh. Which keys are

@@ -5,6 +5,7 @@ use crate::desc::{LayerDesc, MaterialDesc};
 use crate::error::Result;
 use crate::load::{finite3, Ctx};
 use rt_core::material::MaterialError;
+use rt_core::spectral::{Dispersion, LAMBDA_D, PRESETS};
 use rt_core::{Layer, Material, Rgb};
 use std::collections::HashMap;
 use std::ops::Range;
@@ -142,6 +143,29 @@ pub(crate) fn build(ctx: &mut Ctx, d: &Spanned<MaterialDesc>) -> Result<Material
             ),
         ));
     }
+    if let (Some(v), false) = (&d.dispersion, kind == "glass") {
+        return Err(err(
+            v.span(),
+            format!(
+                "`dispersion` does not apply to type \"{kind}\" (it applies to glass{})",
+                if kind == "layered" {
+                    "; give it per layer"
+                } else {
+                    ""
+                }
+            ),
+        ));
+    }
+    if let (Some(v), Some(_)) = (&d.dispersion, &d.ior) {
+        return Err(err(
+            v.span(),
+            "`ior` and `dispersion` exclude each other: a dispersive glass's index is n(λ)".into(),
+        ));
+    }
+    let disp = match &d.dispersion {
+        Some(v) => Some(dispersion(v.get_ref()).map_err(|e| err(v.span(), e))?),
+        None => None,
+    };
     let color = match &d.color {
         Some(c) => finite3(ctx, c, "color")?,
         None => DEFAULT_COLOR,
@@ -174,11 +198,16 @@ pub(crate) fn build(ctx: &mut Ctx, d: &Spanned<MaterialDesc>) -> Result<Material
             m.layers = layers
                 .get_ref()
                 .iter()
-                .map(|l| layer(l.get_ref(), color))
-                .collect();
+                .map(|l| layer(l.get_ref(), color).map_err(|e| err(l.span(), e)))
+                .collect::<Result<_>>()?;
             m
         }
     };
+    if let Some(disp) = disp {
+        let l = &mut m.layers[0];
+        l.dispersion = Some(disp);
+        l.ior = disp.ior(LAMBDA_D);
+    }
     if let Some(e) = &d.emission {
         m.emission = finite3(ctx, e, "emission")?;
     }
@@ -200,6 +229,8 @@ pub(crate) fn build(ctx: &mut Ctx, d: &Spanned<MaterialDesc>) -> Result<Material
                     d.hardness.as_ref().map(|c| c.span())
                 } else if what.starts_with("ior") {
                     d.ior.as_ref().map(|c| c.span())
+                } else if what.starts_with("dispersion") {
+                    d.dispersion.as_ref().map(|c| c.span())
                 } else {
                     None
                 }
@@ -213,16 +244,106 @@ pub(crate) fn build(ctx: &mut Ctx, d: &Spanned<MaterialDesc>) -> Result<Material
 }
 
 /// One entry of `layers`; `color` is the material's `color` (the default layer colour).
-fn layer(l: &LayerDesc, color: Rgb) -> Layer {
+fn layer(l: &LayerDesc, color: Rgb) -> std::result::Result<Layer, String> {
     let c = l.color.map_or(color, Rgb::from);
-    Layer {
+    let dispersion = match &l.dispersion {
+        Some(v) => {
+            if l.ior.is_some() {
+                return Err(
+                    "`ior` and `dispersion` exclude each other: a dispersive layer's index is n(λ)"
+                        .into(),
+                );
+            }
+            Some(dispersion(v)?)
+        }
+        None => None,
+    };
+    Ok(Layer {
         weight: l.weight.unwrap_or(1.0),
         color: c,
         color90: l.color90.map_or(c, Rgb::from),
         hardness: l.hardness.unwrap_or(0.0),
         transmission: l.transmission.unwrap_or(false),
-        ior: l.ior.unwrap_or(DEFAULT_IOR),
+        ior: dispersion.map_or(l.ior.unwrap_or(DEFAULT_IOR), |d| d.ior(LAMBDA_D)),
         coat: l.coat.unwrap_or(false),
+        dispersion,
+    })
+}
+
+/// The forms of `dispersion`: a preset name, `{ cauchy = [A, B] }` or `[A, B, C]`, or
+/// `{ sellmeier = { b = [B1, B2, B3], c = [C1, C2, C3] } }` (λ in µm). Ranges are checked by
+/// `Material::validate`.
+fn dispersion(v: &toml::Value) -> std::result::Result<Dispersion, String> {
+    let presets = || {
+        PRESETS
+            .iter()
+            .map(|(n, _)| format!("\"{n}\""))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let forms = "`dispersion` must be a preset name, { cauchy = [A, B] } or [A, B, C], or \
+                 { sellmeier = { b = [B1, B2, B3], c = [C1, C2, C3] } }";
+    let numbers =
+        |v: &toml::Value, what: &str, lens: &[usize]| -> std::result::Result<Vec<f32>, String> {
+            let a = v
+                .as_array()
+                .ok_or_else(|| format!("dispersion {what} must be an array of numbers"))?;
+            let xs: Option<Vec<f32>> = a
+                .iter()
+                .map(|x| {
+                    x.as_float()
+                        .or_else(|| x.as_integer().map(|i| i as f64))
+                        .map(|f| f as f32)
+                })
+                .collect();
+            let xs = xs.ok_or_else(|| format!("dispersion {what} must be an array of numbers"))?;
+            if !lens.contains(&xs.len()) {
+                let n: Vec<_> = lens.iter().map(|l| l.to_string()).collect();
+                return Err(format!(
+                    "dispersion {what} needs {} numbers, got {}",
+                    n.join(" or "),
+                    xs.len()
+                ));
+            }
+            Ok(xs)
+        };
+    match v {
+        toml::Value::String(name) => Dispersion::preset(name).ok_or_else(|| {
+            format!(
+                "unknown dispersion preset \"{name}\"; the presets are {}",
+                presets()
+            )
+        }),
+        toml::Value::Table(t) if t.len() == 1 => {
+            let (key, v) = t.iter().next().expect("one entry");
+            match key.as_str() {
+                "cauchy" => {
+                    let x = numbers(v, "`cauchy`", &[2, 3])?;
+                    Ok(Dispersion::Cauchy {
+                        a: x[0],
+                        b: x[1],
+                        c: x.get(2).copied().unwrap_or(0.0),
+                    })
+                }
+                "sellmeier" => {
+                    let t = v
+                        .as_table()
+                        .filter(|t| t.len() == 2 && t.contains_key("b") && t.contains_key("c"))
+                        .ok_or_else(|| {
+                            "dispersion `sellmeier` must be { b = [B1, B2, B3], c = [C1, C2, C3] }"
+                                .to_string()
+                        })?;
+                    let b = numbers(&t["b"], "`sellmeier.b`", &[3])?;
+                    let c = numbers(&t["c"], "`sellmeier.c`", &[3])?;
+                    Ok(Dispersion::Sellmeier {
+                        b: [b[0], b[1], b[2]],
+                        c: [c[0], c[1], c[2]],
+                    })
+                }
+                other => Err(format!("unknown dispersion model `{other}`; {forms}")),
+            }
+        }
+        _ => Err(forms.into()),
     }
 }
 
@@ -391,7 +512,8 @@ mod tests {
                 hardness: 0.8,
                 transmission: false,
                 ior: 1.6,
-                coat: true
+                coat: true,
+                dispersion: None,
             }
         );
         assert_eq!(m.layers[1], Layer::new(0.7, Rgb::splat(0.5), 0.0));
@@ -418,6 +540,65 @@ mod tests {
         assert!(e.contains("needs `layers`") || e.contains("layers"), "{e}");
         let e = bad("layers = [{ weight = 1 }]\nhardness = 0.5");
         assert!(e.contains("give it per layer"), "{e}");
+    }
+
+    #[test]
+    fn dispersion_presets_tables_and_errors() {
+        let bk7 = Dispersion::preset("bk7").unwrap();
+        let m = ok("type = \"glass\"\ndispersion = \"BK7\"");
+        assert_eq!(m.layers[0].dispersion, Some(bk7));
+        assert!((m.layers[0].ior - 1.5168).abs() < 1e-4, "ior holds n_d");
+        let m = ok("type = \"glass\"\ndispersion = { cauchy = [1.5046, 0.0042] }");
+        assert_eq!(
+            m.layers[0].dispersion,
+            Some(Dispersion::Cauchy {
+                a: 1.5046,
+                b: 0.0042,
+                c: 0.0
+            })
+        );
+        let m = ok("type = \"glass\"\ndispersion = { sellmeier = { b = [1.03961212, 0.231792344, 1.01046945], c = [0.00600069867, 0.0200179144, 103.560653] } }");
+        assert_eq!(m.layers[0].dispersion, Some(bk7));
+        let m = ok("layers = [{ transmission = true, hardness = 1, dispersion = \"sf11\" }]");
+        assert_eq!(m.layers[0].dispersion, Dispersion::preset("sf11"));
+        let e = bad("type = \"glass\"\ndispersion = \"crown\"");
+        assert!(
+            e.contains("m.toml:4:14: material \"m\": unknown dispersion preset \"crown\"; the presets are \"bk7\", \"sf11\", \"fused-silica\""),
+            "{e}"
+        );
+        let e = bad("type = \"glass\"\ndispersion = { sellmeier = { b = [1, 0.2, 1], c = [0.006, 0.25, 100] } }");
+        assert!(
+            e.contains("m.toml:4:14: material \"m\": layer 0: dispersion: Sellmeier c = 0.25")
+                && e.contains("500 nm"),
+            "{e}"
+        );
+        let e = bad("type = \"glass\"\ndispersion = { cauchy = [1.5] }");
+        assert!(e.contains("`cauchy` needs 2 or 3 numbers, got 1"), "{e}");
+        let e = bad("type = \"glass\"\ndispersion = { abbe = 60 }");
+        assert!(e.contains("unknown dispersion model `abbe`"), "{e}");
+        let e = bad("type = \"glass\"\nior = 1.6\ndispersion = \"bk7\"");
+        assert!(
+            e.contains("`ior` and `dispersion` exclude each other"),
+            "{e}"
+        );
+        let e = bad("type = \"glass\"\nhardness = 0.5\ndispersion = \"bk7\"");
+        assert!(e.contains("smooth transmitting layers only"), "{e}");
+        let e = bad("type = \"mirror\"\ndispersion = \"bk7\"");
+        assert!(
+            e.contains("`dispersion` does not apply to type \"mirror\""),
+            "{e}"
+        );
+        let e = bad("layers = [{ dispersion = \"bk7\" }]");
+        assert!(
+            e.contains("m.toml:3:11:") && e.contains("smooth transmitting layers only"),
+            "{e}"
+        );
+        let e = bad("layers = [{ transmission = true, hardness = 1, dispersion = { cauchy = [0.9, 0.01] } }]");
+        assert!(
+            e.contains("m.toml:3:11:")
+                && e.contains("dispersion: index of refraction must be in (1, 4]"),
+            "{e}"
+        );
     }
 
     #[test]
