@@ -33,6 +33,9 @@ use std::time::{Duration, Instant};
 /// Photons per parallel work item.
 const CHUNK: u32 = 1024;
 
+/// One work item's landings (pixel, value), rays and photons traced.
+type ItemResult = (Vec<(u32, Rgb)>, RayCounters, u64);
+
 /// Cosine of the largest angle between a bin's and a photon's surface normals.
 const SAME_SURFACE_COS: f32 = 0.9;
 
@@ -142,7 +145,7 @@ impl Partitioned {
             })
             .collect();
         let vpl_paths = self.options.vpl_paths;
-        let results: Vec<(Vec<(u32, Rgb)>, RayCounters, u64)> = work
+        let results: Vec<ItemResult> = work
             .par_iter()
             .map(|item| {
                 let mut sampler = Sampler::with_stream(seed, stream);

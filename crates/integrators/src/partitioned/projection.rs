@@ -104,7 +104,7 @@ impl ProjectionMap {
         let v = o.center - p;
         let d = v.length();
         let all_rows = 0..=THETA_CELLS - 1;
-        if !(d > o.radius) {
+        if d.is_nan() || d <= o.radius {
             // The light is inside the sphere (or the distance is not a number): everything.
             self.set_rows(all_rows, None);
             return;
@@ -130,7 +130,7 @@ impl ProjectionMap {
         // The azimuth half-width of a cone of half-angle α around polar angle θc, with no pole
         // inside (α < θc < π - α): asin(sin α / sin θc).
         let ratio = alpha.sin() / theta_c.sin();
-        if !(ratio < 1.0) {
+        if ratio.is_nan() || ratio >= 1.0 {
             self.set_rows(rows, None);
             return;
         }
