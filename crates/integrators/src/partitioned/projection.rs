@@ -176,12 +176,13 @@ mod tests {
     #[test]
     fn a_small_occupant_covers_little_and_nothing_behind_is_set() {
         let o = Occupant {
-            center: Vec3::new(0.0, 0.0, 10.0),
+            center: Vec3::new(7.0, 0.0, 7.0),
             radius: 0.5,
         };
         let map = ProjectionMap::build(Vec3::ZERO, Vec3::Z, false, &[o]);
+        // A cone of 2.9° at 45° from the normal: a few cells of the 32768.
         assert!(
-            map.coverage() > 0.0 && map.coverage() < 0.02,
+            map.coverage() > 0.0 && map.coverage() < 0.005,
             "{}",
             map.coverage()
         );
