@@ -56,9 +56,11 @@ pub struct Args {
     /// (direct lighting: one bounce, NEE + MIS), ao (ambient occlusion), light (light tracing:
     /// particles from the lights and the sky splatted through the camera; one light path per
     /// pixel per spp; no AOVs), bdpt (bidirectional path tracing, MIS over all strategies;
-    /// one camera and one light subpath per pixel per spp; no AOVs); options max-depth=N
-    /// (path, path-bsdf, light, bdpt) and distance=F (ao), e.g. path:max-depth=4
-    /// (crates/integrators/src/spec.rs).
+    /// one camera and one light subpath per pixel per spp; no AOVs), partitioned (the
+    /// path-space-partitioned renderer: VPLs, caustic histogram, specular gathering; options
+    /// vpls=N, photons=N, clamp=F, cull=off|unbiased|biased, maps=on|off); options
+    /// max-depth=N (path, path-bsdf, light, bdpt, partitioned) and distance=F (ao), e.g.
+    /// path:max-depth=4 (crates/integrators/src/spec.rs).
     /// [default: `[render] integrator`, else path]
     #[arg(long, value_name = "SPEC", value_parser = parse_integrator)]
     pub integrator: Option<IntegratorSpec>,
@@ -215,7 +217,7 @@ mod tests {
         assert!(a.command.is_none());
         assert_eq!(a.aov.unwrap(), vec!["albedo", "normal"]);
         assert_eq!(a.exposure, -1.0);
-        assert!(Args::try_parse_from(["render", "s.toml", "--integrator", "bdpt"]).is_err());
+        assert!(Args::try_parse_from(["render", "s.toml", "--integrator", "vcm"]).is_err());
     }
 
     #[test]

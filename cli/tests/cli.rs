@@ -364,18 +364,31 @@ fn bad_command_line_values() {
     assert_eq!(out.status.code(), Some(1));
     assert!(err.contains("scene.toml") && err.contains("spp"), "{err}");
     expect_error(
-        &format!("{GOOD}\n[render]\nintegrator = \"bdpt\"\n"),
+        &format!("{GOOD}\n[render]\nintegrator = \"vcm\"\n"),
         &[],
-        &["scene.toml", "bdpt"],
+        &["scene.toml", "vcm"],
     );
     let r = Run::new();
     r.write("scene.toml", GOOD);
     let out = r.render(&["scene.toml", "-o", "x.jpg"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("x.jpg"));
+    // Bad partitioned options (zero photons, an unknown culling, an unknown option) are
+    // usage errors naming the option.
+    for bad in [
+        "partitioned:photons=0",
+        "partitioned:cull=sometimes",
+        "partitioned:gather=2",
+    ] {
+        let out = r.render(&["scene.toml", "--integrator", bad]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{bad}: {err}");
+        let option = bad.split(':').nth(1).unwrap();
+        assert!(err.contains(option), "{bad}: {err}");
+    }
     // Usage errors (clap) exit with 2.
     assert_eq!(
-        r.render(&["scene.toml", "--integrator", "bdpt"])
+        r.render(&["scene.toml", "--integrator", "vcm"])
             .status
             .code(),
         Some(2)

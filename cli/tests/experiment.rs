@@ -292,8 +292,8 @@ fn bad_experiment_files_give_one_line_naming_the_file() {
         "spp is an empty list",
     );
     expect_error(
-        &CONFIG.replace("\"path-bsdf\"", "\"bdpt\""),
-        "\"bdpt\" is not one of",
+        &CONFIG.replace("\"path-bsdf\"", "\"vcm\""),
+        "\"vcm\" is not one of",
     );
     let d = Dir::new();
     let o = d.render(&["experiment", "none.toml"]);
