@@ -642,8 +642,8 @@ seconds = [0.5, 0.1]
                 "two methods are named \"a\"",
             ),
             (
-                GOOD.replace("\"path-bsdf\"", "\"bdpt\""),
-                "\"bdpt\" is not one of",
+                GOOD.replace("\"path-bsdf\"", "\"vcm\""),
+                "\"vcm\" is not one of",
             ),
             (GOOD.replace("\"bvh\"", "\"kd-tree\""), "kd-tree"),
             (

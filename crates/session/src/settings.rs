@@ -378,10 +378,10 @@ mod tests {
         .unwrap_err();
         assert!(e.to_string().starts_with("--threads: thread count"), "{e}");
         let e = Overrides::default()
-            .resolve(&table(|d| d.integrator = Some("bdpt".into())), path)
+            .resolve(&table(|d| d.integrator = Some("vcm".into())), path)
             .unwrap_err();
         assert!(
-            e.to_string().contains("[render] integrator: \"bdpt\""),
+            e.to_string().contains("[render] integrator: \"vcm\""),
             "{e}"
         );
         let e = Overrides::default()
