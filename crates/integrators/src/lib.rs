@@ -19,7 +19,6 @@
 //! Depends on `rt-core` and `rt-film`.
 #![forbid(unsafe_code)]
 
-mod adjoint;
 mod ao;
 mod bdpt;
 pub mod driver;
@@ -28,6 +27,7 @@ pub mod partitioned;
 mod path;
 pub mod spec;
 pub mod technique;
+mod transport;
 
 pub use ao::AoIntegrator;
 pub use bdpt::Bdpt;

@@ -23,6 +23,7 @@
 
 use crate::driver::{RenderStats, SamplePass};
 use crate::technique::Technique;
+use crate::transport::{adjoint_cos, importance_weight, survives_roulette};
 use crate::{Ctx, RayCounters};
 use rayon::prelude::*;
 use rt_core::{
@@ -229,40 +230,17 @@ impl LightTracer {
                 break;
             };
             // `s.weight` holds |cos(wi, ns)|; importance transport wants the adjoint's.
-            let cos_ns = s.wi.dot(si.ns).abs();
-            let correction = if cos_ns > 0.0 {
-                adjoint_cos(wo, s.wi, si.ns, si.ng) / cos_ns
-            } else {
-                0.0
-            };
-            beta *= s.weight * correction;
+            beta *= importance_weight(&s, wo, si.ns, si.ng);
             if beta.max_element() <= 0.0 || !beta.is_finite() {
                 break;
             }
             lambda = s.wavelength;
             ray = spawn_ray(si.p, si.p_error, si.ng, s.wi);
-            if depth > self.rr_depth {
-                let q = beta.max_element().min(0.95);
-                if u_rr >= q {
-                    break;
-                }
-                beta /= q;
+            if depth > self.rr_depth && !survives_roulette(&mut beta, u_rr) {
+                break;
             }
         }
     }
-}
-
-/// The cosine factor of importance transport with shading normals (Veach 1997, eq. 5.17):
-/// `|wo·ns| |wi·ng| / |wo·ng|` in place of the radiance transport's `|wi·ns|`, where `wo`
-/// points to the light side and `wi` onward (to the camera for a connection). Equal to
-/// `|wi·n|` when the normals agree.
-#[inline]
-fn adjoint_cos(wo: Vec3, wi: Vec3, ns: Vec3, ng: Vec3) -> f32 {
-    let wo_ng = wo.dot(ng).abs();
-    if wo_ng <= 0.0 {
-        return 0.0;
-    }
-    wo.dot(ns).abs() * wi.dot(ng).abs() / wo_ng
 }
 
 /// Pushes `value` for the pixel `c` lands in if the segment from `p` to the lens is clear.

@@ -15,13 +15,11 @@
 //! every later vertex's BSDF gets that wavelength. Light sampling needs none: dispersive lobes
 //! are delta lobes, which light sampling skips.
 
+use crate::transport::{light_visible, survives_roulette};
 use crate::{Ctx, Integrator, RayCounters, SampleAux};
 use rt_core::{
-    lights::LightSampler,
-    material::Bsdf,
-    ray::{shadow_segment, spawn_ray},
-    sampling::power_heuristic,
-    Ray, Rgb, Sampler,
+    lights::LightSampler, material::Bsdf, ray::spawn_ray, sampling::power_heuristic, Ray, Rgb,
+    Sampler,
 };
 use rt_film::FirstHit;
 
@@ -172,22 +170,7 @@ impl Integrator for PathIntegrator {
                     let cos = ls.wi.dot(si.ns).abs();
                     if f.max_element() > 0.0 && cos > 0.0 {
                         counters.shadow_rays += 1;
-                        let occluded = if ls.dist.is_infinite() {
-                            let r = spawn_ray(si.p, si.p_error, si.ng, ls.wi);
-                            ctx.accel.occluded(&r, f32::INFINITY)
-                        } else {
-                            let (r, t_max) = shadow_segment(
-                                si.p,
-                                si.p_error,
-                                si.ng,
-                                ls.point,
-                                ls.point_error,
-                                ls.normal,
-                            );
-                            // The light point keys the shadow cache of structures that have one.
-                            ctx.accel.occluded_toward(&r, t_max, ls.point)
-                        };
-                        if !occluded {
+                        if light_visible(ctx, si.p, si.p_error, si.ng, &ls) {
                             let w = power_heuristic(ls.pdf, bsdf_pdf);
                             l += beta * f * ls.le * (cos * w / ls.pdf);
                         }
@@ -208,14 +191,8 @@ impl Integrator for PathIntegrator {
             prev_p = si.p;
             ray = spawn_ray(si.p, si.p_error, si.ng, s.wi);
             depth += 1;
-            if depth > self.rr_depth {
-                // Continue with probability tied to the throughput, so that surviving paths
-                // carry comparable weights; capped so bright paths still terminate eventually.
-                let q = beta.max_element().min(0.95);
-                if u_rr >= q {
-                    break;
-                }
-                beta /= q;
+            if depth > self.rr_depth && !survives_roulette(&mut beta, u_rr) {
+                break;
             }
         }
         l

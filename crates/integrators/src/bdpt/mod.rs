@@ -31,9 +31,9 @@
 
 mod vertex;
 
-use crate::adjoint::adjoint_cos;
 use crate::driver::{RenderStats, SamplePass};
 use crate::technique::Technique;
+use crate::transport::{adjoint_cos, importance_weight, light_visible, survives_roulette};
 use crate::{Ctx, RayCounters};
 use rayon::prelude::*;
 use rt_core::{
@@ -415,28 +415,18 @@ impl Bdpt {
             } else {
                 (s.pdf, path[cur].bsdf_pdf(Some(s.wi), wo))
             };
-            let mut weight = s.weight;
-            if mode == Transport::Importance {
-                let cos_ns = s.wi.dot(si.ns).abs();
-                weight *= if cos_ns > 0.0 {
-                    adjoint_cos(wo, s.wi, si.ns, si.ng) / cos_ns
-                } else {
-                    0.0
-                };
-            }
-            beta *= weight;
+            beta *= match mode {
+                Transport::Radiance => s.weight,
+                Transport::Importance => importance_weight(&s, wo, si.ns, si.ng),
+            };
             path[cur].delta = s.delta;
             let rev = to_area(pdf_rev, &path[cur], &path[prev]);
             path[prev].pdf_rev = rev;
             if beta.max_element() <= 0.0 || !beta.is_finite() {
                 break;
             }
-            if bounces > self.rr_depth as usize {
-                let q = beta.max_element().min(0.95);
-                if u_rr >= q {
-                    break;
-                }
-                beta /= q;
+            if bounces > self.rr_depth as usize && !survives_roulette(&mut beta, u_rr) {
+                break;
             }
             pdf = pdf_fwd;
             ray = spawn_ray(si.p, si.p_error, si.ng, s.wi);
@@ -537,15 +527,7 @@ impl Bdpt {
             return Rgb::ZERO;
         }
         counters.shadow_rays += 1;
-        let occluded = if ls.dist.is_infinite() {
-            let r = spawn_ray(pt.p, pt.p_error, pt.ng, ls.wi);
-            ctx.accel.occluded(&r, f32::INFINITY)
-        } else {
-            let (r, t_max) =
-                shadow_segment(pt.p, pt.p_error, pt.ng, ls.point, ls.point_error, ls.normal);
-            ctx.accel.occluded_toward(&r, t_max, ls.point)
-        };
-        if occluded {
+        if !light_visible(ctx, pt.p, pt.p_error, pt.ng, &ls) {
             return Rgb::ZERO;
         }
         // The sampled light as a vertex, for the densities of the other strategies.

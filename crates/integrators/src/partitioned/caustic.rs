@@ -14,7 +14,7 @@ use super::eye::EyeVertex;
 use super::projection::{Occupant, ProjectionMap};
 use super::vpl::PrimaryLight;
 use super::Partitioned;
-use crate::adjoint::adjoint_cos;
+use crate::transport::{importance_weight, survives_roulette};
 use crate::{Ctx, RayCounters};
 use rayon::prelude::*;
 use rt_accel::points::{PointItem, PointKdTree, PointQuery};
@@ -239,22 +239,12 @@ impl Partitioned {
             let Some(s) = bsdf.sample(u_layer, u_bsdf) else {
                 return;
             };
-            let cos_ns = s.wi.dot(si.ns).abs();
-            let correction = if cos_ns > 0.0 {
-                adjoint_cos(wo, s.wi, si.ns, si.ng) / cos_ns
-            } else {
-                0.0
-            };
-            beta *= s.weight * correction;
+            beta *= importance_weight(&s, wo, si.ns, si.ng);
             if beta.max_element() <= 0.0 || !beta.is_finite() {
                 return;
             }
-            if bounce + 1 > self.rr_depth {
-                let q = beta.max_element().min(0.95);
-                if u_rr >= q {
-                    return;
-                }
-                beta /= q;
+            if bounce + 1 > self.rr_depth && !survives_roulette(&mut beta, u_rr) {
+                return;
             }
             ray = spawn_ray(si.p, si.p_error, si.ng, s.wi);
         }

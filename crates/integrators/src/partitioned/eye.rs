@@ -2,6 +2,7 @@
 //! collecting emission on the way (part D, `ES*L`).
 
 use super::Partitioned;
+use crate::transport::survives_roulette;
 use crate::Ctx;
 use rayon::prelude::*;
 use rt_core::{
@@ -159,12 +160,8 @@ impl Partitioned {
             if beta.max_element() <= 0.0 || !beta.is_finite() {
                 break;
             }
-            if depth > self.rr_depth {
-                let q = beta.max_element().min(0.95);
-                if u_rr >= q {
-                    break;
-                }
-                beta /= q;
+            if depth > self.rr_depth && !survives_roulette(&mut beta, u_rr) {
+                break;
             }
             ray = spawn_ray(si.p, si.p_error, si.ng, s.wi);
         }

@@ -5,7 +5,7 @@
 
 use super::eye::EyeVertex;
 use super::{Culling, Partitioned};
-use crate::adjoint::adjoint_cos;
+use crate::transport::{adjoint_cos, importance_weight, survives_roulette};
 use crate::{Ctx, RayCounters};
 use rt_core::{
     glam::{Vec2, Vec3},
@@ -198,22 +198,12 @@ impl Partitioned {
             let Some(s) = bsdf.sample(u_layer, u_bsdf) else {
                 break;
             };
-            let cos_ns = s.wi.dot(si.ns).abs();
-            let correction = if cos_ns > 0.0 {
-                adjoint_cos(wo, s.wi, si.ns, si.ng) / cos_ns
-            } else {
-                0.0
-            };
-            beta *= s.weight * correction;
+            beta *= importance_weight(&s, wo, si.ns, si.ng);
             if beta.max_element() <= 0.0 || !beta.is_finite() {
                 break;
             }
-            if bounce > self.rr_depth {
-                let q = beta.max_element().min(0.95);
-                if u_rr >= q {
-                    break;
-                }
-                beta /= q;
+            if bounce > self.rr_depth && !survives_roulette(&mut beta, u_rr) {
+                break;
             }
             ray = spawn_ray(si.p, si.p_error, si.ng, s.wi);
         }

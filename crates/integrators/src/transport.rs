@@ -1,0 +1,70 @@
+//! Steps every path-building technique here takes the same way: importance transport's
+//! shading-normal factor, Russian roulette, and the shadow test of a light sample.
+
+use crate::Ctx;
+use rt_core::{
+    glam::Vec3,
+    lights::LightSample,
+    material::BsdfSample,
+    ray::{shadow_segment, spawn_ray},
+    Rgb,
+};
+
+/// The cosine factor of importance transport with shading normals (Veach 1997, eq. 5.17):
+/// `|wo·ns| |wi·ng| / |wo·ng|` in place of the radiance transport's `|wi·ns|`, where `wo`
+/// points to the light side and `wi` onward (to the camera for a connection). Equal to
+/// `|wi·n|` when the normals agree.
+#[inline]
+pub(crate) fn adjoint_cos(wo: Vec3, wi: Vec3, ns: Vec3, ng: Vec3) -> f32 {
+    let wo_ng = wo.dot(ng).abs();
+    if wo_ng <= 0.0 {
+        return 0.0;
+    }
+    wo.dot(ns).abs() * wi.dot(ng).abs() / wo_ng
+}
+
+/// The throughput factor of BSDF sample `s` on a path from the lights: the sample's weight
+/// (which holds `|wi·ns|`) with the adjoint cosine in its place.
+#[inline]
+pub(crate) fn importance_weight(s: &BsdfSample, wo: Vec3, ns: Vec3, ng: Vec3) -> Rgb {
+    let cos_ns = s.wi.dot(ns).abs();
+    let correction = if cos_ns > 0.0 {
+        adjoint_cos(wo, s.wi, ns, ng) / cos_ns
+    } else {
+        0.0
+    };
+    s.weight * correction
+}
+
+/// Russian roulette on throughput `beta` with random number `u`: continues with probability
+/// tied to the throughput, so surviving paths carry comparable weights, capped so bright paths
+/// still end. Returns false if the path ends; a survivor's `beta` is divided by the
+/// probability.
+#[inline]
+pub(crate) fn survives_roulette(beta: &mut Rgb, u: f32) -> bool {
+    let q = beta.max_element().min(0.95);
+    if u >= q {
+        return false;
+    }
+    *beta /= q;
+    true
+}
+
+/// True if light sample `ls` is unoccluded from surface point `p` (error bound `p_error`,
+/// geometric normal `ng`): a ray to infinity for the environment, else a segment to the light
+/// point (which keys the shadow cache of structures that have one).
+pub(crate) fn light_visible(
+    ctx: &Ctx<'_>,
+    p: Vec3,
+    p_error: Vec3,
+    ng: Vec3,
+    ls: &LightSample,
+) -> bool {
+    if ls.dist.is_infinite() {
+        let r = spawn_ray(p, p_error, ng, ls.wi);
+        !ctx.accel.occluded(&r, f32::INFINITY)
+    } else {
+        let (r, t_max) = shadow_segment(p, p_error, ng, ls.point, ls.point_error, ls.normal);
+        !ctx.accel.occluded_toward(&r, t_max, ls.point)
+    }
+}
