@@ -106,7 +106,7 @@ const SENTINELS: u32 = 256;
 pub struct PartitionStats {
     /// Passes (sample indices) rendered.
     pub passes: u64,
-    /// VPLs stored, and VPLs culled.
+    /// VPLs stored.
     pub vpls: u64,
     /// VPLs culled.
     pub culled: u64,
@@ -116,8 +116,8 @@ pub struct PartitionStats {
     pub photons_traced: u64,
     /// Photon landings in bins.
     pub photons_landed: u64,
-    /// Mean coverage of the projection maps built.
-    pub mean_coverage: f64,
+    /// Sum of the built projection maps' coverages ([`PartitionStats::mean_coverage`]).
+    pub coverage_sum: f64,
     /// Projection maps built.
     pub maps: u64,
     /// Time building projection maps.
@@ -126,6 +126,34 @@ pub struct PartitionStats {
     pub caustic_time: Duration,
     /// Time in eye paths, VPL walks and gathering.
     pub other_time: Duration,
+}
+
+impl PartitionStats {
+    /// Mean fraction of cells set in the projection maps built (the photon rays saved are
+    /// about one minus the cosine-weighted coverage, which this approximates).
+    pub fn mean_coverage(&self) -> f64 {
+        if self.maps > 0 {
+            self.coverage_sum / self.maps as f64
+        } else {
+            0.0
+        }
+    }
+}
+
+impl std::ops::AddAssign for PartitionStats {
+    fn add_assign(&mut self, o: Self) {
+        self.passes += o.passes;
+        self.vpls += o.vpls;
+        self.culled += o.culled;
+        self.photons_emitted += o.photons_emitted;
+        self.photons_traced += o.photons_traced;
+        self.photons_landed += o.photons_landed;
+        self.coverage_sum += o.coverage_sum;
+        self.maps += o.maps;
+        self.map_time += o.map_time;
+        self.caustic_time += o.caustic_time;
+        self.other_time += o.other_time;
+    }
 }
 
 /// The path-space-partitioned progressive renderer.
@@ -185,7 +213,6 @@ impl Technique for Partitioned {
         let mut rays = RayCounters::default();
         let mut samples = 0u64;
         let mut stats = PartitionStats::default();
-        let mut coverage_sum = 0.0;
         let n_passes = pass.indices.len().max(1) as u64;
         for (p, index) in pass.indices.clone().enumerate() {
             let t0 = Instant::now();
@@ -262,32 +289,13 @@ impl Technique for Partitioned {
             stats.photons_traced += caustics.traced;
             stats.photons_landed += caustics.landed;
             stats.maps += caustics.maps;
-            coverage_sum += caustics.coverage_sum;
+            stats.coverage_sum += caustics.coverage_sum;
             stats.map_time += caustics.map_time;
             stats.caustic_time += t2 - t1;
             stats.other_time += (t1 - t0) + (t3 - t2);
             progress(((p as u64 + 1) * u64::from(h) / n_passes) as u32);
         }
-        {
-            let mut total = self.stats.lock().unwrap_or_else(|e| e.into_inner());
-            let maps = total.maps + stats.maps;
-            let coverage = total.mean_coverage * total.maps as f64 + coverage_sum;
-            total.passes += stats.passes;
-            total.vpls += stats.vpls;
-            total.culled += stats.culled;
-            total.photons_emitted += stats.photons_emitted;
-            total.photons_traced += stats.photons_traced;
-            total.photons_landed += stats.photons_landed;
-            total.maps = maps;
-            total.mean_coverage = if maps > 0 {
-                coverage / maps as f64
-            } else {
-                0.0
-            };
-            total.map_time += stats.map_time;
-            total.caustic_time += stats.caustic_time;
-            total.other_time += stats.other_time;
-        }
+        *self.stats.lock().unwrap_or_else(|e| e.into_inner()) += stats;
         RenderStats {
             elapsed: start.elapsed(),
             samples,
