@@ -7,48 +7,21 @@
 //! Control: BDPT with 2 % of its connections reported occluded (`DroppedShadowRays`) must be
 //! caught. Also: bit-identical images for any thread count and for a render split in passes.
 
-use rt_film::{AovSet, Film, FilmBuffers};
-use rt_integrators::{Bdpt, PathIntegrator, SamplePass};
-use rt_testkit::mutants::DroppedShadowRays;
-use rt_testkit::stats::{compare_estimates, Comparison, Estimate, ALPHA};
-use rt_testkit::{shipped_scene, Renderer, SceneExt};
+use rt_integrators::Bdpt;
+use rt_testkit::agreement::{path_reference, render_in_passes, technique_estimate};
+use rt_testkit::stats::{compare_estimates, Comparison, ALPHA};
+use rt_testkit::{shipped_scene, SceneExt};
 
 const SIZE: u32 = 24;
 const BLOCK: u32 = 4;
 const DEPTH: u32 = 6;
 
-fn bdpt_estimate(scene: &rt_core::Scene, runs: u32, spp: u32, dropped: f64) -> Estimate {
-    let renderer = Renderer::new(scene).threads(2);
-    let mutant = DroppedShadowRays {
-        inner: renderer.accel(),
-        fraction: dropped,
-    };
-    let renderer = Renderer::new(scene).with_accel(&mutant).threads(2);
-    let images: Vec<_> = (0..runs)
-        .map(|seed| {
-            let (film, _) =
-                renderer.render_technique(&Bdpt::new(DEPTH), AovSet::default(), spp, 100 + seed);
-            film.mean_image()
-        })
-        .collect();
-    Estimate::from_runs(&images)
-}
-
 /// BDPT (8 runs of `spp`) against the path tracer (2048 spp): honestly and, if asked, with 2 %
 /// of the connections dropped.
 fn compare(scene: &rt_core::Scene, spp: u32, control: bool) -> (Comparison, Option<Comparison>) {
-    let path = Renderer::new(scene).threads(2).render(
-        &PathIntegrator::new(DEPTH),
-        FilmBuffers::from(AovSet::default()).with_variance(),
-        2048,
-        7,
-    );
-    let reference = Estimate {
-        mean: path.0.mean_image(),
-        variance: path.0.variance_image().expect("kept"),
-    };
+    let reference = path_reference(scene, DEPTH, 2048);
     let test = |dropped| {
-        let b = bdpt_estimate(scene, 8, spp, dropped);
+        let b = technique_estimate(scene, &Bdpt::new(DEPTH), 8, spp, dropped);
         compare_estimates(&b, &reference, SIZE, BLOCK, ALPHA)
     };
     let honest = test(0.0);
@@ -91,19 +64,7 @@ fn bdpt_agrees_with_path_tracing_under_an_environment_map() {
 fn bdpt_is_deterministic_across_threads_and_passes() {
     let scene = shipped_scene("cornell-box.toml").with_resolution(20, 12);
     let bdpt = Bdpt::new(DEPTH);
-    let render = |threads, cuts: &[u32]| -> Film {
-        let r = Renderer::new(&scene).threads(threads);
-        let mut film = r.film(FilmBuffers::from(AovSet::default()).with_halves());
-        for p in cuts.windows(2) {
-            let pass = SamplePass {
-                indices: p[0]..p[1],
-                stream: rt_core::SampleStream::Render,
-                pixels: None,
-            };
-            r.technique_pass(&bdpt, &mut film, 3, &pass);
-        }
-        film
-    };
+    let render = |threads, cuts: &[u32]| render_in_passes(&scene, &bdpt, threads, cuts);
     let one = render(1, &[0, 6]);
     let three = render(3, &[0, 6]);
     let split = render(2, &[0, 2, 6]);

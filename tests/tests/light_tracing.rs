@@ -7,52 +7,21 @@
 //! `DroppedShadowRays` mutant) must be caught. Also: bit-identical images for any thread count
 //! and for a render split into passes.
 
-use rt_film::{AovSet, Film, FilmBuffers};
-use rt_integrators::{LightTracer, PathIntegrator, SamplePass};
-use rt_testkit::mutants::DroppedShadowRays;
-use rt_testkit::stats::{compare_estimates, Comparison, Estimate, ALPHA};
-use rt_testkit::{shipped_scene, Renderer, SceneExt};
+use rt_integrators::LightTracer;
+use rt_testkit::agreement::{path_reference, render_in_passes, technique_estimate};
+use rt_testkit::stats::{compare_estimates, Comparison, ALPHA};
+use rt_testkit::{shipped_scene, SceneExt};
 
 const SIZE: u32 = 24;
 const BLOCK: u32 = 4;
 const DEPTH: u32 = 6;
 
-fn light_estimate(scene: &rt_core::Scene, runs: u32, spp: u32, dropped: f64) -> Estimate {
-    let renderer = Renderer::new(scene).threads(2);
-    let mutant = DroppedShadowRays {
-        inner: renderer.accel(),
-        fraction: dropped,
-    };
-    let renderer = Renderer::new(scene).with_accel(&mutant).threads(2);
-    let images: Vec<_> = (0..runs)
-        .map(|seed| {
-            let (film, _) = renderer.render_technique(
-                &LightTracer::new(DEPTH),
-                AovSet::default(),
-                spp,
-                100 + seed,
-            );
-            film.mean_image()
-        })
-        .collect();
-    Estimate::from_runs(&images)
-}
-
 /// The light tracer (8 runs of 256 light paths per pixel) against the path tracer (2048 spp):
 /// honestly and with 2 % of the connections dropped.
 fn honest_and_biased(scene: &rt_core::Scene) -> (Comparison, Comparison) {
-    let path = Renderer::new(scene).threads(2).render(
-        &PathIntegrator::new(DEPTH),
-        FilmBuffers::from(AovSet::default()).with_variance(),
-        2048,
-        7,
-    );
-    let reference = Estimate {
-        mean: path.0.mean_image(),
-        variance: path.0.variance_image().expect("kept"),
-    };
+    let reference = path_reference(scene, DEPTH, 2048);
     let test = |dropped| {
-        let lt = light_estimate(scene, 8, 256, dropped);
+        let lt = technique_estimate(scene, &LightTracer::new(DEPTH), 8, 256, dropped);
         compare_estimates(&lt, &reference, SIZE, BLOCK, ALPHA)
     };
     let (honest, biased) = (test(0.0), test(0.02));
@@ -92,20 +61,7 @@ fn light_tracing_agrees_with_path_tracing_through_a_thin_lens() {
 fn light_tracing_is_deterministic_across_threads_and_passes() {
     let scene = shipped_scene("cornell-box.toml").with_resolution(20, 12);
     let lt = LightTracer::new(DEPTH);
-    // Pass boundaries as sample-index cut points: [0, 8] is one pass, [0, 3, 8] two.
-    let render = |threads, cuts: &[u32]| -> Film {
-        let r = Renderer::new(&scene).threads(threads);
-        let mut film = r.film(FilmBuffers::from(AovSet::default()).with_halves());
-        for p in cuts.windows(2) {
-            let pass = SamplePass {
-                indices: p[0]..p[1],
-                stream: rt_core::SampleStream::Render,
-                pixels: None,
-            };
-            r.technique_pass(&lt, &mut film, 3, &pass);
-        }
-        film
-    };
+    let render = |threads, cuts: &[u32]| render_in_passes(&scene, &lt, threads, cuts);
     let one = render(1, &[0, 8]);
     let three = render(3, &[0, 8]);
     let split = render(2, &[0, 3, 8]);

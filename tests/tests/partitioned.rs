@@ -4,10 +4,10 @@
 //! glass (parts B and C) the histogram's half-pixel blur is its only bias. Also: bit-identical
 //! images for any thread count.
 
-use rt_film::{AovSet, FilmBuffers};
-use rt_integrators::{PartitionOptions, Partitioned, PathIntegrator};
-use rt_testkit::mutants::DroppedShadowRays;
-use rt_testkit::stats::{compare_estimates, Comparison, Estimate, ALPHA};
+use rt_film::AovSet;
+use rt_integrators::{PartitionOptions, Partitioned};
+use rt_testkit::agreement::{path_reference, technique_estimate};
+use rt_testkit::stats::{compare_estimates, Comparison, ALPHA};
 use rt_testkit::{shipped_scene, Renderer, SceneExt};
 
 const SIZE: u32 = 24;
@@ -21,42 +21,11 @@ fn unclamped() -> PartitionOptions {
     }
 }
 
-fn estimate(
-    scene: &rt_core::Scene,
-    runs: u32,
-    spp: u32,
-    dropped: f64,
-    o: PartitionOptions,
-) -> Estimate {
-    let renderer = Renderer::new(scene).threads(2);
-    let mutant = DroppedShadowRays {
-        inner: renderer.accel(),
-        fraction: dropped,
-    };
-    let renderer = Renderer::new(scene).with_accel(&mutant).threads(2);
-    let images: Vec<_> = (0..runs)
-        .map(|seed| {
-            let t = Partitioned::new(DEPTH, o);
-            let (film, _) = renderer.render_technique(&t, AovSet::default(), spp, 100 + seed);
-            film.mean_image()
-        })
-        .collect();
-    Estimate::from_runs(&images)
-}
-
 fn compare(scene: &rt_core::Scene, spp: u32, dropped: f64, o: PartitionOptions) -> Comparison {
-    let path = Renderer::new(scene).threads(2).render(
-        &PathIntegrator::new(DEPTH),
-        FilmBuffers::from(AovSet::default()).with_variance(),
-        2048,
-        7,
-    );
-    let reference = Estimate {
-        mean: path.0.mean_image(),
-        variance: path.0.variance_image().expect("kept"),
-    };
+    let reference = path_reference(scene, DEPTH, 2048);
+    let t = Partitioned::new(DEPTH, o);
     let c = compare_estimates(
-        &estimate(scene, 8, spp, dropped, o),
+        &technique_estimate(scene, &t, 8, spp, dropped),
         &reference,
         SIZE,
         BLOCK,

@@ -27,6 +27,7 @@
 
 #![forbid(unsafe_code)]
 
+pub mod agreement;
 pub mod chi2;
 pub mod furnace;
 pub mod mutants;
