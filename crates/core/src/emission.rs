@@ -12,8 +12,9 @@
 //! [`LightSampler::sample`]): half and half when both emit.
 
 use crate::lights::LightSampler;
+use crate::ray::spawn_ray;
 use crate::sampling::{cosine_hemisphere, uniform_triangle};
-use crate::{frame::Frame, triangle, Aabb, Rgb, Scene};
+use crate::{frame::Frame, triangle, Aabb, Ray, Rgb, Scene};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -123,22 +124,7 @@ impl LightSampler {
             });
         }
         let p = self.sample_emitter_point(u_sel, u_pos)?;
-        // A two-sided emitter picks its face with the first coordinate, rescaled for the lobe.
-        let (side, u) = if p.two_sided {
-            if u_dir.x < 0.5 {
-                (1.0, Vec2::new(u_dir.x * 2.0, u_dir.y))
-            } else {
-                (-1.0, Vec2::new(u_dir.x * 2.0 - 1.0, u_dir.y))
-            }
-        } else {
-            (1.0, u_dir)
-        };
-        let n = p.normal * side;
-        let local = cosine_hemisphere(u);
-        if local.z <= 0.0 {
-            return None;
-        }
-        let dir = Frame::from_normal(n).to_world(local).normalize();
+        let (n, dir, cos) = cosine_emission(p.normal, p.two_sided, u_dir)?;
         // Le cos / (pdf_area · cos/π · face choice): the cosine cancels.
         let faces = if p.two_sided { 2.0 } else { 1.0 };
         let beta = p.emission * (PI * faces / p.pdf_area);
@@ -150,9 +136,46 @@ impl LightSampler {
             beta,
             point: Some(p),
             pdf_position: p.pdf_area,
-            pdf_direction: local.z / (PI * faces),
+            pdf_direction: cos / (PI * faces),
         })
     }
+}
+
+impl Emission {
+    /// The light path's first ray: offset off the emitter, or from the plane point as it is.
+    pub fn ray(&self) -> Ray {
+        if self.point.is_some() {
+            spawn_ray(self.origin, self.origin_error, self.normal, self.dir)
+        } else {
+            Ray::new(self.origin, self.dir)
+        }
+    }
+}
+
+/// A cosine-distributed direction leaving a surface of front normal `normal` for `u` in
+/// [0,1)²: the emitting side's normal, the unit direction and its cosine to that normal. A
+/// two-sided emitter picks its face with the first coordinate, rescaled for the lobe. `None`
+/// for a direction in the surface.
+pub fn cosine_emission(normal: Vec3, two_sided: bool, u: Vec2) -> Option<(Vec3, Vec3, f32)> {
+    let (side, u) = if two_sided {
+        if u.x < 0.5 {
+            (1.0, Vec2::new(u.x * 2.0, u.y))
+        } else {
+            (-1.0, Vec2::new(u.x * 2.0 - 1.0, u.y))
+        }
+    } else {
+        (1.0, u)
+    };
+    let n = normal * side;
+    let local = cosine_hemisphere(u);
+    if local.z <= 0.0 {
+        return None;
+    }
+    Some((
+        n,
+        Frame::from_normal(n).to_world(local).normalize(),
+        local.z,
+    ))
 }
 
 /// A point uniform on a rectangle perpendicular to travel direction `dir` (unit) that covers

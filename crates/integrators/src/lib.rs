@@ -28,6 +28,7 @@ mod path;
 pub mod spec;
 pub mod technique;
 mod transport;
+mod work;
 
 pub use ao::AoIntegrator;
 pub use bdpt::Bdpt;
@@ -77,6 +78,23 @@ pub struct SampleAux {
     pub want_first_hit: bool,
     /// The first visible surface, if any and if wanted.
     pub first_hit: Option<FirstHit>,
+}
+
+/// The first-hit AOVs of surface point `si` seen from direction `wo` (unit, towards the
+/// camera) at distance `depth`, with its BSDF `bsdf`: the normal is turned to face the camera.
+pub(crate) fn first_hit(
+    bsdf: &rt_core::material::Bsdf<'_>,
+    si: &rt_core::scene::SurfaceHit,
+    wo: rt_core::glam::Vec3,
+    depth: f32,
+) -> FirstHit {
+    let n = if si.ns.dot(wo) < 0.0 { -si.ns } else { si.ns };
+    FirstHit {
+        albedo: bsdf.albedo(),
+        normal: n,
+        depth,
+        position: si.p,
+    }
 }
 
 /// A radiance estimator for camera rays.

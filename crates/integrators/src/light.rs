@@ -24,6 +24,7 @@
 use crate::driver::{RenderStats, SamplePass};
 use crate::technique::Technique;
 use crate::transport::{adjoint_cos, importance_weight, survives_roulette};
+use crate::work;
 use crate::{Ctx, RayCounters};
 use rayon::prelude::*;
 use rt_core::{
@@ -31,7 +32,7 @@ use rt_core::{
     glam::{Vec2, Vec3},
     material::Bsdf,
     ray::{shadow_segment, spawn_ray},
-    Ray, Rgb, Sampler,
+    Rgb, Sampler,
 };
 use rt_film::{Film, Splat};
 use std::time::Instant;
@@ -68,14 +69,6 @@ impl LightTracer {
     }
 }
 
-/// One work item: light paths `first..first + count` of sample index `index`.
-#[derive(Clone, Copy)]
-struct Item {
-    index: u32,
-    first: u32,
-    count: u32,
-}
-
 impl Technique for LightTracer {
     fn name(&self) -> &str {
         "light"
@@ -96,22 +89,12 @@ impl Technique for LightTracer {
         let start = Instant::now();
         let discarded_before = film.discarded();
         let paths = film.width().saturating_mul(film.height());
-        let items: Vec<Item> = pass
-            .indices
-            .clone()
-            .flat_map(|index| {
-                (0..paths.div_ceil(CHUNK_PATHS)).map(move |c| Item {
-                    index,
-                    first: c * CHUNK_PATHS,
-                    count: CHUNK_PATHS.min(paths - c * CHUNK_PATHS),
-                })
-            })
-            .collect();
+        let items = work::items(pass.indices.clone(), paths, CHUNK_PATHS);
         let mut buffers: Vec<(Vec<Splat>, RayCounters)> = (0..BATCH_ITEMS.min(items.len()))
             .map(|_| (Vec::new(), RayCounters::default()))
             .collect();
         let mut rays = RayCounters::default();
-        let rows = film.height() as u64;
+        let rows = film.height();
         // Plane sampling's box, read once per pass rather than once per light path.
         let bounds = ctx.accel.bounds();
         for (b, batch) in items.chunks(BATCH_ITEMS).enumerate() {
@@ -131,8 +114,11 @@ impl Technique for LightTracer {
                 film.add_splats(item.index, u64::from(item.count), splats);
                 rays += *counters;
             }
-            let done = (b * BATCH_ITEMS + batch.len()) as u64;
-            progress((done * rows / items.len().max(1) as u64) as u32);
+            progress(work::rows_done(
+                b * BATCH_ITEMS + batch.len(),
+                items.len(),
+                rows,
+            ));
         }
         RenderStats {
             elapsed: start.elapsed(),
@@ -186,11 +172,7 @@ impl LightTracer {
             }
         }
         let mut beta = e.beta;
-        let mut ray = if e.point.is_some() {
-            spawn_ray(e.origin, e.origin_error, e.normal, e.dir)
-        } else {
-            Ray::new(e.origin, e.dir)
-        };
+        let mut ray = e.ray();
         let mut depth = 0u32;
         // The particle's wavelength once a dispersive event has drawn one (§6.6).
         let mut lambda: Option<f32> = None;

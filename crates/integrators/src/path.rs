@@ -21,7 +21,6 @@ use rt_core::{
     lights::LightSampler, material::Bsdf, ray::spawn_ray, sampling::power_heuristic, Ray, Rgb,
     Sampler,
 };
-use rt_film::FirstHit;
 
 /// Path tracer configuration.
 #[derive(Clone, Debug)]
@@ -145,13 +144,7 @@ impl Integrator for PathIntegrator {
                 bsdf.without_dispersion()
             };
             if first_hit_wanted {
-                let n = if si.ns.dot(wo) < 0.0 { -si.ns } else { si.ns };
-                aux.first_hit = Some(FirstHit {
-                    albedo: bsdf.albedo(),
-                    normal: n,
-                    depth: hit.t * ray.dir.length(),
-                    position: si.p,
-                });
+                aux.first_hit = Some(crate::first_hit(&bsdf, &si, wo, hit.t * ray.dir.length()));
             }
             if depth >= self.max_depth {
                 break;

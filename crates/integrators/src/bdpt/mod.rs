@@ -34,6 +34,7 @@ mod vertex;
 use crate::driver::{RenderStats, SamplePass};
 use crate::technique::Technique;
 use crate::transport::{adjoint_cos, importance_weight, light_visible, survives_roulette};
+use crate::work;
 use crate::{Ctx, RayCounters};
 use rayon::prelude::*;
 use rt_core::{
@@ -71,14 +72,6 @@ impl Bdpt {
     }
 }
 
-/// Pixels `first..first + count` (row-major) at sample index `index`.
-#[derive(Clone, Copy)]
-struct Item {
-    index: u32,
-    first: u32,
-    count: u32,
-}
-
 /// What one work item produced, merged into the film in item order.
 #[derive(Default)]
 struct ItemOutput {
@@ -108,17 +101,7 @@ impl Technique for Bdpt {
         let discarded_before = film.discarded();
         let (w, h) = (film.width(), film.height());
         let pixels = w.saturating_mul(h);
-        let items: Vec<Item> = pass
-            .indices
-            .clone()
-            .flat_map(|index| {
-                (0..pixels.div_ceil(CHUNK_PIXELS)).map(move |c| Item {
-                    index,
-                    first: c * CHUNK_PIXELS,
-                    count: CHUNK_PIXELS.min(pixels - c * CHUNK_PIXELS),
-                })
-            })
-            .collect();
+        let items = work::items(pass.indices.clone(), pixels, CHUNK_PIXELS);
         let mut outputs: Vec<ItemOutput> = (0..BATCH_ITEMS.min(items.len()))
             .map(|_| ItemOutput::default())
             .collect();
@@ -166,8 +149,11 @@ impl Technique for Bdpt {
                 film.add_splats(item.index, u64::from(item.count), &out.splats);
                 rays += out.counters;
             }
-            let done = (b * BATCH_ITEMS + batch.len()) as u64;
-            progress((done * u64::from(h) / items.len().max(1) as u64) as u32);
+            progress(work::rows_done(
+                b * BATCH_ITEMS + batch.len(),
+                items.len(),
+                h,
+            ));
         }
         RenderStats {
             elapsed: start.elapsed(),
@@ -286,7 +272,7 @@ impl Bdpt {
         else {
             return;
         };
-        let ray = match e.point {
+        let start = match e.point {
             Some(pt) => {
                 let mut v = Vertex::endpoint(Kind::Light, pt.point, Rgb::ONE, e.pdf_position);
                 v.p_error = pt.error;
@@ -295,20 +281,13 @@ impl Bdpt {
                 v.emission = pt.emission;
                 v.two_sided = pt.two_sided;
                 v.u_connect = [u_lens.x, u_lens.y, 0.0];
-                path.push(v);
-                spawn_ray(e.origin, e.origin_error, e.normal, e.dir)
+                v
             }
-            None => {
-                // At infinity: the vertex's density is the direction's (solid angle).
-                path.push(Vertex::endpoint(
-                    Kind::Env,
-                    -e.dir,
-                    Rgb::ONE,
-                    e.pdf_direction,
-                ));
-                Ray::new(e.origin, e.dir)
-            }
+            // At infinity: the vertex's density is the direction's (solid angle).
+            None => Vertex::endpoint(Kind::Env, -e.dir, Rgb::ONE, e.pdf_direction),
         };
+        path.push(start);
+        let ray = e.ray();
         // The next vertex's density: the direction's for a point emitter (converted to area at
         // the hit), the plane point's for the environment (`Densities::pdf_light`).
         let pdf_next = match e.point {

@@ -19,12 +19,10 @@ use crate::{Ctx, RayCounters};
 use rayon::prelude::*;
 use rt_accel::points::{PointItem, PointKdTree, PointQuery};
 use rt_core::{
-    emission::plane_sample,
-    frame::Frame,
+    emission::{cosine_emission, plane_sample},
     glam::{Vec2, Vec3},
     material::{Bsdf, LayerClass},
     ray::spawn_ray,
-    sampling::cosine_hemisphere,
     Aabb, Ray, Rgb, SampleStream, Sampler,
 };
 use std::f32::consts::PI;
@@ -263,21 +261,7 @@ fn photon_ray(
         let (o, _) = plane_sample(bounds, light.travel, u)?;
         return Some(Ray::new(o, light.travel));
     }
-    let (side, u) = if light.two_sided {
-        if u.x < 0.5 {
-            (1.0, Vec2::new(u.x * 2.0, u.y))
-        } else {
-            (-1.0, Vec2::new(u.x * 2.0 - 1.0, u.y))
-        }
-    } else {
-        (1.0, u)
-    };
-    let n = light.n * side;
-    let local = cosine_hemisphere(u);
-    if local.z <= 0.0 {
-        return None;
-    }
-    let dir = Frame::from_normal(n).to_world(local).normalize();
+    let (n, dir, _) = cosine_emission(light.n, light.two_sided, u)?;
     if map.is_some_and(|m| !m.allows(dir)) {
         return None;
     }

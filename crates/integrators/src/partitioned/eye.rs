@@ -119,13 +119,7 @@ impl Partitioned {
             let tint = scene.tint(material, si.uv);
             let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo);
             if depth == 0 && want_first_hit {
-                let n = if si.ns.dot(wo) < 0.0 { -si.ns } else { si.ns };
-                out.first_hit = Some(FirstHit {
-                    albedo: bsdf.albedo(),
-                    normal: n,
-                    depth: hit.t * ray.dir.length(),
-                    position: si.p,
-                });
+                out.first_hit = Some(crate::first_hit(&bsdf, &si, wo, hit.t * ray.dir.length()));
             }
             if depth >= self.max_depth {
                 break;

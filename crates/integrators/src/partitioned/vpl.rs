@@ -127,11 +127,7 @@ impl Partitioned {
                     });
                 }
             }
-            let ray = if e.point.is_some() {
-                spawn_ray(e.origin, e.origin_error, e.normal, e.dir)
-            } else {
-                Ray::new(e.origin, e.dir)
-            };
+            let ray = e.ray();
             self.walk(
                 ctx,
                 ray,
