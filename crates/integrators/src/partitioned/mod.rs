@@ -6,10 +6,10 @@
 //!
 //! | part | paths | technique |
 //! |---|---|---|
-//! | A | `EDL`, `EDD(S\|D)*L` | virtual point lights ([`vpl`]) |
-//! | B | `EDS(S\|D)*L` | caustic histogram ([`caustic`]) |
+//! | A | `EDL`, `EDD(S\|D)*L` | virtual point lights (`vpl.rs`) |
+//! | B | `EDS(S\|D)*L` | caustic histogram (`caustic.rs`) |
 //! | C | `ES+D(S\|D)*L` | specular gathering: the eye path continues through `S`, and A and B are evaluated at its first `D` vertex |
-//! | D | `ES*L` | emission found by the eye path ([`eye`]) |
+//! | D | `ES*L` | emission found by the eye path (`eye.rs`) |
 //!
 //! The split is exact, not weighted: a vertex's BSDF is the sum of its diffuse and specular
 //! layers ([`Bsdf::restricted`](rt_core::material::Bsdf::restricted)); the eye path picks one
