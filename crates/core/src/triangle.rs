@@ -251,17 +251,70 @@ pub fn point_with_error(v: &[Vec3; 3], b1: f32, b2: f32) -> (Vec3, Vec3) {
     if room.is_nan() || room <= 0.0 || b.iter().zip(&b_min).all(|(b, m)| b >= m) {
         return (p, err);
     }
-    let excess = b.map(|b| b.max(0.0));
-    let excess = [0, 1, 2].map(|i| (excess[i] - b_min[i]).max(0.0));
-    let total = excess[0] + excess[1] + excess[2];
-    let pulled = [0, 1, 2].map(|i| {
-        if total > 0.0 {
-            b_min[i] + excess[i] * (room / total)
-        } else {
-            b_min[i] + room / 3.0
-        }
-    });
-    point_and_bound(v, pulled[1], pulled[2], twice_area)
+    // Move to the nearest point of the inset triangle {bᵢ ≥ b_minᵢ} (similar to this one, its
+    // edges `e` inside). The nearest point in space, not in barycentric terms: on a sliver one
+    // barycentric step along the long edges is metres, and an earlier rescaling of the weights
+    // moved hits on a 2000 × 25 fan triangle by up to 20 units (shadows vanished).
+    let corner = |i: usize| {
+        let mut c = b_min;
+        c[i] += room;
+        point_at(v, c[1], c[2]) - v[0]
+    };
+    let w = closest_on_triangle(p - v[0], [corner(0), corner(1), corner(2)]);
+    // An inset triangle that rounds to a degenerate one (tiny triangles far out) has no face.
+    if !w.iter().all(|w| w.is_finite()) {
+        return (p, err);
+    }
+    let pulled = [0, 1, 2].map(|i| b_min[i] + room * w[i]);
+    let (q, q_err) = point_and_bound(v, pulled[1], pulled[2], twice_area);
+    // Near a sharp corner the inset triangle starts `e / sin(angle / 2)` away (45 units at the
+    // centre of that fan). Like a sliver too thin for any inset, such a corner keeps its point:
+    // moving it further than a few error bounds would shift shadows visibly. `3e` still covers
+    // the 45° corners of split rectangles (2.6e).
+    if (q - p).length() > 3.0 * e {
+        return (p, err);
+    }
+    (q, q_err)
+}
+
+/// Barycentric weights of the point of triangle `t` nearest to `p` (Ericson, *Real-Time
+/// Collision Detection*, §5.1.5), by Voronoi regions so that no division by a tiny area occurs
+/// outside the face region.
+fn closest_on_triangle(p: Vec3, t: [Vec3; 3]) -> [f32; 3] {
+    let (a, b, c) = (t[0], t[1], t[2]);
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return [1.0, 0.0, 0.0];
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return [0.0, 1.0, 0.0];
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let s = d1 / (d1 - d3);
+        return [1.0 - s, s, 0.0];
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return [0.0, 0.0, 1.0];
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let s = d2 / (d2 - d6);
+        return [1.0 - s, 0.0, s];
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
+        let s = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return [0.0, 1.0 - s, s];
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (s, u) = (vb * denom, vc * denom);
+    [1.0 - s - u, s, u]
 }
 
 /// True if every barycentric weight clearly exceeds its `b_min` in [`point_with_error`], decided
@@ -375,6 +428,32 @@ mod tests {
             assert_eq!(p, point_at(&v, 0.0, 0.5));
             assert!(err.is_finite(), "{err}");
         }
+    }
+
+    #[test]
+    fn pulled_points_move_by_their_error_not_along_slivers() {
+        // One triangle of a 512-sliver fan 2000 in radius (2000 × 25): a hit on a long edge moves
+        // off that edge by a few error bounds and no further along it.
+        let r = 2000.0f32;
+        let a = std::f32::consts::TAU / 512.0;
+        let v = [
+            Vec3::ZERO,
+            Vec3::new(r, 0.0, 0.0),
+            Vec3::new(r * a.cos(), 0.0, r * a.sin()),
+        ];
+        for (b1, b2) in [(0.5, 0.0), (0.0, 0.5), (0.05, 0.0), (0.9, 0.0), (0.3, 0.7)] {
+            let (p, err) = point_with_error(&v, b1, b2);
+            let q = point_at(&v, b1, b2);
+            let moved = (p - q).length();
+            assert!(
+                moved <= 6.0 * err.length() + 1e-3,
+                "({b1}, {b2}) moved {moved}, err {err}"
+            );
+            assert!(moved > 0.0, "({b1}, {b2}) on an edge was not pulled in");
+        }
+        // Within 45 units of the sharp corner no point is far enough from both long edges: the
+        // point stays (it was pulled out to the inset triangle's corner, 45 units away).
+        assert_eq!(point_with_error(&v, 1e-4, 1e-4).0, point_at(&v, 1e-4, 1e-4));
     }
 
     #[test]
