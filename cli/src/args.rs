@@ -90,8 +90,9 @@ pub struct Args {
     pub camera: Option<String>,
 
     /// Extra EXR channels, comma separated: albedo, normal, depth, position (at the first
-    /// visible surface, averaged over the pixel's samples) and variance (of the pixel mean).
-    /// Only computed when asked for. [default: `[render] aov`, else none]
+    /// visible surface, averaged over the pixel's samples), variance (of the pixel mean) and
+    /// blocks (with --error: the stopping criterion's final block index, samples per pixel and
+    /// converged flag per pixel). Only computed when asked for. [default: `[render] aov`, else none]
     #[arg(long, value_delimiter = ',')]
     pub aov: Option<Vec<String>>,
 

@@ -9,8 +9,8 @@ use rt_film::{AovSet, Film, FilmBuffers, OutputOptions};
 use rt_integrators::{Ctx, RenderStats, SamplePass, Technique};
 use rt_scene::{LoadedScene, RenderDesc};
 use rt_session::{
-    pick_camera, render_adaptive, Overrides, RenderReport, ReportInputs, Settings, StopRule,
-    MAX_SPP,
+    pick_camera, render_adaptive, Adaptive, Overrides, RenderReport, ReportInputs, Settings,
+    StopRule, MAX_SPP,
 };
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -103,6 +103,9 @@ impl Job {
             Some(t) => Some(std::time::Duration::from_secs_f64(t)),
             None => None,
         };
+        if settings.aovs.blocks && args.error.is_none() {
+            bail!("--aov blocks writes the stopping criterion's blocks: it needs --error");
+        }
         let stop = (args.error.is_some() || time_limit.is_some()).then(|| StopRule {
             error: args.error,
             time_limit,
@@ -204,12 +207,17 @@ pub fn run(args: &Args) -> Result<()> {
     bar.finish_and_clear();
 
     let t_write = Instant::now();
-    rt_film::write_image(
+    let extra = match adaptive.as_ref() {
+        Some(a) if job.settings.aovs.blocks => block_channels(a, &film),
+        _ => Vec::new(),
+    };
+    rt_film::write_image_with(
         &job.output,
         &film,
         &OutputOptions {
             exposure: job.exposure,
         },
+        &extra,
     )
     .map_err(|e| anyhow::anyhow!("{e}"))?;
     let write_time = t_write.elapsed();
@@ -293,4 +301,32 @@ fn print_summary(
         stats.discarded,
         job.output.display(),
     );
+}
+
+/// The `blocks` AOV: each pixel's final block (`blocks.index`), its sample count
+/// (`blocks.spp`; light-path techniques sample every pixel alike, so it is the passes' samples
+/// per pixel) and whether its block met the threshold (`blocks.converged`, 0 or 1).
+fn block_channels(a: &Adaptive, film: &Film) -> Vec<(&'static str, Vec<f32>)> {
+    let Some(map) = a.block_map(film.width(), film.height()) else {
+        return Vec::new();
+    };
+    let spp: Vec<f32> = if film.light_paths() > 0 {
+        vec![a.spp as f32; map.index.len()]
+    } else {
+        film.pixels().map(|p| p.count() as f32).collect()
+    };
+    vec![
+        (
+            "blocks.index",
+            map.index.iter().map(|&i| i as f32).collect(),
+        ),
+        ("blocks.spp", spp),
+        (
+            "blocks.converged",
+            map.converged
+                .iter()
+                .map(|&c| f32::from(u8::from(c)))
+                .collect(),
+        ),
+    ]
 }

@@ -19,6 +19,9 @@ pub struct AovSet {
     pub position: bool,
     /// Per-pixel variance of the mean (needs the film's variance buffer, 12 bytes per pixel).
     pub variance: bool,
+    /// The stopping criterion's final blocks: per pixel its block's index, its sample count and
+    /// whether the block met the threshold (an adaptive render's output, not a film buffer).
+    pub blocks: bool,
 }
 
 impl AovSet {
@@ -37,6 +40,7 @@ impl AovSet {
                 "depth" => s.depth = true,
                 "position" => s.position = true,
                 "variance" => s.variance = true,
+                "blocks" => s.blocks = true,
                 "" => {}
                 other => return Err(UnknownAov(other.to_string())),
             }
@@ -47,7 +51,7 @@ impl AovSet {
 
 /// An AOV name [`AovSet::parse_list`] does not know.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("unknown AOV '{0}' (expected albedo, normal, depth, position, variance)")]
+#[error("unknown AOV '{0}' (expected albedo, normal, depth, position, variance, blocks)")]
 pub struct UnknownAov(pub String);
 
 /// Which per-pixel buffers a film allocates besides the mean and sample count, which it always
@@ -524,6 +528,7 @@ mod tests {
             depth: true,
             position: true,
             variance: true,
+            blocks: false,
         })
         .with_halves()
     }

@@ -43,7 +43,8 @@ pub mod stopping;
 pub use film::{AovSet, Film, FilmBuffers, FilmMemory, FilmStripe, UnknownAov};
 pub use input::{decode_srgb, read_rgb};
 pub use output::{
-    copy_atomic, read_exr, write_bytes_atomic, write_image, write_rgb, FilmError, OutputOptions,
+    copy_atomic, read_exr, write_bytes_atomic, write_image, write_image_with, write_rgb, FilmError,
+    OutputOptions,
 };
 pub use pixel::{FirstHit, HalfSums, PixelStats};
 pub use splat::Splat;

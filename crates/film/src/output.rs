@@ -51,12 +51,35 @@ pub struct OutputOptions {
 
 /// Writes the film to `path`, choosing the format by extension (`.exr` or `.png`).
 pub fn write_image(path: &Path, film: &Film, opts: &OutputOptions) -> Result<(), FilmError> {
+    write_image_with(path, film, opts, &[])
+}
+
+/// [`write_image`] with further per-pixel channels (name, one value per pixel, row-major),
+/// such as the stopping criterion's block map, which are not film buffers. EXR only: a PNG
+/// holds the beauty image alone, so extra channels there are an error.
+pub fn write_image_with(
+    path: &Path,
+    film: &Film,
+    opts: &OutputOptions,
+    extra: &[(&str, Vec<f32>)],
+) -> Result<(), FilmError> {
+    let pixels = film.width() as usize * film.height() as usize;
+    if let Some((name, _)) = extra.iter().find(|(_, v)| v.len() != pixels) {
+        return Err(FilmError::Codec {
+            path: path.to_path_buf(),
+            message: format!("channel {name} does not have one value per pixel"),
+        });
+    }
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     match ext.as_deref() {
-        Some("exr") => write_atomic(path, |w| write_exr(w, film)),
+        Some("exr") => write_atomic(path, |w| write_exr(w, film, extra)),
+        Some("png") if !extra.is_empty() => Err(FilmError::Codec {
+            path: path.to_path_buf(),
+            message: "a PNG holds only the beauty image; write an .exr for extra channels".into(),
+        }),
         Some("png") => write_atomic(path, |w| {
             write_png(w, film.width(), film.height(), &film.mean_image(), opts)
         }),
@@ -168,7 +191,11 @@ fn rgb_channels(
     }
 }
 
-fn write_exr(w: &mut BufWriter<File>, film: &Film) -> Result<(), String> {
+fn write_exr(
+    w: &mut BufWriter<File>,
+    film: &Film,
+    extra: &[(&str, Vec<f32>)],
+) -> Result<(), String> {
     let mut chans = Vec::new();
     rgb_channels(&mut chans, "", ["R", "G", "B"], &film.mean_image());
     // Each accessor is `None` exactly when the AOV was not asked for (the film allocates the
@@ -189,6 +216,9 @@ fn write_exr(w: &mut BufWriter<File>, film: &Film) -> Result<(), String> {
         if let Some(v) = film.variance_image() {
             rgb_channels(&mut chans, "variance.", ["R", "G", "B"], &v);
         }
+    }
+    for (name, values) in extra {
+        chans.push(channel(name, values.clone()));
     }
     write_exr_channels(w, (film.width() as usize, film.height() as usize), chans)
 }

@@ -70,6 +70,8 @@ pub struct StoppingCriterion {
     width: u32,
     height: u32,
     active: Vec<Block>,
+    /// Blocks that met the threshold, in the order they did.
+    finished: Vec<Block>,
     /// Per pixel: still sampling.
     mask: Vec<bool>,
     /// Reused per decision: per-pixel errors.
@@ -94,6 +96,7 @@ impl StoppingCriterion {
             width,
             height,
             active: if n > 0 { vec![all] } else { Vec::new() },
+            finished: Vec::new(),
             mask: vec![true; n],
             errors: Vec::new(),
         })
@@ -102,6 +105,11 @@ impl StoppingCriterion {
     /// The blocks still sampling.
     pub fn active(&self) -> &[Block] {
         &self.active
+    }
+
+    /// The blocks that met the threshold, in the order they did.
+    pub fn finished(&self) -> &[Block] {
+        &self.finished
     }
 
     /// True once every block has met the threshold.
@@ -158,6 +166,7 @@ impl StoppingCriterion {
             let e = self.block_error(&b);
             if e < t {
                 d.finished += 1;
+                self.finished.push(b);
                 for y in b.y0..b.y1 {
                     let row = (y * self.width) as usize;
                     self.mask[row + b.x0 as usize..row + b.x1 as usize].fill(false);
@@ -242,6 +251,40 @@ impl StoppingCriterion {
                 },
             )
         })
+    }
+}
+
+/// The leaf blocks of a stopping decision as per-pixel maps (`render --aov blocks`): each
+/// pixel's block index (finished blocks first, in the order they finished, then the active
+/// ones) and whether its block met the threshold.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BlockMap {
+    /// Block index per pixel, row-major.
+    pub index: Vec<u32>,
+    /// Per pixel: its block met the threshold.
+    pub converged: Vec<bool>,
+}
+
+impl BlockMap {
+    /// The map of `finished` and `active` blocks over a `width × height` image. Pixels in no
+    /// block (never, for a criterion's blocks, which tile the image) get index `u32::MAX`.
+    pub fn new(width: u32, height: u32, finished: &[Block], active: &[Block]) -> Self {
+        let n = width as usize * height as usize;
+        let mut map = Self {
+            index: vec![u32::MAX; n],
+            converged: vec![false; n],
+        };
+        let leaves = finished.iter().map(|b| (b, true));
+        let leaves = leaves.chain(active.iter().map(|b| (b, false)));
+        for (i, (b, done)) in leaves.enumerate() {
+            for y in b.y0..b.y1.min(height) {
+                let row = (y * width) as usize;
+                let span = row + b.x0 as usize..row + b.x1.min(width) as usize;
+                map.index[span.clone()].fill(i as u32);
+                map.converged[span].fill(done);
+            }
+        }
+        map
     }
 }
 

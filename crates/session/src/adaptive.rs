@@ -11,7 +11,7 @@
 //! sample count, and so the image, depend on the machine.
 
 use rt_core::SampleStream;
-use rt_film::stopping::{BadThreshold, Block, StoppingCriterion};
+use rt_film::stopping::{BadThreshold, Block, BlockMap, StoppingCriterion};
 use rt_film::Film;
 use rt_integrators::{Ctx, RenderStats, SamplePass, Technique};
 use std::sync::Arc;
@@ -62,6 +62,24 @@ pub struct Adaptive {
     pub decisions: Duration,
     /// Blocks still sampling when it stopped (empty when converged).
     pub active_blocks: Vec<Block>,
+    /// Blocks that met the threshold, in the order they did (empty without a criterion).
+    pub finished_blocks: Vec<Block>,
+}
+
+impl Adaptive {
+    /// The final blocks as per-pixel maps over a `width × height` film; `None` without a
+    /// stopping criterion (a time limit alone has no blocks).
+    pub fn block_map(&self, width: u32, height: u32) -> Option<BlockMap> {
+        if self.active_blocks.is_empty() && self.finished_blocks.is_empty() {
+            return None;
+        }
+        Some(BlockMap::new(
+            width,
+            height,
+            &self.finished_blocks,
+            &self.active_blocks,
+        ))
+    }
 }
 
 /// Renders into `film` (which must keep half-buffers when `rule.error` is set) until `rule`
@@ -121,6 +139,10 @@ pub fn render_adaptive(
         spp,
         reason,
         decisions,
-        active_blocks: criterion.map(|c| c.active().to_vec()).unwrap_or_default(),
+        active_blocks: criterion
+            .as_ref()
+            .map(|c| c.active().to_vec())
+            .unwrap_or_default(),
+        finished_blocks: criterion.map(|c| c.finished().to_vec()).unwrap_or_default(),
     })
 }

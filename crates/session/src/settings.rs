@@ -212,7 +212,12 @@ impl Overrides {
             }
         };
         let integrator = self.integrator_spec(desc, scene_path)?;
-        if integrator.kind.splats() && aovs != AovSet::default() {
+        // The block map is the stopping criterion's, which serves every technique.
+        let per_pixel = AovSet {
+            blocks: false,
+            ..aovs
+        };
+        if integrator.kind.splats() && per_pixel != AovSet::default() {
             return Err(SettingsError::AovUnsupported {
                 origin: origin(self.aovs.is_some(), "aov", "aov"),
                 technique: integrator.kind.name(),

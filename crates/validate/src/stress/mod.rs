@@ -354,6 +354,7 @@ pub fn render_film(
         depth: true,
         position: true,
         variance: true,
+        blocks: false,
     };
     // Every buffer a film can keep, so that every one is checked for invalid values.
     let buffers = FilmBuffers::for_outputs(aovs).with_variance().with_halves();
