@@ -256,6 +256,7 @@ pub fn run(args: &Args) -> Result<()> {
                 accel_spec: job.settings.accel.to_string(),
                 film: &film,
                 render: &stats,
+                technique: &integrator.stages(),
                 load_time,
                 accel_time: build_time,
                 write_time,

@@ -274,3 +274,40 @@ fn shipped_scenes_build_the_importance_map_and_use_the_lens() {
     );
     assert_skipped(&table, "lens sampling", "pinhole camera");
 }
+
+#[test]
+fn partitioned_reports_its_own_stages() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("s.toml"), lamp()).unwrap();
+    let table = render(
+        dir.path(),
+        &[
+            "s.toml",
+            "--integrator",
+            "partitioned:vpls=4:photons=1000",
+            "--spp",
+            "2",
+            "--stats",
+            "-q",
+            "-o",
+            "o.exr",
+        ],
+    );
+    let eye = row(&table, "eye paths and VPLs");
+    assert_eq!(eye.status, "done");
+    assert!(eye.details.starts_with("2 passes, "), "{}", eye.details);
+    // No specular surface, so the caustic stage draws its photons but none lands.
+    let caustic = row(&table, "caustic histogram");
+    assert!(
+        caustic.details.ends_with(", 0 landed in bins"),
+        "{}",
+        caustic.details
+    );
+    assert_eq!(row(&table, "projection maps").status, "done");
+    // A camera-ray technique has no such stages.
+    let path = render(
+        dir.path(),
+        &["s.toml", "--spp", "1", "--stats", "-q", "-o", "o.exr"],
+    );
+    assert!(!path.contains("caustic histogram"), "{path}");
+}

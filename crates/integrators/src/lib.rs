@@ -39,7 +39,7 @@ pub use path::PathIntegrator;
 pub use spec::{
     IntegratorKind, IntegratorSpec, IntegratorSpecError, Target, DEFAULT_MAX_DEPTH, MAX_DEPTH,
 };
-pub use technique::{CameraRays, Technique};
+pub use technique::{CameraRays, Technique, TechniqueStage};
 
 use rt_core::{Accel, Camera, Rgb, Sampler, Scene};
 use rt_film::FirstHit;

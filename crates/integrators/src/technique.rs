@@ -9,6 +9,19 @@
 use crate::driver::{render_samples, RenderStats, SamplePass};
 use crate::{Ctx, Integrator};
 use rt_film::Film;
+use std::time::Duration;
+
+/// One line of a technique's own account of a render (`render --stats`): a stage it ran, the
+/// time it took if measured, and what it did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TechniqueStage {
+    /// Stage name, e.g. `projection maps`.
+    pub name: &'static str,
+    /// Time spent in it, summed over passes and threads' wall time, if measured.
+    pub time: Option<Duration>,
+    /// What it did, as text.
+    pub details: String,
+}
 
 /// A light-transport technique that renders in passes of sample indices.
 pub trait Technique: Send + Sync {
@@ -39,6 +52,12 @@ pub trait Technique: Send + Sync {
     /// film then does not know.
     fn splats(&self) -> bool {
         false
+    }
+
+    /// The technique's own stages over the passes rendered so far, for reports; none by
+    /// default (camera-ray estimators have nothing beyond the render's totals).
+    fn stages(&self) -> Vec<TechniqueStage> {
+        Vec::new()
     }
 }
 

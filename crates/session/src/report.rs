@@ -7,7 +7,7 @@
 
 use rt_core::{environment::Environment, Accel, Camera, Scene};
 use rt_film::Film;
-use rt_integrators::RenderStats;
+use rt_integrators::{RenderStats, TechniqueStage};
 use std::fmt;
 use std::path::Path;
 use std::time::Duration;
@@ -89,6 +89,8 @@ pub struct ReportInputs<'a> {
     pub film: &'a Film,
     /// What the render passes reported.
     pub render: &'a RenderStats,
+    /// The technique's own stages ([`rt_integrators::Technique::stages`]).
+    pub technique: &'a [TechniqueStage],
     /// Scene load time.
     pub load_time: Duration,
     /// Acceleration structure build time.
@@ -218,6 +220,9 @@ impl RenderReport {
                 r.samples, r.rays.rays, r.rays.shadow_rays, r.discarded
             )),
         );
+        for t in i.technique {
+            stages.push(Stage::ran(t.name, "done", t.time, None).details(t.details.clone()));
+        }
 
         let file_bytes = std::fs::metadata(i.output).map(|m| m.len()).ok();
         let mut write = Stage::ran("output write", "done", Some(i.write_time), None)
@@ -305,6 +310,7 @@ mod tests {
             accel_spec: "brute-force".into(),
             film,
             render: &RenderStats::default(),
+            technique: &[],
             load_time: Duration::from_millis(2),
             accel_time: Duration::from_millis(1),
             write_time: Duration::from_millis(3),

@@ -38,7 +38,7 @@ mod projection;
 mod vpl;
 
 use crate::driver::{RenderStats, SamplePass};
-use crate::technique::Technique;
+use crate::technique::{Technique, TechniqueStage};
 use crate::{Ctx, RayCounters};
 use rayon::prelude::*;
 use rt_core::Rgb;
@@ -188,6 +188,60 @@ impl Partitioned {
 impl Technique for Partitioned {
     fn name(&self) -> &str {
         "partitioned"
+    }
+
+    fn stages(&self) -> Vec<TechniqueStage> {
+        let s = self.stats();
+        let share = |a: u64, b: u64| 100.0 * a as f64 / b.max(1) as f64;
+        let maps = if !self.options.projection_maps {
+            TechniqueStage {
+                name: "projection maps",
+                time: None,
+                details: "off (maps=off)".into(),
+            }
+        } else if s.photons_emitted == 0 {
+            TechniqueStage {
+                name: "projection maps",
+                time: Some(s.map_time),
+                details: format!("{} maps, no caustic photons drawn", s.maps),
+            }
+        } else {
+            TechniqueStage {
+                name: "projection maps",
+                time: Some(s.map_time),
+                details: format!(
+                    "{} maps, mean coverage {:.1} %, photons traced {:.1} % of drawn \
+                     (saved {:.1} %), {:.1} % of caustic time",
+                    s.maps,
+                    100.0 * s.mean_coverage(),
+                    share(s.photons_traced, s.photons_emitted),
+                    100.0 - share(s.photons_traced, s.photons_emitted),
+                    100.0 * s.map_time.as_secs_f64() / s.caustic_time.as_secs_f64().max(1e-12)
+                ),
+            }
+        };
+        vec![
+            TechniqueStage {
+                name: "eye paths and VPLs",
+                time: Some(s.other_time),
+                details: format!(
+                    "{} passes, {} VPLs stored, {} culled ({})",
+                    s.passes,
+                    s.vpls,
+                    s.culled,
+                    self.options.cull.name()
+                ),
+            },
+            TechniqueStage {
+                name: "caustic histogram",
+                time: Some(s.caustic_time),
+                details: format!(
+                    "{} photons drawn, {} traced, {} landed in bins",
+                    s.photons_emitted, s.photons_traced, s.photons_landed
+                ),
+            },
+            maps,
+        ]
     }
 
     fn render_pass(
