@@ -28,6 +28,10 @@
 //! - The camera strategy `t = 0` (a light path hitting the lens) and `s = 1, t = 1` (a light
 //!   point connected to the camera) are not used, as in pbrt: camera rays that hit a light cover
 //!   those paths.
+//! - Dispersion (§6.6): each subpath draws its own wavelength at its first dispersive event and
+//!   keeps it. A connection joining two subpaths that both did combines two independent
+//!   wavelengths, so such doubly dispersed paths keep their energy but not their exact colour;
+//!   paths dispersed on one side only are exact.
 
 mod vertex;
 
@@ -327,6 +331,8 @@ impl Bdpt {
         let scene = ctx.scene;
         let thin_lens = !ctx.camera.is_pinhole();
         let mut bounces = 0usize;
+        // The subpath's wavelength once a dispersive event has drawn one (§6.6).
+        let mut lambda: Option<f32> = None;
         while bounces < max_vertices {
             counters.rays += 1;
             let prev = path.len() - 1;
@@ -350,7 +356,7 @@ impl Bdpt {
             v.material = Some(material);
             v.tint = tint;
             v.prim = si.prim;
-            v.bsdf = Some(Bsdf::new(material, tint, si.ns, si.ng, wo));
+            v.bsdf = Some(Bsdf::new(material, tint, si.ns, si.ng, wo).with_wavelength(lambda));
             v.pdf_fwd = if path[prev].kind == Kind::Env {
                 // Plane sampling: uniform over the plane perpendicular to the ray.
                 pdf * si.ng.dot(wo).abs()
@@ -399,6 +405,7 @@ impl Bdpt {
                 Transport::Importance => importance_weight(&s, wo, si.ns, si.ng),
             };
             path[cur].delta = s.delta;
+            lambda = s.wavelength;
             let rev = to_area(pdf_rev, &path[cur], &path[prev]);
             path[prev].pdf_rev = rev;
             if beta.max_element() <= 0.0 || !beta.is_finite() {

@@ -204,6 +204,8 @@ impl Partitioned {
         counters: &mut RayCounters,
     ) {
         let scene = ctx.scene;
+        // The photon's wavelength once a dispersive event has drawn one (§6.6).
+        let mut lambda: Option<f32> = None;
         for bounce in 0..self.max_depth {
             counters.rays += 1;
             let Some(hit) = ctx.accel.intersect(&ray, f32::INFINITY) else {
@@ -233,11 +235,14 @@ impl Partitioned {
             let u_bsdf = sampler.next_2d();
             let u_rr = sampler.next_1d();
             // Only the specular part carries a photon on: its diffuse part is the VPLs'.
-            let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo).restricted(LayerClass::Specular);
+            let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo)
+                .with_wavelength(lambda)
+                .restricted(LayerClass::Specular);
             let Some(s) = bsdf.sample(u_layer, u_bsdf) else {
                 return;
             };
             beta *= importance_weight(&s, wo, si.ns, si.ng);
+            lambda = s.wavelength;
             if beta.max_element() <= 0.0 || !beta.is_finite() {
                 return;
             }

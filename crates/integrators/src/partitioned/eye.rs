@@ -106,6 +106,8 @@ impl Partitioned {
         let mut beta = Rgb::ONE;
         let mut length = 0.0f32;
         let mut depth = 0u32;
+        // The eye path's wavelength once a dispersive event has drawn one (§6.6).
+        let mut lambda: Option<f32> = None;
         loop {
             let Some(hit) = ctx.accel.intersect(&ray, f32::INFINITY) else {
                 out.emitted += beta * scene.environment.radiance(ray.dir);
@@ -117,7 +119,7 @@ impl Partitioned {
             let wo = -ray.dir;
             out.emitted += beta * material.emitted(si.ng, wo);
             let tint = scene.tint(material, si.uv);
-            let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo);
+            let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo).with_wavelength(lambda);
             if depth == 0 && want_first_hit {
                 out.first_hit = Some(crate::first_hit(&bsdf, &si, wo, hit.t * ray.dir.length()));
             }
@@ -151,6 +153,7 @@ impl Partitioned {
                 break;
             };
             beta *= s.weight / (1.0 - p_d);
+            lambda = s.wavelength;
             if beta.max_element() <= 0.0 || !beta.is_finite() {
                 break;
             }

@@ -30,7 +30,10 @@
 //! the bin radius is half the pixel's angle times the eye path's length, which is what ray
 //! differentials give through planar mirrors (curved glass would widen or narrow it); photons
 //! from the environment start by plane sampling and have no projection map; indirect caustics
-//! (photons from VPLs beyond the lights) are not traced, as the thesis' default.
+//! (photons from VPLs beyond the lights) are not traced, as the thesis' default. Dispersion:
+//! eye paths, VPL walks and photons each keep the wavelength of their first dispersive event;
+//! as in [`crate::Bdpt`], an eye path and a light walk that both dispersed join two
+//! independent wavelengths.
 
 mod caustic;
 mod eye;

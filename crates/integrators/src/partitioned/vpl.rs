@@ -157,6 +157,8 @@ impl Partitioned {
     ) {
         let scene = ctx.scene;
         // A VPL at bounce b lights eye vertices of depth at most max_depth - b.
+        // The walk's wavelength once a dispersive event has drawn one (§6.6).
+        let mut lambda: Option<f32> = None;
         for bounce in 1..self.max_depth {
             counters.rays += 1;
             let Some(hit) = ctx.accel.intersect(&ray, f32::INFINITY) else {
@@ -166,7 +168,7 @@ impl Partitioned {
             let material = &scene.materials[si.material as usize];
             let wo = -ray.dir;
             let tint = scene.tint(material, si.uv);
-            let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo);
+            let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo).with_wavelength(lambda);
             let u_layer = sampler.next_1d();
             let u_bsdf = sampler.next_2d();
             let u_rr = sampler.next_1d();
@@ -195,6 +197,7 @@ impl Partitioned {
                 break;
             };
             beta *= importance_weight(&s, wo, si.ns, si.ng);
+            lambda = s.wavelength;
             if beta.max_element() <= 0.0 || !beta.is_finite() {
                 break;
             }
