@@ -5,8 +5,8 @@
 use anyhow::{anyhow, Result};
 use rt_film::read_rgb as load_rgb;
 use rt_metrics::{
-    compare, error_image, CompareOptions, FalseColourOptions, Metrics, MetricsError, Role,
-    DEFAULT_EPSILON, DEFAULT_PEAK,
+    compare, error_image, CompareOptions, FalseColourOptions, Metrics, MetricsError, RgbImage,
+    Role, DEFAULT_EPSILON, DEFAULT_PEAK,
 };
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -39,6 +39,29 @@ pub struct CompareArgs {
     /// PSNR's peak value: 10 log10(peak^2 / MSE).
     #[arg(long, default_value_t = DEFAULT_PEAK, value_parser = positive)]
     pub peak: f64,
+
+    /// Measure only the pixels x0..x1 × y0..y1 (half-open, row 0 at the top) of both images,
+    /// e.g. a dark, indirectly lit corner.
+    #[arg(long, value_name = "X0,Y0,X1,Y1", value_delimiter = ',')]
+    pub region: Option<Vec<usize>>,
+}
+
+/// `image` cut to `region` (x0, y0, x1, y1), or a line saying why it cannot be.
+fn crop(image: RgbImage, region: &[usize], path: &Path) -> Result<RgbImage> {
+    let &[x0, y0, x1, y1] = region else {
+        return Err(anyhow!("--region takes four numbers: x0,y0,x1,y1"));
+    };
+    let (w, h) = (image.width(), image.height());
+    if x0 >= x1 || y0 >= y1 || x1 > w || y1 > h {
+        return Err(anyhow!(
+            "--region {x0},{y0},{x1},{y1} is not a non-empty rectangle inside the {w}x{h} image {}",
+            path.display()
+        ));
+    }
+    let px = image.pixels();
+    Ok(RgbImage::from_fn(x1 - x0, y1 - y0, |x, y| {
+        px[(y0 + y) * w + x0 + x]
+    }))
 }
 
 fn positive(s: &str) -> Result<f64, String> {
@@ -50,8 +73,12 @@ fn positive(s: &str) -> Result<f64, String> {
 
 /// Runs `render compare`.
 pub fn run(args: &CompareArgs) -> Result<()> {
-    let test = load_rgb(&args.test)?;
-    let reference = load_rgb(&args.reference)?;
+    let mut test = load_rgb(&args.test)?;
+    let mut reference = load_rgb(&args.reference)?;
+    if let Some(region) = &args.region {
+        test = crop(test, region, &args.test)?;
+        reference = crop(reference, region, &args.reference)?;
+    }
     let explain = |e| explain(e, &args.test, &args.reference);
     let opts = CompareOptions {
         epsilon: args.epsilon,

@@ -296,3 +296,27 @@ fn unreadable_inputs_are_one_error_line_naming_the_file() {
     let out = d.render(&["compare", "a.exr", "a.exr", "--epsilon", "-1"]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn region_measures_only_its_pixels() {
+    let d = Dir::new();
+    // B is flat; A differs from it by 0.5 in the left half only.
+    d.image("b.exr", 8, 4, |_, _| Rgb::splat(0.5));
+    d.image("a.exr", 8, 4, |x, _| {
+        Rgb::splat(if x < 4 { 1.0 } else { 0.5 })
+    });
+    let mse = |args: &[&str]| metrics(&d, &[&["a.exr", "b.exr"], args].concat())[0].1;
+    assert_eq!(mse(&["--region", "4,0,8,4"]), 0.0);
+    assert!((mse(&["--region", "0,1,4,3"]) - 0.25).abs() < 1e-12);
+    assert!((mse(&[]) - 0.125).abs() < 1e-12);
+    expect_error(
+        &d,
+        &["a.exr", "b.exr", "--region", "2,0,9,4"],
+        &["--region 2,0,9,4", "8x4 image a.exr"],
+    );
+    expect_error(
+        &d,
+        &["a.exr", "b.exr", "--region", "3,0,3,4"],
+        &["non-empty"],
+    );
+}
