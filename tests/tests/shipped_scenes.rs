@@ -65,9 +65,8 @@ fn render(path: &Path, technique: &str, camera: Option<&str>) -> Result<Film, St
     let settings = overrides
         .resolve(&loaded.render, path)
         .map_err(|e| e.to_string())?;
-    let camera = ImageSize::Pixels(SIZE.0, SIZE.1).apply(
-        pick_camera(&loaded.scene, path, camera).map_err(|e| e.to_string())?,
-    );
+    let camera = ImageSize::Pixels(SIZE.0, SIZE.1)
+        .apply(pick_camera(&loaded.scene, path, camera).map_err(|e| e.to_string())?);
     let accel = settings.accel.build(&loaded.scene.triangles);
     let integrator = settings.integrator.build();
     let session = Session {
@@ -140,7 +139,11 @@ fn every_shipped_scene_renders_with_every_technique() {
                 "{} {technique}: {:.2} s{}",
                 path.file_name().unwrap_or_default().to_string_lossy(),
                 t.elapsed().as_secs_f64(),
-                result.as_ref().err().map(|e| format!(": {e}")).unwrap_or_default()
+                result
+                    .as_ref()
+                    .err()
+                    .map(|e| format!(": {e}"))
+                    .unwrap_or_default()
             );
             if let Err(e) = result {
                 failures.push(e);
