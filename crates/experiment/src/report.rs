@@ -15,8 +15,14 @@ use std::path::Path;
 /// The columns of results.csv, in order. The first thirteen are the fixed part of the format;
 /// new metrics are appended.
 pub const RESULTS_HEADER: &str = "scene,method,integrator,accel,spp,seconds,rays,\
-samples_per_second,mse,relmse,rmse,psnr,ssim,budget,max_depth,seed,mse_floor,relmse_floor,image,\
-samples,mean_spp,error,time_limit,spp_cap,stop,decide_seconds,blocks_left";
+samples_per_second,mse,relmse,rmse,psnr,ssim,budget,max_depth,seed,mse_floor,relmse_floor,image";
+
+/// The columns appended to [`RESULTS_HEADER`] when the experiment has an adaptive method
+/// (`error`, `time_limit`): the samples actually taken over the image and per pixel on average,
+/// the rule (empty for progressive rows), why the run stopped, the time of the criterion's
+/// decisions and the blocks still sampling.
+pub const ADAPTIVE_COLUMNS: &str =
+    "samples,mean_spp,error,time_limit,spp_cap,stop,decide_seconds,blocks_left";
 
 /// The columns of slopes.csv.
 pub const SLOPES_HEADER: &str = "scene,method,metric,floor,points,slope_vs_spp,se_vs_spp,\
@@ -63,17 +69,25 @@ fn num(v: f64) -> String {
     }
 }
 
-/// results.csv.
+/// results.csv; with [`ADAPTIVE_COLUMNS`] when a method is adaptive.
 pub fn results_csv(plan: &Plan, results: &Results) -> String {
-    let mut s = format!("{RESULTS_HEADER}\n");
+    let adaptive = plan
+        .methods
+        .iter()
+        .any(|m| matches!(m.runs, Runs::Adaptive(_)));
+    let mut s = if adaptive {
+        format!("{RESULTS_HEADER},{ADAPTIVE_COLUMNS}\n")
+    } else {
+        format!("{RESULTS_HEADER}\n")
+    };
     for row in &results.rows {
         let pair = &plan.pairs[row.pair];
         let f = floor(&results.references[pair.scene], plan.epsilon);
         let m = &row.metrics;
         let a = row.stop.as_ref();
-        let _ = writeln!(
+        let _ = write!(
             s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             plan.scenes[pair.scene].name,
             plan.methods[pair.method].name,
             pair.estimator.kind,
@@ -93,6 +107,14 @@ pub fn results_csv(plan: &Plan, results: &Results) -> String {
             f.as_ref().map_or(String::new(), |f| num(f.mse)),
             f.as_ref().map_or(String::new(), |f| num(f.relmse)),
             row.image,
+        );
+        if !adaptive {
+            s.push('\n');
+            continue;
+        }
+        let _ = writeln!(
+            s,
+            ",{},{},{},{},{},{},{},{}",
             row.samples,
             row.mean_spp,
             a.and_then(|a| a.rule.error)
@@ -562,13 +584,19 @@ pub fn markdown(
             "![relMSE against time](plots/{0}.png) ![relMSE against spp](plots/{0}-spp.png)\n",
             scene.name
         );
-        let _ = writeln!(
-            s,
-            "Adaptive runs (`error`, `time_limit`) give the samples they actually took: `samples` \
+        let has_adaptive = plan
+            .pairs
+            .iter()
+            .any(|p| p.scene == si && matches!(plan.methods[p.method].runs, Runs::Adaptive(_)));
+        if has_adaptive {
+            let _ = writeln!(
+                s,
+                "Adaptive runs (`error`, `time_limit`) give the samples they actually took: `samples` \
              over the whole image, `mean spp` per pixel on average, `spp` for the pixels that \
              sampled longest; `stop` says why they stopped, with the time the stopping \
              criterion's decisions took (part of `seconds`).\n"
-        );
+            );
+        }
         let _ = writeln!(
             s,
             "| method | integrator | accel | budget | spp | samples | mean spp | stop | seconds | Msamples/s | MSE | relMSE | PSNR | SSIM |"
@@ -655,11 +683,7 @@ pub fn markdown(
             "relMSE of each method at the same render time (time budgets at their nominal \
              value, other runs interpolated linearly in log-log between measured points).",
         );
-        if plan
-            .pairs
-            .iter()
-            .any(|p| p.scene == si && matches!(plan.methods[p.method].runs, Runs::Adaptive(_)))
-        {
+        if has_adaptive {
             comparison_table(
                 &mut s,
                 plan,
