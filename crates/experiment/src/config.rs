@@ -10,12 +10,13 @@ use rt_integrators::spec::{check_ao_distance, check_max_depth};
 use rt_integrators::IntegratorSpec;
 use rt_metrics::RgbImage;
 use rt_scene::LoadedScene;
-use rt_session::{pick_camera, Budgets, ImageSize, Overrides, MAX_SPP};
+use rt_session::{pick_camera, Budgets, ImageSize, Overrides, StopRule, MAX_SPP};
 use serde::de::{self, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 use std::collections::HashSet;
 use std::fmt;
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
 /// Longest time budget accepted, in seconds (a day): anything longer is a typo.
 const MAX_SECONDS: f64 = 86_400.0;
@@ -100,9 +101,53 @@ struct MethodDesc {
     max_depth: Option<u32>,
     ao_distance: Option<f32>,
     seed: Option<u64>,
-    spp: Option<Vec<u32>>,
+    spp: Option<OneOrMany<u32>>,
     seconds: Option<Vec<f64>>,
+    error: Option<OneOrMany<f32>>,
+    time_limit: Option<OneOrMany<f64>>,
     scenes: Option<Vec<String>>,
+}
+
+/// `key = V` or `key = [V, ...]` of numbers.
+enum OneOrMany<T> {
+    One(T),
+    Many(Vec<T>),
+}
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for OneOrMany<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::IntoDeserializer;
+        struct V<T>(std::marker::PhantomData<T>);
+        impl<'de, T: Deserialize<'de>> Visitor<'de> for V<T> {
+            type Value = OneOrMany<T>;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a number or a list of numbers")
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Self::Value, E> {
+                T::deserialize(v.into_deserializer()).map(OneOrMany::One)
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Self::Value, E> {
+                T::deserialize(v.into_deserializer()).map(OneOrMany::One)
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Self::Value, E> {
+                T::deserialize(v.into_deserializer()).map(OneOrMany::One)
+            }
+            fn visit_seq<A: de::SeqAccess<'de>>(self, seq: A) -> Result<Self::Value, A::Error> {
+                Vec::<T>::deserialize(de::value::SeqAccessDeserializer::new(seq))
+                    .map(OneOrMany::Many)
+            }
+        }
+        d.deserialize_any(V(std::marker::PhantomData))
+    }
+}
+
+impl<T> OneOrMany<T> {
+    fn into_vec(self) -> Vec<T> {
+        match self {
+            OneOrMany::One(v) => vec![v],
+            OneOrMany::Many(v) => v,
+        }
+    }
 }
 
 /// A validated experiment.
@@ -165,8 +210,44 @@ pub enum ReferencePlan {
 pub struct MethodPlan {
     /// Short name (file names, legends).
     pub name: String,
-    /// Its budgets.
-    pub budgets: Budgets,
+    /// What it renders on each scene.
+    pub runs: Runs,
+}
+
+/// How a method renders on a scene.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Runs {
+    /// One progressive render with a snapshot at each budget (`spp = [...]` or
+    /// `seconds = [...]`): uniform sampling.
+    Progressive(Budgets),
+    /// One render per rule, each from the first sample, stopped as `render --error V
+    /// --time-limit S --spp N` stops ([`rt_session::render_adaptive`]): `error` and
+    /// `time_limit`, with `spp` as the cap (default [`MAX_SPP`]). In the order written
+    /// (sorted: the largest error first, then the shortest time).
+    Adaptive(Vec<StopRule>),
+}
+
+impl Runs {
+    /// How many images the method makes per scene.
+    pub fn len(&self) -> usize {
+        match self {
+            Runs::Progressive(b) => b.len(),
+            Runs::Adaptive(v) => v.len(),
+        }
+    }
+
+    /// True when it makes none (never, for a validated plan).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The progressive budgets, if the method has them.
+    pub fn budgets(&self) -> Option<&Budgets> {
+        match self {
+            Runs::Progressive(b) => Some(b),
+            Runs::Adaptive(_) => None,
+        }
+    }
 }
 
 /// A method on a scene, with its settings resolved against that scene's `[render]` table.
@@ -396,34 +477,12 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
             bail!("{here}: two methods are named \"{}\"", m.name);
         }
         let at = |e: String| format!("{here}: {e}");
-        let budgets = match (m.spp, m.seconds) {
-            (Some(_), Some(_)) => bail!("{here}: give spp or seconds, not both"),
-            (None, None) => bail!("{here}: no budgets (spp = [...] or seconds = [...])"),
-            (Some(mut v), None) => {
-                if v.is_empty() {
-                    bail!("{here}: spp is an empty list");
-                }
-                if let Some(bad) = v.iter().find(|&&n| n == 0 || n > MAX_SPP) {
-                    bail!("{here}: spp values must be between 1 and {MAX_SPP}, got {bad}");
-                }
-                v.sort_unstable();
-                v.dedup();
-                Budgets::Spp(v)
-            }
-            (None, Some(mut v)) => {
-                if v.is_empty() {
-                    bail!("{here}: seconds is an empty list");
-                }
-                if let Some(bad) = v
-                    .iter()
-                    .find(|&&t| !(t.is_finite() && t > 0.0 && t <= MAX_SECONDS))
-                {
-                    bail!("{here}: seconds values must be in (0, {MAX_SECONDS}], got {bad}");
-                }
-                v.sort_by(f64::total_cmp);
-                v.dedup();
-                Budgets::Seconds(v)
-            }
+        let runs = if m.error.is_some() || m.time_limit.is_some() {
+            Runs::Adaptive(
+                stop_rules(m.error, m.time_limit, m.spp, m.seconds.is_some()).map_err(at)?,
+            )
+        } else {
+            Runs::Progressive(budgets(m.spp, m.seconds).map_err(at)?)
         };
         let overrides = Overrides {
             integrator: m
@@ -457,10 +516,7 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
                 }
             }
         }
-        methods.push(MethodPlan {
-            name: m.name,
-            budgets,
-        });
+        methods.push(MethodPlan { name: m.name, runs });
         method_overrides.push(overrides);
         method_scenes.push(m.scenes);
     }
@@ -513,6 +569,109 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
         pairs,
         warnings,
     })
+}
+
+/// The budgets of a progressive method: `spp = [...]` or `seconds = [...]`.
+fn budgets(spp: Option<OneOrMany<u32>>, seconds: Option<Vec<f64>>) -> Result<Budgets> {
+    match (spp.map(OneOrMany::into_vec), seconds) {
+        (Some(_), Some(_)) => bail!("give spp or seconds, not both"),
+        (None, None) => bail!(
+            "no budgets (spp = [...] or seconds = [...], or error = V or time_limit = S for an adaptive render)"
+        ),
+        (Some(mut v), None) => {
+            if v.is_empty() {
+                bail!("spp is an empty list");
+            }
+            if let Some(bad) = v.iter().find(|&&n| n == 0 || n > MAX_SPP) {
+                bail!("spp values must be between 1 and {MAX_SPP}, got {bad}");
+            }
+            v.sort_unstable();
+            v.dedup();
+            Ok(Budgets::Spp(v))
+        }
+        (None, Some(mut v)) => {
+            if v.is_empty() {
+                bail!("seconds is an empty list");
+            }
+            check_seconds("seconds", &v)?;
+            v.sort_by(f64::total_cmp);
+            v.dedup();
+            Ok(Budgets::Seconds(v))
+        }
+    }
+}
+
+fn check_seconds(key: &str, v: &[f64]) -> Result<()> {
+    if let Some(bad) = v
+        .iter()
+        .find(|&&t| !(t.is_finite() && t > 0.0 && t <= MAX_SECONDS))
+    {
+        bail!("{key} values must be in (0, {MAX_SECONDS}], got {bad}");
+    }
+    Ok(())
+}
+
+/// The runs of an adaptive method: every `error` threshold (checked as `render --error`
+/// checks it, by the stopping criterion itself) or every `time_limit`, at most one of them a
+/// list, with `spp` as the cap.
+fn stop_rules(
+    error: Option<OneOrMany<f32>>,
+    time_limit: Option<OneOrMany<f64>>,
+    spp: Option<OneOrMany<u32>>,
+    has_seconds: bool,
+) -> Result<Vec<StopRule>> {
+    if has_seconds {
+        bail!(
+            "seconds are the budgets of a progressive render; an adaptive one (error, time_limit) stops at time_limit = S"
+        );
+    }
+    let max_spp = match spp.map(OneOrMany::into_vec).as_deref() {
+        None => MAX_SPP,
+        Some(&[n]) if (1..=MAX_SPP).contains(&n) => n,
+        Some(&[n]) => bail!("spp (the cap of an adaptive render) must be between 1 and {MAX_SPP}, got {n}"),
+        Some(v) => bail!(
+            "with error or time_limit, spp is the cap on samples per pixel: give one value, not {} (for several budgets, list error or time_limit)",
+            v.len()
+        ),
+    };
+    let mut errors: Vec<Option<f32>> = match error.map(OneOrMany::into_vec) {
+        None => vec![None],
+        Some(v) if v.is_empty() => bail!("error is an empty list"),
+        Some(v) => {
+            for &e in &v {
+                rt_film::stopping::StoppingCriterion::new(1, 1, e).map_err(|b| {
+                    format!("error: {b} (the hierarchical stopping criterion's threshold; the thesis uses 2e-4)")
+                })?;
+            }
+            v.into_iter().map(Some).collect()
+        }
+    };
+    let mut limits: Vec<Option<f64>> = match time_limit.map(OneOrMany::into_vec) {
+        None => vec![None],
+        Some(v) if v.is_empty() => bail!("time_limit is an empty list"),
+        Some(v) => {
+            check_seconds("time_limit", &v)?;
+            v.into_iter().map(Some).collect()
+        }
+    };
+    if errors.len() > 1 && limits.len() > 1 {
+        bail!("error and time_limit are both lists: give a list for one of them, a single value for the other");
+    }
+    // Largest threshold first (the cheapest run), shortest time first.
+    errors.sort_by(|a, b| b.unwrap_or(0.0).total_cmp(&a.unwrap_or(0.0)));
+    errors.dedup();
+    limits.sort_by(|a, b| a.unwrap_or(0.0).total_cmp(&b.unwrap_or(0.0)));
+    limits.dedup();
+    Ok(errors
+        .iter()
+        .flat_map(|&error| {
+            limits.iter().map(move |&t| StopRule {
+                error,
+                time_limit: t.map(Duration::from_secs_f64),
+                max_spp,
+            })
+        })
+        .collect())
 }
 
 /// `path, 8 bounces` and the like, for messages.
@@ -593,8 +752,14 @@ seconds = [0.5, 0.1]
             (p.scenes[0].camera.width, p.scenes[0].camera.height),
             (32, 24)
         );
-        assert_eq!(p.methods[0].budgets, Budgets::Spp(vec![1, 2, 4]));
-        assert_eq!(p.methods[1].budgets, Budgets::Seconds(vec![0.1, 0.5]));
+        assert_eq!(
+            p.methods[0].runs,
+            Runs::Progressive(Budgets::Spp(vec![1, 2, 4]))
+        );
+        assert_eq!(
+            p.methods[1].runs,
+            Runs::Progressive(Budgets::Seconds(vec![0.1, 0.5]))
+        );
         assert_eq!(p.pairs.len(), 2);
         // max_depth comes from the scene's [render] table for both method and reference.
         assert_eq!(p.pairs[0].estimator.depth(), 5);
@@ -677,6 +842,106 @@ seconds = [0.5, 0.1]
             let e = error(&config);
             assert!(e.contains(needle), "{needle:?} not in {e:?}");
         }
+    }
+
+    /// GOOD with method "a" made adaptive by `keys` instead of its spp list.
+    fn adaptive(keys: &str) -> String {
+        GOOD.replace("spp = [4, 1, 2, 2]", keys)
+    }
+
+    #[test]
+    fn adaptive_methods_stop_like_render_error_and_time_limit() {
+        let rules = |keys: &str| match plan(&adaptive(keys)).unwrap().methods.remove(0).runs {
+            Runs::Adaptive(r) => r,
+            other => panic!("{keys}: {other:?}"),
+        };
+        let secs = |t: f64| Some(Duration::from_secs_f64(t));
+        // One threshold, no cap: as `render --error 2e-4`.
+        assert_eq!(
+            rules("error = 2e-4"),
+            [StopRule {
+                error: Some(2e-4),
+                time_limit: None,
+                max_spp: MAX_SPP
+            }]
+        );
+        // A list of thresholds (largest first), each capped by spp and the time limit.
+        let r = rules("error = [1e-4, 1e-3, 1e-4]\nspp = 256\ntime_limit = 30");
+        assert_eq!(r.len(), 2);
+        assert_eq!((r[0].error, r[1].error), (Some(1e-3), Some(1e-4)));
+        assert!(r
+            .iter()
+            .all(|r| r.max_spp == 256 && r.time_limit == secs(30.0)));
+        // Time limits alone (uniform sampling in the adaptive render's passes), spp as a list
+        // of one.
+        let r = rules("time_limit = [2, 0.5]\nspp = [64]");
+        assert_eq!(
+            r.iter().map(|r| r.time_limit).collect::<Vec<_>>(),
+            [secs(0.5), secs(2.0)]
+        );
+        assert!(r.iter().all(|r| r.error.is_none() && r.max_spp == 64));
+        // A threshold with several time limits.
+        let r = rules("error = 2e-4\ntime_limit = [1, 2]");
+        assert_eq!(r.len(), 2);
+        assert!(r.iter().all(|r| r.error == Some(2e-4)));
+        // spp may be a single number for a progressive method too.
+        let p = plan(&GOOD.replace("spp = [4, 1, 2, 2]", "spp = 8")).unwrap();
+        assert_eq!(p.methods[0].runs, Runs::Progressive(Budgets::Spp(vec![8])));
+    }
+
+    #[test]
+    fn bad_adaptive_methods_are_one_clear_line() {
+        let cases = [
+            (
+                "error = -2e-4",
+                "error: error threshold must be a positive finite number, got -0.0002",
+            ),
+            (
+                "error = 0.0",
+                "error threshold must be a positive finite number, got 0",
+            ),
+            ("error = [2e-4, 0.0]", "positive finite number, got 0"),
+            ("error = nan", "positive finite number, got NaN"),
+            ("error = inf", "positive finite number, got inf"),
+            ("error = []", "error is an empty list"),
+            (
+                "error = \"small\"",
+                "expected a number or a list of numbers",
+            ),
+            (
+                "time_limit = 0",
+                "time_limit values must be in (0, 86400], got 0",
+            ),
+            ("time_limit = -1.5", "time_limit values must be in"),
+            ("time_limit = []", "time_limit is an empty list"),
+            (
+                "error = 2e-4\nspp = [16, 64]",
+                "spp is the cap on samples per pixel: give one value",
+            ),
+            ("error = 2e-4\nspp = 0", "must be between 1 and"),
+            (
+                "error = 2e-4\nseconds = [1.0]",
+                "seconds are the budgets of a progressive render",
+            ),
+            (
+                "error = [1e-3, 2e-4]\ntime_limit = [1, 2]",
+                "error and time_limit are both lists",
+            ),
+        ];
+        for (keys, needle) in cases {
+            let config = adaptive(keys);
+            let e = error(&config);
+            assert!(e.contains(needle), "{keys:?}: {needle:?} not in {e:?}");
+            if !needle.starts_with("expected") {
+                assert!(e.contains("[[method]] \"a\""), "{e}");
+            }
+        }
+        // Method "b" has seconds; a time limit does not combine with them.
+        let e = error(&GOOD.replace("seconds = [0.5, 0.1]", "seconds = [0.5]\ntime_limit = 1"));
+        assert!(
+            e.contains("[[method]] \"b\": seconds are the budgets"),
+            "{e}"
+        );
     }
 
     #[test]

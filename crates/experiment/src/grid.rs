@@ -1,16 +1,18 @@
 //! Running the grid: references first (from the cache or rendered into it), then every method
-//! on every scene, each as one progressive render stopped at its budgets. Every stop writes its
-//! image and is measured against the scene's reference.
+//! on every scene, each as one progressive render stopped at its budgets, or, for an adaptive
+//! method (`error`, `time_limit`), one render per stopping rule, stopped the way `render --error
+//! --time-limit` stops ([`rt_session::render_adaptive`]). Every stop writes its image and is
+//! measured against the scene's reference.
 
 use crate::cache::{Cache, ReferenceRequest};
-use crate::config::{Plan, ReferencePlan};
+use crate::config::{Plan, ReferencePlan, Runs};
 use crate::error::{io, ExperimentError, Result};
 use crate::Progress;
 use rt_core::{Accel, Rgb, RgbImage, SampleStream};
-use rt_film::{read_rgb, AovSet};
+use rt_film::{read_rgb, AovSet, Film, FilmBuffers};
 use rt_integrators::Ctx;
 use rt_metrics::{compare, CompareOptions, Metrics};
-use rt_session::{Budgets, Session};
+use rt_session::{render_adaptive, Budgets, Session, StopReason, StopRule};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -31,10 +33,19 @@ pub struct Reference {
 pub struct Row {
     /// Index into the plan's pairs.
     pub pair: usize,
-    /// The budget asked for (spp or seconds).
+    /// The budget asked for (spp or seconds; for an adaptive run its error threshold, or its
+    /// time limit when it has no threshold).
     pub budget: f64,
-    /// Samples per pixel taken.
+    /// Samples per pixel taken (for an adaptive run: by the pixels that sampled longest).
     pub spp: u32,
+    /// Samples actually taken over the whole image (camera samples, or light paths for the
+    /// splatting techniques).
+    pub samples: u64,
+    /// Samples per pixel on average: `spp` for uniform sampling, `samples` over the pixel
+    /// count for an adaptive run.
+    pub mean_spp: f64,
+    /// How an adaptive run stopped (`None` for a progressive one).
+    pub stop: Option<AdaptiveRun>,
     /// Render time in seconds.
     pub seconds: f64,
     /// Rays traced.
@@ -45,6 +56,19 @@ pub struct Row {
     pub metrics: Metrics,
     /// The image, relative to the output folder.
     pub image: String,
+}
+
+/// What an adaptive run asked for and did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AdaptiveRun {
+    /// The rule it ran under.
+    pub rule: StopRule,
+    /// Why it stopped.
+    pub reason: StopReason,
+    /// Seconds spent in the stopping criterion's decisions (included in [`Row::seconds`]).
+    pub decide_seconds: f64,
+    /// Blocks still sampling when it stopped.
+    pub blocks_left: usize,
 }
 
 /// Everything the report needs.
@@ -63,6 +87,22 @@ pub fn budget_label(budgets: &Budgets, value: f64) -> String {
         Budgets::Spp(_) => format!("{value}spp"),
         Budgets::Seconds(_) => format!("{value}s"),
     }
+}
+
+/// The file name of an adaptive run: `e0.0002`, `t2s`, `e0.0002-t2s`, `cap64spp` (the cap
+/// only when it is the only limit).
+pub fn rule_label(rule: &StopRule) -> String {
+    let mut parts = Vec::new();
+    if let Some(e) = rule.error {
+        parts.push(format!("e{e}"));
+    }
+    if let Some(t) = rule.time_limit {
+        parts.push(format!("t{}s", t.as_secs_f64()));
+    }
+    if parts.is_empty() {
+        parts.push(format!("cap{}spp", rule.max_spp));
+    }
+    parts.join("-")
 }
 
 /// Reads a reference EXR: its colour and, if present, its `variance.*` channels.
@@ -85,7 +125,7 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
         + plan
             .pairs
             .iter()
-            .map(|p| plan.methods[p.method].budgets.len())
+            .map(|p| plan.methods[p.method].runs.len())
             .sum::<usize>();
     let bar = progress;
     bar.set_length(total_runs as u64 * UNITS);
@@ -182,27 +222,16 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
             aovs: AovSet::default(),
         };
         bar.set_message(format!("{}: {}", scene.name, method.name));
-        let runs = method.budgets.len() as u64;
+        let runs = method.runs.len() as u64;
         let base = done_runs * UNITS;
-        let values: Vec<f64> = match &method.budgets {
-            Budgets::Spp(v) => v.iter().map(|&n| f64::from(n)).collect(),
-            Budgets::Seconds(v) => v.clone(),
-        };
         let mut last_image = None;
-        session.render(
-            &method.budgets,
-            &|f| bar.set_position(base + (f * (runs * UNITS) as f64) as u64),
-            &mut |film, at| {
-                let budget = values[at.budget];
-                let rel: PathBuf =
-                    ["images", &scene.name]
-                        .iter()
-                        .collect::<PathBuf>()
-                        .join(format!(
-                            "{}-{}.exr",
-                            method.name,
-                            budget_label(&method.budgets, budget)
-                        ));
+        // Writes the image of one stop, measures it and records its row.
+        let mut record =
+            |film: &Film, label: String, row: &dyn Fn(Metrics, String) -> Row| -> Result<()> {
+                let rel: PathBuf = ["images", &scene.name]
+                    .iter()
+                    .collect::<PathBuf>()
+                    .join(format!("{}-{label}.exr", method.name));
                 rt_film::write_image(&out.join(&rel), film, &Default::default())?;
                 let image = RgbImage::new(
                     film.width() as usize,
@@ -216,20 +245,84 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
                         scene.name
                     ))
                 })?;
-                rows.push(Row {
-                    pair: pi,
-                    budget,
-                    spp: at.spp,
-                    seconds: at.seconds,
-                    rays: at.rays,
-                    samples_per_second: at.samples as f64 / at.seconds.max(1e-9),
-                    metrics,
-                    image: rel.to_string_lossy().replace('\\', "/"),
-                });
+                rows.push(row(metrics, rel.to_string_lossy().replace('\\', "/")));
                 last_image = Some(image);
-                Ok::<(), ExperimentError>(())
-            },
-        )?;
+                Ok(())
+            };
+        match &method.runs {
+            Runs::Progressive(budgets) => {
+                let values: Vec<f64> = match budgets {
+                    Budgets::Spp(v) => v.iter().map(|&n| f64::from(n)).collect(),
+                    Budgets::Seconds(v) => v.clone(),
+                };
+                session.render(
+                    budgets,
+                    &|f| bar.set_position(base + (f * (runs * UNITS) as f64) as u64),
+                    &mut |film, at| {
+                        let budget = values[at.budget];
+                        record(film, budget_label(budgets, budget), &|metrics, image| Row {
+                            pair: pi,
+                            budget,
+                            spp: at.spp,
+                            samples: at.samples,
+                            mean_spp: f64::from(at.spp),
+                            stop: None,
+                            seconds: at.seconds,
+                            rays: at.rays,
+                            samples_per_second: at.samples as f64 / at.seconds.max(1e-9),
+                            metrics,
+                            image,
+                        })
+                    },
+                )?;
+            }
+            Runs::Adaptive(rules) => {
+                let pixels = (scene.camera.width as f64 * scene.camera.height as f64).max(1.0);
+                for (i, rule) in rules.iter().enumerate() {
+                    // The criterion reads the even samples' half-buffer.
+                    let mut buffers = FilmBuffers::for_outputs(AovSet::default());
+                    if rule.error.is_some() {
+                        buffers = buffers.with_halves();
+                    }
+                    let mut film = Film::new(scene.camera.width, scene.camera.height, buffers);
+                    let run_base = base + i as u64 * UNITS;
+                    let a = render_adaptive(
+                        &session.ctx,
+                        session.integrator,
+                        &mut film,
+                        session.seed,
+                        rule,
+                        &|f| bar.set_position(run_base + (f.min(1.0) * UNITS as f64) as u64),
+                    )
+                    .map_err(|e| ExperimentError::Run(format!("{}: {e}", method.name)))?;
+                    let seconds = a.stats.elapsed.as_secs_f64();
+                    let budget = match (rule.error, rule.time_limit) {
+                        // As written (0.05, not the f32's 0.0500000007).
+                        (Some(e), _) => e.to_string().parse().unwrap_or(f64::from(e)),
+                        (None, Some(t)) => t.as_secs_f64(),
+                        (None, None) => f64::from(rule.max_spp),
+                    };
+                    record(&film, rule_label(rule), &|metrics, image| Row {
+                        pair: pi,
+                        budget,
+                        spp: a.spp,
+                        samples: a.stats.samples,
+                        mean_spp: a.stats.samples as f64 / pixels,
+                        stop: Some(AdaptiveRun {
+                            rule: *rule,
+                            reason: a.reason,
+                            decide_seconds: a.decisions.as_secs_f64(),
+                            blocks_left: a.active_blocks.len(),
+                        }),
+                        seconds,
+                        rays: a.stats.rays.rays + a.stats.rays.shadow_rays,
+                        samples_per_second: a.stats.samples as f64 / seconds.max(1e-9),
+                        metrics,
+                        image,
+                    })?;
+                }
+            }
+        }
         finals.push(last_image.expect("every method has at least one budget"));
         done_runs += runs;
         bar.set_position(done_runs * UNITS);

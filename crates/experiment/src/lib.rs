@@ -5,10 +5,13 @@
 //!   [`Plan`] before the first sample: scenes load, cameras exist, budgets are sane.
 //! - [`reference`](mod@reference) and [`cache`]: high-sample references from their own random streams, stored
 //!   on disk under a key that changes with anything that changes the image.
-//! - [`grid`]: every method on every scene, rendered progressively to its budgets and measured
-//!   against the reference.
+//! - [`grid`]: every method on every scene, rendered progressively to its budgets (`spp`,
+//!   `seconds`) or, for an adaptive method, once per stopping rule (`error` and `time_limit`
+//!   with `spp` as the cap, as `render --error --time-limit --spp` stop:
+//!   [`rt_session::render_adaptive`]), and measured against the reference.
 //! - [`fit`]: log-log slopes and interpolation; [`report`]: results.csv, slopes.csv, equal-time
-//!   comparisons, crops and report.md; [`plot`]: the log-log error plots.
+//!   and equal-samples comparisons (the samples adaptive runs actually took), crops and
+//!   report.md; [`plot`]: the log-log error plots.
 //!
 //! [`run`] does all of it into one output folder.
 //!
@@ -123,6 +126,8 @@ pub struct Outcome {
     pub results: grid::Results,
     /// The equal-time comparison of each scene.
     pub equal_time: Vec<report::EqualTime>,
+    /// The equal-samples comparison of each scene (mean samples per pixel actually taken).
+    pub equal_samples: Vec<report::EqualTime>,
     /// The Markdown report (inside the output folder).
     pub report: PathBuf,
 }
@@ -136,6 +141,7 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
     let results = grid::run(plan, out, cache, progress)?;
     let slopes = report::slopes(plan, &results);
     let equal_time = report::equal_time(plan, &results);
+    let equal_samples = report::equal_samples(plan, &results);
     report::plots(plan, &results, out)?;
     let blocks = report::crops(plan, &results, out)?;
     rt_film::write_bytes_atomic(
@@ -152,12 +158,21 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
         threads: rayon::current_num_threads(),
         wall_seconds: wall.elapsed().as_secs_f64(),
     };
-    let md = report::markdown(plan, &results, &slopes, &equal_time, &blocks, &info);
+    let md = report::markdown(
+        plan,
+        &results,
+        &slopes,
+        &equal_time,
+        &equal_samples,
+        &blocks,
+        &info,
+    );
     let report = out.join("report.md");
     rt_film::write_bytes_atomic(&report, md.as_bytes())?;
     Ok(Outcome {
         results,
         equal_time,
+        equal_samples,
         report,
     })
 }
@@ -173,6 +188,73 @@ mod tests {
         assert_eq!(utc(951_827_696), (2000, 2, 29, 12, 34, 56));
         // 2026-11-22 00:00:00.
         assert_eq!(utc(1_795_305_600), (2026, 11, 22, 0, 0, 0));
+    }
+
+    /// An adaptive method next to a uniform one: each threshold is its own render, its row
+    /// gives the samples actually taken, and the report and results.csv say so.
+    #[test]
+    fn adaptive_methods_report_the_samples_they_took() {
+        let dir = tempfile::tempdir().unwrap();
+        let config = dir.path().join("x.toml");
+        std::fs::write(
+            &config,
+            r#"
+[[scene]]
+path = "gen:rotated"
+resolution = [24, 16]
+reference = { spp = 32 }
+
+[[method]]
+name = "uniform"
+spp = [2, 4, 8]
+
+[[method]]
+name = "adaptive"
+error = [0.5, 0.05]
+spp = 8
+
+[[method]]
+name = "timed"
+time_limit = 0.01
+spp = 4
+"#,
+        )
+        .unwrap();
+        let plan = config::load(&config).unwrap();
+        let out = dir.path().join("out");
+        prepare_out(&out).unwrap();
+        let outcome = run(&plan, &out, &Cache::new(&dir.path().join("cache")), &Silent).unwrap();
+        let rows = &outcome.results.rows;
+        assert_eq!(rows.len(), 3 + 2 + 1);
+        let pixels = 24.0 * 16.0;
+        for r in rows {
+            let name = &plan.methods[plan.pairs[r.pair].method].name;
+            assert!(r.samples > 0 && r.spp <= 8, "{name}: {} spp", r.spp);
+            assert!(
+                (r.mean_spp - r.samples as f64 / pixels).abs() < 1e-9,
+                "{name}"
+            );
+            assert_eq!(r.stop.is_some(), name != "uniform", "{name}");
+            assert!(out.join(&r.image).exists(), "{}", r.image);
+        }
+        let adaptive: Vec<&grid::Row> = rows
+            .iter()
+            .filter(|r| r.stop.is_some_and(|a| a.rule.error == Some(0.05)))
+            .collect();
+        assert_eq!(adaptive.len(), 1);
+        let a = adaptive[0].stop.unwrap();
+        assert_eq!((adaptive[0].budget, a.rule.max_spp), (0.05, 8));
+        // Adaptive renders never take more than the cap, and with a threshold they stop
+        // sampling finished blocks, so the mean is at most the cap.
+        assert!(adaptive[0].mean_spp <= 8.0);
+        let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+        assert!(csv.lines().next().unwrap().ends_with(
+            "samples,mean_spp,error,time_limit,spp_cap,stop,decide_seconds,blocks_left"
+        ));
+        assert!(csv.contains("adaptive-e0.05.exr"), "{csv}");
+        let md = std::fs::read_to_string(&outcome.report).unwrap();
+        assert!(md.contains("### Equal samples"), "{md}");
+        assert!(md.contains("blocks left"), "{md}");
     }
 
     #[test]

@@ -2,7 +2,7 @@
 //! the crops and report.md. Everything is computed from the rows, so the report and the CSV
 //! files always agree.
 
-use crate::config::Plan;
+use crate::config::{Plan, Runs};
 use crate::error::{io, Result};
 use crate::fit::{comparison_times, log_log_interpolate, log_log_slope, Fit};
 use crate::grid::{Reference, Results, Row};
@@ -17,11 +17,19 @@ use std::path::Path;
 pub const RESULTS_HEADER: &str = "scene,method,integrator,accel,spp,seconds,rays,\
 samples_per_second,mse,relmse,rmse,psnr,ssim,budget,max_depth,seed,mse_floor,relmse_floor,image";
 
+/// The columns appended to [`RESULTS_HEADER`] when the experiment has an adaptive method
+/// (`error`, `time_limit`): the samples actually taken over the image and per pixel on average,
+/// the rule (empty for progressive rows), why the run stopped, the time of the criterion's
+/// decisions and the blocks still sampling.
+pub const ADAPTIVE_COLUMNS: &str =
+    "samples,mean_spp,error,time_limit,spp_cap,stop,decide_seconds,blocks_left";
+
 /// The columns of slopes.csv.
 pub const SLOPES_HEADER: &str = "scene,method,metric,floor,points,slope_vs_spp,se_vs_spp,\
 slope_vs_seconds,se_vs_seconds";
 
-/// How many times the equal-time table compares at when no time budgets fall in range.
+/// How many times (or sample counts) the equal-time (equal-samples) table compares at when no
+/// budgets fall in range.
 const EQUAL_TIME_POINTS: usize = 5;
 
 /// The reference's own expected contribution to the error: with `b` the reference, the
@@ -61,14 +69,23 @@ fn num(v: f64) -> String {
     }
 }
 
-/// results.csv.
+/// results.csv; with [`ADAPTIVE_COLUMNS`] when a method is adaptive.
 pub fn results_csv(plan: &Plan, results: &Results) -> String {
-    let mut s = format!("{RESULTS_HEADER}\n");
+    let adaptive = plan
+        .methods
+        .iter()
+        .any(|m| matches!(m.runs, Runs::Adaptive(_)));
+    let mut s = if adaptive {
+        format!("{RESULTS_HEADER},{ADAPTIVE_COLUMNS}\n")
+    } else {
+        format!("{RESULTS_HEADER}\n")
+    };
     for row in &results.rows {
         let pair = &plan.pairs[row.pair];
         let f = floor(&results.references[pair.scene], plan.epsilon);
         let m = &row.metrics;
-        let _ = writeln!(
+        let a = row.stop.as_ref();
+        let _ = write!(
             s,
             "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             plan.scenes[pair.scene].name,
@@ -90,6 +107,24 @@ pub fn results_csv(plan: &Plan, results: &Results) -> String {
             f.as_ref().map_or(String::new(), |f| num(f.mse)),
             f.as_ref().map_or(String::new(), |f| num(f.relmse)),
             row.image,
+        );
+        if !adaptive {
+            s.push('\n');
+            continue;
+        }
+        let _ = writeln!(
+            s,
+            ",{},{},{},{},{},{},{},{}",
+            row.samples,
+            row.mean_spp,
+            a.and_then(|a| a.rule.error)
+                .map_or(String::new(), |e| e.to_string()),
+            a.and_then(|a| a.rule.time_limit)
+                .map_or(String::new(), |t| t.as_secs_f64().to_string()),
+            a.map_or(String::new(), |a| a.rule.max_spp.to_string()),
+            a.map_or(String::new(), |a| a.reason.to_string()),
+            a.map_or(String::new(), |a| a.decide_seconds.to_string()),
+            a.map_or(String::new(), |a| a.blocks_left.to_string()),
         );
     }
     s
@@ -137,7 +172,7 @@ pub fn slopes(plan: &Plan, results: &Results) -> Vec<Slopes> {
                         .collect()
                 };
                 (
-                    log_log_slope(&by(|r| f64::from(r.spp))),
+                    log_log_slope(&by(|r| r.mean_spp)),
                     log_log_slope(&by(|r| r.seconds)),
                 )
             };
@@ -212,17 +247,31 @@ impl EqualTime {
     }
 }
 
-/// A method's relMSE against time: time budgets at their nominal value (each run stops within
-/// about one sample's time of it), sample budgets at their measured time.
-fn time_curve(plan: &Plan, results: &Results, pair: usize) -> Vec<(f64, f64)> {
+/// What the methods of a scene are compared at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Axis {
+    /// Render time.
+    Time,
+    /// Samples per pixel on average (the samples an adaptive run actually took).
+    Samples,
+}
+
+/// A method's relMSE against `axis`. Time: time budgets at their nominal value (each run stops
+/// within about one sample's time of it), everything else at its measured time. Samples: the
+/// mean samples per pixel taken.
+fn curve(plan: &Plan, results: &Results, pair: usize, axis: Axis) -> Vec<(f64, f64)> {
     let seconds_budgets = matches!(
-        plan.methods[plan.pairs[pair].method].budgets,
-        Budgets::Seconds(_)
+        plan.methods[plan.pairs[pair].method].runs,
+        Runs::Progressive(Budgets::Seconds(_))
     );
     let mut c: Vec<(f64, f64)> = rows_of(results, pair)
         .map(|r| {
-            let t = if seconds_budgets { r.budget } else { r.seconds };
-            (t, r.metrics.relmse)
+            let x = match axis {
+                Axis::Time if seconds_budgets => r.budget,
+                Axis::Time => r.seconds,
+                Axis::Samples => r.mean_spp,
+            };
+            (x, r.metrics.relmse)
         })
         .filter(|p| p.0 > 0.0 && p.1 > 0.0)
         .collect();
@@ -232,6 +281,18 @@ fn time_curve(plan: &Plan, results: &Results, pair: usize) -> Vec<(f64, f64)> {
 
 /// Which method has the lowest relMSE at equal time, per scene.
 pub fn equal_time(plan: &Plan, results: &Results) -> Vec<EqualTime> {
+    compare_at(plan, results, Axis::Time)
+}
+
+/// Which method has the lowest relMSE at an equal number of samples (mean samples per pixel),
+/// per scene: adaptive sampling against uniform sampling.
+pub fn equal_samples(plan: &Plan, results: &Results) -> Vec<EqualTime> {
+    compare_at(plan, results, Axis::Samples)
+}
+
+/// The comparison of every scene's methods along `axis`, at the budgets of that kind that
+/// every curve covers (or evenly spaced points in log space).
+pub fn compare_at(plan: &Plan, results: &Results, axis: Axis) -> Vec<EqualTime> {
     (0..plan.scenes.len())
         .map(|si| {
             let pairs: Vec<usize> = (0..plan.pairs.len())
@@ -239,14 +300,19 @@ pub fn equal_time(plan: &Plan, results: &Results) -> Vec<EqualTime> {
                 .collect();
             let curves: Vec<Vec<(f64, f64)>> = pairs
                 .iter()
-                .map(|&p| time_curve(plan, results, p))
+                .map(|&p| curve(plan, results, p, axis))
                 .collect();
             let budgets: Vec<f64> = pairs
                 .iter()
-                .filter_map(|&p| match &plan.methods[plan.pairs[p].method].budgets {
-                    Budgets::Seconds(v) => Some(v.clone()),
-                    Budgets::Spp(_) => None,
-                })
+                .filter_map(
+                    |&p| match (&plan.methods[plan.pairs[p].method].runs, axis) {
+                        (Runs::Progressive(Budgets::Seconds(v)), Axis::Time) => Some(v.clone()),
+                        (Runs::Progressive(Budgets::Spp(v)), Axis::Samples) => {
+                            Some(v.iter().map(|&n| f64::from(n)).collect())
+                        }
+                        _ => None,
+                    },
+                )
                 .flatten()
                 .collect();
             let refs: Vec<&[(f64, f64)]> = curves.iter().map(Vec::as_slice).collect();
@@ -305,11 +371,11 @@ pub fn plots(plan: &Plan, results: &Results, out: &Path) -> Result<()> {
             &dir.join(format!("{}.png", scene.name)),
             &dir.join(format!("{}.svg", scene.name)),
         )?;
-        let spp = series(|r| f64::from(r.spp));
+        let spp = series(|r| r.mean_spp);
         plot::write(
             &Chart {
                 title: &title,
-                x_label: "samples per pixel",
+                x_label: "samples per pixel (mean)",
                 y_label: "relMSE",
                 x_base: 2.0,
                 series: &spp,
@@ -449,6 +515,7 @@ pub fn markdown(
     results: &Results,
     slopes: &[Slopes],
     equal: &[EqualTime],
+    equal_samples: &[EqualTime],
     blocks: &[(usize, usize, usize)],
     info: &RunInfo,
 ) -> String {
@@ -517,11 +584,27 @@ pub fn markdown(
             "![relMSE against time](plots/{0}.png) ![relMSE against spp](plots/{0}-spp.png)\n",
             scene.name
         );
+        let has_adaptive = plan
+            .pairs
+            .iter()
+            .any(|p| p.scene == si && matches!(plan.methods[p.method].runs, Runs::Adaptive(_)));
+        if has_adaptive {
+            let _ = writeln!(
+                s,
+                "Adaptive runs (`error`, `time_limit`) give the samples they actually took: `samples` \
+             over the whole image, `mean spp` per pixel on average, `spp` for the pixels that \
+             sampled longest; `stop` says why they stopped, with the time the stopping \
+             criterion's decisions took (part of `seconds`).\n"
+            );
+        }
         let _ = writeln!(
             s,
-            "| method | integrator | accel | spp | seconds | Msamples/s | MSE | relMSE | PSNR | SSIM |"
+            "| method | integrator | accel | budget | spp | samples | mean spp | stop | seconds | Msamples/s | MSE | relMSE | PSNR | SSIM |"
         );
-        let _ = writeln!(s, "|---|---|---|---:|---:|---:|---:|---:|---:|---:|");
+        let _ = writeln!(
+            s,
+            "|---|---|---|---|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|"
+        );
         for row in results
             .rows
             .iter()
@@ -529,13 +612,31 @@ pub fn markdown(
         {
             let pair = &plan.pairs[row.pair];
             let m = &row.metrics;
+            let (budget, stop) = match &row.stop {
+                None => (
+                    plan.methods[pair.method]
+                        .runs
+                        .budgets()
+                        .map_or(String::new(), |b| crate::grid::budget_label(b, row.budget)),
+                    "–".to_string(),
+                ),
+                Some(a) => (
+                    crate::grid::rule_label(&a.rule),
+                    format!(
+                        "{}, {} blocks left, {:.3} s deciding",
+                        a.reason, a.blocks_left, a.decide_seconds
+                    ),
+                ),
+            };
             let _ = writeln!(
                 s,
-                "| {} | {} | {} | {} | {:.3} | {:.2} | {} | {} | {:.2} | {:.4} |",
+                "| {} | {} | {} | {budget} | {} | {} | {:.2} | {stop} | {:.3} | {:.2} | {} | {} | {:.2} | {:.4} |",
                 plan.methods[pair.method].name,
                 pair.estimator.kind,
                 pair.accel,
                 row.spp,
+                row.samples,
+                row.mean_spp,
                 row.seconds,
                 row.samples_per_second / 1e6,
                 sci(m.mse),
@@ -573,36 +674,26 @@ pub fn markdown(
         }
         s.push('\n');
 
-        let e = &equal[si];
-        let _ = writeln!(s, "### Equal time\n");
-        if e.table.is_empty() {
-            let _ = writeln!(
-                s,
-                "Nothing to compare: one method, or no time that every method's curve covers.\n"
+        comparison_table(
+            &mut s,
+            plan,
+            &equal[si],
+            "### Equal time",
+            "seconds",
+            "relMSE of each method at the same render time (time budgets at their nominal \
+             value, other runs interpolated linearly in log-log between measured points).",
+        );
+        if has_adaptive {
+            comparison_table(
+                &mut s,
+                plan,
+                &equal_samples[si],
+                "### Equal samples",
+                "mean spp",
+                "relMSE of each method at the same number of samples, counted as the mean \
+                 samples per pixel actually taken (sample budgets at their value, adaptive runs \
+                 interpolated linearly in log-log between measured points).",
             );
-        } else {
-            let names: Vec<&str> = e
-                .pairs
-                .iter()
-                .map(|&p| plan.methods[plan.pairs[p].method].name.as_str())
-                .collect();
-            let _ = writeln!(
-                s,
-                "relMSE of each method at the same render time (time budgets at their nominal \
-                 value, other runs interpolated linearly in log-log between measured points).\n"
-            );
-            let _ = writeln!(s, "| seconds | {} | lowest |", names.join(" | "));
-            let _ = writeln!(s, "|---:|{}---|", "---:|".repeat(names.len()));
-            for (i, (t, errs)) in e.table.iter().enumerate() {
-                let cells: Vec<String> = errs.iter().map(|&v| sci(v)).collect();
-                let _ = writeln!(
-                    s,
-                    "| {t:.3} | {} | {} |",
-                    cells.join(" | "),
-                    names[e.winner(i)]
-                );
-            }
-            s.push('\n');
         }
 
         let (x0, y0, c) = blocks[si];
@@ -622,6 +713,9 @@ pub fn markdown(
             let name = &plan.methods[plan.pairs[p].method].name;
             let last = rows_of(results, p).last();
             head.push(match last {
+                Some(r) if r.stop.is_some() => {
+                    format!("{name} ({:.1} mean spp, {:.2} s)", r.mean_spp, r.seconds)
+                }
                 Some(r) => format!("{name} ({} spp, {:.2} s)", r.spp, r.seconds),
                 None => name.clone(),
             });
@@ -632,6 +726,43 @@ pub fn markdown(
         let _ = writeln!(s, "| {} |\n", cells.join(" | "));
     }
     s
+}
+
+/// One comparison section of report.md: each point of `e` and every method's relMSE there.
+fn comparison_table(
+    s: &mut String,
+    plan: &Plan,
+    e: &EqualTime,
+    heading: &str,
+    x_name: &str,
+    explanation: &str,
+) {
+    let _ = writeln!(s, "{heading}\n");
+    if e.table.is_empty() {
+        let _ = writeln!(
+            s,
+            "Nothing to compare: one method, or no {x_name} value that every method's curve covers.\n"
+        );
+        return;
+    }
+    let names: Vec<&str> = e
+        .pairs
+        .iter()
+        .map(|&p| plan.methods[plan.pairs[p].method].name.as_str())
+        .collect();
+    let _ = writeln!(s, "{explanation}\n");
+    let _ = writeln!(s, "| {x_name} | {} | lowest |", names.join(" | "));
+    let _ = writeln!(s, "|---:|{}---|", "---:|".repeat(names.len()));
+    for (i, (t, errs)) in e.table.iter().enumerate() {
+        let cells: Vec<String> = errs.iter().map(|&v| sci(v)).collect();
+        let _ = writeln!(
+            s,
+            "| {t:.3} | {} | {} |",
+            cells.join(" | "),
+            names[e.winner(i)]
+        );
+    }
+    s.push('\n');
 }
 
 #[cfg(test)]
