@@ -19,10 +19,12 @@
 //! estimate the mean and spread of 8 independent runs (distinct seeds for the two sides). The
 //! tests share a lock: the allocator counts the whole process.
 
+use rt_core::Rgb;
 use rt_core::SampleStream;
 use rt_film::AovSet;
-use rt_integrators::{Culling, PartitionOptions, PartitionStats, Partitioned, SamplePass, Technique};
-use rt_core::Rgb;
+use rt_integrators::{
+    Culling, PartitionOptions, PartitionStats, Partitioned, SamplePass, Technique,
+};
 use rt_testkit::stats::{compare_estimates, Estimate, ALPHA};
 use rt_testkit::{scene_from_toml, shipped_scene, Renderer, SceneExt};
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -97,6 +99,7 @@ fn block_means(image: &[Rgb]) -> Vec<Rgb> {
 /// block underestimate the block's variance (two sets of 8 runs of identical options differed
 /// by a block z of 8.3 that way; by block means 2.1–2.5).
 struct Runs {
+    runs: Vec<Vec<Rgb>>,
     blocks: Estimate,
     image: Estimate,
 }
@@ -110,7 +113,7 @@ fn estimate(
 ) -> (Runs, PartitionStats) {
     let t = Partitioned::new(DEPTH, o);
     let r = Renderer::new(scene).threads(2);
-    let (mut blocks, mut image) = (Vec::new(), Vec::new());
+    let (mut pixels, mut blocks, mut image) = (Vec::new(), Vec::new(), Vec::new());
     for i in 0..RUNS {
         let run = r
             .render_technique(&t, AovSet::default(), spp, first_seed + i)
@@ -119,8 +122,10 @@ fn estimate(
         let b = block_means(&run);
         image.push(vec![b.iter().copied().sum::<Rgb>() / b.len() as f32]);
         blocks.push(b);
+        pixels.push(run);
     }
     let runs = Runs {
+        runs: pixels,
         blocks: Estimate::from_runs(&blocks),
         image: Estimate::from_runs(&image),
     };
@@ -175,7 +180,10 @@ fn vpl_paths_and_photons_change_the_noise_not_the_image() {
     let glass = caustic_box();
     let (full, s_full) = estimate(&glass, options(|_| ()), 8, 400);
     let (fewer, s_fewer) = estimate(&glass, options(|o| o.photons = 40_000), 8, 500);
-    assert!(s_full.photons_landed > 0 && s_fewer.photons_landed > 0, "no caustic");
+    assert!(
+        s_full.photons_landed > 0 && s_fewer.photons_landed > 0,
+        "no caustic"
+    );
     let cp = compare("photons 4e4 vs 1e5", &fewer, &full);
     assert!(c1 <= 1.0, "1 VPL path differs from 16: {c1:.2}");
     assert!(c64 <= 1.0, "64 VPL paths differ from 16: {c64:.2}");
@@ -189,18 +197,27 @@ fn projection_maps_save_photon_rays_and_keep_the_image() {
     let (on, s_on) = estimate(&glass, options(|_| ()), 8, 100);
     let (off, s_off) = estimate(&glass, options(|o| o.projection_maps = false), 8, 200);
     let c = compare("maps on vs off", &on, &off);
+    // Control: without the histogram (no photons) the image loses its caustic and the test
+    // sees it, so the caustic is large enough to tell maps that lose photons.
+    let (none, _) = estimate(&glass, options(|o| o.photons = 0), 8, 300);
+    let control = compare("control: no photons vs maps off", &none, &off);
     let traced = s_on.photons_traced as f64 / s_on.photons_emitted as f64;
     let coverage = s_on.mean_coverage();
     eprintln!(
-        "maps on: {} of {} photons traced ({traced:.4}), {} maps, mean coverage {coverage:.4}; \
-         off: {} of {}",
+        "maps on: {} of {} photons traced ({traced:.4}), {} landed, {} maps, mean coverage \
+         {coverage:.4}; off: {} of {}",
         s_on.photons_traced,
         s_on.photons_emitted,
+        s_on.photons_landed,
         s_on.maps,
         s_off.photons_traced,
         s_off.photons_emitted
     );
     assert!(c <= 1.0, "maps change the image: {c:.2}");
+    assert!(
+        control > 1.0,
+        "control: the caustic is not seen: {control:.2}"
+    );
     assert_eq!(s_off.maps, 0);
     // Without maps every draw is traced, but for the rare direction in the light's plane.
     assert!(s_off.photons_emitted - s_off.photons_traced <= s_off.photons_emitted / 100_000);
@@ -217,10 +234,16 @@ fn projection_maps_save_photon_rays_and_keep_the_image() {
     );
 }
 
-/// Two rooms joined by a doorway: the light is in the far room, the camera in the near one,
-/// looking at the part of it that the far room cannot see; most VPLs (the far room's) are
-/// unseen.
-fn two_rooms() -> rt_core::Scene {
+/// Two rooms, the near one lit by its own lamp, seen from 1.5 m in front of the 10 cm thick
+/// dividing wall, which has a window 3 cm square at the height of the camera: the window is
+/// 2 × 2 pixels, and through it the far room, lit by a bright lamp, is seen. The only
+/// sentinels that far-room VPLs can see are the window's, so in some passes none is there and
+/// the far room's VPLs are culled although they light the window's pixels: the bias that
+/// biased culling has and unbiased culling must not have. (The wall has thickness: the
+/// culling test offsets the eye vertex towards the VPL, which for a VPL behind a wall of one
+/// quad is through the wall, so every VPL on the far side "sees" it; in a first version of
+/// this scene with such a wall 14 of 21,329 VPLs were culled.)
+fn window() -> rt_core::Scene {
     scene_from_toml(&format!(
         r#"
 [environment]
@@ -228,10 +251,10 @@ color = [0.0, 0.0, 0.0]
 
 [[camera]]
 name = "near"
-position = [-1.9, 1.0, 0.5]
-look_at = [0.0, 0.8, 0.5]
+position = [-1.5, 0.8, 0.0]
+look_at = [0.0, 0.8, 0.0]
 up = [0.0, 1.0, 0.0]
-fov = 40.0
+fov = 25.0
 resolution = [{SIZE}, {SIZE}]
 
 [[material]]
@@ -239,9 +262,14 @@ name = "white"
 color = [0.7, 0.7, 0.7]
 
 [[material]]
-name = "light"
+name = "dim"
 color = [0.0, 0.0, 0.0]
-emission = [20.0, 20.0, 20.0]
+emission = [2.0, 2.0, 2.0]
+
+[[material]]
+name = "bright"
+color = [0.0, 0.0, 0.0]
+emission = [200.0, 200.0, 200.0]
 
 [[geometry]]
 name = "floor"
@@ -279,49 +307,103 @@ shape = "quad"
 vertices = [[2.0, 0.0, -1.0], [2.0, 2.0, -1.0], [2.0, 2.0, 1.0], [2.0, 0.0, 1.0]]
 material = "white"
 
-# The dividing wall, 10 cm thick at x = 0..0.1, with a doorway 0.4 wide and 1.4 high at its
-# back end; the camera looks at the wall's other end, which no point of the far room sees.
-# (A wall of one quad would not do: the culling test offsets the eye vertex towards the VPL,
-# which for a VPL behind a wall of no thickness is through the wall, so every VPL on the far
-# side "sees" it: 14 of 21,329 were culled that way.)
+# The wall around the window: y 0.785..0.815, z -0.015..0.015.
 [[geometry]]
-name = "wall"
+name = "wall-below"
 shape = "box"
-min = [0.0, 0.0, -0.6]
+min = [0.0, 0.0, -1.0]
+max = [0.1, 0.785, 1.0]
+material = "white"
+
+[[geometry]]
+name = "wall-above"
+shape = "box"
+min = [0.0, 0.815, -1.0]
 max = [0.1, 2.0, 1.0]
 material = "white"
 
 [[geometry]]
-name = "lintel"
+name = "wall-back"
 shape = "box"
-min = [0.0, 1.4, -1.0]
-max = [0.1, 2.0, -0.6]
+min = [0.0, 0.785, -1.0]
+max = [0.1, 0.815, -0.015]
 material = "white"
 
 [[geometry]]
-name = "light"                   # faces down
+name = "wall-front"
+shape = "box"
+min = [0.0, 0.785, 0.015]
+max = [0.1, 0.815, 1.0]
+material = "white"
+
+[[geometry]]
+name = "near-lamp"               # faces down
 shape = "quad"
-vertices = [[1.8, 1.99, 0.2], [1.8, 1.99, 0.8], [1.2, 1.99, 0.8], [1.2, 1.99, 0.2]]
-material = "light"
+vertices = [[-0.8, 1.99, -0.3], [-0.8, 1.99, 0.3], [-1.4, 1.99, 0.3], [-1.4, 1.99, -0.3]]
+material = "dim"
+
+[[geometry]]
+name = "far-lamp"                # faces down
+shape = "quad"
+vertices = [[1.8, 1.99, -0.3], [1.8, 1.99, 0.3], [1.2, 1.99, 0.3], [1.2, 1.99, -0.3]]
+material = "bright"
 "#
     ))
+}
+
+/// The window's pixels (the 2 × 2 at the image's centre) and a margin of one pixel.
+fn window_mean(run: &[Rgb]) -> Vec<Rgb> {
+    let (lo, hi) = (SIZE / 2 - 2, SIZE / 2 + 2);
+    let mut sum = Rgb::ZERO;
+    for y in lo..hi {
+        for x in lo..hi {
+            sum += run[(y * SIZE + x) as usize];
+        }
+    }
+    vec![sum / ((hi - lo) * (hi - lo)) as f32]
 }
 
 #[test]
 fn unbiased_culling_keeps_the_image_and_stores_fewer_vpls() {
     let _lock = serial();
-    let scene = two_rooms();
-    let (unbiased, s_u) = estimate(&scene, options(|o| o.cull = Culling::Unbiased), 16, 100);
+    let scene = window();
     let (off, s_off) = estimate(&scene, options(|o| o.cull = Culling::Off), 16, 200);
-    let c = compare("cull unbiased vs off", &unbiased, &off);
+    let (unbiased, s_u) = estimate(&scene, options(|o| o.cull = Culling::Unbiased), 16, 100);
+    let (biased, s_b) = estimate(&scene, options(|o| o.cull = Culling::Biased), 16, 300);
     eprintln!(
-        "VPLs stored: unbiased {} ({} culled), off {} ({} culled), over {} passes",
-        s_u.vpls, s_u.culled, s_off.vpls, s_off.culled, s_u.passes
+        "VPLs stored: off {}, unbiased {} ({} culled), biased {} ({} culled), over {} passes",
+        s_off.vpls, s_u.vpls, s_u.culled, s_b.vpls, s_b.culled, s_u.passes
     );
+    // The image, and the window where culling bites: the mean over its pixels in each run.
+    let c = compare("cull unbiased vs off", &unbiased, &off);
+    let window =
+        |r: &Runs| Estimate::from_runs(&r.runs.iter().map(|i| window_mean(i)).collect::<Vec<_>>());
+    let z_window = |r: &Runs| {
+        let w = compare_estimates(&window(r), &window(&off), 1, 1, ALPHA);
+        eprintln!(
+            "window: {} vs off {} : z {:.2} (tolerance {:.2})",
+            window(r).mean[0],
+            window(&off).mean[0],
+            w.image_z,
+            w.image_crit
+        );
+        w.image_z.abs() / w.image_crit
+    };
+    let w_unbiased = z_window(&unbiased);
+    // Control: biased culling darkens the window, and the window's test sees it.
+    let w_biased = z_window(&biased);
     assert!(c <= 1.0, "culling changes the image: {c:.2}");
+    assert!(
+        w_unbiased <= 1.0,
+        "culling changes the window: {w_unbiased:.2}"
+    );
+    assert!(
+        w_biased > 1.0,
+        "control: biased culling passes: {w_biased:.2}"
+    );
     assert_eq!(s_off.culled, 0);
     assert!(
-        (s_u.vpls as f64) < 0.7 * s_off.vpls as f64,
+        (s_u.vpls as f64) < 0.8 * s_off.vpls as f64,
         "culling stores {} VPLs against {}",
         s_u.vpls,
         s_off.vpls
