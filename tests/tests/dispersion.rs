@@ -62,10 +62,10 @@ fn scenes_without_dispersion_are_bit_identical_with_spectral_on_and_off() {
     for name in ["environment.toml", "cornell-box.toml"] {
         let scene = shipped_scene(name).with_resolution(24, 16);
         assert!(
-            scene.materials.iter().all(|m| m
-                .layers
+            scene
+                .materials
                 .iter()
-                .all(|l| l.dispersion.is_none())),
+                .all(|m| m.layers.iter().all(|l| l.dispersion.is_none())),
             "{name} has a dispersive material"
         );
         let on = path_image(&scene, true, 2);
@@ -151,14 +151,26 @@ fn white_light_through_dispersive_slabs_keeps_its_mean_colour() {
     // weight 1 (the 1/n² of entering cancels the n² of leaving): L up to rounding.
     let rgb = render(false, 8);
     for p in &rgb.mean {
-        assert!((*p - rt_core::Rgb::splat(L)).abs().max_element() < 1e-4, "{p}");
+        assert!(
+            (*p - rt_core::Rgb::splat(L)).abs().max_element() < 1e-4,
+            "{p}"
+        );
     }
     let spectral = render(true, 512);
     // Every sample is L times one wavelength's weight: noisy colour, whose spread the
     // variance buffer shows (the RGB render has none).
-    let spread = |e: &Estimate| e.variance.iter().map(|v| v.max_element()).fold(0.0, f32::max);
+    let spread = |e: &Estimate| {
+        e.variance
+            .iter()
+            .map(|v| v.max_element())
+            .fold(0.0, f32::max)
+    };
     assert!(spread(&rgb) < 1e-10, "RGB render varies: {}", spread(&rgb));
-    assert!(spread(&spectral) > 1e-5, "no dispersion: {}", spread(&spectral));
+    assert!(
+        spread(&spectral) > 1e-5,
+        "no dispersion: {}",
+        spread(&spectral)
+    );
     let exact = Estimate {
         mean: vec![rt_core::Rgb::splat(L); n],
         variance: vec![rt_core::Rgb::ZERO; n],
@@ -180,5 +192,9 @@ fn dispersive_scene_is_deterministic_across_threads() {
     let scope = scope.with_resolution(64, 32);
     let one = path_image(&scope, true, 1);
     assert!(coloured(&one), "the spectroscope sees no spectrum");
-    assert_eq!(one, path_image(&scope, true, 4), "path tracer, spectroscope");
+    assert_eq!(
+        one,
+        path_image(&scope, true, 4),
+        "path tracer, spectroscope"
+    );
 }
