@@ -66,9 +66,16 @@ fn expect_one_line(scene: &str, args: &[&str], code: i32, needles: &[&str]) {
     let (out, dir) = render(scene, args);
     let lines = error_lines(&out);
     assert_eq!(out.status.code(), Some(code), "{args:?}: {lines:?}");
-    assert_eq!(lines.len(), 1, "{args:?}: expected one error line: {lines:?}");
+    assert_eq!(
+        lines.len(),
+        1,
+        "{args:?}: expected one error line: {lines:?}"
+    );
     for n in needles {
-        assert!(lines[0].contains(n), "{args:?}: should mention {n:?}: {lines:?}");
+        assert!(
+            lines[0].contains(n),
+            "{args:?}: should mention {n:?}: {lines:?}"
+        );
     }
     assert!(!dir.path().join("out.exr").exists(), "{args:?}: no image");
 }
@@ -77,7 +84,12 @@ fn expect_one_line(scene: &str, args: &[&str], code: i32, needles: &[&str]) {
 fn negative_and_zero_error_thresholds_are_one_line() {
     for bad in ["-1", "0", "-2e-4"] {
         expect_one_line(SCENE, &["--error", bad], 1, &["--error", "positive"]);
-        expect_one_line(SCENE, &["--time-limit", bad], 1, &["--time-limit", "positive"]);
+        expect_one_line(
+            SCENE,
+            &["--time-limit", bad],
+            1,
+            &["--time-limit", "positive"],
+        );
     }
 }
 
@@ -88,9 +100,17 @@ fn bad_partitioned_options_are_one_line() {
     expect_one_line(SCENE, &["--integrator", "partitioned:photons=0"], 2, &zero);
     // An unknown option: named, with the options there are.
     let unknown = ["gather=2", "does not apply", "photons=N"];
-    expect_one_line(SCENE, &["--integrator", "partitioned:gather=2"], 2, &unknown);
+    expect_one_line(
+        SCENE,
+        &["--integrator", "partitioned:gather=2"],
+        2,
+        &unknown,
+    );
     // The same in the scene's `[render]` table: a scene error, naming the file and the key.
-    for (spec, needles) in [("partitioned:photons=0", &zero[..]), ("partitioned:gather=2", &unknown[..])] {
+    for (spec, needles) in [
+        ("partitioned:photons=0", &zero[..]),
+        ("partitioned:gather=2", &unknown[..]),
+    ] {
         let scene = format!("{SCENE}\n[render]\nintegrator = \"{spec}\"\n");
         let mut with_file = vec!["scene.toml", "integrator"];
         with_file.extend(needles);

@@ -68,9 +68,21 @@ fn projection(bounds: &Aabb, dir: Vec3) -> ([f32; 4], f32) {
     let mut upstream = f32::INFINITY;
     for i in 0..8 {
         let c = Vec3::new(
-            if i & 1 == 0 { bounds.min.x } else { bounds.max.x },
-            if i & 2 == 0 { bounds.min.y } else { bounds.max.y },
-            if i & 4 == 0 { bounds.min.z } else { bounds.max.z },
+            if i & 1 == 0 {
+                bounds.min.x
+            } else {
+                bounds.max.x
+            },
+            if i & 2 == 0 {
+                bounds.min.y
+            } else {
+                bounds.max.y
+            },
+            if i & 4 == 0 {
+                bounds.min.z
+            } else {
+                bounds.max.z
+            },
         );
         let l = frame.to_local(c);
         r = [r[0].min(l.x), r[1].min(l.y), r[2].max(l.x), r[3].max(l.y)];
@@ -135,7 +147,10 @@ fn plane_sampled_starts_follow_the_environment_pdf_and_cover_the_box_uniformly()
     // The environment is chosen half the time (the light sampler's rule when both emit).
     let p = 0.5;
     let sd = (N as f64 * p * (1.0 - p)).sqrt();
-    eprintln!("{from_env} of {N} from the environment (expect {:.0} ± {sd:.0})", N as f64 * p);
+    eprintln!(
+        "{from_env} of {N} from the environment (expect {:.0} ± {sd:.0})",
+        N as f64 * p
+    );
     assert!(
         (from_env as f64 - N as f64 * p).abs() < 5.0 * sd,
         "{from_env} of {N} light paths from the environment"
@@ -143,7 +158,10 @@ fn plane_sampled_starts_follow_the_environment_pdf_and_cover_the_box_uniformly()
     assert_eq!(outside, 0, "start points outside the box's projection");
     assert_eq!(downstream, 0, "start points not upstream of the box");
     assert_eq!(bad_area, 0, "1 / pdf_position is not the rectangle's area");
-    assert_eq!(bad_beta, 0, "beta · p(y) · p(ω) is not the environment's radiance");
+    assert_eq!(
+        bad_beta, 0,
+        "beta · p(y) · p(ω) is not the environment's radiance"
+    );
 
     let expected = chi2::expected(|d| env.pdf(d) as f64, 8);
     let total: f64 = expected.iter().sum();
