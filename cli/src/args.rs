@@ -44,11 +44,11 @@ pub struct Args {
     /// Render until the hierarchical stopping criterion (Dammertz 2009) finds every block of
     /// the image below error V (the thesis uses 2e-4, for radiance in about [0, 1]); finished
     /// blocks stop sampling. Works with every integrator.
-    #[arg(long, value_name = "V")]
+    #[arg(long, value_name = "V", allow_hyphen_values = true)]
     pub error: Option<f32>,
 
     /// Stop rendering after this many seconds of passes (with or without --error).
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", allow_hyphen_values = true)]
     pub time_limit: Option<f64>,
 
     /// Light transport algorithm and its options, KIND[:OPTION...]: path (path tracing,

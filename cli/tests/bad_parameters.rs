@@ -1,0 +1,119 @@
+//! Bad parameters of the techniques and the stopping criterion give one clear error line (issue
+//! 11): a negative or zero `--error` (and `--time-limit`) given as a separate argument, as a
+//! user types it; zero caustic photons and an unknown option of the partitioned renderer, on
+//! the command line and in a scene's `[render]` table. `cli.rs` has the `--error=V` spelling
+//! and the exit code of the `--integrator` cases; this file checks the line count and the
+//! wording.
+
+use std::process::{Command, Output};
+
+const SCENE: &str = r#"
+[[camera]]
+name = "main"
+position = [0.0, 1.0, 3.0]
+look_at = [0.0, 1.0, 0.0]
+up = [0.0, 1.0, 0.0]
+fov = 40.0
+resolution = [8, 6]
+
+[[material]]
+name = "white"
+color = [0.7, 0.7, 0.7]
+
+[[material]]
+name = "lamp"
+color = [0.0, 0.0, 0.0]
+emission = [5.0, 5.0, 5.0]
+
+[[geometry]]
+name = "floor"
+shape = "quad"
+vertices = [[-1, 0, 1], [1, 0, 1], [1, 0, -1], [-1, 0, -1]]
+material = "white"
+
+[[geometry]]
+name = "light"
+shape = "quad"
+vertices = [[-0.3, 2, -0.3], [0.3, 2, -0.3], [0.3, 2, 0.3], [-0.3, 2, 0.3]]
+material = "lamp"
+"#;
+
+/// Renders `scene` (written to `scene.toml` in a fresh directory) with `args`.
+fn render(scene: &str, args: &[&str]) -> (Output, tempfile::TempDir) {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("scene.toml"), scene).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_render"))
+        .current_dir(dir.path())
+        .arg("scene.toml")
+        .args(["-o", "out.exr", "-q"])
+        .args(args)
+        .output()
+        .unwrap();
+    (out, dir)
+}
+
+/// The error lines of `out` (clap's closing "For more information" hint is not one).
+fn error_lines(out: &Output) -> Vec<String> {
+    String::from_utf8_lossy(&out.stderr)
+        .lines()
+        .filter(|l| !l.trim().is_empty() && !l.starts_with("For more information"))
+        .map(str::to_owned)
+        .collect()
+}
+
+/// Expects exit code `code`, one error line containing every needle, and no image.
+fn expect_one_line(scene: &str, args: &[&str], code: i32, needles: &[&str]) {
+    let (out, dir) = render(scene, args);
+    let lines = error_lines(&out);
+    assert_eq!(out.status.code(), Some(code), "{args:?}: {lines:?}");
+    assert_eq!(
+        lines.len(),
+        1,
+        "{args:?}: expected one error line: {lines:?}"
+    );
+    for n in needles {
+        assert!(
+            lines[0].contains(n),
+            "{args:?}: should mention {n:?}: {lines:?}"
+        );
+    }
+    assert!(!dir.path().join("out.exr").exists(), "{args:?}: no image");
+}
+
+#[test]
+fn negative_and_zero_error_thresholds_are_one_line() {
+    for bad in ["-1", "0", "-2e-4"] {
+        expect_one_line(SCENE, &["--error", bad], 1, &["--error", "positive"]);
+        expect_one_line(
+            SCENE,
+            &["--time-limit", bad],
+            1,
+            &["--time-limit", "positive"],
+        );
+    }
+}
+
+#[test]
+fn bad_partitioned_options_are_one_line() {
+    // Zero photons: the option, what it must be.
+    let zero = ["photons=0", "1 to"];
+    expect_one_line(SCENE, &["--integrator", "partitioned:photons=0"], 2, &zero);
+    // An unknown option: named, with the options there are.
+    let unknown = ["gather=2", "does not apply", "photons=N"];
+    expect_one_line(
+        SCENE,
+        &["--integrator", "partitioned:gather=2"],
+        2,
+        &unknown,
+    );
+    // The same in the scene's `[render]` table: a scene error, naming the file and the key.
+    for (spec, needles) in [
+        ("partitioned:photons=0", &zero[..]),
+        ("partitioned:gather=2", &unknown[..]),
+    ] {
+        let scene = format!("{SCENE}\n[render]\nintegrator = \"{spec}\"\n");
+        let mut with_file = vec!["scene.toml", "integrator"];
+        with_file.extend(needles);
+        expect_one_line(&scene, &[], 1, &with_file);
+    }
+}
