@@ -28,6 +28,7 @@ use rt_film::AovSet;
 use rt_integrators::{
     Culling, PartitionOptions, PartitionStats, Partitioned, SamplePass, Technique,
 };
+use rt_testkit::agreement::block_means;
 use rt_testkit::stats::{compare_estimates, Estimate, ALPHA};
 use rt_testkit::{scene_from_toml, shipped_scene, Renderer, SceneExt};
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -84,17 +85,6 @@ fn options(f: impl FnOnce(&mut PartitionOptions)) -> PartitionOptions {
     o
 }
 
-/// Mean of each `BLOCK × BLOCK` block of `image` (`SIZE` wide), row-major.
-fn block_means(image: &[Rgb]) -> Vec<Rgb> {
-    let bw = SIZE / BLOCK;
-    let mut out = vec![Rgb::ZERO; (bw * bw) as usize];
-    for (i, p) in image.iter().enumerate() {
-        let (x, y) = (i as u32 % SIZE, i as u32 / SIZE);
-        out[((y / BLOCK) * bw + x / BLOCK) as usize] += *p / (BLOCK * BLOCK) as f32;
-    }
-    out
-}
-
 /// A technique's estimate from independent runs, at two scales: the block means and the
 /// image mean, each with its variance from the spread of the runs. The spread is taken of the
 /// blocks' and the image's means, not summed over pixels: a VPL lights many pixels at once, so
@@ -122,7 +112,7 @@ fn estimate(
             .render_technique(&t, AovSet::default(), spp, first_seed + i)
             .0
             .mean_image();
-        let b = block_means(&run);
+        let b = block_means(&run, SIZE, BLOCK);
         image.push(vec![b.iter().copied().sum::<Rgb>() / b.len() as f32]);
         blocks.push(b);
         pixels.push(run);
