@@ -541,21 +541,36 @@ pub fn markdown(
     }
 
     let _ = writeln!(s, "## Summary\n");
-    let _ = writeln!(
-        s,
-        "| scene | lowest relMSE at equal time | MSE slope vs spp |"
-    );
-    let _ = writeln!(s, "|---|---|---|");
+    let any_adaptive = plan
+        .methods
+        .iter()
+        .any(|m| matches!(m.runs, Runs::Adaptive(_)));
+    let winner = |e: &EqualTime, what: &str| match e.overall() {
+        Some((p, wins)) => format!(
+            "{} ({wins} of {} {what})",
+            plan.methods[plan.pairs[p].method].name,
+            e.table.len()
+        ),
+        None => "–".into(),
+    };
+    if any_adaptive {
+        let _ = writeln!(
+            s,
+            "| scene | lowest relMSE at equal time | lowest relMSE at equal samples | MSE slope vs spp |"
+        );
+        let _ = writeln!(s, "|---|---|---|---|");
+    } else {
+        let _ = writeln!(
+            s,
+            "| scene | lowest relMSE at equal time | MSE slope vs spp |"
+        );
+        let _ = writeln!(s, "|---|---|---|");
+    }
     for (si, scene) in plan.scenes.iter().enumerate() {
-        let e = &equal[si];
-        let winner = match e.overall() {
-            Some((p, wins)) => format!(
-                "{} ({wins} of {} times)",
-                plan.methods[plan.pairs[p].method].name,
-                e.table.len()
-            ),
-            None => "–".into(),
-        };
+        let mut cells = vec![winner(&equal[si], "times")];
+        if any_adaptive {
+            cells.push(winner(&equal_samples[si], "sample counts"));
+        }
         let rates: Vec<String> = slopes
             .iter()
             .filter(|sl| sl.metric == "mse" && plan.pairs[sl.pair].scene == si)
@@ -564,7 +579,13 @@ pub fn markdown(
                 format!("{name} {}", fit_text(sl.raw.0))
             })
             .collect();
-        let _ = writeln!(s, "| {} | {winner} | {} |", scene.name, rates.join("; "));
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} |",
+            scene.name,
+            cells.join(" | "),
+            rates.join("; ")
+        );
     }
     s.push('\n');
 
