@@ -309,7 +309,12 @@ fn bad_experiment_files_give_one_line_naming_the_file() {
 #[test]
 fn shipped_configs_are_valid() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    for name in ["configs/convergence.toml", "configs/accel.toml"] {
+    for name in [
+        "configs/convergence.toml",
+        "configs/accel.toml",
+        "configs/light-transport.toml",
+        "configs/stopping.toml",
+    ] {
         let out = Command::new(env!("CARGO_BIN_EXE_render"))
             .current_dir(&root)
             .args(["experiment", name, "--check"])

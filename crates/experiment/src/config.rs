@@ -437,13 +437,6 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
                 let estimator = overrides
                     .integrator_spec(&loaded.render, &scene_path)
                     .map_err(|e| e.to_string())?;
-                if estimator.kind.splats() {
-                    // A reference keeps per-pixel variances, which splatted light paths lack.
-                    return Err(format!(
-                        "reference integrator `{}` splats light paths; references come from a camera-ray integrator (path, path-bsdf, direct, ao)",
-                        estimator.kind
-                    ));
-                }
                 ReferencePlan::Render {
                     spp: r.spp,
                     estimator,

@@ -72,7 +72,9 @@ pub fn obtain(
     })
 }
 
-/// Renders the reference: the reference stream, the variance AOV kept.
+/// Renders the reference: the reference stream, the variance AOV kept where the film knows
+/// it. A technique that splats (bdpt, light; the reference for caustics that camera paths
+/// rarely find) has no per-pixel variance, so its reference has no noise floor.
 fn render(
     req: &ReferenceRequest<'_>,
     accel: &dyn Accel,
@@ -89,7 +91,7 @@ fn render(
         seed: req.seed,
         stream: SampleStream::Reference,
         aovs: AovSet {
-            variance: true,
+            variance: !req.estimator.kind.splats(),
             ..AovSet::default()
         },
     };
