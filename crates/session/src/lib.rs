@@ -49,7 +49,7 @@ pub mod progressive;
 pub mod report;
 pub mod settings;
 
-pub use adaptive::{render_adaptive, Adaptive, StopReason, StopRule};
+pub use adaptive::{render_adaptive, Adaptive, StopReason, StopRule, FIRST_DECISION_SPP};
 pub use camera::{parse_resolution, pick_camera, ImageSize, MAX_SIDE};
 pub use progressive::{Budgets, Checkpoint, Session};
 pub use report::{RenderReport, ReportInputs, Stage, Status};
