@@ -57,29 +57,56 @@ pub(super) struct CausticPass {
     pub map_time: Duration,
 }
 
-/// The specular triangles of a scene, as the projection maps see them.
+/// Specular triangles grouped by [`OCCUPANT_GROUP`] consecutive ones of one object, each group
+/// as its bounding sphere: what the projection maps cover. Per triangle (the thesis' choice),
+/// the 1280 triangles of a glass sphere made the maps cost 12 % of the caustic time; grouped,
+/// the spheres grow a little and cover slightly more cells, and building takes an eighth.
 pub(super) fn occupants(scene: &rt_core::Scene) -> Vec<Occupant> {
     let specular = |m: &rt_core::Material| {
         m.layers
             .iter()
             .any(|l| l.weight > 0.0 && LayerClass::Specular.contains(l))
     };
-    scene
-        .triangles
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| specular(scene.material_of(*i as u32)))
-        .map(|(_, v)| {
-            let b = Aabb::from_points(v.iter());
-            let center = b.center();
-            let radius = v.iter().map(|p| p.distance(center)).fold(0.0, f32::max);
-            Occupant {
-                center,
-                radius: radius * (1.0 + 1e-4) + 1e-6 * center.abs().max_element(),
-            }
-        })
-        .collect()
+    let mut out = Vec::new();
+    let mut group: Vec<Vec3> = Vec::with_capacity(3 * OCCUPANT_GROUP);
+    let flush = |group: &mut Vec<Vec3>, out: &mut Vec<Occupant>| {
+        if group.is_empty() {
+            return;
+        }
+        let b = Aabb::from_points(group.iter());
+        let center = b.center();
+        let radius = group.iter().map(|p| p.distance(center)).fold(0.0, f32::max);
+        out.push(Occupant {
+            center,
+            radius: radius * (1.0 + 1e-4) + 1e-6 * center.abs().max_element(),
+        });
+        group.clear();
+    };
+    // Object ranges in triangle order; triangles outside every object form their own run.
+    let mut object_end = scene.objects.iter().map(|o| o.first + o.count);
+    let mut next_end = object_end.next();
+    let mut prev: Option<u32> = None;
+    for (i, v) in scene.triangles.iter().enumerate() {
+        let i = i as u32;
+        while next_end.is_some_and(|e| i >= e) {
+            flush(&mut group, &mut out);
+            next_end = object_end.next();
+        }
+        if !specular(scene.material_of(i)) {
+            continue;
+        }
+        if prev.is_some_and(|p| p + 1 != i) || group.len() >= 3 * OCCUPANT_GROUP {
+            flush(&mut group, &mut out);
+        }
+        group.extend_from_slice(v);
+        prev = Some(i);
+    }
+    flush(&mut group, &mut out);
+    out
 }
+
+/// Consecutive specular triangles per projection-map occupant.
+const OCCUPANT_GROUP: usize = 8;
 
 /// One work item: photons `first..first + count` of primary light `light`.
 #[derive(Clone, Copy)]
@@ -127,7 +154,7 @@ impl Partitioned {
         }
         let start = Instant::now();
         let maps: Vec<Option<ProjectionMap>> = primaries
-            .iter()
+            .par_iter()
             .map(|l| {
                 (self.options.projection_maps && l.travel == Vec3::ZERO)
                     .then(|| ProjectionMap::build(l.p, l.n, l.two_sided, occupants))
