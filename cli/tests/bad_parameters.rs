@@ -7,36 +7,16 @@
 
 use std::process::{Command, Output};
 
-const SCENE: &str = r#"
-[[camera]]
-name = "main"
-position = [0.0, 1.0, 3.0]
-look_at = [0.0, 1.0, 0.0]
-up = [0.0, 1.0, 0.0]
-fov = 40.0
-resolution = [8, 6]
+mod common;
 
-[[material]]
-name = "white"
-color = [0.7, 0.7, 0.7]
-
-[[material]]
-name = "lamp"
-color = [0.0, 0.0, 0.0]
-emission = [5.0, 5.0, 5.0]
-
-[[geometry]]
-name = "floor"
-shape = "quad"
-vertices = [[-1, 0, 1], [1, 0, 1], [1, 0, -1], [-1, 0, -1]]
-material = "white"
-
-[[geometry]]
-name = "light"
-shape = "quad"
-vertices = [[-0.3, 2, -0.3], [0.3, 2, -0.3], [0.3, 2, 0.3], [-0.3, 2, 0.3]]
-material = "lamp"
-"#;
+/// The floor under a lamp, seen by an 8×6 camera.
+fn scene() -> String {
+    format!(
+        "[[camera]]\nname = \"main\"\nposition = [0.0, 1.0, 3.0]\nlook_at = [0.0, 1.0, 0.0]\n\
+         fov = 40.0\nresolution = [8, 6]\n{}",
+        common::FLOOR_AND_LAMP
+    )
+}
 
 /// Renders `scene` (written to `scene.toml` in a fresh directory) with `args`.
 fn render(scene: &str, args: &[&str]) -> (Output, tempfile::TempDir) {
@@ -83,9 +63,9 @@ fn expect_one_line(scene: &str, args: &[&str], code: i32, needles: &[&str]) {
 #[test]
 fn negative_and_zero_error_thresholds_are_one_line() {
     for bad in ["-1", "0", "-2e-4"] {
-        expect_one_line(SCENE, &["--error", bad], 1, &["--error", "positive"]);
+        expect_one_line(&scene(), &["--error", bad], 1, &["--error", "positive"]);
         expect_one_line(
-            SCENE,
+            &scene(),
             &["--time-limit", bad],
             1,
             &["--time-limit", "positive"],
@@ -97,11 +77,16 @@ fn negative_and_zero_error_thresholds_are_one_line() {
 fn bad_partitioned_options_are_one_line() {
     // Zero photons: the option, what it must be.
     let zero = ["photons=0", "1 to"];
-    expect_one_line(SCENE, &["--integrator", "partitioned:photons=0"], 2, &zero);
+    expect_one_line(
+        &scene(),
+        &["--integrator", "partitioned:photons=0"],
+        2,
+        &zero,
+    );
     // An unknown option: named, with the options there are.
     let unknown = ["gather=2", "does not apply", "photons=N"];
     expect_one_line(
-        SCENE,
+        &scene(),
         &["--integrator", "partitioned:gather=2"],
         2,
         &unknown,
@@ -111,7 +96,7 @@ fn bad_partitioned_options_are_one_line() {
         ("partitioned:photons=0", &zero[..]),
         ("partitioned:gather=2", &unknown[..]),
     ] {
-        let scene = format!("{SCENE}\n[render]\nintegrator = \"{spec}\"\n");
+        let scene = format!("{}\n[render]\nintegrator = \"{spec}\"\n", scene());
         let mut with_file = vec!["scene.toml", "integrator"];
         with_file.extend(needles);
         expect_one_line(&scene, &[], 1, &with_file);

@@ -172,6 +172,7 @@ impl LightTracer {
             }
         }
         let mut beta = e.beta;
+        let start = beta.max_element();
         let mut ray = e.ray();
         let mut depth = 0u32;
         // The particle's wavelength once a dispersive event has drawn one (§6.6).
@@ -218,7 +219,7 @@ impl LightTracer {
             }
             lambda = s.wavelength;
             ray = spawn_ray(si.p, si.p_error, si.ng, s.wi);
-            if depth > self.rr_depth && !survives_roulette(&mut beta, u_rr) {
+            if depth > self.rr_depth && !survives_roulette(&mut beta, start, u_rr) {
                 break;
             }
         }

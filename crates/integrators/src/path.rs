@@ -184,7 +184,7 @@ impl Integrator for PathIntegrator {
             prev_p = si.p;
             ray = spawn_ray(si.p, si.p_error, si.ng, s.wi);
             depth += 1;
-            if depth > self.rr_depth && !survives_roulette(&mut beta, u_rr) {
+            if depth > self.rr_depth && !survives_roulette(&mut beta, 1.0, u_rr) {
                 break;
             }
         }

@@ -37,12 +37,20 @@ pub(crate) fn importance_weight(s: &BsdfSample, wo: Vec3, ns: Vec3, ng: Vec3) ->
 }
 
 /// Russian roulette on throughput `beta` with random number `u`: continues with probability
-/// tied to the throughput, so surviving paths carry comparable weights, capped so bright paths
-/// still end. Returns false if the path ends; a survivor's `beta` is divided by the
-/// probability.
+/// tied to the throughput relative to `start`, the largest channel of the path's weight where
+/// it began (1 for camera paths; a light path's `Le / pdf`, a photon's `Φ / N`), so surviving
+/// paths carry comparable weights, capped so bright paths still end. Returns false if the path
+/// ends; a survivor's `beta` is divided by the probability.
+///
+/// Relative, not absolute: a caustic photon carries `Φ / N` (10⁻³ on `scenes/caustic.toml`),
+/// and roulette on that killed 999 photons in 1000 and gave the survivor a thousandfold weight,
+/// one pixel of 1600 in one pass.
 #[inline]
-pub(crate) fn survives_roulette(beta: &mut Rgb, u: f32) -> bool {
-    let q = beta.max_element().min(0.95);
+pub(crate) fn survives_roulette(beta: &mut Rgb, start: f32, u: f32) -> bool {
+    let q = (beta.max_element() / start).min(0.95);
+    if q.is_nan() {
+        return false;
+    }
     if u >= q {
         return false;
     }
@@ -66,5 +74,29 @@ pub(crate) fn light_visible(
     } else {
         let (r, t_max) = shadow_segment(p, p_error, ng, ls.point, ls.point_error, ls.normal);
         !ctx.accel.occluded_toward(&r, t_max, ls.point)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn roulette_is_relative_to_the_starting_weight() {
+        // A photon of power 1e-3 that lost nothing survives as often as a camera path of 1.
+        let survivals = |start: f32| {
+            (0..1000)
+                .filter(|i| {
+                    let mut b = Rgb::splat(start);
+                    survives_roulette(&mut b, start, (*i as f32 + 0.5) / 1000.0)
+                })
+                .count()
+        };
+        assert_eq!(survivals(1e-3), survivals(1.0));
+        assert_eq!(survivals(1.0), 950);
+        // And the survivor's weight grows by 1/0.95, not by 1/q of the absolute weight.
+        let mut b = Rgb::splat(1e-3);
+        assert!(survives_roulette(&mut b, 1e-3, 0.5));
+        assert!((b.x - 1e-3 / 0.95).abs() < 1e-9);
     }
 }

@@ -331,6 +331,7 @@ impl Bdpt {
         let scene = ctx.scene;
         let thin_lens = !ctx.camera.is_pinhole();
         let mut bounces = 0usize;
+        let start = beta.max_element();
         // The subpath's wavelength once a dispersive event has drawn one (§6.6).
         let mut lambda: Option<f32> = None;
         while bounces < max_vertices {
@@ -411,7 +412,7 @@ impl Bdpt {
             if beta.max_element() <= 0.0 || !beta.is_finite() {
                 break;
             }
-            if bounces > self.rr_depth as usize && !survives_roulette(&mut beta, u_rr) {
+            if bounces > self.rr_depth as usize && !survives_roulette(&mut beta, start, u_rr) {
                 break;
             }
             pdf = pdf_fwd;

@@ -238,6 +238,7 @@ impl Partitioned {
         let scene = ctx.scene;
         // The photon's wavelength once a dispersive event has drawn one (§6.6).
         let mut lambda: Option<f32> = None;
+        let start = beta.max_element();
         for bounce in 0..self.max_depth {
             counters.rays += 1;
             let Some(hit) = ctx.accel.intersect(&ray, f32::INFINITY) else {
@@ -283,7 +284,7 @@ impl Partitioned {
             if beta.max_element() <= 0.0 || !beta.is_finite() {
                 return;
             }
-            if bounce + 1 > self.rr_depth && !survives_roulette(&mut beta, u_rr) {
+            if bounce + 1 > self.rr_depth && !survives_roulette(&mut beta, start, u_rr) {
                 return;
             }
             ray = spawn_ray(si.p, si.p_error, si.ng, s.wi);

@@ -157,7 +157,7 @@ impl Partitioned {
             if beta.max_element() <= 0.0 || !beta.is_finite() {
                 break;
             }
-            if depth > self.rr_depth && !survives_roulette(&mut beta, u_rr) {
+            if depth > self.rr_depth && !survives_roulette(&mut beta, 1.0, u_rr) {
                 break;
             }
             ray = spawn_ray(si.p, si.p_error, si.ng, s.wi);

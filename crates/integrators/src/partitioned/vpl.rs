@@ -159,6 +159,7 @@ impl Partitioned {
         // A VPL at bounce b lights eye vertices of depth at most max_depth - b.
         // The walk's wavelength once a dispersive event has drawn one (§6.6).
         let mut lambda: Option<f32> = None;
+        let start = beta.max_element();
         for bounce in 1..self.max_depth {
             counters.rays += 1;
             let Some(hit) = ctx.accel.intersect(&ray, f32::INFINITY) else {
@@ -201,7 +202,7 @@ impl Partitioned {
             if beta.max_element() <= 0.0 || !beta.is_finite() {
                 break;
             }
-            if bounce > self.rr_depth && !survives_roulette(&mut beta, u_rr) {
+            if bounce > self.rr_depth && !survives_roulette(&mut beta, start, u_rr) {
                 break;
             }
             ray = spawn_ray(si.p, si.p_error, si.ng, s.wi);
