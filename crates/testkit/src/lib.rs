@@ -80,7 +80,9 @@ fn first_camera_as(mut scene: Scene, size: (u32, u32), lens: (f32, f32)) -> Scen
     scene.cameras[0] = rt_core::Camera::look_at(
         &c.name,
         c.position,
-        c.position + c.forward,
+        // A target one unit ahead rounds back onto a camera far from the origin (a mutant
+        // scene's camera at 4·10⁹ got a NaN view): step as far as the position's magnitude.
+        c.position + c.forward * (1.0 + c.position.abs().max_element()),
         c.up,
         c.fov_y_deg,
         size.0,

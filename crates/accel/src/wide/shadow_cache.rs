@@ -74,6 +74,10 @@ impl<N: WideNode> WideBvh<N> {
         target: Vec3,
         counter: &mut C,
     ) -> bool {
+        // As in the traversal: a ray with a NaN hits nothing (and must not descend forever).
+        if !(ray.origin.is_finite() && ray.dir.is_finite()) {
+            return false;
+        }
         #[cfg(target_arch = "x86_64")]
         if let Some(avx2) = self.avx2 {
             // SAFETY: `Avx2::detect` made `avx2`, so the CPU has AVX2.

@@ -318,7 +318,9 @@ impl<N: WideNode> WideBvh<N> {
         counter: &mut C,
     ) -> Option<Hit> {
         let nodes = &self.nodes[..];
-        if nodes.is_empty() {
+        // A NaN in the ray makes every slab test pass, empty slots included, and the descent
+        // then never ends (it overflowed the stack); such a ray hits nothing.
+        if nodes.is_empty() || !(ray.origin.is_finite() && ray.dir.is_finite()) {
             return None;
         }
         let slab = Slab::new(ray);
