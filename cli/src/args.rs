@@ -58,7 +58,7 @@ pub struct Args {
     /// pixel per spp; no AOVs), bdpt (bidirectional path tracing, MIS over all strategies;
     /// one camera and one light subpath per pixel per spp; no AOVs), partitioned (the
     /// path-space-partitioned renderer: VPLs, caustic histogram, specular gathering; options
-    /// vpls=N, photons=N, clamp=F, cull=off|unbiased|biased, maps=on|off); options
+    /// vpls=N, photons=N, clamp=F, cull=off|unbiased|biased, maps=on|off, indirect-caustics=N); options
     /// max-depth=N (path, path-bsdf, light, bdpt, partitioned) and distance=F (ao), e.g.
     /// path:max-depth=4 (crates/integrators/src/spec.rs).
     /// [default: `[render] integrator`, else path]

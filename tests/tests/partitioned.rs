@@ -51,16 +51,26 @@ fn partitioned_agrees_with_path_tracing_on_the_cornell_box() {
 
 #[test]
 fn partitioned_is_deterministic_across_threads() {
-    let scene = shipped_scene("environment.toml").with_resolution(20, 12);
-    let t = Partitioned::new(DEPTH, PartitionOptions::default());
-    let one = Renderer::new(&scene)
-        .threads(1)
-        .render_technique(&t, AovSet::default(), 3, 5)
-        .0;
-    let three = Renderer::new(&scene)
-        .threads(3)
-        .render_technique(&t, AovSet::default(), 3, 5)
-        .0;
-    assert_eq!(one.mean_image(), three.mean_image());
-    assert!(one.mean_image().iter().any(|p| p.max_element() > 0.0));
+    let indirect = PartitionOptions {
+        indirect_caustics: 2,
+        photons: 20_000,
+        ..PartitionOptions::default()
+    };
+    for (name, o) in [
+        ("environment.toml", PartitionOptions::default()),
+        ("caustic.toml", indirect),
+    ] {
+        let scene = shipped_scene(name).with_resolution(20, 12);
+        let t = Partitioned::new(DEPTH, o);
+        let one = Renderer::new(&scene)
+            .threads(1)
+            .render_technique(&t, AovSet::default(), 3, 5)
+            .0;
+        let three = Renderer::new(&scene)
+            .threads(3)
+            .render_technique(&t, AovSet::default(), 3, 5)
+            .0;
+        assert_eq!(one.mean_image(), three.mean_image(), "{name}");
+        assert!(one.mean_image().iter().any(|p| p.max_element() > 0.0));
+    }
 }

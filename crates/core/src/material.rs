@@ -427,6 +427,12 @@ impl<'a> Bsdf<'a> {
         self
     }
 
+    /// The wavelength the path carries (see [`Bsdf::with_wavelength`]).
+    #[inline]
+    pub fn wavelength(&self) -> Option<f32> {
+        self.wavelength
+    }
+
     /// Treats dispersive layers as plain glass of index `n_d`: the renderer as if it had no
     /// spectral code. For tests.
     #[doc(hidden)]

@@ -11,7 +11,7 @@
 //! | option | kinds | meaning |
 //! |---|---|---|
 //! | `max-depth=N` | path, path-bsdf, light, bdpt, partitioned |
-//! | `vpls=N`, `photons=N`, `clamp=F`, `cull=off\|unbiased\|biased`, `maps=on\|off` | partitioned | VPL paths and caustic photons per pass (16, 100000), G-clamp distance as a fraction of the scene diagonal (0.001), VPL culling (unbiased), projection maps (on): [`PartitionOptions`] | bounce limit (default [`DEFAULT_MAX_DEPTH`], at most [`MAX_DEPTH`]) |
+//! | `vpls=N`, `photons=N`, `clamp=F`, `cull=off\|unbiased\|biased`, `maps=on\|off`, `indirect-caustics=N` | partitioned | VPL paths and caustic photons per pass (16, 100000), G-clamp distance as a fraction of the scene diagonal (0.001), VPL culling (unbiased), projection maps (on), caustic photons also from the VPLs of the first N diffuse bounces (0): [`PartitionOptions`] | bounce limit (default [`DEFAULT_MAX_DEPTH`], at most [`MAX_DEPTH`]) |
 //! | `distance=F` | ao | occluder distance (default unlimited) |
 
 use crate::{
@@ -165,7 +165,7 @@ pub enum IntegratorSpecError {
     #[error("\"{0}\" is not one of {names}", names = IntegratorKind::names())]
     UnknownKind(String),
     /// An option this crate does not know, or one that does not apply to the kind.
-    #[error("option `{option}` does not apply to `{kind}` (options: max-depth=N for path, path-bsdf, light, bdpt and partitioned, distance=F for ao, vpls=N, photons=N, clamp=F, cull=off|unbiased|biased and maps=on|off for partitioned)")]
+    #[error("option `{option}` does not apply to `{kind}` (options: max-depth=N for path, path-bsdf, light, bdpt and partitioned, distance=F for ao, vpls=N, photons=N, clamp=F, cull=off|unbiased|biased, maps=on|off and indirect-caustics=N for partitioned)")]
     UnknownOption {
         /// The integrator.
         kind: IntegratorKind,
@@ -294,7 +294,10 @@ impl FromStr for IntegratorSpec {
                     spec.with_max_depth(depth)?
                 }
                 (key, IntegratorKind::Partitioned)
-                    if matches!(key, "vpls" | "photons" | "clamp" | "cull" | "maps") =>
+                    if matches!(
+                        key,
+                        "vpls" | "photons" | "clamp" | "cull" | "maps" | "indirect-caustics"
+                    ) =>
                 {
                     spec.partition = parse_partition_option(spec.partition, key, value.trim())
                         .map_err(|what| IntegratorSpecError::BadPartitionOption {
@@ -327,6 +330,9 @@ pub const MAX_VPL_PATHS: u32 = 65_536;
 /// Most caustic photons per pass.
 pub const MAX_PHOTONS: u32 = 100_000_000;
 
+/// Deepest diffuse bounce indirect caustics may start from.
+pub const MAX_INDIRECT_CAUSTICS: u32 = 64;
+
 /// One `partitioned` option applied to `o`, or what its value must be.
 fn parse_partition_option(
     mut o: PartitionOptions,
@@ -354,6 +360,13 @@ fn parse_partition_option(
                 .ok()
                 .filter(|c: &f32| c.is_finite() && *c >= 0.0)
                 .ok_or("the clamp distance (a fraction of the scene's diagonal) must be a number at least 0")?;
+        }
+        "indirect-caustics" => {
+            o.indirect_caustics = value
+                .parse()
+                .ok()
+                .filter(|n| *n <= MAX_INDIRECT_CAUSTICS)
+                .ok_or("the depth of indirect caustics must be an integer from 0 to 64")?;
         }
         "cull" => {
             o.cull = [Culling::Off, Culling::Unbiased, Culling::Biased]
@@ -397,6 +410,9 @@ impl fmt::Display for IntegratorSpec {
             }
             if o.projection_maps != d.projection_maps {
                 write!(f, ":maps=off")?;
+            }
+            if o.indirect_caustics != d.indirect_caustics {
+                write!(f, ":indirect-caustics={}", o.indirect_caustics)?;
             }
         }
         Ok(())
@@ -472,6 +488,22 @@ mod tests {
     fn built_integrators_are_named_as_specs() {
         for k in IntegratorKind::ALL {
             assert_eq!(IntegratorSpec::new(k).build().name(), k.name());
+        }
+    }
+
+    #[test]
+    fn partition_options_round_trip_and_refuse_bad_values() {
+        let text =
+            "partitioned:vpls=4:photons=2000:clamp=0.01:cull=biased:maps=off:indirect-caustics=2";
+        let spec: IntegratorSpec = text.parse().unwrap();
+        assert_eq!(spec.partition.indirect_caustics, 2);
+        assert_eq!(spec.to_string(), text);
+        for bad in [
+            "partitioned:indirect-caustics=-1",
+            "partitioned:indirect-caustics=65",
+            "path:indirect-caustics=1",
+        ] {
+            assert!(bad.parse::<IntegratorSpec>().is_err(), "{bad}");
         }
     }
 }

@@ -1,7 +1,11 @@
 //! The caustic histogram of the partitioned renderer (Dammertz 2011, §6.3.2): the pass's eye
 //! vertices are the bins, in a point kd-tree with a radius each; photons leave the primary
 //! lights, must meet a specular part first, and at every later vertex land in every bin that
-//! covers them (part B, `EDS(S|D)*L`, and behind specular chains part C).
+//! covers them (part B, `EDS(S|D)*L`, and behind specular chains part C). With
+//! `indirect_caustics = k` photons also leave the VPLs of the first `k` diffuse bounces, in
+//! directions drawn from their diffuse part (the thesis' artist-set depth of indirect
+//! caustics, `EDS+D+L`); without them those paths are missing from the image, a bias the
+//! thesis accepts by default.
 //!
 //! A photon's contribution to its bin's pixel is `β_eye · f_D(ω_photon) · Φ / (π r²)`, `Φ` the
 //! photon's power over the draws of its light (rejected draws of the projection maps
@@ -17,7 +21,7 @@
 
 use super::eye::EyeVertex;
 use super::projection::{Occupant, ProjectionMap};
-use super::vpl::PrimaryLight;
+use super::vpl::{PrimaryLight, Source, Vpl};
 use super::Partitioned;
 use crate::transport::{importance_weight, survives_roulette};
 use crate::{Ctx, RayCounters};
@@ -108,12 +112,31 @@ pub(super) fn occupants(scene: &rt_core::Scene) -> Vec<Occupant> {
 /// Consecutive specular triangles per projection-map occupant.
 const OCCUPANT_GROUP: usize = 8;
 
-/// One work item: photons `first..first + count` of primary light `light`.
+/// One work item: photons `first..first + count` of photon source `light` (the primary
+/// lights, then the VPLs that emit indirect caustics).
 #[derive(Clone, Copy)]
 struct Item {
     light: usize,
     first: u32,
     count: u32,
+}
+
+/// Where a pass's caustic photons start.
+#[derive(Clone, Copy)]
+enum PhotonSource<'v, 'a> {
+    /// A point on a light (or the environment).
+    Light(&'v PrimaryLight),
+    /// A VPL on a surface with a diffuse part: indirect caustics.
+    Vpl(&'v Vpl<'a>),
+}
+
+/// A photon in flight: its ray, power, wavelength and the scattering vertices of its light
+/// path before the ray (0 from a light).
+struct Photon {
+    ray: Ray,
+    beta: Rgb,
+    lambda: Option<f32>,
+    vertices: u32,
 }
 
 impl Partitioned {
@@ -128,6 +151,7 @@ impl Partitioned {
         index: u32,
         eyes: &[EyeVertex],
         primaries: &[PrimaryLight],
+        vpls: &[Vpl<'_>],
         occupants: &[Occupant],
         counters: &mut RayCounters,
     ) -> CausticPass {
@@ -152,12 +176,29 @@ impl Partitioned {
         if bins.is_empty() {
             return out;
         }
+        // A photon from a VPL needs a specular vertex and then a diffuse one within the depth.
+        let sources: Vec<PhotonSource> = primaries
+            .iter()
+            .map(PhotonSource::Light)
+            .chain(
+                vpls.iter()
+                    .filter(|v| {
+                        matches!(v.source, Source::Surface { .. })
+                            && v.bounce <= self.options.indirect_caustics
+                            && v.bounce + 2 <= self.max_depth
+                    })
+                    .map(PhotonSource::Vpl),
+            )
+            .collect();
         let start = Instant::now();
-        let maps: Vec<Option<ProjectionMap>> = primaries
+        let maps: Vec<Option<ProjectionMap>> = sources
             .par_iter()
-            .map(|l| {
-                (self.options.projection_maps && l.travel == Vec3::ZERO)
-                    .then(|| ProjectionMap::build(l.p, l.n, l.two_sided, occupants))
+            .map(|source| match source {
+                _ if !self.options.projection_maps => None,
+                PhotonSource::Light(l) => (l.travel == Vec3::ZERO)
+                    .then(|| ProjectionMap::build(l.p, l.n, l.two_sided, occupants)),
+                // Both hemispheres: a diffuse part may transmit.
+                PhotonSource::Vpl(v) => Some(ProjectionMap::build(v.p, v.ng, true, occupants)),
             })
             .collect();
         out.map_time = start.elapsed();
@@ -165,7 +206,7 @@ impl Partitioned {
             out.coverage_sum += f64::from(m.coverage());
             out.maps += 1;
         }
-        let work: Vec<Item> = (0..primaries.len())
+        let work: Vec<Item> = (0..sources.len())
             .flat_map(|light| {
                 (0..per_light.div_ceil(CHUNK)).map(move |c| Item {
                     light,
@@ -183,20 +224,33 @@ impl Partitioned {
                 let mut deposits = Vec::new();
                 let mut rays = RayCounters::default();
                 let mut traced = 0u64;
-                let light = &primaries[item.light];
-                let phi = light.beta / per_light as f32;
+                let map = maps[item.light].as_ref();
                 for m in item.first..item.first + item.count {
-                    let k = vpl_paths + item.light as u32 * per_light + m;
+                    let k = (item.light as u32)
+                        .wrapping_mul(per_light)
+                        .wrapping_add(vpl_paths + m);
                     sampler.start_light_path(k, index);
-                    let u = sampler.next_2d();
-                    let Some(ray) = photon_ray(light, maps[item.light].as_ref(), bounds, u) else {
+                    let photon = match sources[item.light] {
+                        PhotonSource::Light(light) => {
+                            photon_ray(light, map, bounds, sampler.next_2d()).map(|ray| Photon {
+                                ray,
+                                beta: light.beta / per_light as f32,
+                                lambda: None,
+                                vertices: 0,
+                            })
+                        }
+                        PhotonSource::Vpl(vpl) => {
+                            let u_layer = sampler.next_1d();
+                            vpl_photon(vpl, map, per_light, u_layer, sampler.next_2d())
+                        }
+                    };
+                    let Some(photon) = photon else {
                         continue;
                     };
                     traced += 1;
                     self.trace_photon(
                         ctx,
-                        ray,
-                        phi,
+                        photon,
                         &mut sampler,
                         &bins,
                         &mut query,
@@ -216,7 +270,7 @@ impl Partitioned {
             *counters += rays;
             out.traced += traced;
         }
-        out.emitted = u64::from(per_light) * primaries.len() as u64;
+        out.emitted = u64::from(per_light) * sources.len() as u64;
         out
     }
 
@@ -226,8 +280,7 @@ impl Partitioned {
     fn trace_photon(
         &self,
         ctx: &Ctx<'_>,
-        mut ray: Ray,
-        mut beta: Rgb,
+        photon: Photon,
         sampler: &mut Sampler,
         bins: &PointKdTree,
         query: &mut PointQuery,
@@ -236,10 +289,15 @@ impl Partitioned {
         counters: &mut RayCounters,
     ) {
         let scene = ctx.scene;
-        // The photon's wavelength once a dispersive event has drawn one (§6.6).
-        let mut lambda: Option<f32> = None;
+        let Photon {
+            mut ray,
+            mut beta,
+            // The photon's wavelength once a dispersive event has drawn one (§6.6).
+            mut lambda,
+            vertices,
+        } = photon;
         let start = beta.max_element();
-        for bounce in 0..self.max_depth {
+        for bounce in 0..self.max_depth.saturating_sub(vertices) {
             counters.rays += 1;
             let Some(hit) = ctx.accel.intersect(&ray, f32::INFINITY) else {
                 return;
@@ -255,7 +313,7 @@ impl Partitioned {
                     let e = &eyes[n.payload as usize];
                     let same_side = e.wo.dot(si.ng) * wo.dot(si.ng) > 0.0;
                     if n.dist2 <= e.radius * e.radius
-                        && e.depth + bounce <= self.max_depth
+                        && e.depth + bounce + vertices <= self.max_depth
                         && same_side
                         && e.ng.dot(si.ng) >= SAME_SURFACE_COS
                     {
@@ -290,6 +348,32 @@ impl Partitioned {
             ray = spawn_ray(si.p, si.p_error, si.ng, s.wi);
         }
     }
+}
+
+/// A photon leaving `vpl` in a direction its diffuse part scatters to, for random numbers
+/// `u_layer` and `u`, with its share of `per_light` photons; `None` when the projection map
+/// rejects the direction or the part scatters nothing.
+fn vpl_photon(
+    vpl: &Vpl<'_>,
+    map: Option<&ProjectionMap>,
+    per_light: u32,
+    u_layer: f32,
+    u: Vec2,
+) -> Option<Photon> {
+    let Source::Surface { bsdf, wo, ns } = &vpl.source else {
+        return None;
+    };
+    let s = bsdf.sample(u_layer, u)?;
+    if map.is_some_and(|m| !m.allows(s.wi)) {
+        return None;
+    }
+    let beta = vpl.beta * importance_weight(&s, *wo, *ns, vpl.ng) / per_light as f32;
+    Some(Photon {
+        ray: spawn_ray(vpl.p, vpl.p_error, vpl.ng, s.wi),
+        beta,
+        lambda: s.wavelength.or(bsdf.wavelength()),
+        vertices: vpl.bounce,
+    })
 }
 
 /// The ray of a photon from `light` for random numbers `u`, or `None` when the projection map

@@ -30,7 +30,8 @@
 //! the bin radius is half the pixel's angle times the eye path's length, which is what ray
 //! differentials give through planar mirrors (curved glass would widen or narrow it); photons
 //! from the environment start by plane sampling and have no projection map; indirect caustics
-//! (photons from VPLs beyond the lights) are not traced, as the thesis' default. Dispersion:
+//! (photons from VPLs beyond the lights, `EDS+D+L`) are traced only when asked for
+//! (`indirect_caustics`), as in the thesis; by default those paths are missing. Dispersion:
 //! eye paths, VPL walks and photons each keep the wavelength of their first dispersive event;
 //! as in [`crate::Bdpt`], an eye path and a light walk that both dispersed join two
 //! independent wavelengths.
@@ -87,6 +88,11 @@ pub struct PartitionOptions {
     pub cull: Culling,
     /// Projection maps for caustic photons.
     pub projection_maps: bool,
+    /// Indirect caustics: caustic photons also leave the VPLs of the first this many diffuse
+    /// bounces (`per pass photons / VPL paths` each, so the cost grows with it); 0, the
+    /// thesis' default, leaves out the paths `EDS+D+L` (light reaching a mirror from a
+    /// diffuse surface).
+    pub indirect_caustics: u32,
 }
 
 impl Default for PartitionOptions {
@@ -97,6 +103,7 @@ impl Default for PartitionOptions {
             clamp: 1e-3,
             cull: Culling::Unbiased,
             projection_maps: true,
+            indirect_caustics: 0,
         }
     }
 }
@@ -305,6 +312,7 @@ impl Technique for Partitioned {
                 index,
                 &vertices,
                 &primaries,
+                &vpls,
                 &occupants,
                 &mut rays,
             );
