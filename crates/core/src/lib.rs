@@ -23,6 +23,7 @@
 
 pub mod aabb;
 pub mod accel;
+pub mod animation;
 pub mod camera;
 pub mod color;
 pub mod content_hash;
@@ -31,6 +32,7 @@ pub mod emission;
 pub mod environment;
 pub mod frame;
 pub mod image;
+pub mod instance;
 pub mod lights;
 pub mod material;
 pub mod ray;

@@ -3,10 +3,19 @@
 //! This is plain data filled in by `rt-scene` (from TOML and mesh files) or by tests. Triangles
 //! are stored flat, in file order, so a triangle index is the same everywhere: in `Hit::prim`,
 //! in material associations and in the light sampler.
+//!
+//! Instances ([`crate::instance`]) are prototypes placed by (possibly animated) transforms;
+//! their world copies at the scene's current time ([`Scene::set_time`]) sit in the same flat
+//! arrays, one range per instance, so a triangle index still means one thing everywhere.
 
 use crate::{
-    environment::Environment, lights::LightSampler, texture::Texture, triangle, Camera, Hit,
-    Material, Rgb,
+    animation::{CameraMotion, Motion},
+    environment::Environment,
+    instance::{place_attributes, place_triangle, placement_error, Instance, Prototype},
+    lights::LightSampler,
+    texture::Texture,
+    transform::Transform,
+    triangle, Camera, Hit, Material, Rgb,
 };
 use glam::{Vec2, Vec3};
 use std::sync::OnceLock;
@@ -44,8 +53,16 @@ pub struct Scene {
     pub environment: Environment,
     /// Cameras; the first is the default.
     pub cameras: Vec<Camera>,
-    /// Named triangle ranges.
+    /// Named triangle ranges (instances' world copies included).
     pub objects: Vec<Object>,
+    /// Geometries in object space that instances place.
+    pub prototypes: Vec<Prototype>,
+    /// Placed prototypes, in the order of their world ranges.
+    pub instances: Vec<Instance>,
+    /// Keyframed cameras.
+    pub camera_motions: Vec<CameraMotion>,
+    /// The time (seconds) the world copies and cameras are at ([`Scene::set_time`]).
+    pub time: f32,
     /// Emitter sampling structure, built on first use ([`Scene::lights`]), so integrators that
     /// never sample lights never pay for it. Reset with [`Scene::build_lights`] after changing
     /// geometry, materials or the environment.
@@ -71,6 +88,8 @@ pub struct SurfaceHit {
     pub material: u32,
     /// Triangle index.
     pub prim: u32,
+    /// The instance the triangle belongs to, if any.
+    pub instance: Option<u32>,
 }
 
 impl Scene {
@@ -86,6 +105,10 @@ impl Scene {
             environment: Environment::Constant(Rgb::ZERO),
             cameras: Vec::new(),
             objects: Vec::new(),
+            prototypes: Vec::new(),
+            instances: Vec::new(),
+            camera_motions: Vec::new(),
+            time: 0.0,
             lights: OnceLock::new(),
         }
     }
@@ -185,6 +208,18 @@ impl Scene {
             Some(t) => t[0] * b0 + t[1] * b1 + t[2] * b2,
             None => Vec2::new(b1, b2),
         };
+        let instance = self.instance_of(hit.prim);
+        // A two-level structure intersects the prototype with an inverse-transformed ray:
+        // the origin offset must also cover the placement's rounding.
+        let p_error = match instance {
+            Some(k) => {
+                let inst = &self.instances[k as usize];
+                let local = (hit.prim - inst.first) as usize;
+                let object = &self.prototypes[inst.prototype as usize].triangles[local];
+                p_error + placement_error(&inst.transform, object, p)
+            }
+            None => p_error,
+        };
         SurfaceHit {
             p,
             p_error,
@@ -193,7 +228,144 @@ impl Scene {
             uv,
             material: self.material_ids[i],
             prim: hit.prim,
+            instance,
         }
+    }
+
+    /// The instance triangle `prim` belongs to, if any.
+    #[inline]
+    pub fn instance_of(&self, prim: u32) -> Option<u32> {
+        if self.instances.is_empty() {
+            return None;
+        }
+        let k = self.instances.partition_point(|i| i.first <= prim);
+        let i = k.checked_sub(1)?;
+        let inst = &self.instances[i];
+        (prim - inst.first < inst.count).then_some(i as u32)
+    }
+
+    /// Adds a prototype (object-space geometry for instances) and returns its index.
+    pub fn add_prototype(&mut self, p: Prototype) -> u32 {
+        self.prototypes.push(p);
+        (self.prototypes.len() - 1) as u32
+    }
+
+    /// Places prototype `prototype` by `base` (then `motion`), appending its world copy at the
+    /// scene's current time to the flat arrays and an object of the same name; returns the
+    /// instance's index.
+    ///
+    /// # Panics
+    /// If `prototype` is not a prototype of this scene or the scene would exceed 2³² − 1
+    /// triangles (loaders check both).
+    pub fn add_instance(
+        &mut self,
+        name: impl Into<String>,
+        prototype: u32,
+        base: Transform,
+        motion: Option<Motion>,
+    ) -> u32 {
+        let name = name.into();
+        let first = self.triangles.len();
+        let count = self.prototypes[prototype as usize].triangles.len();
+        assert!(first + count <= u32::MAX as usize, "too many triangles");
+        let mut inst = Instance {
+            name: name.clone(),
+            prototype,
+            base,
+            motion,
+            transform: base,
+            first: first as u32,
+            count: count as u32,
+        };
+        inst.transform = inst.transform_at(self.time);
+        let proto = &self.prototypes[prototype as usize];
+        self.triangles.extend_from_slice(&proto.triangles);
+        self.material_ids.extend_from_slice(&proto.material_ids);
+        if !proto.normals.is_empty() {
+            self.normals.resize(first, None);
+            self.normals.extend_from_slice(&proto.normals);
+        }
+        if !proto.uvs.is_empty() {
+            self.uvs.resize(first, None);
+            self.uvs.extend_from_slice(&proto.uvs);
+        }
+        self.objects.push(Object {
+            name,
+            first: first as u32,
+            count: count as u32,
+        });
+        self.instances.push(inst);
+        let k = self.instances.len() - 1;
+        self.write_world_copy(k);
+        self.lights = OnceLock::new();
+        k as u32
+    }
+
+    /// Rewrites instance `k`'s world copy from its prototype and current transform.
+    fn write_world_copy(&mut self, k: usize) {
+        let inst = &self.instances[k];
+        let proto = &self.prototypes[inst.prototype as usize];
+        let (t, flip) = (inst.transform, inst.transform.flips_handedness());
+        let range = inst.first as usize..(inst.first + inst.count) as usize;
+        for (w, v) in self.triangles[range.clone()]
+            .iter_mut()
+            .zip(&proto.triangles)
+        {
+            *w = place_triangle(&t, flip, v);
+        }
+        let has_normals = !proto.normals.is_empty() && !self.normals.is_empty();
+        let has_uvs = !proto.uvs.is_empty() && !self.uvs.is_empty();
+        for (j, i) in range.enumerate() {
+            let n = if has_normals { proto.normals[j] } else { None };
+            let uv = if has_uvs { proto.uvs[j] } else { None };
+            let (n, uv) = place_attributes(&t, flip, n, uv);
+            if has_normals {
+                self.normals[i] = n;
+            }
+            if has_uvs {
+                self.uvs[i] = uv;
+            }
+        }
+    }
+
+    /// Moves the animated instances and cameras to time `t` (seconds): rewrites the world
+    /// copies of the instances whose transform changed and resets the light table if any did.
+    /// Returns the indices of the instances that moved.
+    pub fn set_time(&mut self, t: f32) -> Vec<u32> {
+        self.time = t;
+        let mut moved = Vec::new();
+        for k in 0..self.instances.len() {
+            let next = self.instances[k].transform_at(t);
+            if next != self.instances[k].transform {
+                self.instances[k].transform = next;
+                self.write_world_copy(k);
+                moved.push(k as u32);
+            }
+        }
+        if !moved.is_empty() {
+            self.lights = OnceLock::new();
+        }
+        for m in &self.camera_motions {
+            let k = m.at(t);
+            let old = &self.cameras[m.camera];
+            let c = Camera::look_at(
+                old.name.clone(),
+                k.position,
+                k.look_at,
+                k.up,
+                k.fov,
+                old.width,
+                old.height,
+                old.aperture,
+                old.focus_distance,
+            );
+            // A blend of two valid keys can still be degenerate (position crossing look_at):
+            // keep the last good camera then.
+            if c.forward.is_finite() && c.right.is_finite() && c.up.is_finite() {
+                self.cameras[m.camera] = c;
+            }
+        }
+        moved
     }
 
     /// Texture tint of material `m` at `uv` (white without a texture).
@@ -240,6 +412,22 @@ impl Scene {
                 .objects
                 .iter()
                 .map(|o| size_of::<Object>() + o.name.len())
+                .sum::<usize>()
+            + self
+                .prototypes
+                .iter()
+                .map(|p| {
+                    size_of_val(p.triangles.as_slice())
+                        + size_of_val(p.normals.as_slice())
+                        + size_of_val(p.uvs.as_slice())
+                        + size_of_val(p.material_ids.as_slice())
+                        + p.name.len()
+                })
+                .sum::<usize>()
+            + self
+                .instances
+                .iter()
+                .map(|i| size_of::<Instance>() + i.name.len())
                 .sum::<usize>();
         let materials = self
             .materials
@@ -282,6 +470,10 @@ impl crate::content_hash::ContentHash for Scene {
             environment,
             cameras,
             objects,
+            prototypes,
+            instances,
+            camera_motions,
+            time,
             lights: _,
         } = self;
         triangles.content_hash(out);
@@ -293,6 +485,10 @@ impl crate::content_hash::ContentHash for Scene {
         environment.content_hash(out);
         cameras.content_hash(out);
         objects.content_hash(out);
+        prototypes.content_hash(out);
+        instances.content_hash(out);
+        camera_motions.content_hash(out);
+        time.content_hash(out);
     }
 }
 

@@ -87,6 +87,12 @@ pub(crate) struct SceneDesc {
     /// `[[assign]]`.
     #[serde(default)]
     pub assign: Vec<Spanned<AssignDesc>>,
+    /// `[[instance]]`.
+    #[serde(default)]
+    pub instance: Vec<Spanned<InstanceDesc>>,
+    /// `[[animation]]`.
+    #[serde(default)]
+    pub animation: Vec<Spanned<AnimationDesc>>,
     /// `[render]`.
     #[serde(default)]
     pub render: Option<RenderTableDesc>,
@@ -267,6 +273,38 @@ pub(crate) struct AssignDesc {
     /// Half-open `[start, end)`.
     pub triangles: Spanned<Arr<u32, 2>>,
     pub material: Spanned<String>,
+}
+
+/// `[[instance]]`: a geometry placed once more, by its own transform.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct InstanceDesc {
+    pub name: Spanned<String>,
+    pub geometry: Spanned<String>,
+    pub transform: Option<Spanned<TransformDesc>>,
+}
+
+/// `[[animation]]`: keyframes of a geometry, an instance or a camera.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct AnimationDesc {
+    pub target: Spanned<String>,
+    pub keys: Spanned<Vec<Spanned<KeyDesc>>>,
+}
+
+/// One key: `time` and either transform values (geometries, instances) or camera values.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct KeyDesc {
+    pub time: f32,
+    pub translate: Option<V3>,
+    /// Degrees about x, then y, then z.
+    pub rotate: Option<V3>,
+    pub scale: Option<ScaleDesc>,
+    pub position: Option<V3>,
+    pub look_at: Option<V3>,
+    pub up: Option<V3>,
+    pub fov: Option<f32>,
 }
 
 /// `[render]`: defaults for the renderer's command-line options.
@@ -477,7 +515,7 @@ mod tests {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/scene-format.md");
         let doc = std::fs::read_to_string(path).unwrap();
         let rows: Vec<&str> = doc.lines().filter(|l| l.starts_with('|')).collect();
-        let types: [(&str, Vec<&str>); 10] = [
+        let types: [(&str, Vec<&str>); 13] = [
             ("SceneDesc", fields_of::<SceneDesc>()),
             ("EnvironmentDesc", fields_of::<EnvironmentDesc>()),
             ("SkyDesc", fields_of::<SkyDesc>()),
@@ -488,6 +526,9 @@ mod tests {
             ("TransformDesc", fields_of::<TransformDesc>()),
             ("AssignDesc", fields_of::<AssignDesc>()),
             ("RenderTableDesc", fields_of::<RenderTableDesc>()),
+            ("InstanceDesc", fields_of::<InstanceDesc>()),
+            ("AnimationDesc", fields_of::<AnimationDesc>()),
+            ("KeyDesc", fields_of::<KeyDesc>()),
         ];
         // The top level's fields are the tables; each must be one of the types above.
         assert_eq!(
@@ -498,6 +539,8 @@ mod tests {
                 "material",
                 "geometry",
                 "assign",
+                "instance",
+                "animation",
                 "render"
             ],
             "a new top-level table needs its *Desc type in this list"

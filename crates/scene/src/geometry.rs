@@ -320,7 +320,7 @@ fn check_keys(ctx: &Ctx, d: &GeometryDesc, kind: &Kind) -> Result<()> {
 }
 
 /// `transform = { translate, rotate, scale }`; `None` for the identity.
-fn transform(ctx: &Ctx, t: &Spanned<TransformDesc>) -> Result<Option<Transform>> {
+pub(crate) fn transform(ctx: &Ctx, t: &Spanned<TransformDesc>) -> Result<Option<Transform>> {
     let d = t.get_ref();
     let translate = d.translate.map_or(Vec3::ZERO, Vec3::from);
     let rotate = d.rotate.map_or(Vec3::ZERO, Vec3::from);

@@ -57,6 +57,7 @@ mod error;
 mod geometry;
 mod gltf;
 mod image_io;
+mod instances;
 mod load;
 mod material;
 mod obj;

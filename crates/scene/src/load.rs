@@ -1,5 +1,6 @@
 //! Turns a parsed scene description into an `rt_core::Scene`, section by section:
-//! environment, cameras, materials, geometry, material assignments, lights.
+//! environment, cameras, materials, geometry, material assignments, instances and animation,
+//! lights.
 
 use crate::desc::{
     self, AssignDesc, CameraDesc, EnvironmentDesc, RenderTableDesc, SceneDesc, SkyDesc, V3,
@@ -7,6 +8,7 @@ use crate::desc::{
 use crate::error::{Result, Source};
 use crate::geometry;
 use crate::image_io::{self, Textures};
+use crate::instances;
 use crate::material::{self, MaterialTable};
 use crate::{LoadedScene, RenderDesc};
 use glam::Vec3;
@@ -74,6 +76,7 @@ pub(crate) fn load(text: &str, base: &Path, name: &Path) -> Result<LoadedScene> 
     for a in &d.assign {
         assign(&ctx, a.get_ref(), &mut mats, &mut scene)?;
     }
+    instances::apply(&ctx, &d.instance, &d.animation, &d.camera, &mut scene)?;
     let render = render(&ctx, d.render)?;
 
     for name in mats.unused() {
