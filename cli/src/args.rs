@@ -114,6 +114,34 @@ pub struct Args {
     /// No progress bar and no summary line.
     #[arg(short, long)]
     pub quiet: bool,
+
+    /// Render frames A..B (half-open) of the scene's animation, frame f at time f / fps, each
+    /// with its own sample streams (from the seed and the frame); the output must name the
+    /// frame, e.g. -o 'out/frame_{frame:04}.exr'.
+    #[arg(long, value_name = "A..B", value_parser = parse_frames, conflicts_with = "frame")]
+    pub frames: Option<std::ops::Range<u32>>,
+
+    /// Render one frame of the scene's animation (time F / fps).
+    #[arg(long, value_name = "F")]
+    pub frame: Option<u32>,
+
+    /// Frames per second of --frames and --frame.
+    #[arg(long, default_value_t = 24.0)]
+    pub fps: f64,
+}
+
+/// `A..B` with `A < B`.
+pub fn parse_frames(s: &str) -> Result<std::ops::Range<u32>, String> {
+    let bad = || format!("frames must be A..B with integers 0 <= A < B (half-open), got `{s}`");
+    let (a, b) = s.split_once("..").ok_or_else(bad)?;
+    let (a, b): (u32, u32) = (
+        a.trim().parse().map_err(|_| bad())?,
+        b.trim().parse().map_err(|_| bad())?,
+    );
+    if a >= b {
+        return Err(bad());
+    }
+    Ok(a..b)
 }
 
 /// `--accel`'s help, naming the default from the accel crate.

@@ -9,8 +9,8 @@ use rt_film::{AovSet, Film, FilmBuffers, OutputOptions};
 use rt_integrators::{Ctx, RenderStats, SamplePass, Technique};
 use rt_scene::{LoadedScene, RenderDesc};
 use rt_session::{
-    pick_camera, render_adaptive, Adaptive, Overrides, RenderReport, ReportInputs, Settings,
-    StopRule, MAX_SPP,
+    frame_seed, pick_camera, render_adaptive, Adaptive, Overrides, RenderReport, ReportInputs,
+    Settings, StopRule, MAX_SPP,
 };
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -128,22 +128,93 @@ pub fn run(args: &Args) -> Result<()> {
     let t_load = Instant::now();
     let loaded = load_scene(scene_arg(args))?;
     let load_time = t_load.elapsed();
-    let load_secs = load_time.as_secs_f64();
     for w in &loaded.warnings {
         if !args.quiet {
             eprintln!("warning: {w}");
         }
     }
-    let job = Job::resolve(args, &loaded.render)?;
-    let scene = loaded.scene;
-    let camera = pick_camera(&scene, &job.scene_path, job.camera.as_deref())?;
+    let mut job = Job::resolve(args, &loaded.render)?;
+    let mut scene = loaded.scene;
+    let frames = frame_list(args, &job.output)?;
 
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(t) = job.settings.threads {
         pool = pool.num_threads(t);
     }
     let pool = pool.build().context("cannot start worker threads")?;
+    let (pattern, seed) = (job.output.clone(), job.settings.seed);
+    for frame in frames {
+        if let Some(f) = frame {
+            scene.set_time((f64::from(f) / args.fps) as f32);
+            job.output = frame_output(&pattern, f);
+            job.settings.seed = frame_seed(seed, f);
+        }
+        render_one(args, &job, &scene, &pool, load_time)?;
+    }
+    Ok(())
+}
 
+/// The frames to render: `None` for a plain render (the scene at time 0).
+fn frame_list(args: &Args, output: &Path) -> Result<Vec<Option<u32>>> {
+    if args.frames.is_none() && args.frame.is_none() {
+        return Ok(vec![None]);
+    }
+    if !(args.fps.is_finite() && args.fps > 0.0) {
+        bail!("--fps must be a positive number, got {}", args.fps);
+    }
+    match (&args.frames, args.frame) {
+        (Some(r), _) => {
+            if !output.to_string_lossy().contains("{frame") {
+                bail!(
+                    "{}: --frames needs an output that names the frame, e.g. -o 'out/frame_{{frame:04}}.exr'",
+                    output.display()
+                );
+            }
+            Ok(r.clone().map(Some).collect())
+        }
+        (None, f) => Ok(vec![f]),
+    }
+}
+
+/// `pattern` with `{frame}` replaced by the frame number and `{frame:0N}` by it padded to N
+/// digits.
+pub fn frame_output(pattern: &Path, frame: u32) -> PathBuf {
+    let text = pattern.to_string_lossy();
+    let mut out = String::new();
+    let mut rest = text.as_ref();
+    while let Some(i) = rest.find("{frame") {
+        out.push_str(&rest[..i]);
+        let tail = &rest[i + "{frame".len()..];
+        let Some(end) = tail.find('}') else {
+            out.push_str(&rest[i..]);
+            rest = "";
+            break;
+        };
+        let spec = &tail[..end];
+        match spec
+            .strip_prefix(":0")
+            .and_then(|w| w.parse::<usize>().ok())
+        {
+            Some(width) => out.push_str(&format!("{frame:0width$}")),
+            None if spec.is_empty() => out.push_str(&frame.to_string()),
+            None => out.push_str(&rest[i..i + "{frame".len() + end + 1]),
+        }
+        rest = &tail[end + 1..];
+    }
+    out.push_str(rest);
+    PathBuf::from(out)
+}
+
+/// Renders one image of `scene` as it is now and writes it; prints the summary line.
+fn render_one(
+    args: &Args,
+    job: &Job,
+    scene: &Scene,
+    pool: &rayon::ThreadPool,
+    load_time: std::time::Duration,
+) -> Result<()> {
+    let load_secs = load_time.as_secs_f64();
+    let camera = pick_camera(scene, &job.scene_path, job.camera.as_deref())?;
     let t_build = Instant::now();
     let accel = pool.install(|| job.settings.accel.build(&scene.triangles));
     let build_time = t_build.elapsed();

@@ -54,7 +54,8 @@ pub use camera::{parse_resolution, pick_camera, ImageSize, MAX_SIDE};
 pub use progressive::{Budgets, Checkpoint, Session};
 pub use report::{RenderReport, ReportInputs, Stage, Status};
 pub use settings::{
-    fold_seed, Origin, Overrides, Settings, SettingsError, DEFAULT_SPP, MAX_SPP, MAX_THREADS,
+    fold_seed, frame_seed, Origin, Overrides, Settings, SettingsError, DEFAULT_SPP, MAX_SPP,
+    MAX_THREADS,
 };
 
 use std::path::PathBuf;

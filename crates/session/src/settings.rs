@@ -142,6 +142,15 @@ pub enum SettingsError {
     },
 }
 
+/// The stream key of frame `frame` of an animation rendered with stream key `seed`: every
+/// frame gets its own streams (frame 0 those of a plain render), so noise does not stand still
+/// on the screen while the scene moves, and any frame renders alone to the same bits.
+pub fn frame_seed(seed: u32, frame: u32) -> u32 {
+    // The golden-ratio increment: consecutive frames land far apart in key space, and the
+    // sampler hashes the key with every sample coordinate anyway.
+    seed.wrapping_add(frame.wrapping_mul(0x9E37_79B9))
+}
+
 /// Folds a 64-bit seed into the 32-bit stream key without discarding the high half.
 pub fn fold_seed(seed: u64) -> u32 {
     (seed ^ (seed >> 32)) as u32
