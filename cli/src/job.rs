@@ -228,7 +228,7 @@ fn render_one(
     }
     let mut film = Film::new(camera.width, camera.height, buffers);
     let ctx = Ctx {
-        scene: &scene,
+        scene,
         accel: accel.as_ref(),
         camera,
     };
@@ -305,8 +305,8 @@ fn render_one(
             ),
         };
         print_summary(
-            &job,
-            &scene,
+            job,
+            scene,
             camera,
             accel.as_ref(),
             integrator.as_ref(),
@@ -321,7 +321,7 @@ fn render_one(
         print!(
             "{}",
             RenderReport::collect(&ReportInputs {
-                scene: &scene,
+                scene,
                 camera,
                 accel: accel.as_ref(),
                 accel_spec: job.settings.accel.to_string(),
