@@ -143,13 +143,30 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let pool = pool.build().context("cannot start worker threads")?;
     let (pattern, seed) = (job.output.clone(), job.settings.seed);
+    let mut accel: Option<Box<dyn Accel>> = None;
     for frame in frames {
         if let Some(f) = frame {
             scene.set_time((f64::from(f) / args.fps) as f32);
             job.output = frame_output(&pattern, f);
             job.settings.seed = frame_seed(seed, f);
         }
-        render_one(args, &job, &scene, &pool, load_time)?;
+        // Two-level structures follow rigid motion in place; flat ones are rebuilt.
+        let t_build = Instant::now();
+        let updated = accel
+            .as_mut()
+            .is_some_and(|a| pool.install(|| a.update(&scene)));
+        if !updated {
+            accel = Some(pool.install(|| job.settings.accel.build_scene(&scene)));
+        }
+        let built = accel.as_deref().expect("built above");
+        render_one(
+            args,
+            &job,
+            &scene,
+            &pool,
+            built,
+            (load_time, t_build.elapsed()),
+        )?;
     }
     Ok(())
 }
@@ -206,18 +223,17 @@ pub fn frame_output(pattern: &Path, frame: u32) -> PathBuf {
 }
 
 /// Renders one image of `scene` as it is now and writes it; prints the summary line.
+/// `times`: the scene's load and the structure's build (or update) for this image.
 fn render_one(
     args: &Args,
     job: &Job,
     scene: &Scene,
     pool: &rayon::ThreadPool,
-    load_time: std::time::Duration,
+    accel: &dyn Accel,
+    (load_time, build_time): (std::time::Duration, std::time::Duration),
 ) -> Result<()> {
     let load_secs = load_time.as_secs_f64();
     let camera = pick_camera(scene, &job.scene_path, job.camera.as_deref())?;
-    let t_build = Instant::now();
-    let accel = pool.install(|| job.settings.accel.build(&scene.triangles));
-    let build_time = t_build.elapsed();
     let build_secs = build_time.as_secs_f64();
     let integrator = job.settings.integrator.build();
     // Only the buffers the outputs read: no variance or half-buffers unless asked for.
@@ -229,7 +245,7 @@ fn render_one(
     let mut film = Film::new(camera.width, camera.height, buffers);
     let ctx = Ctx {
         scene,
-        accel: accel.as_ref(),
+        accel,
         camera,
     };
     let pass = SamplePass {
@@ -308,7 +324,7 @@ fn render_one(
             job,
             scene,
             camera,
-            accel.as_ref(),
+            accel,
             integrator.as_ref(),
             &sampling,
             &stats,
@@ -323,7 +339,7 @@ fn render_one(
             RenderReport::collect(&ReportInputs {
                 scene,
                 camera,
-                accel: accel.as_ref(),
+                accel,
                 accel_spec: job.settings.accel.to_string(),
                 film: &film,
                 render: &stats,

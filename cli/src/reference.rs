@@ -146,7 +146,7 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     );
     let cache = (!args.no_cache).then(|| Cache::new(&args.cache));
     let obtained = pool.install(|| {
-        let accel = accel_spec.build(&loaded.scene.triangles);
+        let accel = accel_spec.build_scene(&loaded.scene);
         rt_experiment::reference::obtain(
             &req,
             accel.as_ref(),

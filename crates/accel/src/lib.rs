@@ -64,6 +64,7 @@ pub mod on_demand;
 pub mod points;
 pub mod spec;
 mod traversal;
+pub mod two_level;
 pub mod wide;
 
 pub use brute_force::BruteForce;
@@ -82,6 +83,7 @@ pub use bvh2::{BuildParams, Bvh2, BvhStats, Node, Split, MAX_BINS};
 pub use on_demand::OnDemandQbvh;
 pub use points::PointKdTree;
 pub use spec::{AccelKind, AccelSpec, SpecError, DEFAULT_ACCEL};
+pub use two_level::{TopLevel, TwoLevel};
 pub use wide::{
     Bvh8, Node8, Order, QNode, Qbvh, TriangleTest, WideBvh, WideNode, WideOptions,
     FINE_LEAVES_MAX_TRIANGLES,

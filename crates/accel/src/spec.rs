@@ -9,16 +9,20 @@
 //!
 //! | option | kinds | meaning |
 //! |---|---|---|
-//! | `leaf=N` | bvh, qbvh, bvh8 | largest leaf (default 4 for bvh, 16 for qbvh and bvh8) |
+//! | `leaf=N` | bvh, qbvh, bvh8, two-level | largest leaf (default 4 for bvh, 16 for qbvh and bvh8) |
 //! | `bins=N` | bvh, qbvh, bvh8 | SAH bins per axis |
 //! | `icost=F` | bvh, qbvh, bvh8 | SAH cost of a triangle test relative to a node visit (default 1 for bvh, 0.2 for the wide ones) |
 //! | `evh=T` / `bbah=T` | bvh, qbvh, bvh8 | triangle splitting with threshold exponent T |
 //! | `compact` | bvh, qbvh, bvh8 | remove duplicate references per leaf |
-//! | `order=unsorted\|distance\|split` | qbvh, bvh8 | child order (default `split`) |
+//! | `order=unsorted\|distance\|split` | qbvh, bvh8, two-level | child order (default `split`) |
 //! | `tstack` / `no-tstack` | qbvh, bvh8 | keep entry distances on the stack and skip stale entries, or not (default: on for bvh8, off for qbvh) |
 //! | `shadow-cache` | qbvh, bvh8 | start occlusion queries at the last occluder's node |
 //! | `isect=watertight\|subdivision\|hybrid` | qbvh, bvh8 | triangle test (default watertight) |
 //! | `lazy` | qbvh | build subtrees the first time a ray reaches them |
+//! | `top=rebuild\|refit` | two-level | per frame, rebuild the top level over the instances' boxes or refit it (default `rebuild`) |
+//!
+//! `two-level` takes the bvh8 options for its object BVHs; built over a scene
+//! ([`AccelSpec::build_scene`]) it follows moving instances by [`Accel::update`].
 
 use crate::wide::{Order, TriangleTest, WideOptions};
 use crate::{BruteForce, BuildParams, Bvh2, Bvh8, Qbvh, Split};
@@ -43,15 +47,18 @@ pub enum AccelKind {
     Bvh8,
     /// [`BruteForce`].
     BruteForce,
+    /// [`TwoLevel`](crate::TwoLevel): per-object BVH8s under a top level over the placements.
+    TwoLevel,
 }
 
 impl AccelKind {
     /// Every kind, in the order reports list them.
-    pub const ALL: [AccelKind; 4] = [
+    pub const ALL: [AccelKind; 5] = [
         AccelKind::Qbvh,
         AccelKind::Bvh8,
         AccelKind::Bvh,
         AccelKind::BruteForce,
+        AccelKind::TwoLevel,
     ];
 
     /// True for the wide BVHs collapsed from a binary one (QBVH and BVH8).
@@ -66,6 +73,7 @@ impl AccelKind {
             AccelKind::Qbvh => "qbvh",
             AccelKind::Bvh8 => "bvh8",
             AccelKind::BruteForce => "brute-force",
+            AccelKind::TwoLevel => "two-level",
         }
     }
 }
@@ -81,6 +89,8 @@ pub struct AccelSpec {
     pub wide: WideOptions,
     /// Build subtrees on demand (QBVH only).
     pub lazy: bool,
+    /// How a two-level structure's top level follows moving instances.
+    pub top: crate::TopLevel,
 }
 
 /// Why an accel spec was rejected.
@@ -88,7 +98,9 @@ pub struct AccelSpec {
 #[non_exhaustive]
 pub enum SpecError {
     /// The text before the first `:` is not a structure.
-    #[error("unknown acceleration structure `{0}` (expected qbvh, bvh8, bvh or brute-force)")]
+    #[error(
+        "unknown acceleration structure `{0}` (expected qbvh, bvh8, bvh, brute-force or two-level)"
+    )]
     UnknownKind(String),
     /// An option this crate does not know.
     #[error("unknown option `{option}` of `{kind}` (see the options table in rt_accel::spec)")]
@@ -127,7 +139,7 @@ impl AccelSpec {
     /// The default spec of `kind`.
     pub fn new(kind: AccelKind) -> Self {
         let mut build = BuildParams::default();
-        if kind.is_wide() {
+        if kind.is_wide() || kind == AccelKind::TwoLevel {
             build.max_leaf_size = crate::wide::DEFAULT_LEAF_SIZE;
             build.intersection_cost = crate::wide::DEFAULT_INTERSECTION_COST;
         }
@@ -139,12 +151,35 @@ impl AccelSpec {
                 _ => WideOptions::default(),
             },
             lazy: false,
+            top: crate::TopLevel::default(),
         }
     }
 
-    /// Builds the structure over `triangles` (whose indices become [`rt_core::Hit::prim`]).
+    /// Builds the structure over `scene`'s triangles as they are now. Two-level structures
+    /// build their object BVHs from the scene's prototypes and place its instances (and then
+    /// follow them with [`Accel::update`]); the others see the flat triangles.
+    pub fn build_scene(&self, scene: &rt_core::Scene) -> Box<dyn Accel> {
+        match self.kind {
+            AccelKind::TwoLevel => Box::new(crate::TwoLevel::build(
+                scene,
+                &self.build,
+                &self.wide,
+                self.top,
+            )),
+            _ => self.build(&scene.triangles),
+        }
+    }
+
+    /// Builds the structure over `triangles` (whose indices become [`rt_core::Hit::prim`]);
+    /// a two-level structure gets them as one static object.
     pub fn build(&self, triangles: &[[Vec3; 3]]) -> Box<dyn Accel> {
         match self.kind {
+            AccelKind::TwoLevel => Box::new(crate::TwoLevel::build_flat(
+                triangles,
+                &self.build,
+                &self.wide,
+                self.top,
+            )),
             AccelKind::Bvh => Box::new(Bvh2::build(triangles, &self.build)),
             AccelKind::Qbvh if self.lazy => {
                 Box::new(crate::OnDemandQbvh::new(triangles, &self.build, &self.wide))
@@ -175,12 +210,14 @@ impl AccelSpec {
             None => Ok(()),
             Some(_) => Err(bad("this option takes no value")),
         };
-        let tree = self.kind == AccelKind::Bvh || self.kind.is_wide();
-        let wide = self.kind.is_wide();
+        let two_level = self.kind == AccelKind::TwoLevel;
+        let tree = self.kind == AccelKind::Bvh || self.kind.is_wide() || two_level;
+        let wide = self.kind.is_wide() || two_level;
         let applies = match key {
             "leaf" | "bins" | "icost" | "evh" | "bbah" | "compact" => tree,
             "order" | "tstack" | "no-tstack" | "shadow-cache" | "isect" => wide,
             "lazy" => self.kind == AccelKind::Qbvh,
+            "top" => two_level,
             _ => {
                 return Err(SpecError::UnknownOption {
                     kind,
@@ -259,6 +296,13 @@ impl AccelSpec {
                 flag()?;
                 self.lazy = true;
             }
+            "top" => {
+                self.top = match value {
+                    Some("rebuild") => crate::TopLevel::Rebuild,
+                    Some("refit") => crate::TopLevel::Refit,
+                    _ => return Err(bad("expected rebuild or refit")),
+                }
+            }
             _ => unreachable!("keys were checked above"),
         }
         Ok(())
@@ -331,6 +375,9 @@ impl fmt::Display for AccelSpec {
         }
         if self.lazy {
             f.write_str(":lazy")?;
+        }
+        if self.top != default.top {
+            write!(f, ":top={}", self.top.name())?;
         }
         Ok(())
     }

@@ -91,6 +91,15 @@ pub trait Accel: Send + Sync {
         false
     }
 
+    /// Moves the structure to `scene` as it is now (after [`crate::Scene::set_time`]) in
+    /// place, if it can: two-level structures refit or rebuild their top level. False if the
+    /// caller must build a new structure (flat structures, or a scene whose instances are not
+    /// the ones the structure was built over).
+    fn update(&mut self, scene: &crate::Scene) -> bool {
+        let _ = scene;
+        false
+    }
+
     /// Closest hit with `t ∈ (0, t_max]`, uncounted.
     fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         self.closest_hit(ray, t_max, None)

@@ -169,7 +169,7 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
                     seed: *seed,
                 };
                 let base = done_runs * UNITS;
-                let built = accel.build(&scene.loaded.scene.triangles);
+                let built = accel.build_scene(&scene.loaded.scene);
                 let got =
                     crate::reference::obtain(&req, built.as_ref(), Some(cache), None, &|f| {
                         bar.set_position(base + (f * UNITS as f64) as u64)
@@ -208,7 +208,7 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
         let reference = &references[pair.scene];
         let accel = accels
             .entry((pair.scene, pair.accel.to_string()))
-            .or_insert_with(|| pair.accel.build(&scene.loaded.scene.triangles));
+            .or_insert_with(|| pair.accel.build_scene(&scene.loaded.scene));
         let integrator = pair.estimator.build();
         let session = Session {
             ctx: Ctx {

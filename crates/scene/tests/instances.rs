@@ -45,8 +45,7 @@ fn error(extra: &str) -> String {
         Path::new("."),
         Path::new("t.toml"),
     )
-    .err()
-    .expect("loads, but should not");
+    .expect_err("loads, but should not");
     let s = e.to_string();
     assert!(s.starts_with("t.toml:"), "names the file: {s}");
     assert_eq!(s.lines().count(), 1, "one line: {s}");

@@ -11,7 +11,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let loaded = rt_scene::load_any(&scene)?;
     let settings = Overrides::default().resolve(&loaded.render, &scene)?;
     let camera = pick_camera(&loaded.scene, &scene, None)?;
-    let accel = settings.accel.build(&loaded.scene.triangles);
+    let accel = settings.accel.build_scene(&loaded.scene);
     let integrator = settings.integrator.build();
     let ctx = rt_integrators::Ctx {
         scene: &loaded.scene,

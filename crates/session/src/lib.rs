@@ -23,7 +23,7 @@
 //! let loaded = rt_scene::load_any(path)?;
 //! let settings = Overrides::default().resolve(&loaded.render, path)?;
 //! let camera = rt_session::ImageSize::Pixels(16, 12).apply(pick_camera(&loaded.scene, path, None)?);
-//! let accel = settings.accel.build(&loaded.scene.triangles);
+//! let accel = settings.accel.build_scene(&loaded.scene);
 //! let integrator = settings.integrator.build();
 //! let session = Session {
 //!     ctx: rt_integrators::Ctx { scene: &loaded.scene, accel: accel.as_ref(), camera: &camera },

@@ -61,7 +61,7 @@ impl LoadError {
 /// large triangles in leaves shared with others, where the binary BVH often culls them by a
 /// flat box, so they also show false hits that the binary BVH would hide.
 pub fn default_accel(scene: &Scene) -> Box<dyn rt_core::Accel> {
-    rt_accel::AccelSpec::default().build(&scene.triangles)
+    rt_accel::AccelSpec::default().build_scene(scene)
 }
 
 /// A bare mesh file as a scene ([`rt_scene::load_mesh`]), without its placeholder camera.

@@ -100,6 +100,34 @@ pub(crate) fn build(triangles: &[[Vec3; 3]], cfg: &Config) -> Built {
     Built { nodes, order }
 }
 
+/// Builds a hierarchy over boxes (a top level over objects): leaf slots index `boxes`. Empty
+/// boxes are left out. The SAH, bins and leaf size of `params` apply.
+pub(crate) fn build_over_boxes(boxes: &[Aabb], params: &BuildParams) -> Built {
+    let mut cfg = Config::from(params);
+    cfg.compact_leaves = false;
+    let mut refs: Vec<PrimRef> = boxes
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| !b.is_empty())
+        .map(|(i, &bounds)| PrimRef {
+            bounds,
+            index: i as u32,
+        })
+        .collect();
+    if refs.is_empty() {
+        return Built {
+            nodes: Vec::new(),
+            order: Vec::new(),
+        };
+    }
+    let mut nodes = Vec::with_capacity(2 * refs.len());
+    nodes.push(PLACEHOLDER);
+    let root = build_node(&mut refs, 0, 0, &cfg, &mut nodes);
+    nodes[0] = root;
+    let order = refs.iter().map(|r| r.index).collect();
+    Built { nodes, order }
+}
+
 const PLACEHOLDER: Node = Node {
     bounds: [0.0; 6],
     index: 0,

@@ -9,7 +9,7 @@
 //! (see [`split_references`]), so a triangle can fill several leaf slots; each slot still holds
 //! the whole triangle and its caller's index.
 
-mod build;
+pub(crate) mod build;
 mod compact;
 mod node;
 mod split;

@@ -1,0 +1,190 @@
+//! The two-level structure against brute force over the scene's world copies, for every frame
+//! of an animated scene, with rigid, scaled, non-uniformly scaled and mirroring instances; the
+//! top level rebuilt and refitted; rays spawned from instance hits do not hit their own
+//! triangle again; and updating follows the instances without building an object BVH.
+//!
+//! The two-level structure intersects a prototype's triangle with an inverse-transformed ray,
+//! the brute force the world copy: the same surface up to the rounding of the transform, so
+//! hits agree on the triangle and on `t` to a few ULPs of the scene's size, except where two
+//! triangles are hit within that tolerance of each other, a ray grazes an edge or starts on
+//! a surface.
+
+mod common;
+
+use common::{rays, rotation, soup, Rng};
+use glam::Vec3;
+use rt_accel::{AccelKind, AccelSpec, BruteForce, TopLevel};
+use rt_core::animation::{Key, Motion};
+use rt_core::instance::Prototype;
+use rt_core::ray::spawn_ray;
+use rt_core::transform::Transform;
+use rt_core::{Accel, Scene};
+
+/// A scene of a static soup and a prototype soup placed by `n` instances, half of them moving.
+fn scene(rng: &mut Rng, n: usize) -> Scene {
+    let mut s = Scene::empty();
+    s.materials
+        .push(rt_core::Material::diffuse("m", rt_core::Rgb::ONE));
+    for t in soup(rng, 300) {
+        s.push_triangle(t, 0);
+    }
+    let proto = soup(rng, 200);
+    let p = s.add_prototype(Prototype {
+        name: "p".into(),
+        material_ids: vec![0; proto.len()],
+        triangles: proto,
+        ..Prototype::default()
+    });
+    for k in 0..n {
+        let scale = match k % 4 {
+            0 => Vec3::ONE,
+            1 => Vec3::splat(0.3),
+            2 => Vec3::new(2.0, 0.25, 0.7),
+            _ => Vec3::new(-0.8, 0.6, 1.1),
+        };
+        let (axis_angle, angle) = rotation(rng).to_axis_angle();
+        let rot = rt_core::glam::Quat::from_axis_angle(axis_angle, angle);
+        let base = Transform::from_mat4(rt_core::glam::Mat4::from_scale_rotation_translation(
+            scale,
+            rot,
+            rng.vec_in(-1.5, 1.5),
+        ));
+        let motion = (k % 2 == 0).then(|| {
+            Motion::new(vec![
+                Key::from_trs(0.0, Vec3::ZERO, Vec3::ZERO, Vec3::ONE),
+                Key::from_trs(
+                    1.0,
+                    rng.vec_in(-1.0, 1.0),
+                    Vec3::new(0.0, 120.0, 30.0),
+                    Vec3::ONE,
+                ),
+            ])
+            .unwrap()
+        });
+        s.add_instance(format!("i{k}"), p, base, motion);
+    }
+    s
+}
+
+/// Hits of `a` against brute force on `rays`: (rays compared, disagreements beyond the
+/// tolerance). Rounding of the transforms makes a few grazing rays legitimately differ.
+fn compare(a: &dyn Accel, s: &Scene, rays: &[(rt_core::Ray, f32)]) -> (usize, usize) {
+    let bf = BruteForce::new(&s.triangles);
+    let tol = 1e-4;
+    let mut bad = 0;
+    for (ray, t_max) in rays {
+        let (x, y) = (a.intersect(ray, *t_max), bf.intersect(ray, *t_max));
+        let scale = ray.dir.length();
+        // A ray starting on a surface (no offset) may find it at t ≈ 0 on one side of the
+        // rounding and not on the other.
+        let at_origin = |h: Option<rt_core::Hit>| h.is_some_and(|h| h.t * scale < tol);
+        let ok = at_origin(x)
+            || at_origin(y)
+            || match (x, y) {
+                (None, None) => true,
+                // The same triangle, or another within the tolerance (overlapping coplanar ones).
+                (Some(x), Some(y)) => (x.t - y.t).abs() * scale < tol,
+                // A hit the other misses must be grazing: within tolerance of t_max or an edge.
+                (Some(h), None) | (None, Some(h)) => {
+                    (h.t - t_max).abs() * scale < tol || {
+                        let b0 = 1.0 - h.b1 - h.b2;
+                        b0.min(h.b1).min(h.b2) < 1e-4
+                    }
+                }
+            };
+        if let (Some(x), Some(y)) = (x, y) {
+            if x.prim == y.prim {
+                // Barycentrics are ill-conditioned on slivers; the points they give are not.
+                let v = &s.triangles[x.prim as usize];
+                let (px, py) = (
+                    rt_core::triangle::point_at(v, x.b1, x.b2),
+                    rt_core::triangle::point_at(v, y.b1, y.b2),
+                );
+                assert!(
+                    px.distance(py) < 10.0 * tol,
+                    "hit points differ on {}: {x:?} vs {y:?}",
+                    x.prim
+                );
+            }
+        }
+        bad += usize::from(!ok);
+        assert_eq!(
+            a.occluded(ray, *t_max),
+            x.is_some(),
+            "occluded disagrees with intersect"
+        );
+    }
+    (rays.len(), bad)
+}
+
+#[test]
+fn two_level_matches_brute_force_on_every_frame() {
+    for mode in [TopLevel::Rebuild, TopLevel::Refit] {
+        let mut rng = Rng::new(7);
+        let mut s = scene(&mut rng, 12);
+        let mut spec = AccelSpec::new(AccelKind::TwoLevel);
+        spec.top = mode;
+        let mut a = spec.build_scene(&s);
+        let mut total = (0, 0);
+        for frame in 0..5 {
+            if frame > 0 {
+                s.set_time(frame as f32 * 0.3);
+                assert!(a.update(&s), "two-level follows its own scene in place");
+            }
+            let rays = rays(&mut rng, &s.triangles, 4000);
+            let (n, bad) = compare(a.as_ref(), &s, &rays);
+            total.0 += n;
+            total.1 += bad;
+        }
+        assert!(
+            total.1 * 1000 <= total.0,
+            "{mode:?}: {} of {} rays disagree",
+            total.1,
+            total.0
+        );
+    }
+}
+
+#[test]
+fn flat_structures_do_not_update_in_place_and_a_new_scene_needs_a_build() {
+    let mut rng = Rng::new(3);
+    let s = scene(&mut rng, 4);
+    let mut flat = AccelSpec::new(AccelKind::Bvh8).build_scene(&s);
+    assert!(!flat.update(&s));
+    let mut two = AccelSpec::new(AccelKind::TwoLevel).build_scene(&s);
+    let other = scene(&mut Rng::new(4), 5);
+    assert!(!two.update(&other), "different instances: rebuild");
+}
+
+#[test]
+fn rays_spawned_from_instance_hits_leave_their_triangle() {
+    let mut rng = Rng::new(11);
+    let s = scene(&mut rng, 8);
+    let a = AccelSpec::new(AccelKind::TwoLevel).build_scene(&s);
+    let mut checked = 0;
+    for (ray, t_max) in rays(&mut rng, &s.triangles, 20_000) {
+        let Some(hit) = a.intersect(&ray, t_max) else {
+            continue;
+        };
+        let si = s.surface(&hit);
+        if si.instance.is_none() {
+            continue;
+        }
+        for side in [1.0f32, -1.0] {
+            let d = (si.ng * side + rng.unit_vec() * 0.9).normalize_or_zero();
+            if d == Vec3::ZERO || d.dot(si.ng) * side <= 0.0 {
+                continue;
+            }
+            let r = spawn_ray(si.p, si.p_error, si.ng, d);
+            if let Some(again) = a.intersect(&r, f32::INFINITY) {
+                assert_ne!(
+                    again.prim, hit.prim,
+                    "a ray leaving triangle {} hit it again at t = {}",
+                    hit.prim, again.t
+                );
+            }
+            checked += 1;
+        }
+    }
+    assert!(checked > 1000, "only {checked} spawned rays");
+}
