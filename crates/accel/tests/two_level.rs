@@ -1,4 +1,4 @@
-//! The two-level structure against brute force over the scene's world copies, for every frame
+//! The two-level structure and clustering (entry points at t = 1, 8 and 1000) against brute force over the scene's world copies, for every frame
 //! of an animated scene, with rigid, scaled, non-uniformly scaled and mirroring instances; the
 //! top level rebuilt and refitted; rays spawned from instance hits do not hit their own
 //! triangle again; and updating follows the instances without building an object BVH.
@@ -74,6 +74,12 @@ fn compare(a: &dyn Accel, s: &Scene, rays: &[(rt_core::Ray, f32)]) -> (usize, us
     let mut bad = 0;
     for (ray, t_max) in rays {
         let (x, y) = (a.intersect(ray, *t_max), bf.intersect(ray, *t_max));
+        let mut counted = rt_core::TraversalCounters::default();
+        assert_eq!(
+            a.closest_hit(ray, *t_max, Some(&mut counted)),
+            x,
+            "counting changes the hit"
+        );
         let scale = ray.dir.length();
         // A ray starting on a surface (no offset) may find it at t ≈ 0 on one side of the
         // rounding and not on the other.
@@ -118,12 +124,26 @@ fn compare(a: &dyn Accel, s: &Scene, rays: &[(rt_core::Ray, f32)]) -> (usize, us
 }
 
 #[test]
-fn two_level_matches_brute_force_on_every_frame() {
-    for mode in [TopLevel::Rebuild, TopLevel::Refit] {
-        let mut rng = Rng::new(7);
-        let mut s = scene(&mut rng, 12);
+fn two_level_and_clusters_match_brute_force_on_every_frame() {
+    let clusters = |t: f32| {
+        let mut spec = AccelSpec::new(AccelKind::Clusters);
+        spec.cluster_t = t;
+        spec
+    };
+    let two_level = |mode| {
         let mut spec = AccelSpec::new(AccelKind::TwoLevel);
         spec.top = mode;
+        spec
+    };
+    for spec in [
+        two_level(TopLevel::Rebuild),
+        two_level(TopLevel::Refit),
+        clusters(1.0),
+        clusters(8.0),
+        clusters(1000.0),
+    ] {
+        let mut rng = Rng::new(7);
+        let mut s = scene(&mut rng, 12);
         let mut a = spec.build_scene(&s);
         let mut total = (0, 0);
         for frame in 0..5 {
@@ -138,11 +158,30 @@ fn two_level_matches_brute_force_on_every_frame() {
         }
         assert!(
             total.1 * 1000 <= total.0,
-            "{mode:?}: {} of {} rays disagree",
+            "{spec}: {} of {} rays disagree",
             total.1,
             total.0
         );
     }
+}
+
+#[test]
+fn clustering_cuts_objects_into_more_entries_as_t_grows() {
+    let s = scene(&mut Rng::new(5), 6);
+    let entries = |t: f32| {
+        rt_accel::TwoLevel::build_clustered(&s, &Default::default(), &Default::default(), t)
+            .entry_count()
+    };
+    let one = rt_accel::TwoLevel::build(
+        &s,
+        &Default::default(),
+        &Default::default(),
+        TopLevel::Rebuild,
+    )
+    .entry_count();
+    assert_eq!(one, 7, "the static object and six instances");
+    let (a, b, c) = (entries(1.0), entries(8.0), entries(1000.0));
+    assert!(one < a && a <= b && b < c, "{one} {a} {b} {c}");
 }
 
 #[test]

@@ -12,6 +12,17 @@
 //! flat triangle order; for a mirroring transform the barycentrics swap with the world copy's
 //! winding ([`rt_core::instance::place_triangle`]).
 //!
+//! **Rigid-body entry-point clustering** (Dammertz 2011, §4.5; `clusters:t=T`): the top level
+//! does not stop at whole objects. Each object BVH is cut into *entry points*, the nodes (or
+//! leaves) whose world-space size is below `size(scene) / t` while their parents' are not
+//! ([`Bvh8::entry_points`]); the top level is a binary SAH tree over the entry points' world
+//! boxes, rebuilt every frame down to one entry per leaf, and a ray reaching a leaf continues
+//! inside the object at that node with the inverse-transformed ray
+//! ([`Bvh8::closest_hit_from`]). Overlapping parts (seats inside a hull) then separate in the
+//! top level instead of forcing every ray into both. Deviation: sizes are the boxes' longest
+//! sides, and an object's threshold is divided by its instance's largest scale factor (the
+//! BVH is shared by instances of different sizes).
+//!
 //! Deviations: the static geometry is one object (not one per `[[geometry]]`): seed 002 found
 //! per-object BVHs of overlapping static parts slower than one, and nothing moves there. The
 //! world box of an instance is its object box's eight corners transformed, padded by a
@@ -54,6 +65,11 @@ struct Placement {
 pub struct TwoLevel {
     objects: Vec<Object>,
     placements: Vec<Placement>,
+    /// Clustering's `t`; `None`: one entry per placement (its root).
+    cut: Option<f32>,
+    /// The top level's leaves: (placement, child code to start at), and their world boxes.
+    entries: Vec<(u32, u32)>,
+    entry_boxes: Vec<Aabb>,
     /// Each instance's object, and its prototype (to check an update matches the build).
     instance_objects: Vec<u32>,
     instance_prototypes: Vec<u32>,
@@ -78,6 +94,25 @@ impl TwoLevel {
             params,
             options,
             mode,
+            None,
+        )
+    }
+
+    /// [`TwoLevel::build`] with rigid-body entry-point clustering at threshold `t` (> 0).
+    pub fn build_clustered(
+        scene: &Scene,
+        params: &BuildParams,
+        options: &WideOptions,
+        t: f32,
+    ) -> Self {
+        Self::build_parts(
+            &scene.triangles,
+            &scene.instances,
+            &scene.prototypes,
+            params,
+            options,
+            TopLevel::Rebuild,
+            Some(t),
         )
     }
 
@@ -87,8 +122,9 @@ impl TwoLevel {
         params: &BuildParams,
         options: &WideOptions,
         mode: TopLevel,
+        cut: Option<f32>,
     ) -> Self {
-        Self::build_parts(triangles, &[], &[], params, options, mode)
+        Self::build_parts(triangles, &[], &[], params, options, mode, cut)
     }
 
     fn build_parts(
@@ -98,6 +134,7 @@ impl TwoLevel {
         params: &BuildParams,
         options: &WideOptions,
         mode: TopLevel,
+        cut: Option<f32>,
     ) -> Self {
         let mut objects = Vec::new();
         let mut placements = Vec::new();
@@ -152,14 +189,51 @@ impl TwoLevel {
             placements,
             instance_prototypes: instances.iter().map(|i| i.prototype).collect(),
             instance_objects,
+            cut,
+            entries: Vec::new(),
+            entry_boxes: Vec::new(),
             top: top::Top::default(),
             mode,
             bounds: Aabb::EMPTY,
         };
         s.place_instances(instances);
-        s.top = top::Top::build(&s.boxes());
-        s.bounds = s.boxes().into_iter().fold(Aabb::EMPTY, Aabb::union);
+        s.make_entries();
+        s.top = top::Top::build(&s.entry_boxes);
         s
+    }
+
+    /// The top level's leaves for the current placements: each placement's root, or with
+    /// clustering its entry points.
+    fn make_entries(&mut self) {
+        self.bounds = self
+            .placements
+            .iter()
+            .map(|p| p.world)
+            .fold(Aabb::EMPTY, Aabb::union);
+        self.entries.clear();
+        self.entry_boxes.clear();
+        let scene_size = (self.bounds.max - self.bounds.min).max_element();
+        for (k, p) in self.placements.iter().enumerate() {
+            let Some(t) = self.cut else {
+                self.entries.push((k as u32, 0));
+                self.entry_boxes.push(p.world);
+                continue;
+            };
+            let to_world = p.to_object.map(|m| m.inverse());
+            // The largest factor by which the placement stretches a length.
+            let stretch = to_world.map_or(1.0, |m| {
+                let len = |v: glam::Vec4| v.truncate().length();
+                len(m.x_axis).max(len(m.y_axis)).max(len(m.z_axis))
+            });
+            let threshold = scene_size / t / stretch;
+            for (code, local) in self.objects[p.object as usize].bvh.entry_points(threshold) {
+                self.entries.push((k as u32, code));
+                self.entry_boxes.push(match &to_world {
+                    None => local,
+                    Some(m) => world_box(m, &local),
+                });
+            }
+        }
     }
 
     /// Sets every instance's placement from the scene's current transforms.
@@ -183,13 +257,17 @@ impl TwoLevel {
         }
     }
 
-    fn boxes(&self) -> Vec<Aabb> {
-        self.placements.iter().map(|p| p.world).collect()
-    }
-
     /// Bytes of the top level alone (what a frame rebuilds).
     pub fn top_bytes(&self) -> usize {
-        self.top.memory_bytes() + std::mem::size_of_val(self.placements.as_slice())
+        self.top.memory_bytes()
+            + std::mem::size_of_val(self.placements.as_slice())
+            + std::mem::size_of_val(self.entries.as_slice())
+            + std::mem::size_of_val(self.entry_boxes.as_slice())
+    }
+
+    /// Leaves of the top level (placements, or entry points when clustered).
+    pub fn entry_count(&self) -> usize {
+        self.entries.len()
     }
 
     /// Closest hit (or any hit) over all placements.
@@ -205,7 +283,8 @@ impl TwoLevel {
         let mut best: Option<Hit> = None;
         let mut local = TraversalCounters::default();
         let counting = counters.is_some();
-        self.top.walk(ray, t_max, &mut local, ANY, |k, t_cull, c| {
+        self.top.walk(ray, t_max, &mut local, ANY, |e, t_cull, c| {
+            let (k, code) = self.entries[e as usize];
             let p = &self.placements[k as usize];
             let obj = &self.objects[p.object as usize];
             let r = match &p.to_object {
@@ -214,7 +293,7 @@ impl TwoLevel {
             };
             let hit = if ANY {
                 obj.bvh
-                    .any_hit(&r, t_cull, None, counting.then_some(&mut *c))
+                    .any_hit_from(code, &r, t_cull, counting.then_some(&mut *c))
                     .then_some(Hit {
                         t: t_cull,
                         prim: 0,
@@ -222,7 +301,8 @@ impl TwoLevel {
                         b2: 0.0,
                     })
             } else {
-                obj.bvh.closest_hit(&r, t_cull, counting.then_some(&mut *c))
+                obj.bvh
+                    .closest_hit_from(code, &r, t_cull, counting.then_some(&mut *c))
             };
             let mut h = hit?;
             if !ANY {
@@ -266,7 +346,11 @@ fn world_box(m: &Mat4, b: &Aabb) -> Aabb {
 
 impl Accel for TwoLevel {
     fn name(&self) -> &str {
-        "two-level"
+        if self.cut.is_some() {
+            "clusters"
+        } else {
+            "two-level"
+        }
     }
 
     fn closest_hit(
@@ -315,12 +399,14 @@ impl Accel for TwoLevel {
             return false;
         }
         self.place_instances(&scene.instances);
-        let boxes = self.boxes();
-        match self.mode {
-            TopLevel::Rebuild => self.top = top::Top::build(&boxes),
-            TopLevel::Refit => self.top.refit(&boxes),
+        let before = std::mem::take(&mut self.entries);
+        self.make_entries();
+        // Refitting needs the same leaves; a clustered cut may change with the scene's size.
+        if self.mode == TopLevel::Refit && self.entries == before {
+            self.top.refit(&self.entry_boxes);
+        } else {
+            self.top = top::Top::build(&self.entry_boxes);
         }
-        self.bounds = boxes.into_iter().fold(Aabb::EMPTY, Aabb::union);
         true
     }
 }

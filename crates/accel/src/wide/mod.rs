@@ -160,10 +160,64 @@ impl<N: WideNode> WideBvh<N> {
         self.references
     }
 
+    /// Closest hit within the subtree of child code `entry` (an inner node's index or a leaf
+    /// code, as [`WideBvh::entry_points`] gives them; 0 is the root): what a two-level
+    /// structure whose top level ends at entry points continues with.
+    pub fn closest_hit_from(
+        &self,
+        entry: u32,
+        ray: &Ray,
+        t_max: f32,
+        counters: Option<&mut TraversalCounters>,
+    ) -> Option<Hit> {
+        if entry == 0 {
+            return self.closest_hit(ray, t_max, counters);
+        }
+        with_counter!(counters, |c| self.query::<false, _>(entry, ray, t_max, c))
+    }
+
+    /// True if anything in the subtree of child code `entry` is hit within `t_max`.
+    pub fn any_hit_from(
+        &self,
+        entry: u32,
+        ray: &Ray,
+        t_max: f32,
+        counters: Option<&mut TraversalCounters>,
+    ) -> bool {
+        with_counter!(counters, |c| self
+            .query::<true, _>(entry, ray, t_max, c)
+            .is_some())
+    }
+
+    /// The cut of the tree into entry points for rigid-body clustering (Dammertz §4.5): the
+    /// children, top down from the root's, whose boxes are smaller than `size` (longest side)
+    /// or that are leaves, with their boxes. The root is never one (the thesis' t = 1 gives
+    /// four entries per QBVH: the root's children); one entry per object is `two-level`.
+    pub fn entry_points(&self, size: f32) -> Vec<(u32, Aabb)> {
+        let longest = |b: &Aabb| (b.max - b.min).max_element();
+        if self.nodes.is_empty() {
+            return Vec::new();
+        }
+        let mut out = Vec::new();
+        let mut pending = vec![0usize];
+        while let Some(n) = pending.pop() {
+            let node = &self.nodes[n];
+            for slot in 0..N::WIDTH {
+                match node.child(slot) {
+                    QChild::Empty => {}
+                    QChild::Inner(i) if longest(&node.child_aabb(slot)) >= size => pending.push(i),
+                    _ => out.push((node.code(slot), node.child_aabb(slot))),
+                }
+            }
+        }
+        out
+    }
+
     /// Runs the traversal variant the options select, compiled for AVX2 when the CPU has it.
     #[inline]
     fn query<const ANY_HIT: bool, C: Counter>(
         &self,
+        start: u32,
         ray: &Ray,
         t_max: f32,
         c: &mut C,
@@ -172,9 +226,9 @@ impl<N: WideNode> WideBvh<N> {
         if let Some(avx2) = self.avx2 {
             // SAFETY: `Avx2::detect` made `avx2`, so the CPU has AVX2.
             #[allow(unsafe_code)]
-            return unsafe { self.query_avx2::<ANY_HIT, C>(ray, t_max, avx2, c) };
+            return unsafe { self.query_avx2::<ANY_HIT, C>(start, ray, t_max, avx2, c) };
         }
-        self.query_baseline::<ANY_HIT, C>(ray, t_max, c)
+        self.query_baseline::<ANY_HIT, C>(start, ray, t_max, c)
     }
 
     /// [`WideBvh::query_any`] without AVX2. Kept out of line so that [`WideBvh::query`] stays a
@@ -182,11 +236,12 @@ impl<N: WideNode> WideBvh<N> {
     #[inline(never)]
     fn query_baseline<const ANY_HIT: bool, C: Counter>(
         &self,
+        start: u32,
         ray: &Ray,
         t_max: f32,
         c: &mut C,
     ) -> Option<Hit> {
-        self.query_any::<ANY_HIT, _, C>(ray, t_max, Baseline, c)
+        self.query_any::<ANY_HIT, _, C>(start, ray, t_max, Baseline, c)
     }
 
     /// [`WideBvh::query_any`] compiled with AVX2 enabled: the eight-wide box test in one
@@ -200,17 +255,19 @@ impl<N: WideNode> WideBvh<N> {
     #[allow(unsafe_code)]
     unsafe fn query_avx2<const ANY_HIT: bool, C: Counter>(
         &self,
+        start: u32,
         ray: &Ray,
         t_max: f32,
         avx2: Avx2,
         c: &mut C,
     ) -> Option<Hit> {
-        self.query_any::<ANY_HIT, _, C>(ray, t_max, avx2, c)
+        self.query_any::<ANY_HIT, _, C>(start, ray, t_max, avx2, c)
     }
 
     #[inline(always)]
     fn query_any<const ANY_HIT: bool, I: Isa, C: Counter>(
         &self,
+        start: u32,
         ray: &Ray,
         t_max: f32,
         isa: I,
@@ -220,22 +277,22 @@ impl<N: WideNode> WideBvh<N> {
         // entry distances on the stack would cull nothing.
         match (self.options.order, self.options.t_stack && !ANY_HIT) {
             (Order::SplitPlane, false) => {
-                self.traverse::<ANY_HIT, SPLIT_PLANE, false, I, C>(ray, t_max, isa, c)
+                self.traverse::<ANY_HIT, SPLIT_PLANE, false, I, C>(start, ray, t_max, isa, c)
             }
             (Order::SplitPlane, true) => {
-                self.traverse::<ANY_HIT, SPLIT_PLANE, true, I, C>(ray, t_max, isa, c)
+                self.traverse::<ANY_HIT, SPLIT_PLANE, true, I, C>(start, ray, t_max, isa, c)
             }
             (Order::Distance, false) => {
-                self.traverse::<ANY_HIT, DISTANCE, false, I, C>(ray, t_max, isa, c)
+                self.traverse::<ANY_HIT, DISTANCE, false, I, C>(start, ray, t_max, isa, c)
             }
             (Order::Distance, true) => {
-                self.traverse::<ANY_HIT, DISTANCE, true, I, C>(ray, t_max, isa, c)
+                self.traverse::<ANY_HIT, DISTANCE, true, I, C>(start, ray, t_max, isa, c)
             }
             (Order::Unsorted, false) => {
-                self.traverse::<ANY_HIT, UNSORTED, false, I, C>(ray, t_max, isa, c)
+                self.traverse::<ANY_HIT, UNSORTED, false, I, C>(start, ray, t_max, isa, c)
             }
             (Order::Unsorted, true) => {
-                self.traverse::<ANY_HIT, UNSORTED, true, I, C>(ray, t_max, isa, c)
+                self.traverse::<ANY_HIT, UNSORTED, true, I, C>(start, ray, t_max, isa, c)
             }
         }
     }
@@ -252,7 +309,7 @@ impl<N: WideNode> Accel for WideBvh<N> {
         t_max: f32,
         counters: Option<&mut TraversalCounters>,
     ) -> Option<Hit> {
-        with_counter!(counters, |c| self.query::<false, _>(ray, t_max, c))
+        with_counter!(counters, |c| self.query::<false, _>(0, ray, t_max, c))
     }
 
     fn any_hit(
@@ -266,7 +323,9 @@ impl<N: WideNode> Accel for WideBvh<N> {
             Some(target) if self.options.shadow_cache => {
                 with_counter!(counters, |c| self.occluded_cached(ray, t_max, target, c))
             }
-            _ => with_counter!(counters, |c| self.query::<true, _>(ray, t_max, c).is_some()),
+            _ => with_counter!(counters, |c| self
+                .query::<true, _>(0, ray, t_max, c)
+                .is_some()),
         }
     }
 

@@ -312,6 +312,7 @@ impl<N: WideNode> WideBvh<N> {
         C: Counter,
     >(
         &self,
+        start: u32,
         ray: &Ray,
         t_max: f32,
         isa: I,
@@ -326,7 +327,7 @@ impl<N: WideNode> WideBvh<N> {
         let slab = Slab::new(ray);
         // The eight boxes of the root node are tested next anyway, as cheaply as the scene's
         // box; the four-wide node keeps the test (and its count).
-        if N::WIDTH < 8 {
+        if N::WIDTH < 8 && start == 0 {
             counter.boxes(1);
             slab.hit_box(&self.bounds, t_max)?;
         }
@@ -337,7 +338,8 @@ impl<N: WideNode> WideBvh<N> {
 
         let mut closest = Closest::new(t_max);
         let mut stack = Stack::<TSTACK>::new();
-        let mut cur: u32 = 0;
+        // The root, or an entry point of a clustered top level (a node or a leaf).
+        let mut cur: u32 = start;
         loop {
             if cur & LEAF_BIT != 0 {
                 let pre = pre.get_or_insert_with(|| RayPrecomp4::new(ray));
