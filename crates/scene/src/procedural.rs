@@ -11,6 +11,8 @@
 //! | `rotated` | 97,794 | a tessellated city of boxes on a tessellated ground (axis-aligned triangles, the ideal case for boxes) rotated by 45° about x and then about y, the "rotated Sponza" idea: the same geometry, now with diagonal triangles |
 //! | `mixed` | 36,934 | two ground and two backdrop triangles 2·10⁵ wide, grass blades of 10⁻¹, dust clouds of triangles from 10⁻² down to 10⁻⁶ across, far mountains of 10³: sizes over 11 orders of magnitude, coordinates from 10⁻⁴ to 10⁵ |
 //! | `million` | 1,002,256 | a closed, displaced cube-sphere of 12·289² triangles on a ground quad |
+//! | `car` | 70,114 | animated: 61 rigid parts of a car driving for 2 s (spinning wheels, opening doors, the engine and seats inside the hull), instances of 61 prototypes ([`dynamic`]) |
+//! | `furniture` | 223,074 | animated: 123 pieces of furniture (five prototypes) in a static room, chairs sliding and turning, lamps swinging |
 //!
 //! ```
 //! let scene = rt_scene::procedural::generate("worst-case").unwrap();
@@ -25,11 +27,18 @@ use rt_core::{
 };
 
 /// Names accepted by [`generate`], in the order of the table above.
-pub const NAMES: [&str; 4] = ["worst-case", "rotated", "mixed", "million"];
+pub const NAMES: [&str; 6] = [
+    "worst-case",
+    "rotated",
+    "mixed",
+    "million",
+    "car",
+    "furniture",
+];
 
 /// A name that is not one of [`NAMES`].
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("unknown procedural scene `{0}` (expected one of worst-case, rotated, mixed, million)")]
+#[error("unknown procedural scene `{0}` (expected one of worst-case, rotated, mixed, million, car, furniture)")]
 pub struct UnknownScene(pub String);
 
 /// Generates the scene called `name` (one of [`NAMES`]), ready to render: the light sampler is
@@ -40,6 +49,8 @@ pub fn generate(name: &str) -> Result<Scene, UnknownScene> {
         "rotated" => Ok(rotated()),
         "mixed" => Ok(mixed()),
         "million" => Ok(million()),
+        "car" => Ok(dynamic::car()),
+        "furniture" => Ok(dynamic::furniture()),
         _ => Err(UnknownScene(name.to_string())),
     }
 }
@@ -47,6 +58,8 @@ pub fn generate(name: &str) -> Result<Scene, UnknownScene> {
 /// The generators' random numbers: rt-core's SplitMix64 started at the seed itself (so the
 /// scenes stay what they were when their sizes were specified).
 type Rng = rt_core::rng::SplitMix64;
+
+pub mod dynamic;
 
 fn rng(seed: u64) -> Rng {
     Rng::from_state(seed)
@@ -473,11 +486,25 @@ mod tests {
         assert!(s.triangle_count() >= 1_000_000);
     }
 
+        #[test]
+    fn dynamic_scenes_move_and_stay_finite() {
+        for (name, parts, triangles) in [("car", 61, 70_114), ("furniture", 123, 223_074)] {
+            let mut s = check(name, triangles);
+            assert_eq!(s.instances.len(), parts, "{name}");
+            assert!(s.instances.iter().any(|i| i.is_animated()), "{name}");
+            let before = s.triangles.clone();
+            let moved = s.set_time(1.0);
+            assert!(!moved.is_empty(), "{name}: nothing moved");
+            assert!(s.triangles.iter().flatten().all(|v| v.is_finite()));
+            assert_ne!(s.triangles, before);
+        }
+    }
+
     #[test]
     fn unknown_name() {
         let e = generate("sponza").unwrap_err();
         assert!(e.to_string().contains("sponza") && e.to_string().contains("worst-case"));
-        assert_eq!(NAMES.len(), 4);
+                assert_eq!(NAMES.len(), 6);
         for n in NAMES {
             assert!(e.to_string().contains(n));
         }
