@@ -133,13 +133,18 @@ mod tests {
             Vec3::new(0.9, 0.9, 2.0),
         ];
         assert!(!triangle_box_overlap(&far_corner, lo, hi));
-        // Separated by an edge axis only.
+        // Separated by an edge axis only: the boxes and the planes overlap, x + y >= 2.1.
         let edge = [
-            Vec3::new(1.6, -0.5, 0.5),
-            Vec3::new(-0.5, 1.6, 0.5),
-            Vec3::new(-0.5, 1.6, 0.6),
+            Vec3::new(1.6, 0.5, 0.5),
+            Vec3::new(0.5, 1.6, 0.5),
+            Vec3::new(1.6, 1.6, 0.5),
         ];
         assert!(!triangle_box_overlap(&edge, lo, hi));
+        assert!(triangle_box_overlap(
+            &edge.map(|v| v - Vec3::new(0.1, 0.1, 0.0)),
+            lo,
+            hi
+        ));
         // A degenerate segment through the box, and one beside it.
         let seg = [Vec3::splat(-1.0), Vec3::splat(2.0), Vec3::splat(2.0)];
         assert!(triangle_box_overlap(&seg, lo, hi));
@@ -160,6 +165,31 @@ mod tests {
                 p.cmpge(lo).all() && p.cmple(hi).all()
             })
         })
+    }
+
+    #[test]
+    fn agrees_with_sampling_on_random_triangles() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 40) as f32 / (1u64 << 24) as f32 * 3.0 - 1.0
+        };
+        let (lo, hi) = (Vec3::ZERO, Vec3::ONE);
+        let (mut rejected_by_sat_only, mut sampled_in) = (0, 0);
+        for _ in 0..2000 {
+            let t = [0; 3].map(|_| Vec3::new(next(), next(), next()));
+            let sat = triangle_box_overlap(&t, lo, hi);
+            let sampled = overlaps_by_sampling(&t, lo, hi);
+            // Sampling finds points of real overlaps only, so it never contradicts a `false`.
+            assert!(sat || !sampled, "{t:?}");
+            sampled_in += usize::from(sampled);
+            let tb = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
+            let boxes = tb.0.cmple(hi).all() && tb.1.cmpge(lo).all();
+            rejected_by_sat_only += usize::from(boxes && !sat);
+        }
+        assert!(sampled_in > 200 && rejected_by_sat_only > 50);
     }
 
     #[test]
