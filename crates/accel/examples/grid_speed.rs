@@ -1,0 +1,83 @@
+//! Rays per second of the uniform and irregular grids against `bvh8` on one mesh, with uniform
+//! random rays from the crate's bench code (`bench::sets::uniform`, `bench::measure`).
+//!
+//! ```text
+//! cargo run --release -p rt-accel --example grid_speed -- [MESH.obj] [RAYS] [REPEAT]
+//! ```
+//!
+//! `MESH` defaults to `models/stanford-bunny.obj` under `../shared/data`; one thread, best of
+//! `REPEAT` (3) runs of `RAYS` (200,000) closest-hit queries.
+
+use rt_accel::bench::{measure, sets};
+use rt_accel::{AccelSpec, IrregularGrid, IrregularGridParams, UniformGrid, UniformGridParams};
+use rt_core::Accel;
+use std::time::Instant;
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let tris = match args.first() {
+        Some(p) => rt_testkit::obj::read(std::path::Path::new(p)),
+        None => rt_testkit::obj::shared_mesh("models/stanford-bunny.obj"),
+    }
+    .expect("mesh not found");
+    let n_rays: usize = args.get(1).map_or(200_000, |s| s.parse().expect("RAYS"));
+    let repeat: u32 = args.get(2).map_or(3, |s| s.parse().expect("REPEAT"));
+
+    let timed = |f: &dyn Fn() -> Box<dyn Accel>| {
+        let t = Instant::now();
+        let a = f();
+        (a, t.elapsed().as_secs_f64() * 1e3)
+    };
+    let structures: Vec<(Box<dyn Accel>, f64, Option<usize>)> = vec![
+        {
+            let (a, ms) = timed(&|| "bvh8".parse::<AccelSpec>().unwrap().build(&tris));
+            (a, ms, None)
+        },
+        {
+            let t = Instant::now();
+            let g = UniformGrid::build(&tris, &UniformGridParams::default()).unwrap();
+            let ms = t.elapsed().as_secs_f64() * 1e3;
+            let s = g.structure_bytes();
+            (Box::new(g) as Box<dyn Accel>, ms, Some(s))
+        },
+        {
+            let t = Instant::now();
+            let g = IrregularGrid::build(&tris, &IrregularGridParams::default()).unwrap();
+            let ms = t.elapsed().as_secs_f64() * 1e3;
+            eprintln!(
+                "irregular: virtual {:?}, {} cells, {} references",
+                g.virtual_resolution(),
+                g.cell_count(),
+                g.references()
+            );
+            let s = g.structure_bytes();
+            (Box::new(g) as Box<dyn Accel>, ms, Some(s))
+        },
+    ];
+    let bounds = structures[0].0.bounds();
+    let set = sets::uniform(&bounds, n_rays, 1);
+    println!(
+        "{} triangles, {n_rays} uniform rays in the scene box, 1 thread, best of {repeat}",
+        tris.len()
+    );
+    println!(
+        "{:<16} {:>10} {:>9} {:>9} {:>12} {:>12} {:>9} {:>9}",
+        "structure", "build ms", "MRay/s", "hits", "struct B", "memory B", "cells/ray", "tris/ray"
+    );
+    for (a, build_ms, structure) in &structures {
+        let t = measure::time(a.as_ref(), &set, None, repeat);
+        let c = measure::count(a.as_ref(), &set).unwrap_or_default();
+        let per = |x: u64| x as f64 / n_rays as f64;
+        println!(
+            "{:<16} {:>10.1} {:>9.2} {:>9} {:>12} {:>12} {:>9.1} {:>9.1}",
+            a.name(),
+            build_ms,
+            n_rays as f64 / t.seconds / 1e6,
+            t.hits,
+            structure.map_or("-".to_string(), |s| s.to_string()),
+            a.memory_bytes(),
+            per(c.nodes_visited),
+            per(c.prims_tested),
+        );
+    }
+}
