@@ -50,7 +50,8 @@
 //! we know it):
 //! - The second level is a per-top-cell grid of `2^d` cells per axis (as seed 002 did; the
 //!   paper used an octree, which subdivides space identically), with `d` from Cleary's rule
-//!   with λ₂ on the top cell's triangle count (`2^d ≥ ∛(λ₂ n)`), capped by `max_depth` and so
+//!   with λ₂ on the top cell's triangle count (`2^d` the power of two nearest to `∛(λ₂ n)`
+//!   in log scale, so a top cell gets about `λ₂ n` cells), capped by `max_depth` and so
 //!   that the virtual grid has at most 1024 cells per axis (the seed's 10-bit packing) and
 //!   `2^24` cells in all. λ₁ = 0.12 and λ₂ = 2.4 by default: our choice, of the order the paper
 //!   used; seed 002's values are not stated.
