@@ -375,3 +375,62 @@ fn slivers_hit_by_aimed_rays() {
         check_rays(g.as_ref(), &tris, &rays, &format!("slivers {name}"));
     }
 }
+
+/// Rays starting exactly on cell faces (of the uniform grid's cells, the irregular grid's own
+/// and expanded boxes, and the grid's outer box), moving within the face plane (with `0.0` or
+/// `-0.0` on its axis), across it along the axis, or obliquely.
+#[test]
+fn rays_from_cell_faces() {
+    let mut rng = Rng::new(101);
+    let tris = soup(&mut rng, 400);
+    let uniform = UniformGrid::build(&tris, &UniformGridParams::default()).unwrap();
+    let irregular = IrregularGrid::build(&tris, &IrregularGridParams::default()).unwrap();
+    let r = uniform.resolution();
+    let mut boxes = vec![uniform.bounds(), irregular.bounds()];
+    for _ in 0..100 {
+        let c = [0, 1, 2].map(|a| rng.below(r[a] as usize) as u32);
+        boxes.push(uniform.cell_bounds(c).unwrap());
+        let cell = irregular.cell(rng.below(irregular.cell_count())).unwrap();
+        boxes.push(cell.bounds);
+        boxes.push(cell.expanded_bounds);
+    }
+    let mut rays = Vec::new();
+    for b in &boxes {
+        for _ in 0..20 {
+            let axis = rng.below(3);
+            let mut o = b.min + (b.max - b.min) * rng.vec_in(0.0, 1.0);
+            o[axis] = if rng.chance(0.5) { b.min[axis] } else { b.max[axis] };
+            let mut d = match rng.below(3) {
+                0 => rng.unit_vec(),
+                1 => {
+                    let mut d = Vec3::ZERO;
+                    d[(axis + 1 + rng.below(2)) % 3] = if rng.chance(0.5) { 1.0 } else { -1.0 };
+                    d
+                }
+                _ => {
+                    let mut d = Vec3::splat(-0.0);
+                    d[axis] = if rng.chance(0.5) { 1.0 } else { -1.0 };
+                    d
+                }
+            };
+            if d[axis].abs() != 1.0 {
+                // In the face plane: a signed zero on its axis.
+                d[axis] = if rng.chance(0.5) { 0.0 } else { -0.0 };
+                if d == Vec3::ZERO {
+                    d[(axis + 1) % 3] = 1.0;
+                }
+            }
+            let t_max = if rng.chance(0.25) {
+                rng.range(0.05, 2.0)
+            } else {
+                f32::INFINITY
+            };
+            rays.push((Ray::new(o, d), t_max));
+        }
+    }
+    let mut hits = 0;
+    for (name, g) in grids(&tris) {
+        hits += check_rays(g.as_ref(), &tris, &rays, &format!("faces {name}"));
+    }
+    assert!(hits > rays.len(), "{hits}");
+}
