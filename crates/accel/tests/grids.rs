@@ -399,7 +399,11 @@ fn rays_from_cell_faces() {
         for _ in 0..20 {
             let axis = rng.below(3);
             let mut o = b.min + (b.max - b.min) * rng.vec_in(0.0, 1.0);
-            o[axis] = if rng.chance(0.5) { b.min[axis] } else { b.max[axis] };
+            o[axis] = if rng.chance(0.5) {
+                b.min[axis]
+            } else {
+                b.max[axis]
+            };
             let mut d = match rng.below(3) {
                 0 => rng.unit_vec(),
                 1 => {
@@ -431,6 +435,28 @@ fn rays_from_cell_faces() {
     let mut hits = 0;
     for (name, g) in grids(&tris) {
         hits += check_rays(g.as_ref(), &tris, &rays, &format!("faces {name}"));
+    }
+    assert!(hits > rays.len(), "{hits}");
+}
+
+/// Rays from outside the grid's box (most of `rays`' origins lie inside it): aimed at points on
+/// triangles from every side, so they enter through faces, edges and corners of the grid.
+#[test]
+fn rays_from_outside_the_grid() {
+    let mut rng = Rng::new(111);
+    let tris = soup(&mut rng, 1000);
+    let rays: Vec<(Ray, f32)> = (0..3000)
+        .map(|_| {
+            let t = tris[rng.below(tris.len())];
+            let (b1, b2) = rng.barycentric();
+            let p = rt_core::triangle::point_at(&t, b1, b2);
+            let o = rng.unit_vec() * rng.range(4.0, 20.0);
+            (Ray::new(o, p - o), f32::INFINITY)
+        })
+        .collect();
+    let mut hits = 0;
+    for (name, g) in grids(&tris) {
+        hits += check_rays(g.as_ref(), &tris, &rays, &format!("outside {name}"));
     }
     assert!(hits > rays.len(), "{hits}");
 }
