@@ -1,7 +1,7 @@
 //! Construction: the two-level grid at virtual resolution, then merging, expansion and the flat
 //! layout.
 
-use super::{expand, merge, IrregularGrid, IrregularGridParams, VBox};
+use super::{expand, merge, IrregularGrid, IrregularGridParams, Record, VBox};
 use crate::grid::domain::{cleary, padded_bounds, Domain};
 use crate::grid::lists::{bin, Lists};
 use crate::grid::overlap::Binner;
@@ -39,9 +39,9 @@ pub(super) fn build(
     let empty = IrregularGrid {
         domain: None,
         map: Vec::new(),
-        expanded: Vec::new(),
+        records: Vec::new(),
         boxes: Vec::new(),
-        lists: Lists::default(),
+        indices: Vec::new(),
         triangles: triangles.to_vec(),
     };
     let bounds = padded_bounds(triangles);
@@ -160,18 +160,26 @@ pub(super) fn build(
         [lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]].map(|x| x as u16)
     };
     let boxes = cells.iter().map(|c| pack(c.lo, c.hi)).collect();
-    let expanded = expanded.iter().map(|&(lo, hi)| pack(lo, hi)).collect();
-    let mut pairs = Vec::new();
-    for (i, c) in cells.iter().enumerate() {
-        pairs.extend(c.tris.iter().map(|&t| (i as u32, t)));
+    let mut indices = Vec::new();
+    let mut records = Vec::with_capacity(cells.len());
+    for (c, &(lo, hi)) in cells.iter().zip(&expanded) {
+        let start = indices.len();
+        indices.extend_from_slice(&c.tris);
+        if indices.len() > u32::MAX as usize {
+            return Err(GridError::TooManyReferences);
+        }
+        records.push(Record {
+            expanded: pack(lo, hi),
+            start: start as u32,
+            end: indices.len() as u32,
+        });
     }
-    let lists = Lists::from_pairs(cells.len(), &pairs)?;
     Ok(IrregularGrid {
         domain: Some(vd),
         map,
-        expanded,
+        records,
         boxes,
-        lists,
+        indices,
         ..empty
     })
 }

@@ -8,7 +8,6 @@ mod merge;
 mod traverse;
 
 use super::domain::{finite, Domain};
-use super::lists::Lists;
 use super::{Binning, GridError};
 use crate::traversal::with_counter;
 use crate::ValidationError;
@@ -61,12 +60,22 @@ pub struct IrregularGrid {
     domain: Option<Domain>,
     /// The cell owning each virtual cell.
     map: Vec<u32>,
-    /// Per cell, the expanded box the traversal leaves the cell by.
-    expanded: Vec<VBox>,
+    /// Per cell, what the traversal reads: the expanded box it leaves the cell by and the
+    /// cell's range of `indices`, side by side so that a cell costs one cache line.
+    records: Vec<Record>,
     /// Per cell, the box it was merged into (the virtual cells `map` sends to it).
     boxes: Vec<VBox>,
-    lists: Lists,
+    /// The cells' triangle lists, one after another.
+    indices: Vec<u32>,
     triangles: Vec<[Vec3; 3]>,
+}
+
+/// A cell as the traversal reads it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Record {
+    expanded: VBox,
+    start: u32,
+    end: u32,
 }
 
 /// One cell of an [`IrregularGrid`], in virtual-cell coordinates and in space.
@@ -116,7 +125,7 @@ impl IrregularGrid {
     pub fn cell(&self, i: usize) -> Option<IrregularCell<'_>> {
         let d = self.domain.as_ref()?;
         let (lo, hi) = unpack(self.boxes.get(i)?);
-        let (expanded_lo, expanded_hi) = unpack(&self.expanded[i]);
+        let (expanded_lo, expanded_hi) = unpack(&self.records[i].expanded);
         Some(IrregularCell {
             lo,
             hi,
@@ -124,7 +133,7 @@ impl IrregularGrid {
             expanded_hi,
             bounds: d.cell_aabb(lo, hi),
             expanded_bounds: d.cell_aabb(expanded_lo, expanded_hi),
-            triangles: self.lists.get(i),
+            triangles: self.list(i),
         })
     }
 
@@ -158,17 +167,25 @@ impl IrregularGrid {
         Some(v)
     }
 
+    /// The triangles of cell `i`.
+    fn list(&self, i: usize) -> &[u32] {
+        let r = &self.records[i];
+        self.indices
+            .get(r.start as usize..r.end as usize)
+            .unwrap_or_default()
+    }
+
     /// Number of triangle references in all lists.
     pub fn references(&self) -> usize {
-        self.lists.indices.len()
+        self.indices.len()
     }
 
     /// Bytes of the virtual grid, the cells and the lists, without the triangle copies.
     pub fn structure_bytes(&self) -> usize {
         std::mem::size_of_val(self.map.as_slice())
-            + std::mem::size_of_val(self.expanded.as_slice())
+            + std::mem::size_of_val(self.records.as_slice())
             + std::mem::size_of_val(self.boxes.as_slice())
-            + self.lists.bytes()
+            + std::mem::size_of_val(self.indices.as_slice())
     }
 
     /// Checks the invariants: every virtual cell maps to exactly one cell and the cells' own
@@ -194,7 +211,7 @@ impl IrregularGrid {
             return fail(format!("map of {} for {:?}", self.map.len(), d.res));
         }
         let n = self.boxes.len();
-        if self.expanded.len() != n || self.lists.offsets.len() != n + 1 {
+        if self.records.len() != n {
             return fail("cell arrays of different lengths".into());
         }
         if let Some(v) = self.map.iter().position(|&c| c as usize >= n) {
@@ -203,7 +220,7 @@ impl IrregularGrid {
         let mut volume = 0usize;
         for i in 0..n {
             let (lo, hi) = unpack(&self.boxes[i]);
-            let (elo, ehi) = unpack(&self.expanded[i]);
+            let (elo, ehi) = unpack(&self.records[i].expanded);
             if (0..3).any(|a| lo[a] >= hi[a] || hi[a] > d.res[a]) {
                 return fail(format!("cell {i}: box {lo:?}..{hi:?}"));
             }
@@ -213,7 +230,7 @@ impl IrregularGrid {
                 ));
             }
             volume += (0..3).map(|a| (hi[a] - lo[a]) as usize).product::<usize>();
-            let list = self.lists.get(i);
+            let list = self.list(i);
             if list.windows(2).any(|w| w[0] >= w[1])
                 || list.iter().any(|&t| t as usize >= self.triangles.len())
             {
@@ -225,7 +242,7 @@ impl IrregularGrid {
                 let inside = (0..3).all(|a| v[a] >= lo[a] && v[a] < hi[a]);
                 if inside != (owner == i) {
                     bad.get_or_insert(format!("cell {i}: virtual cell {v:?} owned by {owner}"));
-                } else if !is_subset(self.lists.get(owner), list) {
+                } else if !is_subset(self.list(owner), list) {
                     bad.get_or_insert(format!(
                         "cell {i} expanded over {v:?} of cell {owner}, not a subset"
                     ));

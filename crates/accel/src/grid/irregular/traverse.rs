@@ -34,10 +34,11 @@ impl IrregularGrid {
         loop {
             counter.boxes(1);
             let ci = self.map[d.index(v)] as usize;
-            let range = self.lists.range(ci);
+            let r = &self.records[ci];
+            let range = r.start as usize..r.end as usize;
             if !range.is_empty() {
                 counter.leaf();
-                for &id in &self.lists.indices[range] {
+                for &id in &self.indices[range] {
                     counter.triangle();
                     let Some(h) = intersect_triangle(&pre, &self.triangles[id as usize], t_max)
                     else {
@@ -48,7 +49,7 @@ impl IrregularGrid {
                     }
                 }
             }
-            let b = &self.expanded[ci];
+            let b = &r.expanded;
             // Exit face of the expanded box: the nearest crossing among the axes the ray moves on.
             let (mut axis, mut t_exit) = (3, f32::INFINITY);
             for a in 0..3 {
