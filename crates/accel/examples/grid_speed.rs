@@ -20,6 +20,13 @@ fn main() {
         None => rt_testkit::obj::shared_mesh("models/stanford-bunny.obj"),
     }
     .expect("mesh not found");
+    // `GRID_SPEED_MORTON=1`: triangles sorted by the Morton code of their centroids first, to
+    // see how much of the grids' time is fetching triangles scattered in memory.
+    let tris = if std::env::var_os("GRID_SPEED_MORTON").is_some() {
+        morton_sorted(tris)
+    } else {
+        tris
+    };
     let n_rays: usize = args.get(1).map_or(200_000, |s| s.parse().expect("RAYS"));
     let repeat: u32 = args.get(2).map_or(3, |s| s.parse().expect("REPEAT"));
 
@@ -98,4 +105,26 @@ fn main() {
             per(c.prims_tested),
         );
     }
+}
+
+fn morton_sorted(mut tris: Vec<[rt_core::glam::Vec3; 3]>) -> Vec<[rt_core::glam::Vec3; 3]> {
+    let b = tris.iter().fold(rt_core::Aabb::EMPTY, |b, t| {
+        b.union(rt_core::Aabb::from_points(t))
+    });
+    let spread = |x: u64| {
+        let mut x = x & 0x1f_ffff;
+        x = (x | x << 32) & 0x1f00000000ffff;
+        x = (x | x << 16) & 0x1f0000ff0000ff;
+        x = (x | x << 8) & 0x100f00f00f00f00f;
+        x = (x | x << 4) & 0x10c30c30c30c30c3;
+        (x | x << 2) & 0x1249249249249249
+    };
+    let key = |t: &[rt_core::glam::Vec3; 3]| {
+        let c = ((t[0] + t[1] + t[2]) / 3.0 - b.min)
+            / (b.max - b.min).max(rt_core::glam::Vec3::splat(1e-30));
+        let q = c.clamp(rt_core::glam::Vec3::ZERO, rt_core::glam::Vec3::ONE) * 2_097_151.0;
+        spread(q.x as u64) | spread(q.y as u64) << 1 | spread(q.z as u64) << 2
+    };
+    tris.sort_by_cached_key(key);
+    tris
 }
