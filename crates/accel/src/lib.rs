@@ -11,6 +11,9 @@
 //!   boxes are tested together (AVX2 or SSE2, chosen at run time, with a portable fallback),
 //!   with split-plane or distance child order, a shadow cache, EVH/BBAH triangle splitting and
 //!   an on-demand variant ([`OnDemandQbvh`]).
+//! - [`UniformGrid`] and [`IrregularGrid`] (module [`grid`]): the grid baselines of seed 002, a
+//!   Cleary-resolution uniform grid walked by 3D-DDA and the irregular grid of Pérard-Gayot et
+//!   al. 2017 (two-level grid, SAH merging, cell expansion, virtual-grid lookup).
 //! - [`crack_free`]: the crack-free intersection tests of Dammertz §3.4.
 //! - [`BruteForce`]: tests every triangle; the reference the others are checked against.
 //! - [`points`]: a balanced point kd-tree ([`PointKdTree`]) for photon maps and the caustic
@@ -60,6 +63,7 @@ pub mod bench;
 pub mod brute_force;
 pub mod bvh2;
 pub mod crack_free;
+pub mod grid;
 pub mod on_demand;
 pub mod points;
 pub mod spec;
@@ -68,6 +72,7 @@ pub mod two_level;
 pub mod wide;
 
 pub use brute_force::BruteForce;
+pub use grid::{IrregularGrid, IrregularGridParams, UniformGrid, UniformGridParams};
 
 /// A structure that breaks one of its invariants (found by its `validate`, which the tests and
 /// `bench-accel --check` run after every build).

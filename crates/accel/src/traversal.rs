@@ -183,6 +183,24 @@ impl SlabRay {
         }
         (t0 <= t1 * FAR_SCALE).then_some(t0)
     }
+
+    /// Entry and exit distances `(t0, t1)` of `bounds` within `[0, t_max]`, conservatively as
+    /// [`SlabRay::hit`] (the exit widened by [`FAR_SCALE`]): for the grids, which walk cells
+    /// from the entry to the exit.
+    #[inline(always)]
+    pub(crate) fn interval(&self, bounds: &[f32; 6], t_max: f32) -> Option<(f32, f32)> {
+        let mut t0 = 0.0f32;
+        let mut t1 = t_max;
+        for axis in 0..3 {
+            let n = self.neg[axis] as usize;
+            let near = (bounds[axis + 3 * n] - self.org[axis]) * self.inv[axis];
+            let far = (bounds[axis + 3 - 3 * n] - self.org[axis]) * self.inv[axis];
+            t0 = t0.max(near);
+            t1 = t1.min(far);
+        }
+        let t1 = t1 * FAR_SCALE;
+        (t0 <= t1).then_some((t0, t1))
+    }
 }
 
 /// A node of a binary tree whose two children are stored side by side: what [`walk_binary`]
