@@ -148,8 +148,10 @@ pub fn parse_frames(s: &str) -> Result<std::ops::Range<u32>, String> {
 fn accel_help() -> String {
     format!(
         "Acceleration structure and its options, KIND[:OPTION...]: bvh (binned-SAH binary BVH), \
-         qbvh (four-wide BVH), bvh8 (eight-wide BVH) or brute-force (tests every triangle; for \
-         checking only), e.g. qbvh:evh=14:compact or qbvh:order=distance; the options are listed \
+         qbvh (four-wide BVH), bvh8 (eight-wide BVH), two-level (per-object BVHs under a top \
+         level that follows animated instances), clusters (rigid-body entry-point clustering, \
+         clusters:t=8), grid (uniform grid), irregular-grid or brute-force (tests every triangle; \
+         for checking only), e.g. qbvh:evh=14:compact or qbvh:order=distance; the options are listed \
          in crates/accel/src/spec.rs. [default: `[render] accel`, else {}]",
         rt_accel::DEFAULT_ACCEL
     )

@@ -156,7 +156,14 @@ pub fn run(args: &Args) -> Result<()> {
             .as_mut()
             .is_some_and(|a| pool.install(|| a.update(&scene)));
         if !updated {
-            accel = Some(pool.install(|| job.settings.accel.build_scene(&scene)));
+            let built = pool.install(|| job.settings.accel.try_build_scene(&scene));
+            accel = Some(built.map_err(|e| {
+                anyhow::anyhow!(
+                    "{}: --accel {}: {e}",
+                    job.scene_path.display(),
+                    job.settings.accel
+                )
+            })?);
         }
         let built = accel.as_deref().expect("built above");
         render_one(

@@ -72,7 +72,7 @@ pub mod two_level;
 pub mod wide;
 
 pub use brute_force::BruteForce;
-pub use grid::{IrregularGrid, IrregularGridParams, UniformGrid, UniformGridParams};
+pub use grid::{GridError, IrregularGrid, IrregularGridParams, UniformGrid, UniformGridParams};
 
 /// A structure that breaks one of its invariants (found by its `validate`, which the tests and
 /// `bench-accel --check` run after every build).

@@ -19,6 +19,8 @@
 //! | `shadow-cache` | qbvh, bvh8 | start occlusion queries at the last occluder's node |
 //! | `isect=watertight\|subdivision\|hybrid` | qbvh, bvh8 | triangle test (default watertight) |
 //! | `lazy` | qbvh | build subtrees the first time a ray reaches them |
+//! | `lambda=F` | grid | Cleary's density: about F·N cells for N triangles (default 3) |
+//! | `depth=N` | irregular-grid | deepest second-level subdivision, 2^N cells per axis in a top cell (default 3) |
 //! | `t=T` | clusters | entry points are object nodes smaller than the scene's size over T (default 8) |
 //! | `top=rebuild\|refit` | two-level | per frame, rebuild the top level over the instances' boxes or refit it (default `rebuild`) |
 //!
@@ -56,17 +58,23 @@ pub enum AccelKind {
     TwoLevel,
     /// [`TwoLevel`](crate::TwoLevel) with rigid-body entry-point clustering.
     Clusters,
+    /// [`UniformGrid`](crate::UniformGrid).
+    Grid,
+    /// [`IrregularGrid`](crate::IrregularGrid).
+    IrregularGrid,
 }
 
 impl AccelKind {
     /// Every kind, in the order reports list them.
-    pub const ALL: [AccelKind; 6] = [
+    pub const ALL: [AccelKind; 8] = [
         AccelKind::Qbvh,
         AccelKind::Bvh8,
         AccelKind::Bvh,
         AccelKind::BruteForce,
         AccelKind::TwoLevel,
         AccelKind::Clusters,
+        AccelKind::Grid,
+        AccelKind::IrregularGrid,
     ];
 
     /// True for the two-level kinds, whose object BVHs are BVH8s.
@@ -88,6 +96,8 @@ impl AccelKind {
             AccelKind::BruteForce => "brute-force",
             AccelKind::TwoLevel => "two-level",
             AccelKind::Clusters => "clusters",
+            AccelKind::Grid => "grid",
+            AccelKind::IrregularGrid => "irregular-grid",
         }
     }
 }
@@ -107,6 +117,10 @@ pub struct AccelSpec {
     pub top: crate::TopLevel,
     /// Clustering's threshold `t`: entry points are nodes smaller than the scene over `t`.
     pub cluster_t: f32,
+    /// The uniform grid's parameters.
+    pub grid: crate::UniformGridParams,
+    /// The irregular grid's parameters.
+    pub irregular: crate::IrregularGridParams,
 }
 
 /// Why an accel spec was rejected.
@@ -115,7 +129,7 @@ pub struct AccelSpec {
 pub enum SpecError {
     /// The text before the first `:` is not a structure.
     #[error(
-        "unknown acceleration structure `{0}` (expected qbvh, bvh8, bvh, brute-force, two-level or clusters)"
+        "unknown acceleration structure `{0}` (expected qbvh, bvh8, bvh, brute-force, two-level, clusters, grid or irregular-grid)"
     )]
     UnknownKind(String),
     /// An option this crate does not know.
@@ -169,14 +183,29 @@ impl AccelSpec {
             lazy: false,
             top: crate::TopLevel::default(),
             cluster_t: DEFAULT_CLUSTER_T,
+            grid: crate::UniformGridParams::default(),
+            irregular: crate::IrregularGridParams::default(),
         }
     }
 
     /// Builds the structure over `scene`'s triangles as they are now. Two-level structures
     /// build their object BVHs from the scene's prototypes and place its instances (and then
     /// follow them with [`Accel::update`]); the others see the flat triangles.
+    ///
+    /// # Panics
+    /// Where [`AccelSpec::try_build_scene`] fails: a grid past its `u32` limits.
     pub fn build_scene(&self, scene: &rt_core::Scene) -> Box<dyn Accel> {
-        match self.kind {
+        self.try_build_scene(scene)
+            .unwrap_or_else(|e| panic!("{self}: {e}"))
+    }
+
+    /// [`AccelSpec::build_scene`], or why the structure cannot hold the scene (grids index
+    /// triangles and cell references with `u32`).
+    pub fn try_build_scene(
+        &self,
+        scene: &rt_core::Scene,
+    ) -> Result<Box<dyn Accel>, crate::GridError> {
+        Ok(match self.kind {
             AccelKind::TwoLevel => Box::new(crate::TwoLevel::build(
                 scene,
                 &self.build,
@@ -189,14 +218,27 @@ impl AccelSpec {
                 &self.wide,
                 self.cluster_t,
             )),
-            _ => self.build(&scene.triangles),
-        }
+            _ => self.try_build(&scene.triangles)?,
+        })
     }
 
     /// Builds the structure over `triangles` (whose indices become [`rt_core::Hit::prim`]);
     /// a two-level structure gets them as one static object.
+    ///
+    /// # Panics
+    /// Where [`AccelSpec::try_build`] fails: a grid past its `u32` limits.
     pub fn build(&self, triangles: &[[Vec3; 3]]) -> Box<dyn Accel> {
-        match self.kind {
+        self.try_build(triangles)
+            .unwrap_or_else(|e| panic!("{self}: {e}"))
+    }
+
+    /// [`AccelSpec::build`], or why the structure cannot hold the triangles.
+    pub fn try_build(&self, triangles: &[[Vec3; 3]]) -> Result<Box<dyn Accel>, crate::GridError> {
+        Ok(match self.kind {
+            AccelKind::Grid => Box::new(crate::UniformGrid::build(triangles, &self.grid)?),
+            AccelKind::IrregularGrid => {
+                Box::new(crate::IrregularGrid::build(triangles, &self.irregular)?)
+            }
             AccelKind::TwoLevel | AccelKind::Clusters => Box::new(crate::TwoLevel::build_flat(
                 triangles,
                 &self.build,
@@ -211,7 +253,7 @@ impl AccelSpec {
             AccelKind::Qbvh => Box::new(Qbvh::build_with(triangles, &self.build, &self.wide)),
             AccelKind::Bvh8 => Box::new(Bvh8::build_with(triangles, &self.build, &self.wide)),
             AccelKind::BruteForce => Box::new(BruteForce::new(triangles)),
-        }
+        })
     }
 
     fn apply(&mut self, option: &str) -> Result<(), SpecError> {
@@ -243,6 +285,8 @@ impl AccelSpec {
             "lazy" => self.kind == AccelKind::Qbvh,
             "top" => self.kind == AccelKind::TwoLevel,
             "t" => self.kind == AccelKind::Clusters,
+            "lambda" => self.kind == AccelKind::Grid,
+            "depth" => self.kind == AccelKind::IrregularGrid,
             _ => {
                 return Err(SpecError::UnknownOption {
                     kind,
@@ -321,6 +365,13 @@ impl AccelSpec {
                 flag()?;
                 self.lazy = true;
             }
+            "lambda" => {
+                self.grid.lambda = value
+                    .and_then(|v| v.parse::<f32>().ok())
+                    .filter(|l| l.is_finite() && *l > 0.0 && *l <= 1e3)
+                    .ok_or_else(|| bad("lambda must be a number in (0, 1000]"))?
+            }
+            "depth" => self.irregular.max_depth = number(0, 10, "depth must be 0 to 10")?,
             "t" => {
                 self.cluster_t = value
                     .and_then(|v| v.parse::<f32>().ok())
@@ -412,6 +463,12 @@ impl fmt::Display for AccelSpec {
         }
         if self.cluster_t != default.cluster_t {
             write!(f, ":t={}", self.cluster_t)?;
+        }
+        if self.grid.lambda != default.grid.lambda {
+            write!(f, ":lambda={}", self.grid.lambda)?;
+        }
+        if self.irregular.max_depth != default.irregular.max_depth {
+            write!(f, ":depth={}", self.irregular.max_depth)?;
         }
         Ok(())
     }

@@ -486,7 +486,7 @@ mod tests {
         assert!(s.triangle_count() >= 1_000_000);
     }
 
-        #[test]
+    #[test]
     fn dynamic_scenes_move_and_stay_finite() {
         for (name, parts, triangles) in [("car", 61, 70_114), ("furniture", 123, 223_074)] {
             let mut s = check(name, triangles);
@@ -504,7 +504,7 @@ mod tests {
     fn unknown_name() {
         let e = generate("sponza").unwrap_err();
         assert!(e.to_string().contains("sponza") && e.to_string().contains("worst-case"));
-                assert_eq!(NAMES.len(), 6);
+        assert_eq!(NAMES.len(), 6);
         for n in NAMES {
             assert!(e.to_string().contains(n));
         }
