@@ -93,6 +93,7 @@ fn check_structures(tris: &[Tri], rays: &[(Ray, f32)], label: &str) -> usize {
         );
         let oracle = BruteForce::new(&b.triangles);
         let (mut hits, mut outside) = (0, 0);
+        let (mut any_tests, mut closest_tests) = (0, 0);
         for (i, (ray, t_max)) in rays.iter().enumerate() {
             match check_ray(b.accel.as_ref(), &oracle, ray, *t_max, &b.triangles) {
                 Ok(Agreement::OracleOutsideBox) => outside += 1,
@@ -111,6 +112,17 @@ fn check_structures(tris: &[Tri], rays: &[(Ray, f32)], label: &str) -> usize {
                 b.accel.occluded(ray, *t_max)
             );
             hits += usize::from(got.is_some());
+            // Any-hit stops at its first hit, so it never tests more triangles than the
+            // closest-hit query, and over many hits strictly fewer.
+            assert!(
+                c_any.prims_tested <= c.prims_tested,
+                "{label} {name}: ray {i}"
+            );
+            any_tests += c_any.prims_tested;
+            closest_tests += c.prims_tested;
+        }
+        if hits > 100 && tris.len() >= 64 {
+            assert!(any_tests < closest_tests, "{label} {name}");
         }
         assert!(outside * 1000 <= rays.len().max(1000), "{label} {name}");
         first_hits.get_or_insert(hits);

@@ -207,6 +207,7 @@ pub(crate) fn traverse<const ANY_HIT: bool, C: Counter>(
         if tn <= tf * FAR_SCALE {
             counter.leaf();
             // The last node of an odd heap has one triangle: `b == a`.
+            #[allow(clippy::needless_range_loop)]
             for s in a..=b {
                 counter.triangle();
                 if let Some(h) = intersect_triangle(pre, &tris[s], t_max) {

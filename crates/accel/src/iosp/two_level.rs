@@ -128,10 +128,7 @@ impl Iosp2 {
                     heap::check(&self.triangles[r.clone()])
                         .map_err(|e| format!("leaf {i}: {e}"))?;
                     r.clone().for_each(|s| covered[s] += 1);
-                    self.triangles[r]
-                        .iter()
-                        .map(|t| Aabb::from_points(t))
-                        .collect()
+                    self.triangles[r].iter().map(Aabb::from_points).collect()
                 }
                 _ => return Err(format!("node {i} points out of range")),
             };
