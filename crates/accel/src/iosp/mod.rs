@@ -31,6 +31,22 @@
 //! `0..n` (no triangle is duplicated, see the deviations). The structures keep their own copy
 //! of the permuted triangles, available from `triangles()`, and `memory_bytes` counts it.
 //!
+//! ```
+//! use rt_accel::Iosp0;
+//! use rt_core::{glam::Vec3, Accel, Ray};
+//!
+//! let at = |z: f32| [Vec3::new(0.0, 0.0, z), Vec3::new(1.0, 0.0, z), Vec3::new(0.0, 1.0, z)];
+//! let triangles = [at(3.0), at(1.0), at(2.0)];
+//! let materials = ["far", "near", "middle"];
+//! let (iosp, perm) = Iosp0::build(&triangles).unwrap();
+//! assert_eq!(iosp.structure_bytes(), 0);
+//! // The renderer reorders every per-triangle attribute with the permutation...
+//! let materials: Vec<&str> = perm.iter().map(|&i| materials[i as usize]).collect();
+//! // ...so that `Hit::prim` indexes it directly.
+//! let hit = iosp.intersect(&Ray::new(Vec3::new(0.2, 0.2, 0.0), Vec3::Z), f32::INFINITY);
+//! assert_eq!(materials[hit.unwrap().prim as usize], "near");
+//! ```
+//!
 //! # Deviations from the thesis
 //!
 //! - **Odd triangle counts.** The thesis duplicates the last triangle. Here the heap's last
@@ -51,10 +67,11 @@
 //! - **Eq. 7.1 as printed is wrong** (about 41 % of subtree sizes, including the thesis' own
 //!   12-triangle example); [`split::eq_7_1_corrected`] is used, and [`split::eq_7_1_printed`]
 //!   is kept only so the tests can show the difference.
-//! - **Builder.** A level-by-level CPU builder (object median by `select_nth_unstable` on the
-//!   centroid, nodes of a level in parallel with rayon) instead of the thesis' GPU sort-based
-//!   one; it yields the same node-to-pair sets up to ties in the key. The partition key is the
-//!   centroid rather than the min vertex, since the bounding triangles are found by a scan.
+//! - **Builder.** A level-by-level CPU builder (the nodes of a level in parallel with rayon,
+//!   each splitting its remaining triangles at the object median with `select_nth_unstable`)
+//!   instead of the thesis' GPU builder of lexicographic sorts (Fig. 7.3). The partition key is
+//!   the centroid rather than the min vertex: the bounding triangles are found by a scan, so
+//!   the sort order need not put them first.
 //! - **Traversal** is a short stack of (node, interval) entries with ordered descent; the
 //!   thesis leaves stack versus stackless open. The thesis' per-triangle AABB pre-test (which
 //!   it found no faster) is not implemented.
