@@ -14,6 +14,10 @@
 //! - [`UniformGrid`] and [`IrregularGrid`] (module [`grid`]): the grid baselines of seed 002, a
 //!   Cleary-resolution uniform grid walked by 3D-DDA and the irregular grid of Pérard-Gayot et
 //!   al. 2017 (two-level grid, SAH merging, cell expansion, virtual-grid lookup).
+//! - [`iosp`]: Implicit Object Space Partitioning (Eisemann, Bauszat et al., EGSR 2012): BVHs
+//!   whose planes are rebuilt from triangles at known array positions. [`Iosp0`] stores
+//!   nothing beyond the permuted triangles, [`Iosp4`] one word per node, [`Iosp2`] a SAH top
+//!   over IOSP-0 leaves; each build returns the permutation the renderer must apply.
 //! - [`crack_free`]: the crack-free intersection tests of Dammertz §3.4.
 //! - [`BruteForce`]: tests every triangle; the reference the others are checked against.
 //! - [`points`]: a balanced point kd-tree ([`PointKdTree`]) for photon maps and the caustic
@@ -64,6 +68,7 @@ pub mod brute_force;
 pub mod bvh2;
 pub mod crack_free;
 pub mod grid;
+pub mod iosp;
 pub mod on_demand;
 pub mod points;
 pub mod spec;
@@ -85,6 +90,7 @@ pub struct ValidationError {
     pub problem: String,
 }
 pub use bvh2::{BuildParams, Bvh2, BvhStats, Node, Split, MAX_BINS};
+pub use iosp::{Iosp0, Iosp2, Iosp4, IospError};
 pub use on_demand::OnDemandQbvh;
 pub use points::PointKdTree;
 pub use spec::{AccelKind, AccelSpec, SpecError, DEFAULT_ACCEL};

@@ -201,6 +201,27 @@ impl SlabRay {
         let t1 = t1 * FAR_SCALE;
         (t0 <= t1).then_some((t0, t1))
     }
+
+    /// Near and far distances of the single slab `[lo, hi]` on `axis`, ordered by the sign of
+    /// `1 / dir` (not by comparing them: with a `-0.0` component and the origin on a plane the
+    /// two are NaN and ±inf, and a comparison would put the infinity first). The caller folds
+    /// them into its interval with `f32::max`/`min`, which drop the NaN as [`SlabRay::hit`] does,
+    /// and pads the far side by [`FAR_SCALE`] when comparing. For single-axis hierarchies (IOSP).
+    #[inline(always)]
+    pub(crate) fn slab(&self, axis: usize, lo: f32, hi: f32) -> (f32, f32) {
+        let (near, far) = if self.neg[axis] { (hi, lo) } else { (lo, hi) };
+        (
+            (near - self.org[axis]) * self.inv[axis],
+            (far - self.org[axis]) * self.inv[axis],
+        )
+    }
+
+    /// True if the direction's component on `axis` has its sign bit set (`-0.0` included): the
+    /// ray runs towards lower coordinates, so the upper child is the near one.
+    #[inline(always)]
+    pub(crate) fn negative(&self, axis: usize) -> bool {
+        self.neg[axis]
+    }
 }
 
 /// A node of a binary tree whose two children are stored side by side: what [`walk_binary`]
