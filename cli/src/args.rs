@@ -150,7 +150,8 @@ fn accel_help() -> String {
         "Acceleration structure and its options, KIND[:OPTION...]: bvh (binned-SAH binary BVH), \
          qbvh (four-wide BVH), bvh8 (eight-wide BVH), two-level (per-object BVHs under a top \
          level that follows animated instances), clusters (rigid-body entry-point clustering, \
-         clusters:t=8), grid (uniform grid), irregular-grid or brute-force (tests every triangle; \
+         clusters:t=8), grid (uniform grid), irregular-grid, iosp0, iosp4, iosp2 (implicit BVHs in the \
+         triangle order; the scene is reordered) or brute-force (tests every triangle; \
          for checking only), e.g. qbvh:evh=14:compact or qbvh:order=distance; the options are listed \
          in crates/accel/src/spec.rs. [default: `[render] accel`, else {}]",
         rt_accel::DEFAULT_ACCEL

@@ -156,7 +156,8 @@ pub fn run(args: &Args) -> Result<()> {
             .as_mut()
             .is_some_and(|a| pool.install(|| a.update(&scene)));
         if !updated {
-            let built = pool.install(|| job.settings.accel.try_build_scene(&scene));
+            // IOSP reorders the scene's triangles to store nothing beyond them.
+            let built = pool.install(|| job.settings.accel.try_build_scene_mut(&mut scene));
             accel = Some(built.map_err(|e| {
                 anyhow::anyhow!(
                     "{}: --accel {}: {e}",

@@ -93,7 +93,7 @@ pub use bvh2::{BuildParams, Bvh2, BvhStats, Node, Split, MAX_BINS};
 pub use iosp::{Iosp0, Iosp2, Iosp4, IospError};
 pub use on_demand::OnDemandQbvh;
 pub use points::PointKdTree;
-pub use spec::{AccelKind, AccelSpec, SpecError, DEFAULT_ACCEL};
+pub use spec::{AccelKind, AccelSpec, BuildError, SpecError, DEFAULT_ACCEL};
 pub use two_level::{TopLevel, TwoLevel};
 pub use wide::{
     Bvh8, Node8, Order, QNode, Qbvh, TriangleTest, WideBvh, WideNode, WideOptions,

@@ -24,6 +24,10 @@
 //! | `t=T` | clusters | entry points are object nodes smaller than the scene's size over T (default 8) |
 //! | `top=rebuild\|refit` | two-level | per frame, rebuild the top level over the instances' boxes or refit it (default `rebuild`) |
 //!
+//! `iosp0`, `iosp4` and `iosp2` take no options. They live in the triangle order:
+//! [`AccelSpec::try_build_scene_mut`] reorders the scene to match (nothing stored beyond the
+//! triangles), [`AccelSpec::build`] over a slice maps hits back through an index map.
+//!
 //! `two-level` takes the bvh8 options for its object BVHs; built over a scene
 //! ([`AccelSpec::build_scene`]) it follows moving instances by [`Accel::update`].
 
@@ -62,11 +66,17 @@ pub enum AccelKind {
     Grid,
     /// [`IrregularGrid`](crate::IrregularGrid).
     IrregularGrid,
+    /// [`Iosp0`](crate::Iosp0): the implicit BVH in the triangle order, 0 bytes.
+    Iosp0,
+    /// [`Iosp4`](crate::Iosp4): 4 bytes per node.
+    Iosp4,
+    /// [`Iosp2`](crate::Iosp2): a SAH top over IOSP-0 heaps.
+    Iosp2,
 }
 
 impl AccelKind {
     /// Every kind, in the order reports list them.
-    pub const ALL: [AccelKind; 8] = [
+    pub const ALL: [AccelKind; 11] = [
         AccelKind::Qbvh,
         AccelKind::Bvh8,
         AccelKind::Bvh,
@@ -75,7 +85,15 @@ impl AccelKind {
         AccelKind::Clusters,
         AccelKind::Grid,
         AccelKind::IrregularGrid,
+        AccelKind::Iosp0,
+        AccelKind::Iosp4,
+        AccelKind::Iosp2,
     ];
+
+    /// True for the structures that reorder the triangles (IOSP).
+    pub fn permutes(self) -> bool {
+        matches!(self, AccelKind::Iosp0 | AccelKind::Iosp4 | AccelKind::Iosp2)
+    }
 
     /// True for the two-level kinds, whose object BVHs are BVH8s.
     pub fn is_two_level(self) -> bool {
@@ -98,6 +116,9 @@ impl AccelKind {
             AccelKind::Clusters => "clusters",
             AccelKind::Grid => "grid",
             AccelKind::IrregularGrid => "irregular-grid",
+            AccelKind::Iosp0 => "iosp0",
+            AccelKind::Iosp4 => "iosp4",
+            AccelKind::Iosp2 => "iosp2",
         }
     }
 }
@@ -123,13 +144,28 @@ pub struct AccelSpec {
     pub irregular: crate::IrregularGridParams,
 }
 
+/// Why a structure could not be built over the given triangles or scene.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum BuildError {
+    /// A grid's limits.
+    #[error(transparent)]
+    Grid(#[from] crate::GridError),
+    /// An IOSP structure's limits.
+    #[error(transparent)]
+    Iosp(#[from] crate::IospError),
+    /// The scene cannot be reordered.
+    #[error(transparent)]
+    Permute(#[from] rt_core::scene::PermuteError),
+}
+
 /// Why an accel spec was rejected.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 #[non_exhaustive]
 pub enum SpecError {
     /// The text before the first `:` is not a structure.
     #[error(
-        "unknown acceleration structure `{0}` (expected qbvh, bvh8, bvh, brute-force, two-level, clusters, grid or irregular-grid)"
+        "unknown acceleration structure `{0}` (expected qbvh, bvh8, bvh, brute-force, two-level, clusters, grid, irregular-grid, iosp0, iosp4 or iosp2)"
     )]
     UnknownKind(String),
     /// An option this crate does not know.
@@ -199,12 +235,35 @@ impl AccelSpec {
             .unwrap_or_else(|e| panic!("{self}: {e}"))
     }
 
+    /// Builds over `scene`, reordering its triangles (and their attributes) for the
+    /// structures that live in the triangle order (IOSP: nothing stored beyond the
+    /// triangles); the others as [`AccelSpec::try_build_scene`].
+    pub fn try_build_scene_mut(
+        &self,
+        scene: &mut rt_core::Scene,
+    ) -> Result<Box<dyn Accel>, BuildError> {
+        let (accel, perm): (Box<dyn Accel>, Vec<u32>) = match self.kind {
+            AccelKind::Iosp0 => {
+                let (a, p) = crate::Iosp0::build(&scene.triangles)?;
+                (Box::new(a), p)
+            }
+            AccelKind::Iosp4 => {
+                let (a, p) = crate::Iosp4::build(&scene.triangles)?;
+                (Box::new(a), p)
+            }
+            AccelKind::Iosp2 => {
+                let (a, p) = crate::Iosp2::build(&scene.triangles)?;
+                (Box::new(a), p)
+            }
+            _ => return self.try_build_scene(scene),
+        };
+        scene.permute_triangles(&perm)?;
+        Ok(accel)
+    }
+
     /// [`AccelSpec::build_scene`], or why the structure cannot hold the scene (grids index
     /// triangles and cell references with `u32`).
-    pub fn try_build_scene(
-        &self,
-        scene: &rt_core::Scene,
-    ) -> Result<Box<dyn Accel>, crate::GridError> {
+    pub fn try_build_scene(&self, scene: &rt_core::Scene) -> Result<Box<dyn Accel>, BuildError> {
         Ok(match self.kind {
             AccelKind::TwoLevel => Box::new(crate::TwoLevel::build(
                 scene,
@@ -233,8 +292,25 @@ impl AccelSpec {
     }
 
     /// [`AccelSpec::build`], or why the structure cannot hold the triangles.
-    pub fn try_build(&self, triangles: &[[Vec3; 3]]) -> Result<Box<dyn Accel>, crate::GridError> {
+    ///
+    /// The IOSP kinds answer in the caller's order through an index map
+    /// ([`crate::iosp::Unpermuted`], 4 bytes per triangle); [`AccelSpec::try_build_scene_mut`]
+    /// reorders the scene instead and stores nothing.
+    pub fn try_build(&self, triangles: &[[Vec3; 3]]) -> Result<Box<dyn Accel>, BuildError> {
+        use crate::iosp::Unpermuted;
         Ok(match self.kind {
+            AccelKind::Iosp0 => {
+                let (a, perm) = crate::Iosp0::build(triangles)?;
+                Box::new(Unpermuted::new(a, perm))
+            }
+            AccelKind::Iosp4 => {
+                let (a, perm) = crate::Iosp4::build(triangles)?;
+                Box::new(Unpermuted::new(a, perm))
+            }
+            AccelKind::Iosp2 => {
+                let (a, perm) = crate::Iosp2::build(triangles)?;
+                Box::new(Unpermuted::new(a, perm))
+            }
             AccelKind::Grid => Box::new(crate::UniformGrid::build(triangles, &self.grid)?),
             AccelKind::IrregularGrid => {
                 Box::new(crate::IrregularGrid::build(triangles, &self.irregular)?)

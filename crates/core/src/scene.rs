@@ -244,6 +244,51 @@ impl Scene {
         (prim - inst.first < inst.count).then_some(i as u32)
     }
 
+    /// Reorders the triangles and everything stored per triangle (normals, uvs, material
+    /// ids) so that triangle `i` is the one that was at `perm[i]`: what structures that live
+    /// in the triangle order (IOSP) need, so that `Hit::prim` indexes the scene without an
+    /// index map. The light table is rebuilt on next use. Object ranges cannot follow an
+    /// arbitrary order, so the objects become one range over the whole scene, named after
+    /// them when there was one.
+    pub fn permute_triangles(&mut self, perm: &[u32]) -> Result<(), PermuteError> {
+        let n = self.triangles.len();
+        if !self.instances.is_empty() {
+            return Err(PermuteError::Instances);
+        }
+        let mut seen = vec![false; n];
+        if perm.len() != n
+            || perm
+                .iter()
+                .any(|&p| (p as usize) >= n || std::mem::replace(&mut seen[p as usize], true))
+        {
+            return Err(PermuteError::NotAPermutation(n));
+        }
+        fn apply<T: Copy>(v: &mut Vec<T>, perm: &[u32]) {
+            if !v.is_empty() {
+                *v = perm.iter().map(|&p| v[p as usize]).collect();
+            }
+        }
+        apply(&mut self.triangles, perm);
+        apply(&mut self.normals, perm);
+        apply(&mut self.uvs, perm);
+        apply(&mut self.material_ids, perm);
+        let name = match self.objects.as_slice() {
+            [one] => one.name.clone(),
+            _ => "permuted".to_string(),
+        };
+        self.objects = if n == 0 {
+            Vec::new()
+        } else {
+            vec![Object {
+                name,
+                first: 0,
+                count: n as u32,
+            }]
+        };
+        self.lights = OnceLock::new();
+        Ok(())
+    }
+
     /// Adds a prototype (object-space geometry for instances) and returns its index.
     pub fn add_prototype(&mut self, p: Prototype) -> u32 {
         self.prototypes.push(p);
@@ -376,6 +421,17 @@ impl Scene {
             None => Rgb::ONE,
         }
     }
+}
+
+/// Why [`Scene::permute_triangles`] refused.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum PermuteError {
+    /// The order does not name every triangle exactly once.
+    #[error("not a permutation of the scene's {0} triangles")]
+    NotAPermutation(usize),
+    /// Instances keep their world copies in contiguous ranges.
+    #[error("the scene has instances, whose world copies must stay in contiguous ranges: structures that reorder the triangles (iosp0, iosp4, iosp2) cannot hold instanced or animated scenes; use two-level or clusters")]
+    Instances,
 }
 
 /// Bytes a [`Scene`] holds, by kind (length × element size of each buffer, names included).

@@ -86,11 +86,13 @@ mod heap;
 mod iosp0;
 mod iosp4;
 mod iosp4_build;
+mod permuted;
 pub mod split;
 mod two_level;
 
 pub use iosp0::Iosp0;
 pub use iosp4::Iosp4;
+pub use permuted::Unpermuted;
 pub use two_level::{Iosp2, DEFAULT_TOP_LEVELS};
 
 use glam::Vec3;
