@@ -227,3 +227,34 @@ fn rays_spawned_from_instance_hits_leave_their_triangle() {
     }
     assert!(checked > 1000, "only {checked} spawned rays");
 }
+
+#[test]
+fn moving_instances_rebuilds_no_object_bvh() {
+    let mut rng = Rng::new(9);
+    let mut s = scene(&mut rng, 6);
+    for clustered in [false, true] {
+        let mut a = if clustered {
+            rt_accel::TwoLevel::build_clustered(&s, &Default::default(), &Default::default(), 8.0)
+        } else {
+            rt_accel::TwoLevel::build(
+                &s,
+                &Default::default(),
+                &Default::default(),
+                TopLevel::Refit,
+            )
+        };
+        // One object for the static soup and one for the shared prototype.
+        assert_eq!(a.object_count(), 2);
+        let objects = a.object_addresses();
+        for frame in 1..6 {
+            s.set_time(frame as f32 * 0.2);
+            assert!(a.update(&s));
+            assert_eq!(
+                a.object_addresses(),
+                objects,
+                "an object BVH moved in memory"
+            );
+            assert_eq!(a.top_updates(), frame + 1);
+        }
+    }
+}

@@ -76,6 +76,8 @@ pub struct TwoLevel {
     top: top::Top,
     mode: TopLevel,
     bounds: Aabb,
+    /// Top levels built or refitted (the build's included): what a frame costs.
+    top_updates: usize,
 }
 
 impl TwoLevel {
@@ -195,6 +197,7 @@ impl TwoLevel {
             top: top::Top::default(),
             mode,
             bounds: Aabb::EMPTY,
+            top_updates: 1,
         };
         s.place_instances(instances);
         s.make_entries();
@@ -268,6 +271,25 @@ impl TwoLevel {
     /// Leaves of the top level (placements, or entry points when clustered).
     pub fn entry_count(&self) -> usize {
         self.entries.len()
+    }
+
+    /// Object BVHs this structure holds: built once, whatever the frames since.
+    pub fn object_count(&self) -> usize {
+        self.objects.len()
+    }
+
+    /// Times the top level was built or refitted, the first build included.
+    pub fn top_updates(&self) -> usize {
+        self.top_updates
+    }
+
+    /// The object BVHs' node arrays, by address: they stay put across [`Accel::update`]
+    /// (nothing below the top level is rebuilt), which a test can check.
+    pub fn object_addresses(&self) -> Vec<usize> {
+        self.objects
+            .iter()
+            .map(|o| o.bvh.nodes().as_ptr() as usize)
+            .collect()
     }
 
     /// Closest hit (or any hit) over all placements.
@@ -402,6 +424,7 @@ impl Accel for TwoLevel {
         let before = std::mem::take(&mut self.entries);
         self.make_entries();
         // Refitting needs the same leaves; a clustered cut may change with the scene's size.
+        self.top_updates += 1;
         if self.mode == TopLevel::Refit && self.entries == before {
             self.top.refit(&self.entry_boxes);
         } else {
