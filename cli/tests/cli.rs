@@ -167,6 +167,9 @@ fn help_explains_every_flag() {
         "--camera",
         "--aov",
         "--exposure",
+        "--frames",
+        "--frame",
+        "--fps",
     ] {
         assert!(help.contains(flag), "--help lacks {flag}");
     }
