@@ -119,10 +119,10 @@ pub fn placement_error(t: &Transform, object: &[Vec3; 3], p: Vec3) -> Vec3 {
     let translate = t.m.w_axis.truncate().abs();
     let v_max = object[0].abs().max(object[1].abs()).max(object[2].abs());
     let forward = gamma(3) * (m_abs * v_max + translate);
-    let inv = t.m.inverse();
-    let inv_abs = abs(Mat3::from_mat4(inv));
-    let inv_translate = inv.w_axis.truncate().abs();
-    let back = m_abs * (gamma(3) * (inv_abs * p.abs() + inv_translate));
+    // The inverse's linear part is the transpose of the normal matrix (no 4×4 inverse per
+    // hit), and `|M⁻¹ t| ≤ |M⁻¹| |t|` bounds its translation.
+    let inv_abs = abs(t.normal.transpose());
+    let back = m_abs * (gamma(3) * (inv_abs * (p.abs() + translate)));
     // Two more roundings of each sum (the bound itself and its addition to the point's).
     (forward + back) * (1.0 + gamma(2))
 }

@@ -52,8 +52,9 @@ struct Object {
 #[derive(Clone, Copy)]
 struct Placement {
     object: u32,
-    /// World to object space; `None` for the identity.
+    /// World to object space and back; `None` for the identity.
     to_object: Option<Mat4>,
+    to_world: Option<Mat4>,
     /// Scene index of the instance's first triangle (its world copy).
     first: u32,
     /// The world copy's winding is reversed (a mirroring transform).
@@ -163,6 +164,7 @@ impl TwoLevel {
             placements.push(Placement {
                 object: 0,
                 to_object: None,
+                to_world: None,
                 first: 0,
                 flip: false,
                 world: bounds,
@@ -222,7 +224,7 @@ impl TwoLevel {
                 self.entry_boxes.push(p.world);
                 continue;
             };
-            let to_world = p.to_object.map(|m| m.inverse());
+            let to_world = p.to_world;
             // The largest factor by which the placement stretches a length.
             let stretch = to_world.map_or(1.0, |m| {
                 let len = |v: glam::Vec4| v.truncate().length();
@@ -253,6 +255,7 @@ impl TwoLevel {
             self.placements.push(Placement {
                 object,
                 to_object: Some(m.inverse()),
+                to_world: Some(m),
                 first: inst.first,
                 flip: inst.transform.flips_handedness(),
                 world,
