@@ -80,6 +80,17 @@ fn frames_render_to_numbered_files_and_one_frame_alone_is_the_same() {
     // The box moves, and the noise is new every frame.
     assert_ne!(frames[0], frames[1]);
     assert_ne!(frames[1], frames[2]);
+    // Without motion, consecutive frames still differ: their noise is their own.
+    let still = SCENE.split("[[animation]]").next().unwrap();
+    std::fs::write(d.join("still.toml"), still).unwrap();
+    let mut args = vec!["still.toml", "--frames", "0..2", "-o", "s_{frame}.exr"];
+    args.extend_from_slice(&common);
+    ok(&render(d, &args));
+    assert_ne!(
+        std::fs::read(d.join("s_0.exr")).unwrap(),
+        std::fs::read(d.join("s_1.exr")).unwrap(),
+        "frames of a still scene share their noise"
+    );
     // Frame 0 is the scene at time 0 with the plain render's streams.
     let mut plain = vec!["s.toml", "-o", "plain.exr"];
     plain.extend_from_slice(&common);
