@@ -128,6 +128,14 @@ pub struct Args {
     /// Frames per second of --frames and --frame.
     #[arg(long, default_value_t = 24.0)]
     pub fps: f64,
+
+    /// Motion blur: the shutter stays open for this fraction of a frame (1 / fps seconds)
+    /// from the frame's time; every camera sample draws a time in it, its rays carry it, and
+    /// moving instances and cameras are placed at it. Needs a structure that places instances
+    /// per ray (two-level or clusters; chosen when --accel is not given) and a camera-ray
+    /// integrator (path, path-bsdf, direct, ao).
+    #[arg(long, value_name = "S", default_value_t = 0.0)]
+    pub shutter: f64,
 }
 
 /// `A..B` with `A < B`.

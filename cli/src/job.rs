@@ -136,6 +136,8 @@ pub fn run(args: &Args) -> Result<()> {
     let mut job = Job::resolve(args, &loaded.render)?;
     let mut scene = loaded.scene;
     let frames = frame_list(args, &job.output)?;
+    let accel_chosen = args.accel.is_some() || loaded.render.accel.is_some();
+    set_shutter(args, &mut job, &mut scene, accel_chosen)?;
 
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(t) = job.settings.threads {
@@ -149,6 +151,9 @@ pub fn run(args: &Args) -> Result<()> {
             scene.set_time((f64::from(f) / args.fps) as f32);
             job.output = frame_output(&pattern, f);
             job.settings.seed = frame_seed(seed, f);
+        }
+        if let Some(e) = scene.motion_blur_error() {
+            bail!("{}: --shutter: {e}", job.scene_path.display());
         }
         // Two-level structures follow rigid motion in place; flat ones are rebuilt.
         let t_build = Instant::now();
@@ -175,6 +180,44 @@ pub fn run(args: &Args) -> Result<()> {
             built,
             (load_time, t_build.elapsed()),
         )?;
+    }
+    Ok(())
+}
+
+/// Opens the scene's shutter for `--shutter` of a frame and checks that the render can blur
+/// what moves: no moving emitter, a camera-ray technique, and a structure that places
+/// instances per ray (two-level when the user chose none).
+fn set_shutter(args: &Args, job: &mut Job, scene: &mut Scene, accel_chosen: bool) -> Result<()> {
+    let s = args.shutter;
+    if !(s.is_finite() && s >= 0.0) {
+        bail!("--shutter must be a fraction of a frame >= 0, got {s}");
+    }
+    if s == 0.0 {
+        return Ok(());
+    }
+    if !(args.fps.is_finite() && args.fps > 0.0) {
+        bail!("--fps must be a positive number, got {}", args.fps);
+    }
+    scene.shutter = (s / args.fps) as f32;
+    let path = job.scene_path.display();
+    let moving_instances = scene.instances.iter().any(|i| i.is_animated());
+    if !moving_instances && scene.camera_motions.is_empty() {
+        return Ok(());
+    }
+    if !job.settings.integrator.build().motion_blur() {
+        bail!(
+            "{path}: --shutter: the {} integrator cannot motion blur (path, path-bsdf, direct and ao can)",
+            job.settings.integrator
+        );
+    }
+    if moving_instances && !job.settings.accel.kind.is_two_level() {
+        if accel_chosen {
+            bail!(
+                "{path}: --shutter: --accel {} holds the scene at one time; motion blur needs two-level or clusters",
+                job.settings.accel
+            );
+        }
+        job.settings.accel = "two-level".parse().expect("a valid spec");
     }
     Ok(())
 }

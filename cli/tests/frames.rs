@@ -123,3 +123,71 @@ fn bad_frame_arguments_are_one_line() {
         assert!(err.contains(want), "{args:?}: {err}");
     }
 }
+
+#[test]
+fn shutter_blurs_what_moves_and_nothing_else() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("s.toml"), SCENE).unwrap();
+    let common = ["--spp", "8", "--fps", "1", "-q", "--frame", "1"];
+    let run = |extra: &[&str], out: &str| {
+        ok(&render(d, &[&["s.toml", "-o", out][..], &common, extra].concat()));
+        std::fs::read(d.join(out)).unwrap()
+    };
+    // Two-level is chosen for the moving box; the image is the same on any thread count.
+    let blurred = run(&["--shutter", "0.5", "--threads", "2"], "b2.exr");
+    assert_eq!(run(&["--shutter", "0.5", "--threads", "1"], "b1.exr"), blurred);
+    assert_ne!(run(&[], "sharp.exr"), blurred, "the shutter changed nothing");
+    assert_eq!(
+        run(&["--shutter", "0.5", "--accel", "clusters"], "c.exr").len(),
+        blurred.len()
+    );
+    // Nothing moves in a still scene: the same bytes as without a shutter, with any structure.
+    let still = SCENE.split("[[animation]]").next().unwrap();
+    std::fs::write(d.join("still.toml"), still).unwrap();
+    let still_run = |extra: &[&str], out: &str| {
+        ok(&render(d, &[&["still.toml", "-o", out][..], &common, extra].concat()));
+        std::fs::read(d.join(out)).unwrap()
+    };
+    assert_eq!(
+        still_run(&["--shutter", "0.5", "--accel", "bvh8"], "s1.exr"),
+        still_run(&[], "s0.exr")
+    );
+}
+
+#[test]
+fn shutter_refusals_are_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("s.toml"), SCENE).unwrap();
+    let lamp_moves = format!(
+        "{SCENE}\n[[animation]]\ntarget = \"light\"\nkeys = [ {{ time = 0.0, translate = [0, 0, 0] }}, {{ time = 2.0, translate = [0, 0.2, 0] }} ]\n"
+    );
+    std::fs::write(d.join("lamp.toml"), lamp_moves).unwrap();
+    for (scene, args, want) in [
+        ("s.toml", vec!["--shutter=-0.5"], "--shutter must be"),
+        ("s.toml", vec!["--shutter", "NaN"], "--shutter must be"),
+        (
+            "s.toml",
+            vec!["--shutter", "0.5", "--accel", "bvh8"],
+            "motion blur needs two-level or clusters",
+        ),
+        (
+            "s.toml",
+            vec!["--shutter", "0.5", "--integrator", "bdpt"],
+            "cannot motion blur",
+        ),
+        ("lamp.toml", vec!["--shutter", "0.5"], "`light` emits light and moves"),
+    ] {
+        let out = render(
+            d,
+            &[&[scene, "--spp", "1", "--frame", "1", "-o", "x.exr"][..], &args].concat(),
+        );
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_ne!(out.status.code(), Some(0), "{args:?}");
+        assert_ne!(out.status.code(), Some(101), "panic: {err}");
+        assert!(err.contains(want), "{args:?}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{args:?}: {err}");
+        assert!(err.contains(scene) || want.starts_with("--"), "{err}");
+    }
+}

@@ -110,7 +110,7 @@ fn shadows_on_a_sliver_fan_ground_follow_the_geometry() {
                 let Some(hit) = accel.intersect(&ray, f32::INFINITY) else {
                     panic!("{}: no ground below ({x}, {z})", kind.name());
                 };
-                let s = scene.surface(&hit);
+                let s = scene.surface(&hit, 0.0);
                 let q = s.p.as_dvec3();
                 if near_outline(DVec3::new(x as f64, 0.0, z as f64), band) {
                     continue;

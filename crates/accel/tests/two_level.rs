@@ -205,7 +205,7 @@ fn rays_spawned_from_instance_hits_leave_their_triangle() {
         let Some(hit) = a.intersect(&ray, t_max) else {
             continue;
         };
-        let si = s.surface(&hit);
+        let si = s.surface(&hit, 0.0);
         if si.instance.is_none() {
             continue;
         }
@@ -256,5 +256,67 @@ fn moving_instances_rebuilds_no_object_bvh() {
             );
             assert_eq!(a.top_updates(), frame + 1);
         }
+    }
+}
+
+/// Motion blur: with the shutter open over `[0.2, 0.8]`, rays at shutter time `u` hit what
+/// brute force over the scene set to time `0.2 + 0.6 u` hits (the swept boxes hold the
+/// instances between the box samples too), and shading a hit at `u` gives that scene's
+/// surface point. Control: a structure built with the shutter closed answers for the opening
+/// time only, which the comparison sees.
+#[test]
+fn motion_blurred_rays_hit_the_scene_at_their_time() {
+    let (open, shutter) = (0.2f32, 0.6f32);
+    let mut rng = Rng::new(21);
+    let mut s = scene(&mut rng, 10);
+    s.set_time(open);
+    let closed = AccelSpec::new(AccelKind::TwoLevel).build_scene(&s);
+    s.shutter = shutter;
+    let mut clusters = AccelSpec::new(AccelKind::Clusters);
+    clusters.cluster_t = 8.0;
+    for spec in [AccelSpec::new(AccelKind::TwoLevel), clusters] {
+        let a = spec.build_scene(&s);
+        assert!(a.interpolates_motion());
+        let (mut total, mut bad, mut control_bad, mut shaded) = (0, 0, 0, 0);
+        for k in 0..12 {
+            // Times off the box samples (sixteenths of the shutter) on purpose.
+            let u = (k as f32 + 0.37) / 12.0;
+            let mut at = s.clone();
+            at.shutter = 0.0;
+            at.set_time(open + u * shutter);
+            let rays: Vec<_> = rays(&mut rng, &at.triangles, 1500)
+                .into_iter()
+                .map(|(r, t)| (r.at_time(u), t))
+                .collect();
+            let (n, b) = compare(a.as_ref(), &at, &rays);
+            total += n;
+            bad += b;
+            let bf = BruteForce::new(&at.triangles);
+            control_bad += rays
+                .iter()
+                .filter(|(r, t)| {
+                    let (x, y) = (closed.intersect(r, *t), bf.intersect(r, *t));
+                    x.map(|h| (h.prim, (h.t * 1e3) as i64)) != y.map(|h| (h.prim, (h.t * 1e3) as i64))
+                })
+                .count();
+            for (ray, t_max) in &rays {
+                let Some(hit) = a.intersect(ray, *t_max) else {
+                    continue;
+                };
+                let (blurred, still) = (s.surface(&hit, u), at.surface(&hit, 0.0));
+                assert!(
+                    blurred.p.distance(still.p) < 1e-4 && blurred.ng.dot(still.ng) > 0.9999,
+                    "shading at time {u}: {blurred:?} vs {still:?}"
+                );
+                assert_eq!(blurred.time, u);
+                shaded += 1;
+            }
+        }
+        assert!(shaded > 1000, "only {shaded} hits shaded");
+        assert!(bad * 1000 <= total, "{spec}: {bad} of {total} rays disagree");
+        assert!(
+            control_bad * 20 > total,
+            "the closed-shutter control disagrees on only {control_bad} of {total} rays"
+        );
     }
 }

@@ -100,6 +100,13 @@ pub trait Accel: Send + Sync {
         false
     }
 
+    /// True if the structure places moving instances where they are at each ray's
+    /// [`Ray::time`] (two-level structures), as motion blur needs; flat structures hold the
+    /// scene as it is at one time and ignore it.
+    fn interpolates_motion(&self) -> bool {
+        false
+    }
+
     /// Closest hit with `t ∈ (0, t_max]`, uncounted.
     fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         self.closest_hit(ray, t_max, None)

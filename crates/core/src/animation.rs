@@ -161,6 +161,12 @@ impl Motion {
 
     /// The keyed transform at time `t`.
     pub fn at(&self, t: f32) -> Transform {
+        Transform::from_mat4(self.matrix_at(t))
+    }
+
+    /// The keyed transform's matrix at time `t`, without the normal matrix [`Motion::at`]
+    /// inverts for: what a structure interpolating a moving instance per ray needs.
+    pub fn matrix_at(&self, t: f32) -> Mat4 {
         let (i, j, w) = bracket(&self.times, t);
         let (a, b) = (&self.keys[i], &self.keys[j]);
         let translate = a.translate.lerp(b.translate, w);
@@ -170,11 +176,7 @@ impl Motion {
         } else {
             a.rotate.slerp(b.rotate, w)
         };
-        Transform::from_mat4(Mat4::from_scale_rotation_translation(
-            scale,
-            rotate.normalize(),
-            translate,
-        ))
+        Mat4::from_scale_rotation_translation(scale, rotate.normalize(), translate)
     }
 
     /// True if the transform is the same at every time (one key, or all keys equal).

@@ -1,6 +1,6 @@
 //! Pinhole and thin-lens cameras.
 
-use crate::{sampling::concentric_disk, Ray};
+use crate::{animation::CameraKey, sampling::concentric_disk, Ray};
 use glam::{Vec2, Vec3};
 
 /// A perspective camera. Image right is `forward × up` (right-handed: looking down -z with +y
@@ -74,16 +74,52 @@ impl Camera {
     /// lens sample `lens` in [0,1)² (ignored by a pinhole). The direction is normalised.
     #[inline]
     pub fn generate_ray(&self, film: Vec2, lens: Vec2) -> Ray {
+        self.ray_from(
+            self.position,
+            [self.forward, self.right, self.up],
+            self.tan_half,
+            film,
+            lens,
+        )
+    }
+
+    /// [`Camera::generate_ray`] from the pose and field of view of keyframe `key` (this
+    /// camera's resolution, aperture and focus distance), at shutter time `time`: a moving
+    /// camera's ray during the shutter, without building a camera per sample. A degenerate
+    /// blend of two keys (the position crossing the look-at point) keeps this camera's pose.
+    #[inline]
+    pub fn generate_ray_at(&self, key: &CameraKey, time: f32, film: Vec2, lens: Vec2) -> Ray {
+        let forward = (key.look_at - key.position).normalize();
+        let right = forward.cross(key.up).normalize();
+        let up = right.cross(forward);
+        let ray = if forward.is_finite() && right.is_finite() && up.is_finite() {
+            let tan_half = (key.fov.to_radians() * 0.5).tan();
+            self.ray_from(key.position, [forward, right, up], tan_half, film, lens)
+        } else {
+            self.generate_ray(film, lens)
+        };
+        ray.at_time(time)
+    }
+
+    #[inline]
+    fn ray_from(
+        &self,
+        position: Vec3,
+        [forward, right, up]: [Vec3; 3],
+        tan_half: f32,
+        film: Vec2,
+        lens: Vec2,
+    ) -> Ray {
         let aspect = self.width as f32 / self.height as f32;
-        let sx = (2.0 * film.x / self.width as f32 - 1.0) * self.tan_half * aspect;
-        let sy = (1.0 - 2.0 * film.y / self.height as f32) * self.tan_half;
-        let d = self.forward + self.right * sx + self.up * sy;
+        let sx = (2.0 * film.x / self.width as f32 - 1.0) * tan_half * aspect;
+        let sy = (1.0 - 2.0 * film.y / self.height as f32) * tan_half;
+        let d = forward + right * sx + up * sy;
         if self.is_pinhole() {
-            return Ray::new(self.position, d.normalize());
+            return Ray::new(position, d.normalize());
         }
-        let focus = self.position + d * self.focus_distance;
+        let focus = position + d * self.focus_distance;
         let l = concentric_disk(lens) * self.aperture;
-        let o = self.position + self.right * l.x + self.up * l.y;
+        let o = position + right * l.x + up * l.y;
         Ray::new(o, (focus - o).normalize())
     }
 

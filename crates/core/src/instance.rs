@@ -61,6 +61,24 @@ impl Instance {
         }
     }
 
+    /// The object-to-world matrix at time `t` (the matrix of [`Instance::transform_at`]).
+    pub fn matrix_at(&self, t: f32) -> glam::Mat4 {
+        match &self.motion {
+            Some(m) => m.matrix_at(t) * self.base.m,
+            None => self.base.m,
+        }
+    }
+
+    /// True if the instance is animated and its keys span part of the interval `(t0, t1)`:
+    /// it may be somewhere else at some time of the interval than at `t0`.
+    pub fn moves_during(&self, t0: f32, t1: f32) -> bool {
+        self.is_animated()
+            && self.motion.as_ref().is_some_and(|m| {
+                let keys = m.keys();
+                keys[0].time < t1 && keys[keys.len() - 1].time > t0
+            })
+    }
+
     /// True if the instance moves (its transform depends on time).
     pub fn is_animated(&self) -> bool {
         self.motion.as_ref().is_some_and(|m| !m.is_static())

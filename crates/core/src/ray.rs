@@ -10,13 +10,29 @@ pub struct Ray {
     pub origin: Vec3,
     /// Direction (any non-zero length).
     pub dir: Vec3,
+    /// When the ray is traced, as a fraction of the scene's shutter interval
+    /// (`Scene::shutter`): 0 is the scene's current time (the shutter opening), 1 its closing.
+    /// Only motion blur draws other values; structures that interpolate moving instances
+    /// ([`crate::Accel::interpolates_motion`]) place them at this time, and rays spawned at a
+    /// hit keep it ([`crate::scene::SurfaceHit::time`]).
+    pub time: f32,
 }
 
 impl Ray {
-    /// A ray from `origin` along `dir`.
+    /// A ray from `origin` along `dir` at the shutter's opening (time 0).
     #[inline]
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
-        Self { origin, dir }
+        Self {
+            origin,
+            dir,
+            time: 0.0,
+        }
+    }
+
+    /// The same ray at shutter time `time` (see [`Ray::time`]).
+    #[inline]
+    pub fn at_time(self, time: f32) -> Self {
+        Self { time, ..self }
     }
 
     /// The point at parameter `t`.

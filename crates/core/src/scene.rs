@@ -63,6 +63,9 @@ pub struct Scene {
     pub camera_motions: Vec<CameraMotion>,
     /// The time (seconds) the world copies and cameras are at ([`Scene::set_time`]).
     pub time: f32,
+    /// How long (seconds) the shutter stays open after `time`: 0 renders the instant `time`;
+    /// more blurs what moves (a ray's [`crate::Ray::time`] is a fraction of this interval).
+    pub shutter: f32,
     /// Emitter sampling structure, built on first use ([`Scene::lights`]), so integrators that
     /// never sample lights never pay for it. Reset with [`Scene::build_lights`] after changing
     /// geometry, materials or the environment.
@@ -90,6 +93,25 @@ pub struct SurfaceHit {
     pub prim: u32,
     /// The instance the triangle belongs to, if any.
     pub instance: Option<u32>,
+    /// When the ray that found the point was traced, as a fraction of the shutter
+    /// ([`crate::Ray::time`]); rays leaving the point keep it ([`SurfaceHit::spawn_ray`]).
+    pub time: f32,
+}
+
+impl SurfaceHit {
+    /// A ray leaving the point along `w`, offset off the surface, at the point's time.
+    #[inline]
+    pub fn spawn_ray(&self, w: Vec3) -> crate::Ray {
+        crate::ray::spawn_ray(self.p, self.p_error, self.ng, w).at_time(self.time)
+    }
+
+    /// The shadow segment from the point to point `q` (error bound `q_error`, normal `nq`) on
+    /// another surface, at the point's time ([`crate::ray::shadow_segment`]).
+    #[inline]
+    pub fn shadow_segment(&self, q: Vec3, q_error: Vec3, nq: Vec3) -> (crate::Ray, f32) {
+        let (r, t_max) = crate::ray::shadow_segment(self.p, self.p_error, self.ng, q, q_error, nq);
+        (r.at_time(self.time), t_max)
+    }
 }
 
 impl Scene {
@@ -109,6 +131,7 @@ impl Scene {
             instances: Vec::new(),
             camera_motions: Vec::new(),
             time: 0.0,
+            shutter: 0.0,
             lights: OnceLock::new(),
         }
     }
@@ -184,16 +207,30 @@ impl Scene {
         &self.materials[self.material_ids[prim as usize] as usize]
     }
 
-    /// Shading information for a hit.
+    /// Shading information for a hit of a ray traced at shutter time `time` (the ray's
+    /// [`crate::Ray::time`]; 0 without motion blur). A moving instance is shaded where it was
+    /// at that time, from its prototype, not from its world copy at the shutter's opening.
     #[inline]
-    pub fn surface(&self, hit: &Hit) -> SurfaceHit {
+    pub fn surface(&self, hit: &Hit, time: f32) -> SurfaceHit {
         let i = hit.prim as usize;
-        let v = &self.triangles[i];
+        let instance = self.instance_of(hit.prim);
+        let moved = match instance {
+            Some(k) if time != 0.0 && self.shutter > 0.0 => self.moved_triangle(k, i, time),
+            _ => None,
+        };
+        let v = match &moved {
+            Some((v, _, _)) => v,
+            None => &self.triangles[i],
+        };
         let (b1, b2) = (hit.b1, hit.b2);
         let b0 = 1.0 - b1 - b2;
         let (p, p_error) = triangle::point_with_error(v, b1, b2);
         let ng = triangle::geometric_normal(v).normalize_or(Vec3::Z);
-        let ns = match self.normals_of(i) {
+        let normals = match &moved {
+            Some((_, n, _)) => n.as_ref(),
+            None => self.normals_of(i),
+        };
+        let ns = match normals {
             Some(n) => {
                 let n = (n[0] * b0 + n[1] * b1 + n[2] * b2).normalize_or(ng);
                 if n.dot(ng) < 0.0 {
@@ -208,7 +245,6 @@ impl Scene {
             Some(t) => t[0] * b0 + t[1] * b1 + t[2] * b2,
             None => Vec2::new(b1, b2),
         };
-        let instance = self.instance_of(hit.prim);
         // A two-level structure intersects the prototype with an inverse-transformed ray:
         // the origin offset must also cover the placement's rounding.
         let p_error = match instance {
@@ -216,7 +252,11 @@ impl Scene {
                 let inst = &self.instances[k as usize];
                 let local = (hit.prim - inst.first) as usize;
                 let object = &self.prototypes[inst.prototype as usize].triangles[local];
-                p_error + placement_error(&inst.transform, object, p)
+                let placement = match &moved {
+                    Some((_, _, t)) => t,
+                    None => &inst.transform,
+                };
+                p_error + placement_error(placement, object, p)
             }
             None => p_error,
         };
@@ -229,7 +269,72 @@ impl Scene {
             material: self.material_ids[i],
             prim: hit.prim,
             instance,
+            time,
         }
+    }
+
+    /// Triangle `i` of instance `k` (its vertices and shading normals in the world, and the
+    /// placement) at shutter time `time`, if the instance is elsewhere then than its world
+    /// copy.
+    fn moved_triangle(
+        &self,
+        k: u32,
+        i: usize,
+        time: f32,
+    ) -> Option<([Vec3; 3], Option<[Vec3; 3]>, Transform)> {
+        let inst = &self.instances[k as usize];
+        if !inst.is_animated() {
+            return None;
+        }
+        let t = inst.transform_at(self.time + time * self.shutter);
+        let proto = &self.prototypes[inst.prototype as usize];
+        let local = i - inst.first as usize;
+        let flip = t.flips_handedness();
+        let v = place_triangle(&t, flip, &proto.triangles[local]);
+        let normals = proto.normals.get(local).copied().flatten();
+        let (n, _) = place_attributes(&t, flip, normals, None);
+        Some((v, n, t))
+    }
+
+    /// True if something moves while the shutter is open: an instance, or the camera named
+    /// `camera` (see [`Scene::camera_motion`]). Renders then draw a time per camera sample.
+    pub fn is_motion_blurred(&self, camera: &str) -> bool {
+        self.shutter > 0.0
+            && (self.instances.iter().any(|i| self.moves_in_shutter(i))
+                || self.camera_motion(camera).is_some())
+    }
+
+    /// True if instance `inst` moves while the shutter is open.
+    fn moves_in_shutter(&self, inst: &Instance) -> bool {
+        self.shutter > 0.0 && inst.moves_during(self.time, self.time + self.shutter)
+    }
+
+    /// The keyframed motion of the camera named `camera`, if it has one and moves while the
+    /// shutter is open.
+    pub fn camera_motion(&self, camera: &str) -> Option<&CameraMotion> {
+        let (t0, t1) = (self.time, self.time + self.shutter);
+        self.camera_motions.iter().find(|m| {
+            let keys = m.keys();
+            self.shutter > 0.0
+                && self.cameras.get(m.camera).is_some_and(|c| c.name == camera)
+                && keys.len() > 1
+                && keys[0].time < t1
+                && keys[keys.len() - 1].time > t0
+        })
+    }
+
+    /// Why the scene cannot be motion blurred as it is, if it cannot: lights are sampled
+    /// from the world copies at the shutter's opening, so an emitter that moves while the
+    /// shutter is open would light the scene from the wrong place.
+    pub fn motion_blur_error(&self) -> Option<MotionBlurError> {
+        self.instances
+            .iter()
+            .find(|inst| {
+                self.moves_in_shutter(inst)
+                    && (inst.first..inst.first + inst.count)
+                        .any(|p| crate::lights::is_emitter(self, p))
+            })
+            .map(|inst| MotionBlurError::MovingEmitter(inst.name.clone()))
     }
 
     /// The instance triangle `prim` belongs to, if any.
@@ -423,6 +528,15 @@ impl Scene {
     }
 }
 
+/// Why a scene cannot be rendered with motion blur ([`Scene::motion_blur_error`]).
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum MotionBlurError {
+    /// An emitter moves while the shutter is open.
+    #[error("`{0}` emits light and moves while the shutter is open: moving lights cannot be motion blurred (light sampling sees them where the shutter opens); render it with --shutter 0 or make it static")]
+    MovingEmitter(String),
+}
+
 /// Why [`Scene::permute_triangles`] refused.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum PermuteError {
@@ -530,6 +644,7 @@ impl crate::content_hash::ContentHash for Scene {
             instances,
             camera_motions,
             time,
+            shutter,
             lights: _,
         } = self;
         triangles.content_hash(out);
@@ -545,6 +660,7 @@ impl crate::content_hash::ContentHash for Scene {
         instances.content_hash(out);
         camera_motions.content_hash(out);
         time.content_hash(out);
+        shutter.content_hash(out);
     }
 }
 

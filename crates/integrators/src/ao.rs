@@ -4,7 +4,7 @@
 //! (value 1).
 
 use crate::{Ctx, Integrator, RayCounters, SampleAux};
-use rt_core::{frame::Frame, ray::spawn_ray, sampling::cosine_hemisphere, Ray, Rgb, Sampler};
+use rt_core::{frame::Frame, sampling::cosine_hemisphere, Ray, Rgb, Sampler};
 use rt_film::FirstHit;
 
 /// Ambient-occlusion estimator.
@@ -31,7 +31,7 @@ impl Integrator for AoIntegrator {
         let Some(hit) = ctx.accel.intersect(&ray, f32::INFINITY) else {
             return Rgb::ONE;
         };
-        let si = ctx.scene.surface(&hit);
+        let si = ctx.scene.surface(&hit, ray.time);
         let wo = -ray.dir;
         let flip = if si.ng.dot(wo) < 0.0 { -1.0 } else { 1.0 };
         let (ng, ns) = (si.ng * flip, si.ns * flip);
@@ -48,7 +48,7 @@ impl Integrator for AoIntegrator {
             return Rgb::ZERO;
         }
         counters.shadow_rays += 1;
-        let r = spawn_ray(si.p, si.p_error, ng, d);
+        let r = si.spawn_ray(d);
         if ctx.accel.occluded(&r, self.max_distance) {
             Rgb::ZERO
         } else {

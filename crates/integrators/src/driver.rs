@@ -8,7 +8,9 @@
 //! Dimension layout of one sample: the film position (one 2D draw), the lens position (one 2D
 //! draw, only for a thin-lens camera: a pinhole ignores it, so it is not drawn), then whatever
 //! the integrator draws. Pinhole images therefore use the integrator's dimensions one draw
-//! earlier than thin-lens images do.
+//! earlier than thin-lens images do. With motion blur (something moves while the scene's
+//! shutter is open) the shutter time follows the lens (one 1D draw): every ray of the sample
+//! carries it, and a moving camera is placed at it.
 
 use crate::{Ctx, Integrator, RayCounters, SampleAux};
 use rayon::prelude::*;
@@ -105,6 +107,9 @@ pub fn render_samples(
     let rows_done = std::sync::atomic::AtomicU32::new(0);
     let camera = ctx.camera;
     let thin_lens = !camera.is_pinhole();
+    let blurred = ctx.scene.is_motion_blurred(&camera.name);
+    let camera_motion = ctx.scene.camera_motion(&camera.name);
+    let (open, shutter) = (ctx.scene.time, ctx.scene.shutter);
     film.stripes_mut(BAND_ROWS)
         .into_par_iter()
         .for_each(|mut stripe| {
@@ -125,7 +130,18 @@ pub fn render_samples(
                         } else {
                             Vec2::ZERO
                         };
-                        let ray = camera.generate_ray(film_pos, lens);
+                        let ray = if blurred {
+                            let time = sampler.next_1d();
+                            match camera_motion {
+                                Some(m) => {
+                                    let key = m.at(open + time * shutter);
+                                    camera.generate_ray_at(&key, time, film_pos, lens)
+                                }
+                                None => camera.generate_ray(film_pos, lens).at_time(time),
+                            }
+                        } else {
+                            camera.generate_ray(film_pos, lens)
+                        };
                         let mut aux = SampleAux {
                             want_first_hit,
                             first_hit: None,

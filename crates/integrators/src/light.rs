@@ -183,7 +183,7 @@ impl LightTracer {
                 break;
             };
             depth += 1;
-            let si = scene.surface(&hit);
+            let si = scene.surface(&hit, 0.0);
             let material = &scene.materials[si.material as usize];
             let wo = -ray.dir;
             let tint = scene.tint(material, si.uv);

@@ -18,7 +18,7 @@
 use crate::transport::{light_visible, survives_roulette};
 use crate::{Ctx, Integrator, RayCounters, SampleAux};
 use rt_core::{
-    lights::LightSampler, material::Bsdf, ray::spawn_ray, sampling::power_heuristic, Ray, Rgb,
+    lights::LightSampler, material::Bsdf, sampling::power_heuristic, Ray, Rgb,
     Sampler,
 };
 
@@ -119,7 +119,7 @@ impl Integrator for PathIntegrator {
                 }
                 break;
             };
-            let si = scene.surface(&hit);
+            let si = scene.surface(&hit, ray.time);
             let material = &scene.materials[si.material as usize];
             let wo = -ray.dir;
             let le = material.emitted(si.ng, wo);
@@ -163,7 +163,7 @@ impl Integrator for PathIntegrator {
                     let cos = ls.wi.dot(si.ns).abs();
                     if f.max_element() > 0.0 && cos > 0.0 {
                         counters.shadow_rays += 1;
-                        if light_visible(ctx, si.p, si.p_error, si.ng, &ls) {
+                        if light_visible(ctx, si.p, si.p_error, si.ng, si.time, &ls) {
                             let w = power_heuristic(ls.pdf, bsdf_pdf);
                             l += beta * f * ls.le * (cos * w / ls.pdf);
                         }
@@ -182,7 +182,7 @@ impl Integrator for PathIntegrator {
             prev_delta = s.delta;
             prev_pdf = s.pdf;
             prev_p = si.p;
-            ray = spawn_ray(si.p, si.p_error, si.ng, s.wi);
+            ray = si.spawn_ray(s.wi);
             depth += 1;
             if depth > self.rr_depth && !survives_roulette(&mut beta, 1.0, u_rr) {
                 break;

@@ -54,6 +54,14 @@ pub trait Technique: Send + Sync {
         false
     }
 
+    /// True if the technique traces every ray of a sample at the sample's shutter time, so
+    /// it can render a motion-blurred scene ([`rt_core::Scene::is_motion_blurred`]).
+    /// Camera-ray estimators do; light-path techniques do not yet (their light paths and
+    /// caches are traced at the shutter's opening), and callers refuse the combination.
+    fn motion_blur(&self) -> bool {
+        false
+    }
+
     /// The technique's own stages over the passes rendered so far, for reports; none by
     /// default (camera-ray estimators have nothing beyond the render's totals).
     fn stages(&self) -> Vec<TechniqueStage> {
@@ -78,6 +86,10 @@ impl Technique for CameraRays {
         progress: &(dyn Fn(u32) + Sync),
     ) -> RenderStats {
         render_samples(ctx, self.0.as_ref(), film, seed, pass, progress)
+    }
+
+    fn motion_blur(&self) -> bool {
+        true
     }
 
     fn camera_integrator(&self) -> Option<&dyn Integrator> {

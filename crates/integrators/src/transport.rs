@@ -59,21 +59,22 @@ pub(crate) fn survives_roulette(beta: &mut Rgb, start: f32, u: f32) -> bool {
 }
 
 /// True if light sample `ls` is unoccluded from surface point `p` (error bound `p_error`,
-/// geometric normal `ng`): a ray to infinity for the environment, else a segment to the light
-/// point (which keys the shadow cache of structures that have one).
+/// geometric normal `ng`) at shutter time `time`: a ray to infinity for the environment, else
+/// a segment to the light point (which keys the shadow cache of structures that have one).
 pub(crate) fn light_visible(
     ctx: &Ctx<'_>,
     p: Vec3,
     p_error: Vec3,
     ng: Vec3,
+    time: f32,
     ls: &LightSample,
 ) -> bool {
     if ls.dist.is_infinite() {
-        let r = spawn_ray(p, p_error, ng, ls.wi);
+        let r = spawn_ray(p, p_error, ng, ls.wi).at_time(time);
         !ctx.accel.occluded(&r, f32::INFINITY)
     } else {
         let (r, t_max) = shadow_segment(p, p_error, ng, ls.point, ls.point_error, ls.normal);
-        !ctx.accel.occluded_toward(&r, t_max, ls.point)
+        !ctx.accel.occluded_toward(&r.at_time(time), t_max, ls.point)
     }
 }
 

@@ -240,7 +240,7 @@ pub fn bounce_rays(
                 let Some(hit) = accel.intersect(&primary, f32::INFINITY) else {
                     continue;
                 };
-                let si = scene.surface(&hit);
+                let si = scene.surface(&hit, 0.0);
                 let n = if si.ng.dot(primary.dir) < 0.0 {
                     si.ng
                 } else {

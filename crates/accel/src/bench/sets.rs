@@ -216,7 +216,7 @@ pub fn generate(
         .zip(&primary)
         .enumerate()
         .filter_map(|(k, (hit, ray))| {
-            let si = scene.surface(hit.as_ref()?);
+            let si = scene.surface(hit.as_ref()?, 0.0);
             let n = facing(si.ng, ray.dir);
             let mut rng = ray_rng(seed, INCOHERENT, k as u64);
             let wi = Frame::from_normal(n).to_world(cosine_hemisphere(rng.vec2()));
@@ -228,7 +228,7 @@ pub fn generate(
         .zip(&primary)
         .enumerate()
         .filter_map(|(k, (hit, ray))| {
-            let si = scene.surface(hit.as_ref()?);
+            let si = scene.surface(hit.as_ref()?, 0.0);
             let mut rng = ray_rng(seed, SHADOW, k as u64);
             let (q, q_error, nq) = lights.sample(scene, rng.f32(), rng.vec2());
             if facing(si.ng, ray.dir).dot(q - si.p) <= 0.0 {

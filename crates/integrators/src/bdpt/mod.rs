@@ -345,7 +345,7 @@ impl Bdpt {
                 }
                 break;
             };
-            let si = scene.surface(&hit);
+            let si = scene.surface(&hit, 0.0);
             let material = &scene.materials[si.material as usize];
             let wo = -ray.dir;
             let tint = scene.tint(material, si.uv);
@@ -514,7 +514,7 @@ impl Bdpt {
             return Rgb::ZERO;
         }
         counters.shadow_rays += 1;
-        if !light_visible(ctx, pt.p, pt.p_error, pt.ng, &ls) {
+        if !light_visible(ctx, pt.p, pt.p_error, pt.ng, 0.0, &ls) {
             return Rgb::ZERO;
         }
         // The sampled light as a vertex, for the densities of the other strategies.

@@ -302,7 +302,7 @@ impl Partitioned {
             let Some(hit) = ctx.accel.intersect(&ray, f32::INFINITY) else {
                 return;
             };
-            let si = scene.surface(&hit);
+            let si = scene.surface(&hit, 0.0);
             let wo = -ray.dir;
             if bounce > 0 {
                 // Every bin whose disk holds the photon, not only the nearest (the thesis'

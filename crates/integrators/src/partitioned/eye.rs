@@ -114,7 +114,7 @@ impl Partitioned {
                 break;
             };
             length += hit.t * ray.dir.length();
-            let si = scene.surface(&hit);
+            let si = scene.surface(&hit, 0.0);
             let material = &scene.materials[si.material as usize];
             let wo = -ray.dir;
             out.emitted += beta * material.emitted(si.ng, wo);

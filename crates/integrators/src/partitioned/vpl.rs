@@ -165,7 +165,7 @@ impl Partitioned {
             let Some(hit) = ctx.accel.intersect(&ray, f32::INFINITY) else {
                 break;
             };
-            let si = scene.surface(&hit);
+            let si = scene.surface(&hit, 0.0);
             let material = &scene.materials[si.material as usize];
             let wo = -ray.dir;
             let tint = scene.tint(material, si.uv);
