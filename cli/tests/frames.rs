@@ -131,13 +131,23 @@ fn shutter_blurs_what_moves_and_nothing_else() {
     std::fs::write(d.join("s.toml"), SCENE).unwrap();
     let common = ["--spp", "8", "--fps", "1", "-q", "--frame", "1"];
     let run = |extra: &[&str], out: &str| {
-        ok(&render(d, &[&["s.toml", "-o", out][..], &common, extra].concat()));
+        ok(&render(
+            d,
+            &[&["s.toml", "-o", out][..], &common, extra].concat(),
+        ));
         std::fs::read(d.join(out)).unwrap()
     };
     // Two-level is chosen for the moving box; the image is the same on any thread count.
     let blurred = run(&["--shutter", "0.5", "--threads", "2"], "b2.exr");
-    assert_eq!(run(&["--shutter", "0.5", "--threads", "1"], "b1.exr"), blurred);
-    assert_ne!(run(&[], "sharp.exr"), blurred, "the shutter changed nothing");
+    assert_eq!(
+        run(&["--shutter", "0.5", "--threads", "1"], "b1.exr"),
+        blurred
+    );
+    assert_ne!(
+        run(&[], "sharp.exr"),
+        blurred,
+        "the shutter changed nothing"
+    );
     assert_eq!(
         run(&["--shutter", "0.5", "--accel", "clusters"], "c.exr").len(),
         blurred.len()
@@ -146,7 +156,10 @@ fn shutter_blurs_what_moves_and_nothing_else() {
     let still = SCENE.split("[[animation]]").next().unwrap();
     std::fs::write(d.join("still.toml"), still).unwrap();
     let still_run = |extra: &[&str], out: &str| {
-        ok(&render(d, &[&["still.toml", "-o", out][..], &common, extra].concat()));
+        ok(&render(
+            d,
+            &[&["still.toml", "-o", out][..], &common, extra].concat(),
+        ));
         std::fs::read(d.join(out)).unwrap()
     };
     assert_eq!(
@@ -177,11 +190,19 @@ fn shutter_refusals_are_one_line() {
             vec!["--shutter", "0.5", "--integrator", "bdpt"],
             "cannot motion blur",
         ),
-        ("lamp.toml", vec!["--shutter", "0.5"], "`light` emits light and moves"),
+        (
+            "lamp.toml",
+            vec!["--shutter", "0.5"],
+            "`light` emits light and moves",
+        ),
     ] {
         let out = render(
             d,
-            &[&[scene, "--spp", "1", "--frame", "1", "-o", "x.exr"][..], &args].concat(),
+            &[
+                &[scene, "--spp", "1", "--frame", "1", "-o", "x.exr"][..],
+                &args,
+            ]
+            .concat(),
         );
         let err = String::from_utf8_lossy(&out.stderr);
         assert_ne!(out.status.code(), Some(0), "{args:?}");

@@ -97,12 +97,10 @@ fn estimate(film: &rt_film::Film) -> Estimate {
 fn render(scene: &Scene, kind: AccelKind, spp: u32, seed: u32) -> Estimate {
     let accel = AccelSpec::new(kind).build_scene(scene);
     let buffers = FilmBuffers::from(AovSet::default()).with_variance();
-    let (film, _) = Renderer::new(scene).with_accel(accel.as_ref()).threads(2).render(
-        &PathIntegrator::new(3),
-        buffers,
-        spp,
-        seed,
-    );
+    let (film, _) = Renderer::new(scene)
+        .with_accel(accel.as_ref())
+        .threads(2)
+        .render(&PathIntegrator::new(3), buffers, spp, seed);
     estimate(&film)
 }
 

@@ -296,7 +296,8 @@ fn motion_blurred_rays_hit_the_scene_at_their_time() {
                 .iter()
                 .filter(|(r, t)| {
                     let (x, y) = (closed.intersect(r, *t), bf.intersect(r, *t));
-                    x.map(|h| (h.prim, (h.t * 1e3) as i64)) != y.map(|h| (h.prim, (h.t * 1e3) as i64))
+                    x.map(|h| (h.prim, (h.t * 1e3) as i64))
+                        != y.map(|h| (h.prim, (h.t * 1e3) as i64))
                 })
                 .count();
             for (ray, t_max) in &rays {
@@ -313,7 +314,10 @@ fn motion_blurred_rays_hit_the_scene_at_their_time() {
             }
         }
         assert!(shaded > 1000, "only {shaded} hits shaded");
-        assert!(bad * 1000 <= total, "{spec}: {bad} of {total} rays disagree");
+        assert!(
+            bad * 1000 <= total,
+            "{spec}: {bad} of {total} rays disagree"
+        );
         assert!(
             control_bad * 20 > total,
             "the closed-shutter control disagrees on only {control_bad} of {total} rays"

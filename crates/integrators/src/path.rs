@@ -17,10 +17,7 @@
 
 use crate::transport::{light_visible, survives_roulette};
 use crate::{Ctx, Integrator, RayCounters, SampleAux};
-use rt_core::{
-    lights::LightSampler, material::Bsdf, sampling::power_heuristic, Ray, Rgb,
-    Sampler,
-};
+use rt_core::{lights::LightSampler, material::Bsdf, sampling::power_heuristic, Ray, Rgb, Sampler};
 
 /// Path tracer configuration.
 #[derive(Clone, Debug)]

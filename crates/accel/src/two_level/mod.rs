@@ -152,7 +152,15 @@ impl TwoLevel {
         mode: TopLevel,
         cut: Option<f32>,
     ) -> Self {
-        Self::build_parts(triangles, (&[], &[]), (0.0, 0.0), params, options, mode, cut)
+        Self::build_parts(
+            triangles,
+            (&[], &[]),
+            (0.0, 0.0),
+            params,
+            options,
+            mode,
+            cut,
+        )
     }
 
     fn build_parts(
