@@ -47,12 +47,33 @@ fn iosp_renders_the_flat_bvh_image_from_a_reordered_scene() {
     }
 }
 
+/// An animated, instanced scene (the car, frame at 1 s) keeps its order, since every frame
+/// rewrites each instance's world copy in its range: IOSP answers through its index map and
+/// renders the flat BVH's image.
 #[test]
-fn an_instanced_scene_is_refused_with_the_reason() {
-    let mut scene = rt_scene::procedural::generate("car").unwrap();
-    let e = AccelSpec::new(AccelKind::Iosp0)
-        .try_build_scene_mut(&mut scene)
-        .err()
-        .expect("refused");
-    assert!(e.to_string().contains("two-level or clusters"), "{e}");
+fn an_instanced_scene_keeps_its_order_and_renders_through_the_index_map() {
+    let mut scene = rt_scene::procedural::generate("car")
+        .unwrap()
+        .with_resolution(24, 16);
+    scene.set_time(1.0);
+    let flat = AccelSpec::new(AccelKind::Bvh8).build_scene(&scene);
+    let reference = render(&scene, flat.as_ref(), 1);
+    assert!(
+        rt_testkit::stats::image_mean(&reference).0 > 0.01,
+        "a black car"
+    );
+    let mut kept = scene.clone();
+    let accel = AccelSpec::new(AccelKind::Iosp0)
+        .try_build_scene_mut(&mut kept)
+        .unwrap();
+    assert_eq!(
+        kept.triangles, scene.triangles,
+        "the instanced scene was reordered"
+    );
+    assert!(
+        accel.memory_bytes() >= 4 * scene.triangles.len(),
+        "no index map counted"
+    );
+    let c = compare(&render(&kept, accel.as_ref(), 2), &reference, 4, ALPHA);
+    assert!(c.same_within_noise(), "{c:?}");
 }

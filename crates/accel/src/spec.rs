@@ -26,7 +26,9 @@
 //!
 //! `iosp0`, `iosp4` and `iosp2` take no options. They live in the triangle order:
 //! [`AccelSpec::try_build_scene_mut`] reorders the scene to match (nothing stored beyond the
-//! triangles), [`AccelSpec::build`] over a slice maps hits back through an index map.
+//! triangles), [`AccelSpec::build`] over a slice maps hits back through an index map, and so
+//! does a scene with instances (each frame rewrites an instance's world copy in its own
+//! contiguous range, which a reordering would scatter).
 //!
 //! `two-level` takes the bvh8 options for its object BVHs; built over a scene
 //! ([`AccelSpec::build_scene`]) it follows moving instances by [`Accel::update`].
@@ -242,6 +244,12 @@ impl AccelSpec {
         &self,
         scene: &mut rt_core::Scene,
     ) -> Result<Box<dyn Accel>, BuildError> {
+        // Each frame rewrites an instance's world copy in its contiguous range, which a
+        // reordering would scatter: over an instanced scene IOSP keeps the order and answers
+        // through its index map (4 bytes per triangle, counted in its memory).
+        if !scene.instances.is_empty() {
+            return self.try_build_scene(scene);
+        }
         let (accel, perm): (Box<dyn Accel>, Vec<u32>) = match self.kind {
             AccelKind::Iosp0 => {
                 let (a, p) = crate::Iosp0::build(&scene.triangles)?;
