@@ -1,4 +1,6 @@
-//! The two-level structure and clustering (entry points at t = 1, 8 and 1000) against brute force over the scene's world copies, for every frame
+//! Every structure on every frame of an animated scene against brute force (flat ones rebuilt,
+//! IOSP through its index map). In detail:
+//! the two-level structure and clustering (entry points at t = 1, 8 and 1000) against brute force over the scene's world copies, for every frame
 //! of an animated scene, with rigid, scaled, non-uniformly scaled and mirroring instances; the
 //! top level rebuilt and refitted; rays spawned from instance hits do not hit their own
 //! triangle again; and updating follows the instances without building an object BVH.
@@ -321,6 +323,36 @@ fn motion_blurred_rays_hit_the_scene_at_their_time() {
         assert!(
             control_bad * 20 > total,
             "the closed-shutter control disagrees on only {control_bad} of {total} rays"
+        );
+    }
+}
+
+/// Every structure `render --accel` offers, over the animated scene on every frame (rebuilt
+/// where it cannot update in place), against brute force on the rays of `common::rays` (axis
+/// rays, zero and negative-zero components, origins on triangles and in axis planes).
+#[test]
+fn every_structure_matches_brute_force_on_every_frame() {
+    for kind in AccelKind::ALL {
+        let mut rng = Rng::new(31);
+        let mut s = scene(&mut rng, 6);
+        let spec = AccelSpec::new(kind);
+        let mut a = spec.try_build_scene_mut(&mut s).unwrap();
+        let (mut total, mut bad) = (0, 0);
+        for frame in 0..3 {
+            if frame > 0 {
+                s.set_time(frame as f32 * 0.4);
+                if !a.update(&s) {
+                    a = spec.try_build_scene_mut(&mut s).unwrap();
+                }
+            }
+            let rays = rays(&mut rng, &s.triangles, 1500);
+            let (n, b) = compare(a.as_ref(), &s, &rays);
+            total += n;
+            bad += b;
+        }
+        assert!(
+            bad * 1000 <= total,
+            "{kind:?}: {bad} of {total} rays disagree"
         );
     }
 }
