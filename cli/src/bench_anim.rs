@@ -43,10 +43,14 @@ pub struct BenchAnimArgs {
     #[arg(long, value_delimiter = ',')]
     pub accel: Option<Vec<String>>,
 
-    /// Primary ray grid WxH (one jittered primary ray per pixel, plus a diffuse bounce and a
-    /// shadow segment from each primary hit).
+    /// Primary ray grid WxH (one jittered primary ray per pixel).
     #[arg(long, value_name = "WxH", value_parser = parse_size, default_value = "480x300")]
     pub size: (u32, u32),
+
+    /// Rays per frame: full (each primary ray, a diffuse bounce and a shadow segment from each
+    /// primary hit) or primary (primary rays only, as the thesis timed its figures).
+    #[arg(long, value_enum, default_value = "full")]
+    pub rays: Rays,
 
     /// Camera of the scene by name. [default: the first]
     #[arg(long)]
@@ -82,6 +86,15 @@ pub struct BenchAnimArgs {
     /// No progress lines on stderr.
     #[arg(short, long)]
     pub quiet: bool,
+}
+
+/// `--rays`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Rays {
+    /// Primary rays, a diffuse bounce and a shadow segment per primary hit.
+    Full,
+    /// Primary rays only.
+    Primary,
 }
 
 /// `WxH`, each side in [1, 16384].
@@ -199,6 +212,10 @@ pub fn run(args: &BenchAnimArgs) -> Result<()> {
         check: args.check,
         repeat: args.repeat,
         count: args.count,
+        workload: match args.rays {
+            Rays::Full => anim::Workload::Full,
+            Rays::Primary => anim::Workload::Primary,
+        },
     };
     let mut progress = |line: &str| info(line);
     let report = anim::run(&mut scene, &mut contenders, &options, &pool, &mut progress)
@@ -221,15 +238,18 @@ fn find<'a>(report: &'a AnimReport, name: &str) -> Option<&'a anim::ContenderRes
 fn print_table(input: &str, options: &AnimOptions, report: &AnimReport) {
     let rays: usize = report.rays.iter().map(|r| r.total()).sum::<usize>() / report.rays.len();
     println!(
-        "{input}: {} triangles; frames {}..{} at {} fps; {}x{} primary rays + bounce + shadow, \
-         {rays} rays per frame on average; seconds per frame: mean over frames of the best of {} \
-         rounds, 1 thread",
+        "{input}: {} triangles; frames {}..{} at {} fps; {}x{} primary rays{}, {rays} rays per \
+         frame on average; seconds per frame: mean over frames of the best of {} rounds, 1 thread",
         report.triangles,
         options.frames.start,
         options.frames.end,
         options.fps,
         options.width,
         options.height,
+        match options.workload {
+            anim::Workload::Full => " + bounce + shadow",
+            anim::Workload::Primary => " only",
+        },
         options.repeat
     );
     let instancing = find(report, "two-level");

@@ -6,7 +6,7 @@
 mod common;
 
 use glam::Vec3;
-use rt_accel::bench::anim::{self, AnimError, AnimOptions, Contender, Follow};
+use rt_accel::bench::anim::{self, AnimError, AnimOptions, Contender, Follow, Workload};
 use rt_accel::AccelSpec;
 use rt_core::animation::{Key, Motion};
 use rt_core::instance::Prototype;
@@ -81,6 +81,7 @@ fn options() -> AnimOptions {
         check: 10_000,
         repeat: 2,
         count: true,
+        workload: Workload::Full,
     }
 }
 
@@ -204,6 +205,20 @@ fn a_structure_that_does_not_follow_the_animation_fails_the_check() {
     }
     assert!(err.to_string().contains("disagree with the flat bvh8"));
     assert!(!err.to_string().contains('\n'));
+}
+
+#[test]
+fn the_primary_workload_traces_primary_rays_only() {
+    let mut s = scene();
+    let mut cs = contenders(&s, &["bvh8", "clusters:t=4"]);
+    let mut o = options();
+    o.workload = Workload::Primary;
+    let report = anim::run(&mut s, &mut cs, &o, &pool(), &mut |_| {}).unwrap();
+    assert!(report
+        .rays
+        .iter()
+        .all(|r| r.total() == 24 * 16 && r.incoherent == 0 && r.shadow == 0));
+    assert_eq!(report.contenders[1].check.checked, 4 * 24 * 16);
 }
 
 #[test]

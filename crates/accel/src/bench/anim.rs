@@ -133,6 +133,19 @@ pub struct AnimOptions {
     pub repeat: u32,
     /// Also count each contender's traversal work per frame (an untimed pass more).
     pub count: bool,
+    /// Which rays a frame traces.
+    pub workload: Workload,
+}
+
+/// The rays traced per frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Workload {
+    /// One primary ray per pixel, a diffuse bounce and a shadow segment from each primary hit:
+    /// what a path tracer's first bounce costs.
+    #[default]
+    Full,
+    /// Primary rays only, as the thesis timed Figs. 4.16 and 4.17.
+    Primary,
 }
 
 /// One contender in one frame: the fastest of the rounds.
@@ -207,9 +220,10 @@ pub struct FrameRays {
     pub frame: u32,
     /// Primary rays (one per pixel).
     pub primary: usize,
-    /// Diffuse bounces (one per primary hit).
+    /// Diffuse bounces (one per primary hit; 0 with [`Workload::Primary`]).
     pub incoherent: usize,
-    /// Shadow segments (one per primary hit facing the light sample).
+    /// Shadow segments (one per primary hit facing the light sample; 0 with
+    /// [`Workload::Primary`]).
     pub shadow: usize,
 }
 
@@ -306,13 +320,14 @@ fn resized(camera: &Camera, width: u32, height: u32) -> Camera {
     )
 }
 
-/// The workload of the scene at its current time: the primary, incoherent and shadow sets.
+/// The workload of the scene at its current time: the primary, incoherent and shadow sets, or
+/// the primary set alone.
 fn frame_rays(
     scene: &Scene,
     reference: &dyn Accel,
     options: &AnimOptions,
     frame: u32,
-) -> Result<[RaySet; 3], AnimError> {
+) -> Result<Vec<RaySet>, AnimError> {
     let camera = scene
         .cameras
         .get(options.camera)
@@ -326,7 +341,10 @@ fn frame_rays(
     if incoherent.rays.is_empty() {
         return Err(AnimError::NoRays { frame });
     }
-    Ok([primary, incoherent, shadow])
+    Ok(match options.workload {
+        Workload::Full => vec![primary, incoherent, shadow],
+        Workload::Primary => vec![primary],
+    })
 }
 
 /// Measures `contenders` over `options.frames` of `scene` (which is left at the last frame).
@@ -374,11 +392,16 @@ pub fn run(
         scene.set_time((f64::from(frame) / options.fps) as f32);
         let reference = pool.install(|| reference_spec.try_build(&scene.triangles))?;
         let sets = pool.install(|| frame_rays(scene, reference.as_ref(), options, frame))?;
+        let count = |name: &str| {
+            sets.iter()
+                .find(|s| s.name == name)
+                .map_or(0, |s| s.rays.len())
+        };
         rays.push(FrameRays {
             frame,
-            primary: sets[0].rays.len(),
-            incoherent: sets[1].rays.len(),
-            shadow: sets[2].rays.len(),
+            primary: count("primary"),
+            incoherent: count("incoherent"),
+            shadow: count("shadow"),
         });
         // Untimed: follow, check. This also warms the caches for the timed rounds.
         for (c, r) in contenders.iter_mut().zip(&mut results) {
