@@ -179,6 +179,11 @@ pub enum Command {
     /// primary, incoherent (diffuse bounce) and shadow rays, after checking their answers
     /// against the binary BVH (docs/benchmarks.md, "Accel benchmark").
     BenchAccel(crate::bench_accel::BenchArgs),
+    /// Measure seconds per frame on an animated scene: each structure's update (top-level
+    /// rebuild or refit, or a flat structure's full rebuild) and the trace of primary, bounce
+    /// and shadow rays, after checking its answers against a flat bvh8 (docs/benchmarks.md,
+    /// "Rigid-body clustering").
+    BenchAnim(crate::bench_anim::BenchAnimArgs),
     /// Compare image A with the reference B: MSE, relMSE, RMSE, PSNR and SSIM, one `name value`
     /// per line (or JSON), optionally a false-colour error image (docs/experiments.md).
     Compare(crate::compare::CompareArgs),

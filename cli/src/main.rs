@@ -3,7 +3,8 @@
 //! film (`rt-integrators`, `rt-film`) and writes the image. All error reporting to the user
 //! happens here: libraries return typed errors, this turns them into one line on stderr and a
 //! non-zero exit code (2 for usage errors, 1 for everything else). `render bench-accel` (in
-//! `bench_accel/`) measures the acceleration structures instead of rendering; `render compare`
+//! `bench_accel/`) measures the acceleration structures instead of rendering, `render
+//! bench-anim` (`bench_anim.rs`) their seconds per frame on an animated scene; `render compare`
 //! (`compare.rs`) measures the error of one image against another; `render reference` and
 //! `render experiment` (`reference/`, `experiment/`) render references and measured grids,
 //! sharing `session.rs` (one configuration, rendered progressively) with plain rendering;
@@ -11,6 +12,7 @@
 
 mod args;
 mod bench_accel;
+mod bench_anim;
 mod compare;
 mod experiment;
 mod job;
@@ -33,6 +35,7 @@ fn main() -> ExitCode {
     };
     let result = match &args.command {
         Some(args::Command::BenchAccel(bench)) => bench_accel::run(bench),
+        Some(args::Command::BenchAnim(bench)) => bench_anim::run(bench),
         Some(args::Command::Compare(c)) => compare::run(c),
         Some(args::Command::Reference(r)) => reference::run(r),
         Some(args::Command::Experiment(x)) => experiment::run(x),

@@ -215,7 +215,10 @@ impl AccelSpec {
             kind,
             build,
             wide: match kind {
-                AccelKind::Bvh8 => WideOptions::defaults_for::<crate::Node8>(),
+                // Two-level kinds' object BVHs are BVH8s: traversed like the flat one.
+                AccelKind::Bvh8 | AccelKind::TwoLevel | AccelKind::Clusters => {
+                    WideOptions::defaults_for::<crate::Node8>()
+                }
                 _ => WideOptions::default(),
             },
             lazy: false,

@@ -1,5 +1,6 @@
 //! Benchmark ray sets and their `.bin` file format, shared by `render bench-accel` and
-//! `tools/accel-peers` so that every tool traces exactly the same rays.
+//! `tools/accel-peers` so that every tool traces exactly the same rays; [`anim`] measures
+//! seconds per frame of an animated scene with them (`render bench-anim`).
 //!
 //! - [`generate`] makes the four sets from a scene, a camera and a reference structure:
 //!   `primary` (one jittered camera ray per pixel), `incoherent` (a cosine-distributed diffuse
@@ -32,6 +33,7 @@
 //! assert!(decode(&bytes[..100]).is_err()); // truncated: an error, not a panic
 //! ```
 
+pub mod anim;
 mod file;
 pub mod measure;
 mod rng;

@@ -15,8 +15,9 @@
 //! **Rigid-body entry-point clustering** (Dammertz 2011, §4.5; `clusters:t=T`): the top level
 //! does not stop at whole objects. Each object BVH is cut into *entry points*, the nodes (or
 //! leaves) whose world-space size is below `size(scene) / t` while their parents' are not
-//! ([`Bvh8::entry_points`]); the top level is a binary SAH tree over the entry points' world
-//! boxes, rebuilt every frame down to one entry per leaf, and a ray reaching a leaf continues
+//! ([`Bvh8::entry_points`]), cut once when the structure is built (the thesis' preprocess;
+//! the scene's size is taken then); the top level is a binary SAH tree over the entry points'
+//! world boxes, rebuilt every frame down to one entry per leaf, and a ray reaching a leaf continues
 //! inside the object at that node with the inverse-transformed ray
 //! ([`Bvh8::closest_hit_from`]). Overlapping parts (seats inside a hull) then separate in the
 //! top level instead of forcing every ray into both. Deviation: sizes are the boxes' longest
@@ -89,8 +90,10 @@ pub struct TwoLevel {
     placements: Vec<Placement>,
     /// Clustering's `t`; `None`: one entry per placement (its root).
     cut: Option<f32>,
-    /// The top level's leaves: (placement, child code to start at), and their world boxes.
+    /// The top level's leaves: (placement, child code to start at; 0 for the object's root),
+    /// their boxes in object space and in the world.
     entries: Vec<(u32, u32)>,
+    entry_local: Vec<Aabb>,
     entry_boxes: Vec<Aabb>,
     /// Each instance's object, and its prototype (to check an update matches the build).
     instance_objects: Vec<u32>,
@@ -229,6 +232,7 @@ impl TwoLevel {
             instance_objects,
             cut,
             entries: Vec::new(),
+            entry_local: Vec::new(),
             entry_boxes: Vec::new(),
             top: top::Top::default(),
             mode,
@@ -238,43 +242,63 @@ impl TwoLevel {
             moving: Vec::new(),
         };
         s.place_instances(instances);
+        s.bounds = s
+            .placements
+            .iter()
+            .map(|p| p.world)
+            .fold(Aabb::EMPTY, Aabb::union);
         s.make_entries();
+        s.place_entries();
         s.top = top::Top::build(&s.entry_boxes);
         s
     }
 
-    /// The top level's leaves for the current placements: each placement's root, or with
-    /// clustering its entry points.
+    /// Cuts the placements into the top level's leaves, once at the build (the thesis'
+    /// preprocess): each placement's root, or with clustering its entry points, sized against
+    /// the scene as it is at the build. The cut is kept from frame to frame, so an update only
+    /// moves boxes and a refit always finds the same leaves.
     fn make_entries(&mut self) {
+        self.entries.clear();
+        self.entry_local.clear();
+        let scene_size = (self.bounds.max - self.bounds.min).max_element();
+        for (k, p) in self.placements.iter().enumerate() {
+            let object = &self.objects[p.object as usize];
+            let Some(t) = self.cut else {
+                self.entries.push((k as u32, 0));
+                self.entry_local.push(object.bounds);
+                continue;
+            };
+            // The largest factor by which the placement stretches a length.
+            let stretch = p.to_world.map_or(1.0, |m| {
+                let len = |v: glam::Vec4| v.truncate().length();
+                len(m.x_axis).max(len(m.y_axis)).max(len(m.z_axis))
+            });
+            let threshold = scene_size / t / stretch;
+            for (code, local) in object.bvh.entry_points(threshold) {
+                self.entries.push((k as u32, code));
+                self.entry_local.push(local);
+            }
+        }
+    }
+
+    /// The entries' world boxes under the current placements (Dammertz's Listing 4.1: the
+    /// local box's eight corners transformed), and the scene's bounds.
+    fn place_entries(&mut self) {
         self.bounds = self
             .placements
             .iter()
             .map(|p| p.world)
             .fold(Aabb::EMPTY, Aabb::union);
-        self.entries.clear();
         self.entry_boxes.clear();
-        let scene_size = (self.bounds.max - self.bounds.min).max_element();
-        for (k, p) in self.placements.iter().enumerate() {
-            let Some(t) = self.cut else {
-                self.entries.push((k as u32, 0));
-                self.entry_boxes.push(p.world);
-                continue;
-            };
-            let to_world = p.to_world;
-            // The largest factor by which the placement stretches a length.
-            let stretch = to_world.map_or(1.0, |m| {
-                let len = |v: glam::Vec4| v.truncate().length();
-                len(m.x_axis).max(len(m.y_axis)).max(len(m.z_axis))
+        for (&(k, code), local) in self.entries.iter().zip(&self.entry_local) {
+            let p = &self.placements[k as usize];
+            self.entry_boxes.push(match (&p.to_world, code, p.moving) {
+                // An object's root: its world box (swept over the shutter) is already known.
+                (_, 0, _) => p.world,
+                (None, _, _) => *local,
+                (Some(_), _, Some(i)) => swept_box(&self.moving[i as usize].samples, local),
+                (Some(m), _, None) => world_box(m, local),
             });
-            let threshold = scene_size / t / stretch;
-            for (code, local) in self.objects[p.object as usize].bvh.entry_points(threshold) {
-                self.entries.push((k as u32, code));
-                self.entry_boxes.push(match (&to_world, p.moving) {
-                    (_, Some(i)) => swept_box(&self.moving[i as usize].samples, &local),
-                    (None, None) => local,
-                    (Some(m), None) => world_box(m, &local),
-                });
-            }
         }
     }
 
@@ -319,6 +343,7 @@ impl TwoLevel {
         self.top.memory_bytes()
             + std::mem::size_of_val(self.placements.as_slice())
             + std::mem::size_of_val(self.entries.as_slice())
+            + std::mem::size_of_val(self.entry_local.as_slice())
             + std::mem::size_of_val(self.entry_boxes.as_slice())
     }
 
@@ -359,24 +384,33 @@ impl TwoLevel {
         let mut best: Option<Hit> = None;
         let mut local = TraversalCounters::default();
         let counting = counters.is_some();
+        // The ray in the space of the placement entered last: a clustered top level often
+        // enters several entry points of one object in a row.
+        let mut last = (u32::MAX, *ray);
         self.top.walk(ray, t_max, &mut local, ANY, |e, t_cull, c| {
             let (k, code) = self.entries[e as usize];
             let p = &self.placements[k as usize];
             let obj = &self.objects[p.object as usize];
-            let r = match (&p.to_object, p.moving) {
-                (Some(_), Some(i)) if ray.time != 0.0 => {
-                    let (open, duration) = self.shutter;
-                    let to_world = self.moving[i as usize]
-                        .instance
-                        .matrix_at(open + ray.time * duration);
-                    let m = to_world.inverse();
-                    Ray::new(m.transform_point3(ray.origin), m.transform_vector3(ray.dir))
-                }
-                (None, _) => *ray,
-                (Some(m), _) => {
-                    Ray::new(m.transform_point3(ray.origin), m.transform_vector3(ray.dir))
-                }
-            };
+            if last.0 != k {
+                last = (
+                    k,
+                    match (&p.to_object, p.moving) {
+                        (Some(_), Some(i)) if ray.time != 0.0 => {
+                            let (open, duration) = self.shutter;
+                            let to_world = self.moving[i as usize]
+                                .instance
+                                .matrix_at(open + ray.time * duration);
+                            let m = to_world.inverse();
+                            Ray::new(m.transform_point3(ray.origin), m.transform_vector3(ray.dir))
+                        }
+                        (None, _) => *ray,
+                        (Some(m), _) => {
+                            Ray::new(m.transform_point3(ray.origin), m.transform_vector3(ray.dir))
+                        }
+                    },
+                );
+            }
+            let r = last.1;
             let hit = if ANY {
                 obj.bvh
                     .any_hit_from(code, &r, t_cull, counting.then_some(&mut *c))
@@ -540,11 +574,9 @@ impl Accel for TwoLevel {
         }
         self.shutter = (scene.time, scene.shutter);
         self.place_instances(&scene.instances);
-        let before = std::mem::take(&mut self.entries);
-        self.make_entries();
-        // Refitting needs the same leaves; a clustered cut may change with the scene's size.
+        self.place_entries();
         self.top_updates += 1;
-        if self.mode == TopLevel::Refit && self.entries == before {
+        if self.mode == TopLevel::Refit {
             self.top.refit(&self.entry_boxes);
         } else {
             self.top = top::Top::build(&self.entry_boxes);

@@ -31,6 +31,7 @@ use crate::traversal::{with_counter, Counter};
 use crate::{BuildParams, Bvh2};
 use glam::Vec3;
 use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
+pub(crate) use traverse::Slab;
 use traverse::{DISTANCE, SPLIT_PLANE, UNSORTED};
 
 /// A four-wide bounding volume hierarchy over triangles (Dammertz's QBVH).
