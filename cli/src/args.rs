@@ -117,7 +117,9 @@ pub struct Args {
 
     /// Render frames A..B (half-open) of the scene's animation, frame f at time f / fps, each
     /// with its own sample streams (from the seed and the frame); the output must name the
-    /// frame, e.g. -o 'out/frame_{frame:04}.exr'.
+    /// frame, e.g. -o 'out/frame_{frame:04}.exr'. Without --accel, a scene whose instances
+    /// move is rendered with clusters (any frame), which only rebuild their top level per
+    /// frame.
     #[arg(long, value_name = "A..B", value_parser = parse_frames, conflicts_with = "frame")]
     pub frames: Option<std::ops::Range<u32>>,
 
@@ -132,7 +134,7 @@ pub struct Args {
     /// Motion blur: the shutter stays open for this fraction of a frame (1 / fps seconds)
     /// from the frame's time; every camera sample draws a time in it, its rays carry it, and
     /// moving instances and cameras are placed at it. Needs a structure that places instances
-    /// per ray (two-level or clusters; chosen when --accel is not given) and a camera-ray
+    /// per ray (two-level or clusters; clusters when --accel is not given) and a camera-ray
     /// integrator (path, path-bsdf, direct, ao).
     #[arg(long, value_name = "S", default_value_t = 0.0)]
     pub shutter: f64,

@@ -136,8 +136,10 @@ pub fn run(args: &Args) -> Result<()> {
     let mut job = Job::resolve(args, &loaded.render)?;
     let mut scene = loaded.scene;
     let frames = frame_list(args, &job.output)?;
-    let accel_chosen = args.accel.is_some() || loaded.render.accel.is_some();
-    set_shutter(args, &mut job, &mut scene, accel_chosen)?;
+    if args.accel.is_none() && loaded.render.accel.is_none() {
+        job.settings.accel = AccelSpec::default_for_scene(&scene);
+    }
+    set_shutter(args, &job, &mut scene)?;
 
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(t) = job.settings.threads {
@@ -186,8 +188,8 @@ pub fn run(args: &Args) -> Result<()> {
 
 /// Opens the scene's shutter for `--shutter` of a frame and checks that the render can blur
 /// what moves: no moving emitter, a camera-ray technique, and a structure that places
-/// instances per ray (two-level when the user chose none).
-fn set_shutter(args: &Args, job: &mut Job, scene: &mut Scene, accel_chosen: bool) -> Result<()> {
+/// instances per ray (the default for a scene whose instances move).
+fn set_shutter(args: &Args, job: &Job, scene: &mut Scene) -> Result<()> {
     let s = args.shutter;
     if !(s.is_finite() && s >= 0.0) {
         bail!("--shutter must be a fraction of a frame >= 0, got {s}");
@@ -211,13 +213,10 @@ fn set_shutter(args: &Args, job: &mut Job, scene: &mut Scene, accel_chosen: bool
         );
     }
     if moving_instances && !job.settings.accel.kind.is_two_level() {
-        if accel_chosen {
-            bail!(
-                "{path}: --shutter: --accel {} holds the scene at one time; motion blur needs two-level or clusters",
-                job.settings.accel
-            );
-        }
-        job.settings.accel = "two-level".parse().expect("a valid spec");
+        bail!(
+            "{path}: --shutter: --accel {} holds the scene at one time; motion blur needs two-level or clusters",
+            job.settings.accel
+        );
     }
     Ok(())
 }

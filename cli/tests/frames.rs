@@ -137,7 +137,7 @@ fn shutter_blurs_what_moves_and_nothing_else() {
         ));
         std::fs::read(d.join(out)).unwrap()
     };
-    // Two-level is chosen for the moving box; the image is the same on any thread count.
+    // Clusters are chosen for the moving box; the image is the same on any thread count.
     let blurred = run(&["--shutter", "0.5", "--threads", "2"], "b2.exr");
     assert_eq!(
         run(&["--shutter", "0.5", "--threads", "1"], "b1.exr"),
@@ -211,4 +211,31 @@ fn shutter_refusals_are_one_line() {
         assert_eq!(err.trim().lines().count(), 1, "{args:?}: {err}");
         assert!(err.contains(scene) || want.starts_with("--"), "{err}");
     }
+}
+
+#[test]
+fn moving_instances_choose_clusters_unless_told_otherwise() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("s.toml"), SCENE).unwrap();
+    std::fs::write(
+        d.join("still.toml"),
+        SCENE.split("[[animation]]").next().unwrap(),
+    )
+    .unwrap();
+    let summary = |scene: &str, extra: &[&str]| {
+        let out = render(
+            d,
+            &[&[scene, "--spp", "1", "-o", "x.exr"][..], extra].concat(),
+        );
+        ok(&out);
+        format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        )
+    };
+    assert!(summary("s.toml", &[]).contains(" clusters "));
+    assert!(summary("still.toml", &[]).contains(" bvh8 "));
+    assert!(summary("s.toml", &["--accel", "bvh"]).contains(" bvh "));
 }

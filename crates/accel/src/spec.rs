@@ -204,6 +204,19 @@ impl Default for AccelSpec {
 }
 
 impl AccelSpec {
+    /// The structure for `scene` when the user names none: [`DEFAULT_ACCEL`], or `clusters`
+    /// when instances move, since clustering only rebuilds its top level per frame (1.6–2.1×
+    /// faster per frame than a `bvh8` rebuilt, `docs/benchmarks.md`) and places moving
+    /// instances per ray for motion blur. Chosen by the scene, not by the frames rendered,
+    /// so a frame rendered alone has the bytes it has in a sequence.
+    pub fn default_for_scene(scene: &rt_core::Scene) -> Self {
+        if scene.instances.iter().any(|i| i.is_animated()) {
+            Self::new(AccelKind::Clusters)
+        } else {
+            Self::default()
+        }
+    }
+
     /// The default spec of `kind`.
     pub fn new(kind: AccelKind) -> Self {
         let mut build = BuildParams::default();
