@@ -72,9 +72,22 @@
 //!   instead of the thesis' GPU builder of lexicographic sorts (Fig. 7.3). The partition key is
 //!   the centroid rather than the min vertex: the bounding triangles are found by a scan, so
 //!   the sort order need not put them first.
-//! - **Traversal** is a short stack of (node, interval) entries with ordered descent; the
-//!   thesis leaves stack versus stackless open. The thesis' per-triangle AABB pre-test (which
-//!   it found no faster) is not implemented.
+//! - **Traversal** is a short stack of (node, axis, interval) entries with ordered descent;
+//!   the thesis leaves stack versus stackless open. The thesis' per-triangle AABB pre-test
+//!   (which it found no faster) is not implemented.
+//! - **Clipped start.** IOSP-0 clips the ray to the scene box (kept for `Accel::bounds`, not
+//!   per node) and 2-Lvl IOSP to the top-level leaf's box before the heap's root, whose slab
+//!   bounds one axis only; the thesis starts the root with the ray's whole interval.
+//! - **Batched triangle tests** (CPU only, not in the thesis). An entered node's triangles
+//!   are not tested at once but queued, and the queue is tested eight at a time, gathered
+//!   from the triangle array with AVX2 where the CPU has it (one at a time otherwise), when
+//!   it is full and before every pop from the stack; a popped node is therefore culled against
+//!   every triangle entered before it, as in the thesis. A node whose two children are leaves
+//!   queues their four triangles instead of testing their slabs, and a heap of at most eight
+//!   triangles (small 2-Lvl leaves) is tested whole. Hits are those of the thesis' traversal
+//!   bit for bit; only the counters move (fewer slab tests, more triangle tests). Batching a
+//!   second level (grandchildren, 14 triangles) measured no faster on the bunny, nor did
+//!   prefetching the children's cache lines on entering a node.
 //! - **Counters.** `nodes_visited` counts slab tests (one per node reached), `leaves_visited`
 //!   counts nodes entered (their triangles are then tested), `prims_tested` triangle tests.
 //! - **IOSP-4 root axis.** The node word gives its children's bounding axis; the root's is the
@@ -86,6 +99,7 @@ mod heap;
 mod iosp0;
 mod iosp4;
 mod iosp4_build;
+mod lanes;
 mod permuted;
 pub mod split;
 mod two_level;

@@ -2,11 +2,12 @@
 //! "2-Lvl IOSP (15)").
 
 use super::heap::{self, MAX_TRIANGLES};
+use super::lanes::SlotTest;
 use super::{IospError, TriBox};
-use crate::traversal::{walk_binary, with_counter, Closest, Counter, SlabRay, Step};
+use crate::traversal::{walk_binary, with_counter, BinaryNode, Closest, Counter, SlabRay, Step};
+use crate::wide::tri4::RayPrecomp4;
 use crate::{BuildParams, Bvh2, Node, ValidationError};
 use glam::Vec3;
-use rt_core::triangle::RayPrecomp;
 use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
 use std::ops::Range;
 
@@ -24,6 +25,7 @@ const MAX_DEPTH: usize = 64;
 pub struct Iosp2 {
     nodes: Vec<Node>,
     triangles: Vec<[Vec3; 3]>,
+    lanes: SlotTest,
 }
 
 impl Iosp2 {
@@ -83,6 +85,7 @@ impl Iosp2 {
             Self {
                 nodes,
                 triangles: permuted,
+                lanes: SlotTest::detect(),
             },
             perm,
         ))
@@ -152,27 +155,40 @@ impl Iosp2 {
         if !(ray.origin.is_finite() && ray.dir.is_finite()) {
             return None;
         }
-        let pre = RayPrecomp::new(ray);
+        let pre = RayPrecomp4::new(ray);
         let slab = SlabRay::new(ray);
         let mut closest = Closest::new(t_max);
         let tris = &self.triangles[..];
-        walk_binary::<_, _, MAX_DEPTH>(&self.nodes, ray, t_max, counter, |node, _, counter| {
-            let range: Range<usize> = node.prims().expect("a leaf");
-            let offset = range.start as u32;
-            if heap::traverse::<ANY_HIT, C>(
-                &tris[range],
-                offset,
-                &slab,
-                &pre,
-                t_max,
-                &mut closest,
-                counter,
-            ) {
-                Step::Done
-            } else {
-                Step::Closer(closest.cull_t)
-            }
-        });
+        walk_binary::<_, _, MAX_DEPTH>(
+            &self.nodes,
+            ray,
+            t_max,
+            counter,
+            |node, cull_t, counter| {
+                let range: Range<usize> = node.prims().expect("a leaf");
+                let offset = range.start as u32;
+                // The leaf's box clips the heap's interval on all three axes (its root slab has
+                // one); the walk found it entered, so this only misses by rounding.
+                let Some(interval) = slab.interval(node.planes(), cull_t) else {
+                    return Step::Miss;
+                };
+                if heap::traverse::<ANY_HIT, C>(
+                    &tris[range],
+                    offset,
+                    &slab,
+                    &pre,
+                    self.lanes,
+                    interval,
+                    t_max,
+                    &mut closest,
+                    counter,
+                ) {
+                    Step::Done
+                } else {
+                    Step::Closer(closest.cull_t)
+                }
+            },
+        );
         closest.hit
     }
 }

@@ -18,7 +18,7 @@ mod node8;
 mod options;
 mod shadow_cache;
 mod traverse;
-mod tri4;
+pub(crate) mod tri4;
 mod validate;
 
 pub use bvh::{Avx2, Baseline, Isa, WideNode};
