@@ -152,6 +152,10 @@ impl Accel for Iosp0 {
         std::mem::size_of_val(self.triangles.as_slice())
     }
 
+    fn structure_bytes(&self) -> Option<usize> {
+        Some(Iosp0::structure_bytes(self))
+    }
+
     fn counts_traversal(&self) -> bool {
         true
     }

@@ -264,6 +264,10 @@ impl Accel for Iosp2 {
         self.structure_bytes() + std::mem::size_of_val(self.triangles.as_slice())
     }
 
+    fn structure_bytes(&self) -> Option<usize> {
+        Some(Iosp2::structure_bytes(self))
+    }
+
     fn counts_traversal(&self) -> bool {
         true
     }
