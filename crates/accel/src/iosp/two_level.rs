@@ -1,11 +1,13 @@
 //! 2-Lvl IOSP: the top levels of a binned-SAH BVH whose leaves are IOSP-0 heaps (thesis §7.4,
-//! "2-Lvl IOSP (15)").
+//! "2-Lvl IOSP (15)"), the binary top collapsed into four-wide nodes tested with SSE (a
+//! deviation, see the module doc).
 
 use super::heap::{self, MAX_TRIANGLES};
 use super::lanes::SlotTest;
 use super::{IospError, TriBox};
-use crate::traversal::{walk_binary, with_counter, BinaryNode, Closest, Counter, SlabRay, Step};
+use crate::traversal::{with_counter, Closest, Counter, SlabRay, FAR_SCALE};
 use crate::wide::tri4::RayPrecomp4;
+use crate::wide::Slab;
 use crate::{BuildParams, Bvh2, Node, ValidationError};
 use glam::Vec3;
 use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
@@ -14,16 +16,71 @@ use std::ops::Range;
 /// Levels of the SAH top in the thesis' measurements.
 pub const DEFAULT_TOP_LEVELS: u32 = 15;
 
-/// The top tree's traversal stack: its depth is at most 48 (the clamp of `top_levels`).
-const MAX_DEPTH: usize = 64;
+/// The top tree's traversal stack: at most three entries per level, and at most 48 levels
+/// (the clamp of `top_levels`).
+const STACK: usize = 3 * 48 + 1;
 
-/// The two-level IOSP: a binary SAH BVH of at most `top_levels` levels (32-byte nodes, the only
-/// memory beyond the triangles: [`Iosp2::structure_bytes`]), each leaf an IOSP-0 heap over a
-/// contiguous range of the triangle array. See the [module](super) doc for the permutation
-/// contract.
+/// A four-wide node of the top: the children's boxes as structure of arrays (rows min x, y,
+/// z, max x, y, z, as the QBVH's), and per child either a node index (`count` 0) or a heap's
+/// first triangle and triangle count. Empty slots have inverted boxes, which no ray enters.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct Node4 {
+    bounds: [[f32; 4]; 6],
+    child: [u32; 4],
+    count: [u32; 4],
+}
+
+const _: () = assert!(std::mem::size_of::<Node4>() == 128);
+
+impl Node4 {
+    const EMPTY: Self = Self {
+        bounds: [
+            [f32::INFINITY; 4],
+            [f32::INFINITY; 4],
+            [f32::INFINITY; 4],
+            [f32::NEG_INFINITY; 4],
+            [f32::NEG_INFINITY; 4],
+            [f32::NEG_INFINITY; 4],
+        ],
+        child: [0; 4],
+        count: [0; 4],
+    };
+
+    fn set_box(&mut self, lane: usize, b: &Aabb) {
+        for axis in 0..3 {
+            self.bounds[axis][lane] = b.min[axis];
+            self.bounds[axis + 3][lane] = b.max[axis];
+        }
+    }
+
+    fn aabb(&self, lane: usize) -> Aabb {
+        let p = |row: usize| {
+            Vec3::new(
+                self.bounds[row][lane],
+                self.bounds[row + 1][lane],
+                self.bounds[row + 2][lane],
+            )
+        };
+        Aabb {
+            min: p(0),
+            max: p(3),
+        }
+    }
+
+    fn planes(&self, lane: usize) -> [f32; 6] {
+        std::array::from_fn(|row| self.bounds[row][lane])
+    }
+}
+
+/// The two-level IOSP: a SAH BVH of at most `top_levels` binary levels, collapsed into
+/// four-wide nodes (128 bytes each, the only memory beyond the triangles:
+/// [`Iosp2::structure_bytes`]), each leaf an IOSP-0 heap over a contiguous range of the
+/// triangle array. See the [module](super) doc for the permutation contract.
 #[derive(Clone, Debug)]
 pub struct Iosp2 {
-    nodes: Vec<Node>,
+    nodes: Vec<Node4>,
+    bounds: Aabb,
     triangles: Vec<[Vec3; 3]>,
     lanes: SlotTest,
 }
@@ -81,9 +138,23 @@ impl Iosp2 {
             }
         }
         let permuted = perm.iter().map(|&i| triangles[i as usize]).collect();
+        let mut wide = Vec::new();
+        if let Some(root) = nodes.first() {
+            wide.push(Node4::EMPTY);
+            match root.prims() {
+                // A scene of one leaf: a root with one child.
+                Some(r) => {
+                    wide[0].set_box(0, &root.aabb());
+                    wide[0].child[0] = r.start as u32;
+                    wide[0].count[0] = r.len() as u32;
+                }
+                None => collapse(&nodes, 0, 0, &mut wide),
+            }
+        }
         Ok((
             Self {
-                nodes,
+                nodes: wide,
+                bounds: bvh.bounds(),
                 triangles: permuted,
                 lanes: SlotTest::detect(),
             },
@@ -96,9 +167,9 @@ impl Iosp2 {
         &self.triangles
     }
 
-    /// The top-level nodes, root first.
-    pub fn nodes(&self) -> &[Node] {
-        &self.nodes
+    /// Number of four-wide top-level nodes.
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
     }
 
     /// Bytes of the structure beyond the triangles: the top level's nodes.
@@ -122,21 +193,33 @@ impl Iosp2 {
     fn check(&self) -> Result<(), String> {
         let mut covered = vec![0u8; self.triangles.len()];
         for (i, node) in self.nodes.iter().enumerate() {
-            let b = node.aabb();
-            let inner: Vec<Aabb> = match (node.children(), node.prims()) {
-                (Some(c), _) if c[1] < self.nodes.len() && c[0] > i => {
-                    c.iter().map(|&k| self.nodes[k].aabb()).collect()
+            for lane in 0..4 {
+                let b = node.aabb(lane);
+                if b.min.x > b.max.x {
+                    continue; // an empty slot
                 }
-                (None, Some(r)) if r.end <= self.triangles.len() => {
-                    heap::check(&self.triangles[r.clone()])
-                        .map_err(|e| format!("leaf {i}: {e}"))?;
-                    r.clone().for_each(|s| covered[s] += 1);
-                    self.triangles[r].iter().map(Aabb::from_points).collect()
+                let (child, count) = (node.child[lane] as usize, node.count[lane] as usize);
+                let inner: Vec<Aabb> = if count == 0 {
+                    let Some(c) = self.nodes.get(child).filter(|_| child > i) else {
+                        return Err(format!("node {i} slot {lane} points out of range"));
+                    };
+                    (0..4)
+                        .map(|l| c.aabb(l))
+                        .filter(|b| b.min.x <= b.max.x)
+                        .collect()
+                } else {
+                    let Some(tris) = self.triangles.get(child..child + count) else {
+                        return Err(format!("node {i} slot {lane} points out of range"));
+                    };
+                    heap::check(tris).map_err(|e| format!("node {i} slot {lane}: {e}"))?;
+                    (child..child + count).for_each(|s| covered[s] += 1);
+                    tris.iter().map(Aabb::from_points).collect()
+                };
+                if let Some(c) = inner.iter().find(|c| !crate::traversal::inside(c, &b)) {
+                    return Err(format!(
+                        "node {i} slot {lane}'s box {b:?} does not contain {c:?}"
+                    ));
                 }
-                _ => return Err(format!("node {i} points out of range")),
-            };
-            if let Some(c) = inner.iter().find(|c| !crate::traversal::inside(c, &b)) {
-                return Err(format!("node {i}'s box {b:?} does not contain {c:?}"));
             }
         }
         match covered.iter().position(|&c| c != 1) {
@@ -152,44 +235,121 @@ impl Iosp2 {
         t_max: f32,
         counter: &mut C,
     ) -> Option<Hit> {
-        if !(ray.origin.is_finite() && ray.dir.is_finite()) {
+        if self.nodes.is_empty() || !(ray.origin.is_finite() && ray.dir.is_finite()) {
             return None;
         }
-        let pre = RayPrecomp4::new(ray);
+        let slab4 = Slab::new(ray);
         let slab = SlabRay::new(ray);
+        let pre = RayPrecomp4::new(ray);
         let mut closest = Closest::new(t_max);
         let tris = &self.triangles[..];
-        walk_binary::<_, _, MAX_DEPTH>(
-            &self.nodes,
-            ray,
-            t_max,
-            counter,
-            |node, cull_t, counter| {
-                let range: Range<usize> = node.prims().expect("a leaf");
-                let offset = range.start as u32;
-                // The leaf's box clips the heap's interval on all three axes (its root slab has
-                // one); the walk found it entered, so this only misses by rounding.
-                let Some(interval) = slab.interval(node.planes(), cull_t) else {
-                    return Step::Miss;
-                };
-                if heap::traverse::<ANY_HIT, C>(
-                    &tris[range],
-                    offset,
-                    &slab,
-                    &pre,
-                    self.lanes,
-                    interval,
-                    t_max,
-                    &mut closest,
-                    counter,
-                ) {
-                    Step::Done
-                } else {
-                    Step::Closer(closest.cull_t)
+        // (node << 2 | lane) of a heap, or a node index, with the HEAP bit; entry distance.
+        const HEAP: u32 = 1 << 31;
+        let mut stack = [(0u32, 0f32); STACK];
+        let mut sp = 0;
+        let mut cur = 0u32;
+        loop {
+            if cur & HEAP != 0 {
+                let (node, lane) = (&self.nodes[(cur & !HEAP) as usize >> 2], cur as usize & 3);
+                let (start, count) = (node.child[lane] as usize, node.count[lane] as usize);
+                // The box clips the heap's interval on all three axes (its root slab has one).
+                if let Some(interval) = slab.interval(&node.planes(lane), closest.cull_t) {
+                    if heap::traverse::<ANY_HIT, C>(
+                        &tris[start..start + count],
+                        start as u32,
+                        &slab,
+                        &pre,
+                        self.lanes,
+                        interval,
+                        t_max,
+                        &mut closest,
+                        counter,
+                    ) {
+                        return closest.hit;
+                    }
                 }
-            },
-        );
-        closest.hit
+            } else {
+                let node = &self.nodes[cur as usize];
+                counter.boxes(4);
+                let (mask, t) = slab4.hit4(&node.bounds, closest.cull_t);
+                // Hit slots nearest first: insertion sort of at most four.
+                let mut order = [(0f32, 0u32); 4];
+                let mut n = 0;
+                let mut rest = mask;
+                while rest != 0 {
+                    let lane = rest.trailing_zeros() as usize;
+                    rest &= rest - 1;
+                    let code = if node.count[lane] == 0 {
+                        node.child[lane]
+                    } else {
+                        HEAP | (cur << 2) | lane as u32
+                    };
+                    let mut k = n;
+                    while k > 0 && order[k - 1].0 > t[lane] {
+                        order[k] = order[k - 1];
+                        k -= 1;
+                    }
+                    order[k] = (t[lane], code);
+                    n += 1;
+                }
+                if n > 0 {
+                    for &(t, code) in order[1..n].iter().rev() {
+                        stack[sp] = (code, t);
+                        sp += 1;
+                    }
+                    cur = order[0].1;
+                    continue;
+                }
+            }
+            loop {
+                if sp == 0 {
+                    return closest.hit;
+                }
+                sp -= 1;
+                let (code, t) = stack[sp];
+                if t <= closest.cull_t * FAR_SCALE {
+                    cur = code;
+                    break;
+                }
+            }
+        }
+    }
+}
+
+/// Collapses the binary node `at` of `src` (an inner node) into `dst[to]`: starting from its
+/// two children, the inner child of largest surface area is replaced by its own two until
+/// there are four or only leaves (Dammertz et al.'s greedy QBVH collapse); inner children
+/// become nodes of their own, leaves become heap slots.
+fn collapse(src: &[Node], at: usize, to: usize, dst: &mut Vec<Node4>) {
+    let mut kids: Vec<usize> = src[at].children().expect("an inner node").to_vec();
+    while kids.len() < 4 {
+        let widest = kids
+            .iter()
+            .enumerate()
+            .filter(|(_, &k)| src[k].children().is_some())
+            .max_by(|a, b| {
+                let area = |k: usize| src[k].aabb().surface_area();
+                area(*a.1).total_cmp(&area(*b.1))
+            })
+            .map(|(i, _)| i);
+        let Some(i) = widest else { break };
+        let k = kids.swap_remove(i);
+        kids.extend(src[k].children().expect("inner"));
+    }
+    for (lane, &k) in kids.iter().enumerate() {
+        dst[to].set_box(lane, &src[k].aabb());
+        match src[k].prims() {
+            Some(r) => {
+                dst[to].child[lane] = r.start as u32;
+                dst[to].count[lane] = r.len() as u32;
+            }
+            None => {
+                let index = dst.len();
+                dst.push(Node4::EMPTY);
+                dst[to].child[lane] = index as u32;
+                collapse(src, k, index, dst);
+            }
+        }
     }
 }
 
@@ -257,7 +417,7 @@ impl Accel for Iosp2 {
     }
 
     fn bounds(&self) -> Aabb {
-        self.nodes.first().map_or(Aabb::EMPTY, Node::aabb)
+        self.bounds
     }
 
     fn memory_bytes(&self) -> usize {

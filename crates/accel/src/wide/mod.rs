@@ -25,6 +25,7 @@ pub use bvh::{Avx2, Baseline, Isa, WideNode};
 pub use node::{QChild, QNode, EMPTY, LEAF_BIT, MAX_LEAF_TRIANGLES, MAX_TRIANGLES, NO_AXIS};
 pub use node8::Node8;
 pub use options::{Order, TriangleTest, WideOptions, DEFAULT_INTERSECTION_COST, DEFAULT_LEAF_SIZE};
+pub(crate) use traverse::Slab;
 pub use tri4::Tri4;
 
 use crate::traversal::{with_counter, Counter};
