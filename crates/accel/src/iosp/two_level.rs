@@ -16,6 +16,23 @@ use std::ops::Range;
 /// Levels of the SAH top in the thesis' measurements.
 pub const DEFAULT_TOP_LEVELS: u32 = 15;
 
+/// Bytes [`Iosp2::build`]'s top may take: the thesis' "at most about 1 MB", in decimal
+/// megabytes.
+pub const DEFAULT_TOP_BYTES: usize = 1_000_000;
+
+/// Binary levels of the top at most, whatever the budget: bounds the traversal stack.
+const MAX_LEVELS: u32 = 48;
+
+/// How deep the binary SAH tree is cut.
+#[derive(Clone, Copy)]
+enum Cut {
+    /// After this many levels.
+    Levels(u32),
+    /// Where the four-wide top reaches this many bytes, opening the subtrees of largest
+    /// surface area times triangle count (the SAH cost of leaving them one heap) first.
+    Bytes(usize),
+}
+
 /// The top tree's traversal stack: at most three entries per level, and at most 48 levels
 /// (the clamp of `top_levels`).
 const STACK: usize = 3 * 48 + 1;
@@ -86,13 +103,15 @@ pub struct Iosp2 {
 }
 
 impl Iosp2 {
-    /// Builds with [`DEFAULT_TOP_LEVELS`]; see [`Iosp2::build_with`].
+    /// Builds as [`Iosp2::build_with`] but cuts the binary tree where the four-wide top reaches
+    /// [`DEFAULT_TOP_BYTES`], opening the subtrees of largest surface area times triangle count
+    /// first (down to at most 48 levels), instead of after a fixed number of levels.
     ///
     /// # Errors
     ///
     /// As [`Iosp2::build_with`].
     pub fn build(triangles: &[[Vec3; 3]]) -> Result<(Self, Vec<u32>), IospError> {
-        Self::build_with(triangles, DEFAULT_TOP_LEVELS)
+        Self::build_top(triangles, Cut::Bytes(DEFAULT_TOP_BYTES))
     }
 
     /// Builds a [`Bvh2`] (default parameters) over `triangles`, cuts it after `top_levels`
@@ -108,6 +127,10 @@ impl Iosp2 {
         triangles: &[[Vec3; 3]],
         top_levels: u32,
     ) -> Result<(Self, Vec<u32>), IospError> {
+        Self::build_top(triangles, Cut::Levels(top_levels))
+    }
+
+    fn build_top(triangles: &[[Vec3; 3]], how: Cut) -> Result<(Self, Vec<u32>), IospError> {
         if triangles.len() >= MAX_TRIANGLES {
             return Err(IospError::TooManyTriangles {
                 structure: "iosp2",
@@ -115,13 +138,34 @@ impl Iosp2 {
                 limit: MAX_TRIANGLES - 1,
             });
         }
-        let top_levels = top_levels.clamp(1, 48);
         let bvh = Bvh2::build(triangles, &BuildParams::default());
-        let mut nodes = Vec::new();
-        if let Some(root) = bvh.nodes().first() {
-            nodes.push(*root);
-            cut(bvh.nodes(), 0, 0, 0, top_levels, &mut nodes);
-        }
+        let src = bvh.nodes();
+        let nodes = match how {
+            Cut::Levels(levels) => {
+                let levels = levels.clamp(1, MAX_LEVELS);
+                binary_top(src, &|_, depth| depth + 1 < levels)
+            }
+            Cut::Bytes(budget) => {
+                // The most expansions whose four-wide top fits: bytes grow with the count.
+                let order = expansion_order(src);
+                let top = |k: usize| {
+                    let mut open = vec![false; src.len()];
+                    order[..k].iter().for_each(|&i| open[i] = true);
+                    binary_top(src, &|at, _| open[at])
+                };
+                let fits = |k: usize| 128 * wide_count(&top(k)) <= budget;
+                let (mut lo, mut hi) = (0, order.len());
+                while lo < hi {
+                    let mid = (lo + hi).div_ceil(2);
+                    if fits(mid) {
+                        lo = mid;
+                    } else {
+                        hi = mid - 1;
+                    }
+                }
+                top(lo)
+            }
+        };
         // Bvh2 without splitting stores each triangle once, in leaf order, so every cut
         // subtree owns a contiguous range; order each range as a heap.
         let mut perm: Vec<u32> = bvh.prim_ids().to_vec();
@@ -353,13 +397,31 @@ fn collapse(src: &[Node], at: usize, to: usize, dst: &mut Vec<Node4>) {
     }
 }
 
+/// The top of the binary tree `src`: a copy whose node `at` (at depth `depth`) keeps its
+/// children where `open(at, depth)` and otherwise becomes a leaf over its subtree's range.
+fn binary_top(src: &[Node], open: &dyn Fn(usize, u32) -> bool) -> Vec<Node> {
+    let mut dst = Vec::new();
+    if let Some(root) = src.first() {
+        dst.push(*root);
+        cut(src, 0, 0, 0, open, &mut dst);
+    }
+    dst
+}
+
 /// Copies the children of `src`'s node `at` (already copied to `dst[to]`, at depth `depth`)
-/// into `dst`, turning nodes on the last kept level into leaves over their subtree's range.
-fn cut(src: &[Node], at: usize, to: usize, depth: u32, levels: u32, dst: &mut Vec<Node>) {
+/// into `dst`, turning nodes not to be opened into leaves over their subtree's range.
+fn cut(
+    src: &[Node],
+    at: usize,
+    to: usize,
+    depth: u32,
+    open: &dyn Fn(usize, u32) -> bool,
+    dst: &mut Vec<Node>,
+) {
     let Some([l, r]) = src[at].children() else {
         return;
     };
-    if depth + 1 >= levels {
+    if !open(at, depth) {
         let range = subtree_range(src, at);
         dst[to] = Node::leaf(src[at].aabb(), range.start as u32, range.len() as u32);
         return;
@@ -368,8 +430,73 @@ fn cut(src: &[Node], at: usize, to: usize, depth: u32, levels: u32, dst: &mut Ve
     dst[to] = Node::inner(src[at].aabb(), first as u32);
     dst.push(src[l]);
     dst.push(src[r]);
-    cut(src, l, first, depth + 1, levels, dst);
-    cut(src, r, first + 1, depth + 1, levels, dst);
+    cut(src, l, first, depth + 1, open, dst);
+    cut(src, r, first + 1, depth + 1, open, dst);
+}
+
+/// The inner nodes of `src` in the order a budgeted cut opens them: largest surface area
+/// times triangle count first (among those whose parent is open), above [`MAX_LEVELS`].
+fn expansion_order(src: &[Node]) -> Vec<usize> {
+    if src.is_empty() {
+        return Vec::new();
+    }
+    // Triangles under each node, children after their parent in `src`.
+    let mut count = vec![0f32; src.len()];
+    for i in (0..src.len()).rev() {
+        count[i] = match (src[i].children(), src[i].prims()) {
+            (Some([l, r]), _) => count[l] + count[r],
+            (None, Some(r)) => r.len() as f32,
+            (None, None) => 0.0,
+        };
+    }
+    let key = |i: usize| src[i].aabb().surface_area() * count[i];
+    let mut order = Vec::new();
+    let mut frontier = std::collections::BinaryHeap::new();
+    frontier.push((Ordered(key(0)), 0usize, 0u32));
+    while let Some((_, i, depth)) = frontier.pop() {
+        let Some(children) = src[i].children() else {
+            continue;
+        };
+        if depth + 1 >= MAX_LEVELS {
+            continue;
+        }
+        order.push(i);
+        for c in children {
+            frontier.push((Ordered(key(c)), c, depth + 1));
+        }
+    }
+    order
+}
+
+/// An `f32` ordered by `total_cmp`, for the frontier heap.
+#[derive(PartialEq)]
+struct Ordered(f32);
+
+impl Eq for Ordered {}
+
+impl PartialOrd for Ordered {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Ordered {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
+}
+
+/// Four-wide nodes [`collapse`] makes of the binary top `nodes`.
+fn wide_count(nodes: &[Node]) -> usize {
+    match nodes.first() {
+        None => 0,
+        Some(root) if root.prims().is_some() => 1,
+        Some(_) => {
+            let mut wide = vec![Node4::EMPTY];
+            collapse(nodes, 0, 0, &mut wide);
+            wide.len()
+        }
+    }
 }
 
 /// The leaf-order range of the subtree of `at`: its leaves are contiguous because the binary
