@@ -243,6 +243,11 @@ pub(crate) fn traverse<const ANY_HIT: bool, C: Counter>(
             // slots 4j + 2 ..= 4j + 5 (fewer at the end of the heap) join this node's in the
             // batch instead of having their slabs tested.
             let leaf_children = left < nodes && 2 * left + 1 >= nodes;
+            // The children's four triangles are next (queued, or read for their slabs) and
+            // far from this node in the heap: start loading them now.
+            if left < nodes {
+                prefetch_slots(tris, 2 * left as usize, 4);
+            }
             let own = 1 + (b > a) as usize;
             let kids = if leaf_children {
                 (n - 2 * left as usize).min(4)
@@ -289,6 +294,29 @@ pub(crate) fn traverse<const ANY_HIT: bool, C: Counter>(
                 }
             }
         }
+    }
+}
+
+/// Asks for the cache lines of the triangles `slot..slot + count` (those in the heap).
+#[inline(always)]
+#[allow(unsafe_code)]
+pub(crate) fn prefetch_slots(tris: &[[Vec3; 3]], slot: usize, count: usize) {
+    let end = (slot + count).min(tris.len());
+    if slot >= end {
+        return;
+    }
+    #[cfg(all(target_arch = "x86_64", target_feature = "sse"))]
+    {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        let bytes = tris[slot..end].as_ptr_range();
+        let (mut line, stop) = (bytes.start.cast::<i8>(), bytes.end.cast::<i8>());
+        while line < stop {
+            // SAFETY: a prefetch is a hint that never faults; `line` is inside the slice.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(line) };
+            line = line.wrapping_add(64);
+        }
+        // SAFETY: as above, for the slice's last byte (its last line may start past `line`).
+        unsafe { _mm_prefetch::<_MM_HINT_T0>(stop.wrapping_sub(1)) };
     }
 }
 

@@ -326,6 +326,10 @@ impl Iosp2 {
                     let code = if node.count[lane] == 0 {
                         node.child[lane]
                     } else {
+                        // The heap's root pair (or all of a small heap) will be read when it is
+                        // popped: start loading it now, as the QBVH does for its leaves.
+                        let start = node.child[lane] as usize;
+                        heap::prefetch_slots(tris, start, node.count[lane].min(2) as usize);
                         HEAP | (cur << 2) | lane as u32
                     };
                     let mut k = n;
