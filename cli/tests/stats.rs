@@ -311,3 +311,31 @@ fn partitioned_reports_its_own_stages() {
     );
     assert!(!path.contains("caustic histogram"), "{path}");
 }
+
+#[test]
+fn stats_give_the_structure_bytes_apart_from_the_triangles() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("lamp.toml"), lamp()).unwrap();
+    let row = |accel: &str| {
+        let table = render(
+            dir.path(),
+            &["lamp.toml", "--spp", "1", "-q", "--stats", "--accel", accel],
+        );
+        table
+            .lines()
+            .find(|l| l.starts_with("acceleration structure"))
+            .unwrap_or_else(|| panic!("{table}"))
+            .to_string()
+    };
+    // IOSP-0 is the reordered scene's triangles and nothing else.
+    let iosp0 = row("iosp0");
+    assert!(
+        iosp0.contains("iosp0; structure 0 B (0.00 B/triangle) beyond "),
+        "{iosp0}"
+    );
+    let bvh = row("bvh");
+    assert!(
+        bvh.contains("; structure ") && bvh.contains(" B of triangles"),
+        "{bvh}"
+    );
+}

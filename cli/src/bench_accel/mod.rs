@@ -105,6 +105,11 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 3)]
     pub repeat: u32,
 
+    /// Time the one-thread runs by the thread's CPU time instead of wall time (Linux; wall time
+    /// elsewhere): on a machine shared with other jobs, wall time also counts waiting for a core.
+    #[arg(long)]
+    pub cpu_time: bool,
+
     /// No progress lines on stderr.
     #[arg(short, long)]
     pub quiet: bool,
@@ -323,7 +328,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             let thread_counts: &[usize] = if threads == 1 { &[1] } else { &[1, threads] };
             let first_row = rows.len();
             for &n in thread_counts {
-                let timing = measure::time(accel, set, (n > 1).then_some(&pool), args.repeat);
+                let timing = if n == 1 && args.cpu_time {
+                    measure::time_cpu(accel, set, args.repeat)
+                } else {
+                    measure::time(accel, set, (n > 1).then_some(&pool), args.repeat)
+                };
                 info(&format!(
                     "{name}: {} rays, {n} thread{}: {:.2} Mrays/s",
                     set.name,
@@ -336,6 +345,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                     threads: n,
                     build_ms,
                     bytes: 0, // filled in below, after the runs (the lazy QBVH grows)
+                    structure_bytes: None,
                     ray_count: set.rays.len(),
                     seconds: timing.seconds,
                     hits: timing.hits,
@@ -354,9 +364,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 r.counters = counted;
             }
         }
-        let bytes = accel.memory_bytes();
+        let (bytes, structure_bytes) = (accel.memory_bytes(), accel.structure_bytes());
         for r in rows.iter_mut().filter(|r| r.accel == name) {
             r.bytes = bytes;
+            r.structure_bytes = structure_bytes;
         }
     }
     report::print_table(&rows, threads);

@@ -7,7 +7,7 @@ use std::path::Path;
 /// The CSV header. The first ten columns are the interface of issue 3; the rest are extras.
 pub const CSV_HEADER: &str = "accel,rays,threads,build_ms,bytes,mrays_per_s,hits,boxes_per_ray,\
 leaves_per_ray,tris_per_ray,scene,triangles,bytes_per_tri,ray_count,seconds,check_mismatches,\
-check_ties";
+check_ties,structure_bytes,structure_bytes_per_tri";
 
 /// One measurement: a structure, a ray set, a thread count.
 pub struct Row {
@@ -20,6 +20,9 @@ pub struct Row {
     pub build_ms: f64,
     /// `Accel::memory_bytes` after the runs.
     pub bytes: usize,
+    /// `Accel::structure_bytes` after the runs: the part of `bytes` beyond one copy of the
+    /// triangles' vertices.
+    pub structure_bytes: Option<usize>,
     /// Rays in the set.
     pub ray_count: usize,
     /// Best time over the repetitions.
@@ -48,6 +51,11 @@ impl Row {
 
     fn bytes_per_tri(&self) -> f64 {
         self.bytes as f64 / self.triangles.max(1) as f64
+    }
+
+    fn structure_per_tri(&self) -> Option<f64> {
+        self.structure_bytes
+            .map(|b| b as f64 / self.triangles.max(1) as f64)
     }
 
     /// Mrays/s relative to the first structure's on the same set and thread count.
@@ -79,6 +87,7 @@ pub fn print_table(rows: &[Row], threads: usize) {
         "build ms",
         "MiB",
         "B/tri",
+        "struct B/tri",
         "rays",
         "count",
         "threads",
@@ -100,6 +109,7 @@ pub fn print_table(rows: &[Row], threads: usize) {
             once(format!("{:.1}", r.build_ms)),
             once(format!("{:.1}", r.bytes as f64 / (1u64 << 20) as f64)),
             once(format!("{:.1}", r.bytes_per_tri())),
+            once(opt(r.structure_per_tri(), 2)),
             r.rays.clone(),
             r.ray_count.to_string(),
             r.threads.to_string(),
@@ -126,7 +136,7 @@ pub fn print_table(rows: &[Row], threads: usize) {
             .enumerate()
             .map(|(i, c)| {
                 // Names left-aligned, numbers right-aligned.
-                if i == 0 || i == 4 {
+                if i == 0 || i == 5 {
                     format!("{c:<w$}", w = widths[i])
                 } else {
                     format!("{c:>w$}", w = widths[i])
@@ -136,7 +146,8 @@ pub fn print_table(rows: &[Row], threads: usize) {
         println!("{}", line.join("  ").trim_end());
     }
     println!(
-        "speedup: Mrays/s over {}'s on the same rays and threads",
+        "speedup: Mrays/s over {}'s on the same rays and threads; MiB and B/tri: all the \
+         structure's memory; struct B/tri: beyond one copy of the triangles (36 B each)",
         first.accel
     );
 }
@@ -175,6 +186,8 @@ pub fn write_csv(path: &Path, rows: &[Row]) -> Result<()> {
             format!("{:.6}", r.seconds),
             r.mismatches.to_string(),
             r.ties.to_string(),
+            r.structure_bytes.map_or(String::new(), |b| b.to_string()),
+            num(r.structure_per_tri()),
         ];
         out.push_str(&line.join(","));
         out.push('\n');

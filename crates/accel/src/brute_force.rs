@@ -96,6 +96,10 @@ impl Accel for BruteForce {
         std::mem::size_of_val(self.triangles.as_slice())
     }
 
+    fn structure_bytes(&self) -> Option<usize> {
+        Some(0)
+    }
+
     fn counts_traversal(&self) -> bool {
         true
     }

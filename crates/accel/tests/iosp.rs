@@ -6,6 +6,7 @@ mod common;
 
 use common::{check_ray, grid_cube, rays, shared_mesh, soup, Agreement, Rng};
 use rt_accel::iosp::split::{complete_split, eq_7_1_corrected, eq_7_1_printed, heap_subtree_nodes};
+use rt_accel::iosp::DEFAULT_TOP_BYTES;
 use rt_accel::{BruteForce, BuildParams, Bvh2, Iosp0, Iosp2, Iosp4, ValidationError};
 use rt_core::glam::Vec3;
 use rt_core::{Accel, Ray, TraversalCounters};
@@ -266,8 +267,22 @@ fn iosp4_and_two_level_structure_bytes() {
     // Fewer nodes than triangle pairs (the leaves hold extras).
     assert!(i4.words().len() < 2500, "{}", i4.words().len());
     let (i2, _) = Iosp2::build_with(&tris, 6).unwrap();
-    assert!(i2.nodes().len() < 64, "{}", i2.nodes().len());
-    assert_eq!(i2.structure_bytes(), 32 * i2.nodes().len());
+    assert!(i2.node_count() < 32, "{}", i2.node_count());
+    assert_eq!(i2.structure_bytes(), 128 * i2.node_count());
+    // The default top fills its byte budget, and no more, on a scene large enough to bind it.
+    let many = soup(&mut rng, 200_000);
+    let (i2, _) = Iosp2::build(&many).unwrap();
+    assert!(
+        i2.structure_bytes() <= DEFAULT_TOP_BYTES,
+        "{}",
+        i2.structure_bytes()
+    );
+    assert!(
+        i2.structure_bytes() > DEFAULT_TOP_BYTES * 9 / 10,
+        "{}",
+        i2.structure_bytes()
+    );
+    i2.validate().unwrap();
 }
 
 #[test]

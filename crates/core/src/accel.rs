@@ -86,6 +86,13 @@ pub trait Accel: Send + Sync {
     /// Bytes of memory held by the structure (nodes and any primitive copies it keeps).
     fn memory_bytes(&self) -> usize;
 
+    /// The part of [`Accel::memory_bytes`] that is the structure's own, beyond one copy of
+    /// the triangles' vertices (36 bytes a triangle, in whatever layout): nodes, cells, index
+    /// maps, padding. `None` if the structure does not tell them apart.
+    fn structure_bytes(&self) -> Option<usize> {
+        None
+    }
+
     /// True if the queries really fill the counters they are given.
     fn counts_traversal(&self) -> bool {
         false

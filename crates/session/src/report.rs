@@ -132,10 +132,21 @@ impl RenderReport {
                 Some(i.accel_time),
                 Some(accel_bytes),
             )
-            .details(if i.accel.name() == i.accel_spec {
-                i.accel_spec.clone()
-            } else {
-                format!("{} ({})", i.accel.name(), i.accel_spec)
+            .details({
+                let name = if i.accel.name() == i.accel_spec {
+                    i.accel_spec.clone()
+                } else {
+                    format!("{} ({})", i.accel.name(), i.accel_spec)
+                };
+                // The structure's own bytes apart from its copy of the triangles (issue 12).
+                match i.accel.structure_bytes() {
+                    Some(own) => format!(
+                        "{name}; structure {own} B ({:.2} B/triangle) beyond {} B of triangles",
+                        own as f64 / scene.triangle_count().max(1) as f64,
+                        accel_bytes.saturating_sub(own)
+                    ),
+                    None => name,
+                }
             }),
         );
 

@@ -176,6 +176,10 @@ impl Accel for Bvh2 {
             + std::mem::size_of_val(self.prim_ids.as_slice())
     }
 
+    fn structure_bytes(&self) -> Option<usize> {
+        Some(self.memory_bytes() - std::mem::size_of_val(self.triangles.as_slice()))
+    }
+
     fn counts_traversal(&self) -> bool {
         true
     }

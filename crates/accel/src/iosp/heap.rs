@@ -7,12 +7,13 @@
 //! bounded on axis `depth % 3`, and its children `2j + 1`, `2j + 2` (when below the node count)
 //! were partitioned on the next level's axis with the lower half on the left.
 
+use super::lanes::{SlotTest, LANES};
 use super::split::{complete_split, heap_contains};
 use super::{slab_of, TriBox};
 use crate::traversal::{Closest, Counter, SlabRay, FAR_SCALE};
+use crate::wide::tri4::RayPrecomp4;
 use glam::Vec3;
 use rayon::prelude::*;
-use rt_core::triangle::{intersect_triangle, RayPrecomp};
 
 /// Heaps are limited to `2^31` triangles, so node indices `2j + 2` never overflow a `u32`.
 pub(crate) const MAX_TRIANGLES: usize = 1 << 31;
@@ -171,15 +172,25 @@ fn argmin(s: &[u32], cmp: impl Fn(u32, u32) -> std::cmp::Ordering) -> usize {
 }
 
 /// Closest (or, with `ANY_HIT`, any) hit in the heap `tris`, reporting slot `i` as prim
-/// `offset + i`, into `closest`; the interval starts at `[0, closest.cull_t]`. Returns true
-/// when an any-hit query has its answer. Does not allocate: the stack is an array.
+/// `offset + i`, into `closest`, for a ray whose interval over the heap's bounds is
+/// `[t0, t1]` (the caller clips it to the scene's or the top-level leaf's box). Returns true
+/// when an any-hit query has its answer. Does not allocate: the stack and the batch are arrays.
+///
+/// The triangles of entered nodes are not tested at once but batched, eight at a time, for
+/// `lanes` (see the module doc's deviations): the batch is tested when full and before every
+/// pop from the stack, so the culling distance a popped node is checked against includes every
+/// triangle entered before it. A node whose children are both leaves adds its children's
+/// triangles to the batch instead of testing their slabs; a heap of at most eight triangles is
+/// tested whole.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn traverse<const ANY_HIT: bool, C: Counter>(
     tris: &[[Vec3; 3]],
     offset: u32,
     slab: &SlabRay,
-    pre: &RayPrecomp,
+    pre: &RayPrecomp4,
+    lanes: SlotTest,
+    (t0, t1): (f32, f32),
     t_max: f32,
     closest: &mut Closest,
     counter: &mut C,
@@ -188,13 +199,34 @@ pub(crate) fn traverse<const ANY_HIT: bool, C: Counter>(
     if n == 0 {
         return false;
     }
+    if n <= LANES {
+        counter.leaf();
+        let slots: [u32; LANES] = std::array::from_fn(|i| i.min(n - 1) as u32);
+        return lanes.run::<ANY_HIT, C>(pre, tris, offset, &slots, n, t_max, closest, counter);
+    }
     let nodes = n.div_ceil(2) as u32;
-    let mut stack = [(0u32, 0f32, 0f32); STACK];
+    let mut batch = [0u32; LANES];
+    let mut len = 0;
+    // Tests the batch; unused lanes repeat its first slot.
+    macro_rules! flush {
+        () => {
+            if len > 0 {
+                let first = batch[0];
+                batch[len..].fill(first);
+                let count = std::mem::replace(&mut len, 0);
+                if lanes
+                    .run::<ANY_HIT, C>(pre, tris, offset, &batch, count, t_max, closest, counter)
+                {
+                    return true;
+                }
+            }
+        };
+    }
+    // (node, its slab's axis, interval) of far children still to visit.
+    let mut stack = [(0u32, 0usize, 0f32, 0f32); STACK];
     let mut sp = 0;
-    let (mut node, mut t0, mut t1) = (0u32, 0f32, closest.cull_t);
+    let (mut node, mut axis, mut t0, mut t1) = (0u32, 0usize, t0, t1);
     loop {
-        let d = depth(node);
-        let axis = (d % 3) as usize;
         let a = 2 * node as usize;
         let b = (a + 1).min(n - 1);
         counter.boxes(1);
@@ -206,48 +238,85 @@ pub(crate) fn traverse<const ANY_HIT: bool, C: Counter>(
         let mut descended = false;
         if tn <= tf * FAR_SCALE {
             counter.leaf();
-            // The last node of an odd heap has one triangle: `b == a`.
-            #[allow(clippy::needless_range_loop)]
-            for s in a..=b {
-                counter.triangle();
-                if let Some(h) = intersect_triangle(pre, &tris[s], t_max) {
-                    if closest.offer::<ANY_HIT>(h.t, offset + s as u32, h.b1, h.b2) {
-                        return true;
-                    }
-                }
-            }
             let left = 2 * node + 1;
+            // With both children leaves (the left child's first child is past the end), their
+            // slots 4j + 2 ..= 4j + 5 (fewer at the end of the heap) join this node's in the
+            // batch instead of having their slabs tested.
+            let leaf_children = left < nodes && 2 * left + 1 >= nodes;
+            // The children's four triangles are next (queued, or read for their slabs) and
+            // far from this node in the heap: start loading them now.
             if left < nodes {
+                prefetch_slots(tris, 2 * left as usize, 4);
+            }
+            let own = 1 + (b > a) as usize;
+            let kids = if leaf_children {
+                (n - 2 * left as usize).min(4)
+            } else {
+                0
+            };
+            if len + own + kids > LANES {
+                flush!();
+            }
+            batch[len..len + own].copy_from_slice(&[a as u32, b as u32][..own]);
+            len += own;
+            let c = 2 * left;
+            batch[len..len + kids].copy_from_slice(&[c, c + 1, c + 2, c + 3][..kids]);
+            len += kids;
+            if left < nodes && !leaf_children {
                 let right = left + 1;
-                let child_axis = ((d + 1) % 3) as usize;
+                let child_axis = if axis == 2 { 0 } else { axis + 1 };
                 node = if right >= nodes {
                     left
                 } else if slab.negative(child_axis) {
-                    stack[sp] = (left, tn, tf);
+                    stack[sp] = (left, child_axis, tn, tf);
                     sp += 1;
                     right
                 } else {
-                    stack[sp] = (right, tn, tf);
+                    stack[sp] = (right, child_axis, tn, tf);
                     sp += 1;
                     left
                 };
-                (t0, t1) = (tn, tf);
+                (axis, t0, t1) = (child_axis, tn, tf);
                 descended = true;
             }
         }
         if !descended {
+            flush!();
             loop {
                 if sp == 0 {
                     return false;
                 }
                 sp -= 1;
-                let (next, e0, e1) = stack[sp];
+                let (next, next_axis, e0, e1) = stack[sp];
                 if e0 <= closest.cull_t * FAR_SCALE {
-                    (node, t0, t1) = (next, e0, e1);
+                    (node, axis, t0, t1) = (next, next_axis, e0, e1);
                     break;
                 }
             }
         }
+    }
+}
+
+/// Asks for the cache lines of the triangles `slot..slot + count` (those in the heap).
+#[inline(always)]
+#[allow(unsafe_code)]
+pub(crate) fn prefetch_slots(tris: &[[Vec3; 3]], slot: usize, count: usize) {
+    let end = (slot + count).min(tris.len());
+    if slot >= end {
+        return;
+    }
+    #[cfg(all(target_arch = "x86_64", target_feature = "sse"))]
+    {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        let bytes = tris[slot..end].as_ptr_range();
+        let (mut line, stop) = (bytes.start.cast::<i8>(), bytes.end.cast::<i8>());
+        while line < stop {
+            // SAFETY: a prefetch is a hint that never faults; `line` is inside the slice.
+            unsafe { _mm_prefetch::<_MM_HINT_T0>(line) };
+            line = line.wrapping_add(64);
+        }
+        // SAFETY: as above, for the slice's last byte (its last line may start past `line`).
+        unsafe { _mm_prefetch::<_MM_HINT_T0>(stop.wrapping_sub(1)) };
     }
 }
 

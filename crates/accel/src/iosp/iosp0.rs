@@ -2,21 +2,23 @@
 //! (thesis §7.3).
 
 use super::heap::{self, MAX_TRIANGLES};
+use super::lanes::SlotTest;
 use super::{bounds_of, IospError, TriBox};
 use crate::traversal::{with_counter, Closest, Counter, SlabRay};
+use crate::wide::tri4::RayPrecomp4;
 use crate::ValidationError;
 use glam::Vec3;
-use rt_core::triangle::RayPrecomp;
 use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
 
 /// The completely implicit IOSP hierarchy: a complete binary tree over the triangles, stored
 /// as a heap inside the triangle array, with no nodes at all (see the [module](super) doc and
-/// its permutation contract). Besides the triangles it keeps only their count and the scene
-/// bounds for [`Accel::bounds`].
+/// its permutation contract). Besides the triangles it keeps only the scene bounds (for
+/// [`Accel::bounds`], and to clip each ray before the root) and which SIMD test the CPU runs.
 #[derive(Clone, Debug)]
 pub struct Iosp0 {
     triangles: Vec<[Vec3; 3]>,
     bounds: Aabb,
+    lanes: SlotTest,
 }
 
 impl Iosp0 {
@@ -43,6 +45,7 @@ impl Iosp0 {
             Self {
                 triangles: permuted,
                 bounds: bounds_of(triangles),
+                lanes: SlotTest::detect(),
             },
             perm,
         ))
@@ -91,14 +94,21 @@ impl Iosp0 {
         if !(ray.origin.is_finite() && ray.dir.is_finite()) {
             return None;
         }
-        let pre = RayPrecomp::new(ray);
         let slab = SlabRay::new(ray);
+        // The root's slab bounds one axis only; the scene box clips all three first.
+        let (lo, hi) = (self.bounds.min, self.bounds.max);
+        let planes = [lo.x, lo.y, lo.z, hi.x, hi.y, hi.z];
+        counter.boxes(1);
+        let interval = slab.interval(&planes, t_max)?;
+        let pre = RayPrecomp4::new(ray);
         let mut closest = Closest::new(t_max);
         heap::traverse::<ANY_HIT, C>(
             &self.triangles,
             0,
             &slab,
             &pre,
+            self.lanes,
+            interval,
             t_max,
             &mut closest,
             counter,
@@ -140,6 +150,10 @@ impl Accel for Iosp0 {
     /// The triangles only: the structure itself takes no memory.
     fn memory_bytes(&self) -> usize {
         std::mem::size_of_val(self.triangles.as_slice())
+    }
+
+    fn structure_bytes(&self) -> Option<usize> {
+        Some(Iosp0::structure_bytes(self))
     }
 
     fn counts_traversal(&self) -> bool {

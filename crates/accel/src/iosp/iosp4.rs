@@ -296,6 +296,10 @@ impl Accel for Iosp4 {
         self.structure_bytes() + std::mem::size_of_val(self.triangles.as_slice())
     }
 
+    fn structure_bytes(&self) -> Option<usize> {
+        Some(Iosp4::structure_bytes(self))
+    }
+
     fn counts_traversal(&self) -> bool {
         true
     }

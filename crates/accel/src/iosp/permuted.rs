@@ -54,6 +54,13 @@ impl<A: Accel> Accel for Unpermuted<A> {
         self.inner.memory_bytes() + std::mem::size_of_val(self.perm.as_slice())
     }
 
+    /// The inner structure's only: the index map stands in for the caller reordering its
+    /// per-triangle data, which the renderer does instead of keeping a map
+    /// ([`crate::AccelSpec::try_build_scene_mut`]); [`Accel::memory_bytes`] counts it.
+    fn structure_bytes(&self) -> Option<usize> {
+        self.inner.structure_bytes()
+    }
+
     fn counts_traversal(&self) -> bool {
         self.inner.counts_traversal()
     }

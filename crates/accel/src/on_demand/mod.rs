@@ -541,6 +541,11 @@ impl Accel for OnDemandQbvh {
                 .sum::<usize>()
     }
 
+    /// Everything but the caller-order triangles (the groups' trees keep packed copies).
+    fn structure_bytes(&self) -> Option<usize> {
+        Some(self.memory_bytes() - std::mem::size_of_val(self.triangles.as_slice()))
+    }
+
     fn counts_traversal(&self) -> bool {
         true
     }

@@ -554,6 +554,23 @@ impl Accel for TwoLevel {
             + self.top_bytes()
     }
 
+    /// The object BVHs' own bytes (each prototype's once, whatever its instances), their
+    /// index maps and the top level.
+    fn structure_bytes(&self) -> Option<usize> {
+        let objects = self
+            .objects
+            .iter()
+            .map(|o| {
+                let own = o
+                    .bvh
+                    .structure_bytes()
+                    .unwrap_or_else(|| o.bvh.memory_bytes());
+                own + o.map.as_ref().map_or(0, |m| 4 * m.len())
+            })
+            .sum::<usize>();
+        Some(objects + self.top_bytes())
+    }
+
     fn counts_traversal(&self) -> bool {
         true
     }

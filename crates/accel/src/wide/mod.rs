@@ -18,20 +18,20 @@ mod node8;
 mod options;
 mod shadow_cache;
 mod traverse;
-mod tri4;
+pub(crate) mod tri4;
 mod validate;
 
 pub use bvh::{Avx2, Baseline, Isa, WideNode};
 pub use node::{QChild, QNode, EMPTY, LEAF_BIT, MAX_LEAF_TRIANGLES, MAX_TRIANGLES, NO_AXIS};
 pub use node8::Node8;
 pub use options::{Order, TriangleTest, WideOptions, DEFAULT_INTERSECTION_COST, DEFAULT_LEAF_SIZE};
+pub(crate) use traverse::Slab;
 pub use tri4::Tri4;
 
 use crate::traversal::{with_counter, Counter};
 use crate::{BuildParams, Bvh2};
 use glam::Vec3;
 use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
-pub(crate) use traverse::Slab;
 use traverse::{DISTANCE, SPLIT_PLANE, UNSORTED};
 
 /// A four-wide bounding volume hierarchy over triangles (Dammertz's QBVH).
@@ -338,6 +338,13 @@ impl<N: WideNode> Accel for WideBvh<N> {
         std::mem::size_of_val(self.nodes.as_slice())
             + std::mem::size_of_val(self.packets.as_slice())
             + std::mem::size_of_val(self.packet_ids.as_slice())
+    }
+
+    /// Nodes, triangle ids and the packets' unused lanes: the packets less 36 bytes per
+    /// reference (a reference split into several leaves counts once per leaf).
+    fn structure_bytes(&self) -> Option<usize> {
+        let vertices = self.references * std::mem::size_of::<[Vec3; 3]>();
+        Some(self.memory_bytes().saturating_sub(vertices))
     }
 
     fn counts_traversal(&self) -> bool {

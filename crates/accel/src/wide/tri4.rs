@@ -55,9 +55,9 @@ impl Tri4 {
 pub(crate) struct RayPrecomp4 {
     pub ray: Ray,
     pub scalar: RayPrecomp,
-    k: [usize; 3],
-    org: [f32; 3],
-    shear: [f32; 3],
+    pub(crate) k: [usize; 3],
+    pub(crate) org: [f32; 3],
+    pub(crate) shear: [f32; 3],
 }
 
 impl RayPrecomp4 {
@@ -203,11 +203,13 @@ macro_rules! watertight_lanes {
         (zero_edge, hits, t, mul(v, inv), mul(w, inv))
     }};
 }
+// The IOSP traversals gather their lanes straight from the triangle array.
+pub(crate) use watertight_lanes;
 
 /// SSE2 lane operations for [`watertight_lanes!`]. SSE2 is part of the x86_64 baseline, but a
 /// caller without `#[target_feature]` still calls them in an `unsafe` block.
 #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
-mod sse {
+pub(crate) mod sse {
     use std::arch::x86_64::*;
     pub type V = __m128;
     #[target_feature(enable = "sse2")]
@@ -306,7 +308,7 @@ mod sse {
 /// compiled with AVX2, so only code that has checked for AVX2 may call them. The comparison
 /// predicates are the SSE2 ones' (`neq` is unordered, as `cmpneqps` is).
 #[cfg(target_arch = "x86_64")]
-mod avx {
+pub(crate) mod avx {
     use std::arch::x86_64::*;
     pub type V = __m256;
     #[target_feature(enable = "avx2")]

@@ -347,6 +347,10 @@ impl Accel for IrregularGrid {
         self.structure_bytes() + std::mem::size_of_val(self.triangles.as_slice())
     }
 
+    fn structure_bytes(&self) -> Option<usize> {
+        Some(IrregularGrid::structure_bytes(self))
+    }
+
     fn counts_traversal(&self) -> bool {
         true
     }

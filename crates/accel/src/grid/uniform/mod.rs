@@ -141,6 +141,10 @@ impl Accel for UniformGrid {
         self.structure_bytes() + std::mem::size_of_val(self.triangles.as_slice())
     }
 
+    fn structure_bytes(&self) -> Option<usize> {
+        Some(UniformGrid::structure_bytes(self))
+    }
+
     fn counts_traversal(&self) -> bool {
         true
     }
