@@ -170,8 +170,9 @@ impl Top {
     }
 
     /// Front-to-back walk: `leaf(entry, t_cull, counters)` returns the distance of a hit
-    /// found in it; with `any` the first hit ends the walk.
-    pub fn walk(
+    /// found in it; with `any` the first hit ends the walk. Nodes are counted only with
+    /// `COUNT`: counting the occupied slots of every node cost a few per cent uncounted.
+    pub fn walk<const COUNT: bool>(
         &self,
         ray: &Ray,
         t_max: f32,
@@ -198,8 +199,10 @@ impl Top {
                 }
             } else {
                 let node = &self.nodes[cur as usize];
-                counters.nodes_visited +=
-                    node.children.iter().filter(|&&c| c != NONE).count() as u64;
+                if COUNT {
+                    counters.nodes_visited +=
+                        node.children.iter().filter(|&&c| c != NONE).count() as u64;
+                }
                 let (mask, t) = slab.hit4(&node.bounds, t_cull);
                 if mask != 0 {
                     // The hit slots by entry distance, nearest first (at most four).
