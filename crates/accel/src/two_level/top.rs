@@ -1,10 +1,10 @@
 //! The top level of [`super::TwoLevel`]: a binary SAH BVH over the entries' world boxes,
-//! collapsed four wide, rebuilt or refitted per frame.
+//! collapsed eight wide, rebuilt or refitted per frame.
 
 use crate::bvh2::build::{build_over_boxes, MAX_DEPTH};
 use crate::bvh2::Node;
 use crate::traversal::FAR_SCALE;
-use crate::wide::Slab;
+use crate::wide::{Avx2, Slab};
 use crate::BuildParams;
 use glam::Vec3;
 use rt_core::{Aabb, Ray, TraversalCounters};
@@ -31,8 +31,9 @@ impl TopLevel {
     }
 }
 
-/// Lanes of a top-level node.
-const WIDTH: usize = 4;
+/// Lanes of a top-level node: eight, tested in one AVX2 register where the CPU has it (two
+/// SSE halves otherwise), so a ray visits fewer, shallower nodes than four wide.
+const WIDTH: usize = 8;
 /// A child code naming an entry (the top level's leaf) rather than a node.
 const ENTRY: u32 = 1 << 31;
 /// A slot with no child; its box is inverted, so no ray enters it.
@@ -40,11 +41,11 @@ const NONE: u32 = u32::MAX;
 /// Pending subtrees at most: each level below the root pushes at most three.
 const STACK: usize = (WIDTH - 1) * MAX_DEPTH + 1;
 
-/// A node of the four-wide top level: its children's boxes as structure of arrays (rows min
-/// x, y, z, max x, y, z, as [`Slab::hit4`] reads them, 16-byte aligned for its SSE loads) and
-/// their codes: a node index, `ENTRY | entry`, or `NONE`.
+/// A node of the eight-wide top level: its children's boxes as structure of arrays (rows min
+/// x, y, z, max x, y, z, as [`Slab::hit8`] reads them, 32-byte aligned) and their codes: a
+/// node index, `ENTRY | entry`, or `NONE`.
 #[derive(Clone, Copy, Debug)]
-#[repr(C, align(16))]
+#[repr(C, align(32))]
 struct Node4 {
     bounds: [[f32; WIDTH]; 6],
     children: [u32; WIDTH],
@@ -82,11 +83,13 @@ impl Node4 {
 }
 
 /// The binary SAH tree over the entries (one entry per leaf, as the thesis builds it)
-/// collapsed four wide for traversal, as the thesis makes its QBVHs: one SIMD test of four
-/// boxes replaces two levels of scalar pairs, which dominated the clustered trace.
+/// collapsed wide for traversal, as the thesis makes its QBVHs: one SIMD test of eight boxes
+/// replaces three levels of scalar pairs, which dominated the clustered trace.
 #[derive(Default)]
 pub(super) struct Top {
     nodes: Vec<Node4>,
+    /// Set when the CPU has AVX2: the walk then runs a copy compiled for it.
+    avx2: Option<Avx2>,
 }
 
 impl Top {
@@ -100,7 +103,8 @@ impl Top {
         };
         let built = build_over_boxes(boxes, &params);
         let mut top = Self {
-            nodes: Vec::with_capacity(built.nodes.len() / 3 + 1),
+            nodes: Vec::with_capacity(built.nodes.len() / (WIDTH - 1) + 1),
+            avx2: Avx2::detect(),
         };
         if !built.nodes.is_empty() {
             top.collapse(&built.nodes, &built.order, 0);
@@ -108,8 +112,8 @@ impl Top {
         top
     }
 
-    /// Emits binary node `b` as a four-wide node (its index returned), its children after
-    /// it: the binary inner child of largest surface area is opened until four slots are
+    /// Emits binary node `b` as a wide node (its index returned), its children after
+    /// it: the binary inner child of largest surface area is opened until every slot is
     /// filled or only leaves remain.
     fn collapse(&mut self, bin: &[Node], order: &[u32], b: usize) -> u32 {
         let index = self.nodes.len();
@@ -170,8 +174,47 @@ impl Top {
     }
 
     /// Front-to-back walk: `leaf(entry, t_cull, counters)` returns the distance of a hit
-    /// found in it; with `any` the first hit ends the walk.
-    pub fn walk(
+    /// found in it; with `any` the first hit ends the walk. Nodes are counted only with
+    /// `COUNT`: counting the occupied slots of every node cost a few per cent uncounted.
+    #[inline]
+    pub fn walk<const COUNT: bool>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        counters: &mut TraversalCounters,
+        any: bool,
+        leaf: impl FnMut(u32, f32, &mut TraversalCounters) -> Option<f32>,
+    ) {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2.is_some() {
+            // SAFETY: `Avx2::detect` found AVX2 when this top level was made.
+            #[allow(unsafe_code)]
+            return unsafe { self.walk_avx2::<COUNT>(ray, t_max, counters, any, leaf) };
+        }
+        self.walk_with::<COUNT, false>(ray, t_max, counters, any, leaf)
+    }
+
+    /// [`Top::walk`] compiled with AVX2: the eight boxes in one register.
+    ///
+    /// # Safety
+    ///
+    /// The CPU must support AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[allow(unsafe_code)]
+    unsafe fn walk_avx2<const COUNT: bool>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        counters: &mut TraversalCounters,
+        any: bool,
+        leaf: impl FnMut(u32, f32, &mut TraversalCounters) -> Option<f32>,
+    ) {
+        self.walk_with::<COUNT, true>(ray, t_max, counters, any, leaf)
+    }
+
+    #[inline(always)]
+    fn walk_with<const COUNT: bool, const AVX2: bool>(
         &self,
         ray: &Ray,
         t_max: f32,
@@ -198,15 +241,32 @@ impl Top {
                 }
             } else {
                 let node = &self.nodes[cur as usize];
-                counters.nodes_visited +=
-                    node.children.iter().filter(|&&c| c != NONE).count() as u64;
-                let (mask, t) = slab.hit4(&node.bounds, t_cull);
+                if COUNT {
+                    counters.nodes_visited +=
+                        node.children.iter().filter(|&&c| c != NONE).count() as u64;
+                }
+                #[cfg(target_arch = "x86_64")]
+                let (mask, t) = if AVX2 {
+                    // SAFETY: `AVX2` is true only in `walk_avx2`, called after detection.
+                    #[allow(unsafe_code)]
+                    unsafe {
+                        slab.hit8_avx2(&node.bounds, t_cull)
+                    }
+                } else {
+                    slab.hit8(&node.bounds, t_cull)
+                };
+                #[cfg(not(target_arch = "x86_64"))]
+                let (mask, t) = slab.hit8(&node.bounds, t_cull);
                 if mask != 0 {
-                    // The hit slots by entry distance, nearest first (at most four).
+                    // The hit slots by entry distance, nearest first.
                     let mut hits = [(0.0f32, 0u32); WIDTH];
                     let mut n = 0;
-                    for (lane, &t_lane) in t.iter().enumerate() {
-                        if mask & (1 << lane) != 0 {
+                    let mut rest = mask;
+                    while rest != 0 {
+                        let lane = rest.trailing_zeros() as usize;
+                        rest &= rest - 1;
+                        let t_lane = t[lane];
+                        {
                             let mut k = n;
                             while k > 0 && hits[k - 1].0 > t_lane {
                                 hits[k] = hits[k - 1];

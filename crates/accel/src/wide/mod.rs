@@ -32,6 +32,7 @@ use crate::traversal::{with_counter, Counter};
 use crate::{BuildParams, Bvh2};
 use glam::Vec3;
 use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
+pub use traverse::PreparedRay;
 use traverse::{DISTANCE, SPLIT_PLANE, UNSORTED};
 
 /// A four-wide bounding volume hierarchy over triangles (Dammertz's QBVH).
@@ -190,6 +191,76 @@ impl<N: WideNode> WideBvh<N> {
             .is_some())
     }
 
+    /// `ray` set up for [`WideBvh::closest_hit_prepared`] and [`WideBvh::any_hit_prepared`].
+    pub fn prepare(ray: &Ray) -> PreparedRay {
+        PreparedRay::new(ray)
+    }
+
+    /// [`WideBvh::closest_hit_from`] with the ray's setup made by [`WideBvh::prepare`] and
+    /// kept there for the next call: a clustered top level enters several entry points of
+    /// one object in a row with the same object-space ray.
+    pub fn closest_hit_prepared(
+        &self,
+        entry: u32,
+        ray: &mut PreparedRay,
+        t_max: f32,
+        counters: Option<&mut TraversalCounters>,
+    ) -> Option<Hit> {
+        with_counter!(counters, |c| self
+            .query_prepared::<false, _>(entry, ray, t_max, c))
+    }
+
+    /// [`WideBvh::any_hit_from`] with the ray's setup kept (see
+    /// [`WideBvh::closest_hit_prepared`]).
+    pub fn any_hit_prepared(
+        &self,
+        entry: u32,
+        ray: &mut PreparedRay,
+        t_max: f32,
+        counters: Option<&mut TraversalCounters>,
+    ) -> bool {
+        with_counter!(counters, |c| self
+            .query_prepared::<true, _>(entry, ray, t_max, c)
+            .is_some())
+    }
+
+    /// [`WideBvh::query`] on a prepared ray.
+    #[inline]
+    fn query_prepared<const ANY_HIT: bool, C: Counter>(
+        &self,
+        start: u32,
+        ray: &mut PreparedRay,
+        t_max: f32,
+        c: &mut C,
+    ) -> Option<Hit> {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(avx2) = self.avx2 {
+            // SAFETY: `Avx2::detect` made `avx2`, so the CPU has AVX2.
+            #[allow(unsafe_code)]
+            return unsafe { self.query_prepared_avx2::<ANY_HIT, C>(start, ray, t_max, avx2, c) };
+        }
+        self.query_any::<ANY_HIT, _, C>(start, ray, t_max, Baseline, c)
+    }
+
+    /// [`WideBvh::query_prepared`] compiled with AVX2 enabled.
+    ///
+    /// # Safety
+    ///
+    /// The CPU must support AVX2.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[allow(unsafe_code)]
+    unsafe fn query_prepared_avx2<const ANY_HIT: bool, C: Counter>(
+        &self,
+        start: u32,
+        ray: &mut PreparedRay,
+        t_max: f32,
+        avx2: Avx2,
+        c: &mut C,
+    ) -> Option<Hit> {
+        self.query_any::<ANY_HIT, _, C>(start, ray, t_max, avx2, c)
+    }
+
     /// The cut of the tree into entry points for rigid-body clustering (Dammertz §4.5): the
     /// children, top down from the root's, whose boxes are smaller than `size` (longest side)
     /// or that are leaves, with their boxes. The root is never one (the thesis' t = 1 gives
@@ -242,7 +313,7 @@ impl<N: WideNode> WideBvh<N> {
         t_max: f32,
         c: &mut C,
     ) -> Option<Hit> {
-        self.query_any::<ANY_HIT, _, C>(start, ray, t_max, Baseline, c)
+        self.query_any::<ANY_HIT, _, C>(start, &mut PreparedRay::new(ray), t_max, Baseline, c)
     }
 
     /// [`WideBvh::query_any`] compiled with AVX2 enabled: the eight-wide box test in one
@@ -262,14 +333,14 @@ impl<N: WideNode> WideBvh<N> {
         avx2: Avx2,
         c: &mut C,
     ) -> Option<Hit> {
-        self.query_any::<ANY_HIT, _, C>(start, ray, t_max, avx2, c)
+        self.query_any::<ANY_HIT, _, C>(start, &mut PreparedRay::new(ray), t_max, avx2, c)
     }
 
     #[inline(always)]
     fn query_any<const ANY_HIT: bool, I: Isa, C: Counter>(
         &self,
         start: u32,
-        ray: &Ray,
+        ray: &mut PreparedRay,
         t_max: f32,
         isa: I,
         c: &mut C,
