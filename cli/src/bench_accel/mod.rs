@@ -299,7 +299,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             (None, reference_ms)
         } else {
             let t = Instant::now();
-            let a = pool.install(|| spec.build(&scene.triangles));
+            // From the scene, so two-level kinds place its instances (over bare triangles they
+            // would be one static object); every kind keeps the triangle order the rays use.
+            let a = pool
+                .install(|| spec.try_build_scene(scene))
+                .map_err(|e| anyhow::anyhow!("{}: --accel {name}: {e}", args.input))?;
             (Some(a), t.elapsed().as_secs_f64() * 1e3)
         };
         let accel = fresh.as_deref().unwrap_or(reference.as_ref());
