@@ -17,8 +17,7 @@ use std::time::Instant;
 const DEFAULT_ACCEL: &str = "bvh8,two-level,two-level:top=refit,clusters:t=1,clusters:t=2,\
 clusters:t=4,clusters:t=8,clusters:t=16,clusters:t=32,clusters:t=64,clusters:t=128,\
 clusters:t=256,clusters:t=512";
-/// Largest side of the primary ray grid.
-const MAX_SIDE: u32 = 16_384;
+use crate::bench_accel::input::{MAX_PIXELS, MAX_SIDE};
 /// Most threads accepted by `--threads`.
 const MAX_THREADS: usize = 1024;
 
@@ -97,9 +96,13 @@ pub enum Rays {
     Primary,
 }
 
-/// `WxH`, each side in [1, 16384].
+/// `WxH`, each side in [1, 16384], at most 2^26 pixels (as `bench-accel`).
 fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let bad = || format!("size must be WxH with sides 1 to {MAX_SIDE}, e.g. 480x300, got `{s}`");
+    let bad = || {
+        format!(
+            "size must be WxH with sides 1 to {MAX_SIDE} and at most {MAX_PIXELS} pixels, e.g. 480x300, got `{s}`"
+        )
+    };
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
     let side = |v: &str| {
         v.trim()
@@ -107,7 +110,11 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
             .ok()
             .filter(|n| (1..=MAX_SIDE).contains(n))
     };
-    Ok((side(w).ok_or_else(bad)?, side(h).ok_or_else(bad)?))
+    let (w, h) = (side(w).ok_or_else(bad)?, side(h).ok_or_else(bad)?);
+    if u64::from(w) * u64::from(h) > MAX_PIXELS {
+        return Err(bad());
+    }
+    Ok((w, h))
 }
 
 fn parse_specs(list: &[String]) -> Result<Vec<AccelSpec>> {
@@ -141,9 +148,7 @@ pub fn run(args: &BenchAnimArgs) -> Result<()> {
             args.threads
         );
     }
-    if !(args.fps.is_finite() && args.fps > 0.0) {
-        bail!("--fps must be a positive number, got {}", args.fps);
-    }
+    crate::args::check_fps(args.fps)?;
     if args.repeat == 0 {
         bail!("--repeat must be at least 1");
     }

@@ -197,9 +197,7 @@ fn set_shutter(args: &Args, job: &Job, scene: &mut Scene) -> Result<()> {
     if s == 0.0 {
         return Ok(());
     }
-    if !(args.fps.is_finite() && args.fps > 0.0) {
-        bail!("--fps must be a positive number, got {}", args.fps);
-    }
+    crate::args::check_fps(args.fps)?;
     scene.shutter = (s / args.fps) as f32;
     let path = job.scene_path.display();
     let moving_instances = scene.instances.iter().any(|i| i.is_animated());
@@ -226,9 +224,7 @@ fn frame_list(args: &Args, output: &Path) -> Result<Vec<Option<u32>>> {
     if args.frames.is_none() && args.frame.is_none() {
         return Ok(vec![None]);
     }
-    if !(args.fps.is_finite() && args.fps > 0.0) {
-        bail!("--fps must be a positive number, got {}", args.fps);
-    }
+    crate::args::check_fps(args.fps)?;
     match (&args.frames, args.frame) {
         (Some(r), _) => {
             if !output.to_string_lossy().contains("{frame") {

@@ -107,8 +107,13 @@ fn bad_arguments_are_one_error_line() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     std::fs::write(d.join("s.toml"), SCENE).unwrap();
-    let cases: [(&[&str], i32, &str); 6] = [
+    let cases: [(&[&str], i32, &str); 7] = [
         (&["s.toml", "--size", "16"], 2, "WxH"),
+        (
+            &["s.toml", "--size", "16384x16384"],
+            2,
+            "at most 67108864 pixels",
+        ),
         (&["s.toml", "--frames", "3..1"], 2, "A..B"),
         (&["s.toml", "--accel", "clusters:t=0"], 1, "t must be"),
         (&["s.toml", "--accel", "iosp0"], 1, "reorders"),

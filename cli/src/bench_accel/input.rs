@@ -37,8 +37,9 @@ const MESH_EXTENSIONS: [&str; 4] = ["obj", "gltf", "glb", "ra2"];
 /// Longest side of the primary ray grid by default.
 const DEFAULT_WIDTH: u32 = 512;
 /// Largest primary ray grid (the scene format's limits).
-const MAX_SIDE: u32 = 16_384;
-const MAX_PIXELS: u64 = 1 << 26;
+pub const MAX_SIDE: u32 = 16_384;
+/// Most primary rays (pixels) a benchmark generates.
+pub const MAX_PIXELS: u64 = 1 << 26;
 
 /// Loads `input`: `gen:NAME`, a `.toml` scene, or a mesh file.
 pub fn load(input: &str, camera: Option<&str>) -> Result<Input> {
@@ -122,21 +123,6 @@ pub fn resolution(camera: &Camera, width: Option<u32>, height: Option<u32>) -> R
         );
     }
     Ok((w, h))
-}
-
-/// `camera` with another image size (the field of view stays vertical).
-pub fn with_resolution(camera: &Camera, width: u32, height: u32) -> Camera {
-    Camera::look_at(
-        camera.name.clone(),
-        camera.position,
-        camera.position + camera.forward,
-        camera.up,
-        camera.fov_y_deg,
-        width,
-        height,
-        camera.aperture,
-        camera.focus_distance,
-    )
 }
 
 /// `render gen-scene NAME -o FILE.obj`: the procedural scene's triangles as OBJ, one `o` per

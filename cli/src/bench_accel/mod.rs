@@ -249,7 +249,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let mut sets: Vec<RaySet> = Vec::new();
     if wanted.any() || args.dump_rays.is_some() {
         let (width, height) = input::resolution(&camera, args.width, args.height)?;
-        let camera = input::with_resolution(&camera, width, height);
+        let camera = camera.resized(width, height);
         let lights = rays::Lights::of(scene, fallback_light);
         info(&format!("shadow rays aim at {}", lights.describe()));
         let t = Instant::now();

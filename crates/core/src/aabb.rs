@@ -54,6 +54,20 @@ impl Aabb {
         self.min.x > self.max.x || self.min.y > self.max.y || self.min.z > self.max.z
     }
 
+    /// The eight corners, corner `i` taking `max` on the axes whose bit is set in `i` (x = 1,
+    /// y = 2, z = 4): the points whose images bound the box's image under an affine map.
+    #[inline]
+    pub fn corners(&self) -> [Vec3; 8] {
+        let (lo, hi) = (self.min, self.max);
+        std::array::from_fn(|i| {
+            Vec3::new(
+                if i & 1 == 0 { lo.x } else { hi.x },
+                if i & 2 == 0 { lo.y } else { hi.y },
+                if i & 4 == 0 { lo.z } else { hi.z },
+            )
+        })
+    }
+
     /// Edge lengths (zero for the empty box).
     #[inline]
     pub fn extent(&self) -> Vec3 {

@@ -101,6 +101,11 @@ fn check_times(times: impl Iterator<Item = f32>) -> Result<usize, AnimationError
     Ok(n)
 }
 
+/// True if the key times `times` (increasing, at least one) span part of `(t0, t1)`.
+fn spans(times: &[f32], t0: f32, t1: f32) -> bool {
+    times[0] < t1 && times[times.len() - 1] > t0
+}
+
 /// The two keys around `t` and the blend weight of the second: `(i, i, 0)` outside the keys.
 fn bracket(times: &[f32], t: f32) -> (usize, usize, f32) {
     let last = times.len() - 1;
@@ -179,6 +184,12 @@ impl Motion {
         Mat4::from_scale_rotation_translation(scale, rotate.normalize(), translate)
     }
 
+    /// True if the keys span part of the interval `(t0, t1)`: the transform may change
+    /// within it (before the first key and after the last it holds).
+    pub fn spans(&self, t0: f32, t1: f32) -> bool {
+        spans(&self.times, t0, t1)
+    }
+
     /// True if the transform is the same at every time (one key, or all keys equal).
     pub fn is_static(&self) -> bool {
         self.keys.windows(2).all(|w| {
@@ -240,6 +251,12 @@ impl CameraMotion {
             keys,
             times,
         })
+    }
+
+    /// True if the camera moves within `(t0, t1)`: it has two keys or more and they span part
+    /// of the interval.
+    pub fn spans(&self, t0: f32, t1: f32) -> bool {
+        self.times.len() > 1 && spans(&self.times, t0, t1)
     }
 
     /// The keys.

@@ -63,6 +63,16 @@ impl Camera {
         }
     }
 
+    /// The same view rendering a `width × height` image (the field of view stays vertical).
+    pub fn resized(&self, width: u32, height: u32) -> Camera {
+        Camera {
+            width,
+            height,
+            name: self.name.clone(),
+            ..*self
+        }
+    }
+
     /// True for a pinhole (aperture 0): [`Camera::generate_ray`] ignores its lens sample, so
     /// the render driver does not draw one.
     #[inline]

@@ -202,15 +202,10 @@ fn plane_extent(bounds: &Aabb, dir: Vec3) -> (Aabb, f32) {
     let frame = Frame::from_normal(dir);
     // Grown so that rounding in the frame change cannot leave the box's faces uncovered.
     let pad = bounds.extent().max_element().max(f32::MIN_POSITIVE) * 1e-4;
-    let (lo, hi) = (bounds.min - pad, bounds.max + pad);
+    let padded = Aabb::new(bounds.min - pad, bounds.max + pad);
     let mut rect = Aabb::default();
     let mut upstream = f32::INFINITY;
-    for i in 0..8 {
-        let c = Vec3::new(
-            if i & 1 == 0 { lo.x } else { hi.x },
-            if i & 2 == 0 { lo.y } else { hi.y },
-            if i & 4 == 0 { lo.z } else { hi.z },
-        );
+    for c in padded.corners() {
         let l = frame.to_local(c);
         rect = rect.grown(Vec3::new(l.x, l.y, 0.0));
         upstream = upstream.min(l.z);

@@ -72,11 +72,7 @@ impl Instance {
     /// True if the instance is animated and its keys span part of the interval `(t0, t1)`:
     /// it may be somewhere else at some time of the interval than at `t0`.
     pub fn moves_during(&self, t0: f32, t1: f32) -> bool {
-        self.is_animated()
-            && self.motion.as_ref().is_some_and(|m| {
-                let keys = m.keys();
-                keys[0].time < t1 && keys[keys.len() - 1].time > t0
-            })
+        self.is_animated() && self.motion.as_ref().is_some_and(|m| m.spans(t0, t1))
     }
 
     /// True if the instance moves (its transform depends on time).

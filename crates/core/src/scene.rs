@@ -299,9 +299,8 @@ impl Scene {
     /// True if something moves while the shutter is open: an instance, or the camera named
     /// `camera` (see [`Scene::camera_motion`]). Renders then draw a time per camera sample.
     pub fn is_motion_blurred(&self, camera: &str) -> bool {
-        self.shutter > 0.0
-            && (self.instances.iter().any(|i| self.moves_in_shutter(i))
-                || self.camera_motion(camera).is_some())
+        self.instances.iter().any(|i| self.moves_in_shutter(i))
+            || self.camera_motion(camera).is_some()
     }
 
     /// True if instance `inst` moves while the shutter is open.
@@ -312,14 +311,10 @@ impl Scene {
     /// The keyframed motion of the camera named `camera`, if it has one and moves while the
     /// shutter is open.
     pub fn camera_motion(&self, camera: &str) -> Option<&CameraMotion> {
-        let (t0, t1) = (self.time, self.time + self.shutter);
         self.camera_motions.iter().find(|m| {
-            let keys = m.keys();
             self.shutter > 0.0
                 && self.cameras.get(m.camera).is_some_and(|c| c.name == camera)
-                && keys.len() > 1
-                && keys[0].time < t1
-                && keys[keys.len() - 1].time > t0
+                && m.spans(self.time, self.time + self.shutter)
         })
     }
 

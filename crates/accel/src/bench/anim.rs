@@ -17,7 +17,7 @@
 use super::measure::{self, CheckResult};
 use super::{generate, Lights, RaySet};
 use crate::{AccelKind, AccelSpec, BuildError, TwoLevel};
-use rt_core::{glam::Vec3, Aabb, Accel, Camera, Scene, TraversalCounters};
+use rt_core::{glam::Vec3, Aabb, Accel, Scene, TraversalCounters};
 use std::ops::Range;
 use std::time::Instant;
 
@@ -305,21 +305,6 @@ pub enum AnimError {
     Build(#[from] BuildError),
 }
 
-/// `camera` rendering a `width × height` image.
-fn resized(camera: &Camera, width: u32, height: u32) -> Camera {
-    Camera::look_at(
-        camera.name.clone(),
-        camera.position,
-        camera.position + camera.forward,
-        camera.up,
-        camera.fov_y_deg,
-        width,
-        height,
-        camera.aperture,
-        camera.focus_distance,
-    )
-}
-
 /// The workload of the scene at its current time: the primary, incoherent and shadow sets, or
 /// the primary set alone.
 fn frame_rays(
@@ -332,7 +317,7 @@ fn frame_rays(
         .cameras
         .get(options.camera)
         .ok_or(AnimError::Camera(options.camera))?;
-    let camera = resized(camera, options.width, options.height);
+    let camera = camera.resized(options.width, options.height);
     let bounds = Aabb::from_points(scene.triangles.iter().flatten());
     let fallback = bounds.center() + Vec3::Y * bounds.extent().length();
     let lights = Lights::of(scene, fallback);
@@ -383,7 +368,8 @@ pub fn run(
             entries: c.entries,
             build_seconds: c.build_seconds,
             bytes: 0,
-            frames: Vec::with_capacity(options.frames.len()),
+            // Grown frame by frame: the range comes from the user unchecked in size.
+            frames: Vec::new(),
             check: CheckResult::default(),
         })
         .collect();

@@ -248,11 +248,6 @@ impl TwoLevel {
             moving: Vec::new(),
         };
         s.place_instances(instances);
-        s.bounds = s
-            .placements
-            .iter()
-            .map(|p| p.world)
-            .fold(Aabb::EMPTY, Aabb::union);
         s.make_entries();
         s.place_entries();
         s.top = top::Top::build(&s.entry_boxes);
@@ -288,13 +283,8 @@ impl TwoLevel {
     }
 
     /// The entries' world boxes under the current placements (Dammertz's Listing 4.1: the
-    /// local box's eight corners transformed), and the scene's bounds.
+    /// local box's eight corners transformed).
     fn place_entries(&mut self) {
-        self.bounds = self
-            .placements
-            .iter()
-            .map(|p| p.world)
-            .fold(Aabb::EMPTY, Aabb::union);
         self.entry_boxes.clear();
         for (&(k, code), local) in self.entries.iter().zip(&self.entry_local) {
             let p = &self.placements[k as usize];
@@ -308,7 +298,8 @@ impl TwoLevel {
         }
     }
 
-    /// Sets every instance's placement from the scene's current transforms.
+    /// Sets every instance's placement from the scene's current transforms, and the bounds
+    /// of all placements.
     fn place_instances(&mut self, instances: &[Instance]) {
         let statics = usize::from(
             self.placements
@@ -342,6 +333,11 @@ impl TwoLevel {
                 world,
             });
         }
+        self.bounds = self
+            .placements
+            .iter()
+            .map(|p| p.world)
+            .fold(Aabb::EMPTY, Aabb::union);
     }
 
     /// Bytes of the top level alone (what a frame rebuilds).
@@ -384,7 +380,7 @@ impl TwoLevel {
         t_max: f32,
         counters: Option<&mut TraversalCounters>,
     ) -> Option<Hit> {
-        if ray.origin.is_nan() || ray.dir.is_nan() || !ray.dir.is_finite() {
+        if ray.origin.is_nan() || !ray.dir.is_finite() {
             return None;
         }
         let mut best: Option<Hit> = None;
@@ -484,23 +480,17 @@ fn swept_box(samples: &[Mat4], b: &Aabb) -> Aabb {
     if b.is_empty() {
         return Aabb::EMPTY;
     }
-    let corner = |i: usize| {
-        Vec3::new(
-            if i & 1 == 0 { b.min.x } else { b.max.x },
-            if i & 2 == 0 { b.min.y } else { b.max.y },
-            if i & 4 == 0 { b.min.z } else { b.max.z },
-        )
-    };
+    let corners = b.corners();
     let mut out = Aabb::EMPTY;
     let mut step = 0.0f32;
-    for (k, m) in samples.iter().enumerate() {
-        out = out.union(world_box(m, b));
-        if let Some(next) = samples.get(k + 1) {
-            for i in 0..8 {
-                let c = corner(i);
-                step = step.max((next.transform_point3(c) - m.transform_point3(c)).length());
-            }
+    for pair in samples.windows(2) {
+        for c in corners {
+            let moved = pair[1].transform_point3(c) - pair[0].transform_point3(c);
+            step = step.max(moved.length());
         }
+    }
+    for m in samples {
+        out = out.union(world_box(m, b));
     }
     let pad = Vec3::splat(2.0 * step);
     Aabb::new(out.min - pad, out.max + pad)
@@ -513,12 +503,7 @@ fn world_box(m: &Mat4, b: &Aabb) -> Aabb {
         return Aabb::EMPTY;
     }
     let mut out = Aabb::EMPTY;
-    for i in 0..8 {
-        let c = Vec3::new(
-            if i & 1 == 0 { b.min.x } else { b.max.x },
-            if i & 2 == 0 { b.min.y } else { b.max.y },
-            if i & 4 == 0 { b.min.z } else { b.max.z },
-        );
+    for c in b.corners() {
         out = out.grown(m.transform_point3(c));
     }
     let pad = gamma(8) * out.min.abs().max(out.max.abs());
