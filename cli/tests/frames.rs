@@ -5,44 +5,9 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-const SCENE: &str = r#"
-[[camera]]
-name = "cam"
-position = [0, 1, 3]
-look_at = [0, 0.5, 0]
-resolution = [12, 8]
+mod common;
 
-[[material]]
-name = "white"
-color = [0.7, 0.7, 0.7]
-
-[[material]]
-name = "lamp"
-emission = [5, 5, 5]
-
-[[geometry]]
-name = "floor"
-shape = "quad"
-vertices = [[-2, 0, 2], [2, 0, 2], [2, 0, -2], [-2, 0, -2]]
-material = "white"
-
-[[geometry]]
-name = "light"
-shape = "quad"
-vertices = [[-0.3, 2, -0.3], [0.3, 2, -0.3], [0.3, 2, 0.3], [-0.3, 2, 0.3]]
-material = "lamp"
-
-[[geometry]]
-name = "box"
-shape = "box"
-min = [-0.3, 0, -0.3]
-max = [0.3, 0.6, 0.3]
-material = "white"
-
-[[animation]]
-target = "box"
-keys = [ { time = 0.0, translate = [-1, 0, 0] }, { time = 2.0, translate = [1, 0, 0], rotate = [0, 90, 0] } ]
-"#;
+use common::MOVING_BOX as SCENE;
 
 fn render(dir: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_render"))

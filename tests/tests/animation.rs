@@ -12,37 +12,7 @@ use rt_integrators::PathIntegrator;
 use rt_testkit::stats::{compare, ALPHA};
 use rt_testkit::{scene_from_toml, Renderer};
 
-const COMMON: &str = r#"
-[[camera]]
-name = "cam"
-position = [0, 1.5, 4]
-look_at = [0, 0.4, 0]
-resolution = [32, 24]
-
-[[material]]
-name = "white"
-color = [0.7, 0.7, 0.7]
-
-[[material]]
-name = "red"
-color = [0.8, 0.2, 0.1]
-
-[[material]]
-name = "lamp"
-emission = [6, 6, 6]
-
-[[geometry]]
-name = "floor"
-shape = "quad"
-vertices = [[-3, 0, 3], [3, 0, 3], [3, 0, -3], [-3, 0, -3]]
-material = "white"
-
-[[geometry]]
-name = "light"
-shape = "quad"
-vertices = [[-0.5, 2.5, -0.5], [0.5, 2.5, -0.5], [0.5, 2.5, 0.5], [-0.5, 2.5, 0.5]]
-material = "lamp"
-"#;
+use rt_testkit::scenes::LIT_FLOOR as COMMON;
 
 /// The animated scene: a box moved and turned, and an instance of a red box scaled, then
 /// moved and turned by its keys.

@@ -14,37 +14,10 @@ use rt_integrators::PathIntegrator;
 use rt_testkit::stats::{compare_estimates, Estimate, ALPHA};
 use rt_testkit::{scene_from_toml, Renderer};
 
-const SCENE: &str = r#"
-[[camera]]
-name = "cam"
-position = [0, 1.5, 4]
-look_at = [0, 0.4, 0]
-resolution = [32, 24]
+use rt_testkit::scenes::LIT_FLOOR;
 
-[[material]]
-name = "white"
-color = [0.7, 0.7, 0.7]
-
-[[material]]
-name = "red"
-color = [0.8, 0.2, 0.1]
-
-[[material]]
-name = "lamp"
-emission = [6, 6, 6]
-
-[[geometry]]
-name = "floor"
-shape = "quad"
-vertices = [[-3, 0, 3], [3, 0, 3], [3, 0, -3], [-3, 0, -3]]
-material = "white"
-
-[[geometry]]
-name = "light"
-shape = "quad"
-vertices = [[-0.5, 2.5, -0.5], [0.5, 2.5, -0.5], [0.5, 2.5, 0.5], [-0.5, 2.5, 0.5]]
-material = "lamp"
-
+/// The boxes on the lit floor, the red one placed by an instance.
+const OBJECTS: &str = r#"
 [[geometry]]
 name = "box"
 shape = "box"
@@ -106,7 +79,7 @@ fn render(scene: &Scene, kind: AccelKind, spp: u32, seed: u32) -> Estimate {
 
 /// The scene with its shutter open over [`SHUTTER`], rendered blurred with `kind`.
 fn blurred(motion: &str, kind: AccelKind) -> Estimate {
-    let mut s = scene_from_toml(&format!("{SCENE}{motion}"));
+    let mut s = scene_from_toml(&format!("{LIT_FLOOR}{OBJECTS}{motion}"));
     s.set_time(SHUTTER.0);
     s.shutter = SHUTTER.1;
     assert!(s.is_motion_blurred("cam"));
@@ -116,7 +89,7 @@ fn blurred(motion: &str, kind: AccelKind) -> Estimate {
 /// The mean of static renders at the midpoints of `slices` equal slices of the first
 /// `fraction` of the shutter (16 samples each), with the variance of that mean.
 fn instants(motion: &str, fraction: f32, slices: u32) -> Estimate {
-    let mut s = scene_from_toml(&format!("{SCENE}{motion}"));
+    let mut s = scene_from_toml(&format!("{LIT_FLOOR}{OBJECTS}{motion}"));
     let mut sum: Option<Estimate> = None;
     for k in 0..slices {
         s.set_time(SHUTTER.0 + SHUTTER.1 * fraction * (k as f32 + 0.5) / slices as f32);

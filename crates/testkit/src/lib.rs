@@ -32,6 +32,7 @@ pub mod chi2;
 pub mod furnace;
 pub mod mutants;
 pub mod obj;
+pub mod scenes;
 pub mod stats;
 
 pub use rt_validate::{data, default_accel, inside_camera, mesh_scene, Renderer, Rng};
