@@ -52,7 +52,7 @@ pub use accel::{Accel, Hit, TraversalCounters};
 pub use camera::Camera;
 pub use color::Rgb;
 pub use content_hash::ContentHash;
-pub use image::{PixelCountError, RgbImage};
+pub use image::{Image, PixelCountError, RgbImage};
 pub use material::{Layer, Material};
 pub use ray::Ray;
 pub use sampler::{SampleStream, Sampler};

@@ -1,36 +1,50 @@
-//! The k×k box filter.
+//! The k×k box filter: the simplest member of a filter bank, and a baseline.
 
-use crate::{DenoiseError, Denoiser, NoisyFrame};
-use rt_core::Rgb;
+use crate::{DenoiseError, Denoiser, NoisyFrame, Options};
+use rt_core::{Image, Rgb, RgbImage};
 
 /// Mean over a `(2r+1)²` window, clamped at the image border (the window shrinks, so a constant
 /// image stays constant up to the edge).
 #[derive(Clone, Debug)]
 pub struct BoxBlur {
     radius: usize,
+    name: String,
 }
 
 impl BoxBlur {
-    /// A filter of the given radius (0 is the identity). Radii above 64 are rejected: they are
-    /// almost certainly a mistake and would be slow with this direct implementation.
+    /// Largest radius accepted: beyond it the direct implementation is slow and the value is
+    /// almost certainly a mistake.
+    pub const MAX_RADIUS: usize = 64;
+
+    /// A filter of the given radius (0 is the identity).
     pub fn new(radius: usize) -> Result<Self, DenoiseError> {
-        if radius > 64 {
+        if radius > Self::MAX_RADIUS {
             return Err(DenoiseError::Param {
+                denoiser: "box",
                 name: "radius",
-                message: format!("must be at most 64, got {radius}"),
+                message: format!("must be at most {}, got {radius}", Self::MAX_RADIUS),
             });
         }
-        Ok(Self { radius })
+        Ok(Self {
+            radius,
+            name: format!("box:radius={radius}"),
+        })
+    }
+
+    /// From spec options: `radius` (default 2).
+    pub fn from_options(o: &mut Options) -> Result<Self, DenoiseError> {
+        Self::new(o.usize("radius", 2)?)
     }
 }
 
 impl Denoiser for BoxBlur {
     fn name(&self) -> &str {
-        "box"
+        &self.name
     }
 
-    fn apply(&self, frame: &NoisyFrame) -> Vec<Rgb> {
-        let (w, h, r) = (frame.width, frame.height, self.radius);
+    fn filter(&self, frame: &NoisyFrame) -> RgbImage {
+        let (w, h) = frame.colour.size();
+        let r = self.radius;
         // Separable: rows, then columns.
         let pass = |src: &[Rgb], horizontal: bool| -> Vec<Rgb> {
             let mut out = vec![Rgb::ZERO; w * h];
@@ -51,8 +65,8 @@ impl Denoiser for BoxBlur {
             }
             out
         };
-        let tmp = pass(&frame.beauty, true);
-        pass(&tmp, false)
+        let tmp = pass(frame.colour.pixels(), true);
+        Image::new(w, h, pass(&tmp, false)).unwrap_or_default()
     }
 }
 
@@ -60,20 +74,25 @@ impl Denoiser for BoxBlur {
 mod tests {
     use super::*;
 
+    fn frame(w: usize, h: usize, px: Vec<Rgb>) -> NoisyFrame {
+        NoisyFrame::new(Image::new(w, h, px).unwrap())
+    }
+
     #[test]
     fn constant_stays_constant_and_mean_is_kept_inside() {
-        let f = NoisyFrame::from_beauty(5, 4, vec![Rgb::splat(2.0); 20]);
-        assert!(BoxBlur::new(2)
-            .unwrap()
-            .apply(&f)
+        let f = frame(5, 4, vec![Rgb::splat(2.0); 20]);
+        let out = BoxBlur::new(2).unwrap().denoise(&f).unwrap();
+        assert!(out
+            .pixels()
             .iter()
             .all(|p| (*p - Rgb::splat(2.0)).length() < 1e-6));
         let mut img = vec![Rgb::ZERO; 25];
         img[12] = Rgb::splat(9.0);
-        let f = NoisyFrame::from_beauty(5, 5, img);
-        let out = BoxBlur::new(1).unwrap().apply(&f);
+        let f = frame(5, 5, img);
+        let out = BoxBlur::new(1).unwrap().denoise(&f).unwrap();
+        let out = out.pixels();
         assert!((out[12].x - 1.0).abs() < 1e-6 && (out[6].x - 1.0).abs() < 1e-6 && out[0].x == 0.0);
-        assert_eq!(BoxBlur::new(0).unwrap().apply(&f), f.beauty);
+        assert_eq!(BoxBlur::new(0).unwrap().denoise(&f).unwrap(), f.colour);
         assert!(BoxBlur::new(65).is_err());
     }
 }

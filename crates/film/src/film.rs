@@ -1,12 +1,16 @@
 //! The film: a grid of pixel statistics plus optional first-hit AOVs.
 
-use crate::pixel::{add_m2, FirstHit, HalfSums, MeanCount, PixelStats};
+use crate::pixel::{
+    add_m2, welford_on_sums, FeatureM2, FirstHit, HalfSums, LightSplit, MeanCount, PixelStats,
+};
 use crate::splat::{Splat, SplatSums};
 use rt_core::glam::Vec3;
 use rt_core::Rgb;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-/// Which first-hit AOVs to keep. The integrator computes them only if one of them is wanted.
+/// Which AOVs to keep: first-hit features, statistics of the pixel estimate, and the lighting
+/// split. The integrator computes the first-hit features only if one of them is wanted, and the
+/// split only if some part of it is.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct AovSet {
     /// Albedo of the first visible surface.
@@ -19,18 +23,105 @@ pub struct AovSet {
     pub position: bool,
     /// Per-pixel variance of the mean (needs the film's variance buffer, 12 bytes per pixel).
     pub variance: bool,
+    /// The means of the even- and odd-numbered samples (two independent half estimates).
+    pub halves: bool,
+    /// For each first-hit feature kept, the variance of its per-pixel mean.
+    pub feature_variance: bool,
+    /// Light seen directly: emitters and the environment at the first hit.
+    pub emission: bool,
+    /// Light reflected once at the first hit (`emission + direct + indirect` is the pixel).
+    pub direct: bool,
+    /// Light reflected at the first hit after more than one bounce.
+    pub indirect: bool,
+    /// Light reflected by the first hit's diffuse layers (`emission + diffuse + glossy` is
+    /// the pixel).
+    pub diffuse: bool,
+    /// Light reflected by the first hit's specular layers (glossy, mirror, glass).
+    pub glossy: bool,
+    /// Light reflected at the first hit divided by its albedo, per sample: the untextured
+    /// lighting that demodulating filters smooth (zero where the albedo is).
+    pub irradiance: bool,
     /// The stopping criterion's final blocks: per pixel its block's index, its sample count and
     /// whether the block met the threshold (an adaptive render's output, not a film buffer).
     pub blocks: bool,
 }
 
+/// The names [`AovSet::parse_list`] knows, in the order help texts list them.
+pub const AOV_NAMES: [&str; 15] = [
+    "albedo",
+    "normal",
+    "depth",
+    "position",
+    "variance",
+    "halves",
+    "feature-variance",
+    "emission",
+    "direct",
+    "indirect",
+    "diffuse",
+    "glossy",
+    "irradiance",
+    "blocks",
+    "denoise",
+];
+
 impl AovSet {
+    /// Everything a denoiser of `rt-denoise` reads: the features with their variances, the
+    /// variance and half-buffers of the pixel estimate, and the whole lighting split.
+    pub const DENOISE: AovSet = AovSet {
+        albedo: true,
+        normal: true,
+        depth: true,
+        position: true,
+        variance: true,
+        halves: true,
+        feature_variance: true,
+        emission: true,
+        direct: true,
+        indirect: true,
+        diffuse: true,
+        glossy: true,
+        irradiance: true,
+        blocks: false,
+    };
+
     /// True if any first-hit quantity is wanted (variance is not a first-hit quantity).
     pub fn any_first_hit(&self) -> bool {
         self.albedo || self.normal || self.depth || self.position
     }
 
-    /// Parses a comma-separated list such as `albedo,normal,variance`.
+    /// True if any part of the lighting split is wanted.
+    pub fn any_split(&self) -> bool {
+        self.emission
+            || self.direct
+            || self.indirect
+            || self.diffuse
+            || self.glossy
+            || self.irradiance
+    }
+
+    /// The union of two sets.
+    pub fn union(self, o: AovSet) -> AovSet {
+        AovSet {
+            albedo: self.albedo | o.albedo,
+            normal: self.normal | o.normal,
+            depth: self.depth | o.depth,
+            position: self.position | o.position,
+            variance: self.variance | o.variance,
+            halves: self.halves | o.halves,
+            feature_variance: self.feature_variance | o.feature_variance,
+            emission: self.emission | o.emission,
+            direct: self.direct | o.direct,
+            indirect: self.indirect | o.indirect,
+            diffuse: self.diffuse | o.diffuse,
+            glossy: self.glossy | o.glossy,
+            irradiance: self.irradiance | o.irradiance,
+            blocks: self.blocks | o.blocks,
+        }
+    }
+
+    /// Parses a comma-separated list such as `albedo,normal,variance`; `denoise` stands for
+    /// [`AovSet::DENOISE`].
     pub fn parse_list<'a>(names: impl IntoIterator<Item = &'a str>) -> Result<Self, UnknownAov> {
         let mut s = Self::default();
         for n in names {
@@ -40,7 +131,16 @@ impl AovSet {
                 "depth" => s.depth = true,
                 "position" => s.position = true,
                 "variance" => s.variance = true,
+                "halves" => s.halves = true,
+                "feature-variance" => s.feature_variance = true,
+                "emission" => s.emission = true,
+                "direct" => s.direct = true,
+                "indirect" => s.indirect = true,
+                "diffuse" => s.diffuse = true,
+                "glossy" => s.glossy = true,
+                "irradiance" => s.irradiance = true,
                 "blocks" => s.blocks = true,
+                "denoise" => s = s.union(Self::DENOISE),
                 "" => {}
                 other => return Err(UnknownAov(other.to_string())),
             }
@@ -51,7 +151,7 @@ impl AovSet {
 
 /// An AOV name [`AovSet::parse_list`] does not know.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("unknown AOV '{0}' (expected albedo, normal, depth, position, variance, blocks)")]
+#[error("unknown AOV '{0}' (expected one of: {names})", names = AOV_NAMES.join(", "))]
 pub struct UnknownAov(pub String);
 
 /// Which per-pixel buffers a film allocates besides the mean and sample count, which it always
@@ -75,7 +175,7 @@ impl FilmBuffers {
         Self {
             aovs,
             variance: aovs.variance,
-            halves: false,
+            halves: aovs.halves,
         }
     }
 
@@ -118,6 +218,10 @@ pub struct FilmMemory {
     pub depth: Option<usize>,
     /// Position sums.
     pub position: Option<usize>,
+    /// Welford `M2` of the first-hit features.
+    pub feature_variance: Option<usize>,
+    /// Sums of the lighting split (one buffer for all its parts).
+    pub split: Option<usize>,
     /// Light-path splat sums (allocated by the first splat).
     pub splats: Option<usize>,
 }
@@ -134,12 +238,29 @@ impl FilmMemory {
                 self.normal,
                 self.depth,
                 self.position,
+                self.feature_variance,
+                self.split,
                 self.splats,
             ]
             .iter()
             .flatten()
             .sum::<usize>()
     }
+}
+
+/// The variance of each pixel's mean feature ([`Film::feature_variance_images`]); `None` for a
+/// feature the film does not keep. Albedo is RGB, stored like the normal and position as three
+/// components.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FeatureVariances {
+    /// Albedo.
+    pub albedo: Option<Vec<Vec3>>,
+    /// Shading normal.
+    pub normal: Option<Vec<Vec3>>,
+    /// Depth.
+    pub depth: Option<Vec<f32>>,
+    /// Position.
+    pub position: Option<Vec<Vec3>>,
 }
 
 /// Sums of the first-hit AOVs, one buffer per quantity; each is empty unless asked for.
@@ -151,6 +272,12 @@ struct AovBuffers {
     normal: Vec<Vec3>,
     depth: Vec<f32>,
     position: Vec<Vec3>,
+    /// Welford `M2` of the features (all four in one buffer).
+    m2: Vec<FeatureM2>,
+    /// Sums of the lighting split, divided by the pixel's sample count (every kept sample
+    /// carries a split when one is kept). One buffer for all parts: 72 bytes per pixel, the
+    /// price of a simple accumulation loop; only written parts reach the output.
+    split: Vec<LightSplit>,
 }
 
 /// A band of [`AovBuffers`].
@@ -160,6 +287,8 @@ struct AovSlices<'a> {
     normal: &'a mut [Vec3],
     depth: &'a mut [f32],
     position: &'a mut [Vec3],
+    m2: &'a mut [FeatureM2],
+    split: &'a mut [LightSplit],
 }
 
 /// Per-pixel accumulation for a `width × height` image, row 0 at the top. Only the buffers
@@ -208,6 +337,21 @@ impl FilmStripe<'_> {
         radiance: Rgb,
         hit: Option<&FirstHit>,
     ) -> bool {
+        self.add_sample_split(x, y, index, radiance, hit, None)
+    }
+
+    /// [`FilmStripe::add_sample`] with the sample's lighting split, which a film keeping one
+    /// needs from every sample (a non-finite split is left out of the sums).
+    #[inline]
+    pub fn add_sample_split(
+        &mut self,
+        x: u32,
+        y: u32,
+        index: u32,
+        radiance: Rgb,
+        hit: Option<&FirstHit>,
+        split: Option<&LightSplit>,
+    ) -> bool {
         let i = ((y - self.y0) * self.width + x) as usize;
         if !radiance.is_finite() || radiance.min_element() < 0.0 {
             self.discarded.fetch_add(1, Ordering::Relaxed);
@@ -223,20 +367,41 @@ impl FilmStripe<'_> {
         if let Some(h) = self.halves.get_mut(i) {
             h.add(radiance, index);
         }
-        if let (Some(n), Some(h)) = (self.aov.hits.get_mut(i), hit) {
+        if let (Some(sum), Some(sp)) = (self.aov.split.get_mut(i), split) {
+            if sp.is_finite() {
+                sum.add(sp);
+            }
+        }
+        let a = &mut self.aov;
+        if let (Some(n), Some(h)) = (a.hits.get_mut(i), hit) {
             if h.is_finite() {
+                if let Some(m2) = a.m2.get_mut(i) {
+                    // Before the sums move: Welford needs the old means.
+                    if let Some(&s) = a.albedo.get(i) {
+                        welford_on_sums(&mut m2.albedo, s, *n, h.albedo);
+                    }
+                    if let Some(&s) = a.normal.get(i) {
+                        welford_on_sums(&mut m2.normal, s, *n, h.normal);
+                    }
+                    if let Some(&s) = a.depth.get(i) {
+                        welford_on_sums(&mut m2.depth, s, *n, h.depth);
+                    }
+                    if let Some(&s) = a.position.get(i) {
+                        welford_on_sums(&mut m2.position, s, *n, h.position);
+                    }
+                }
                 *n += 1;
-                if let Some(a) = self.aov.albedo.get_mut(i) {
-                    *a += h.albedo;
+                if let Some(v) = a.albedo.get_mut(i) {
+                    *v += h.albedo;
                 }
-                if let Some(a) = self.aov.normal.get_mut(i) {
-                    *a += h.normal;
+                if let Some(v) = a.normal.get_mut(i) {
+                    *v += h.normal;
                 }
-                if let Some(a) = self.aov.depth.get_mut(i) {
-                    *a += h.depth;
+                if let Some(v) = a.depth.get_mut(i) {
+                    *v += h.depth;
                 }
-                if let Some(a) = self.aov.position.get_mut(i) {
-                    *a += h.position;
+                if let Some(v) = a.position.get_mut(i) {
+                    *v += h.position;
                 }
             }
         }
@@ -309,6 +474,8 @@ impl Film {
                 normal: buffer(a.normal, n),
                 depth: buffer(a.depth, n),
                 position: buffer(a.position, n),
+                m2: buffer(a.feature_variance && a.any_first_hit(), n),
+                split: buffer(a.any_split(), n),
             },
             splats: SplatSums::default(),
             discarded: AtomicU64::new(0),
@@ -346,6 +513,8 @@ impl Film {
             normal: bytes(&self.aov.normal),
             depth: bytes(&self.aov.depth),
             position: bytes(&self.aov.position),
+            feature_variance: bytes(&self.aov.m2),
+            split: bytes(&self.aov.split),
             splats: self.splats.bytes(),
         }
     }
@@ -408,6 +577,8 @@ impl Film {
         let mut normal = chunks(&mut self.aov.normal, chunk);
         let mut depth = chunks(&mut self.aov.depth, chunk);
         let mut position = chunks(&mut self.aov.position, chunk);
+        let mut feature_m2 = chunks(&mut self.aov.m2, chunk);
+        let mut split = chunks(&mut self.aov.split, chunk);
         self.mean
             .chunks_mut(chunk)
             .enumerate()
@@ -423,6 +594,8 @@ impl Film {
                     normal: normal.next().unwrap_or_default(),
                     depth: depth.next().unwrap_or_default(),
                     position: position.next().unwrap_or_default(),
+                    m2: feature_m2.next().unwrap_or_default(),
+                    split: split.next().unwrap_or_default(),
                 },
                 discarded,
             })
@@ -511,6 +684,61 @@ impl Film {
         averages(&self.aov.position, &self.aov.hits)
     }
 
+    /// Variance of each pixel's mean first-hit feature, for the features kept, when the film
+    /// keeps feature variances; `None` otherwise.
+    pub fn feature_variance_images(&self) -> Option<FeatureVariances> {
+        if self.aov.m2.is_empty() {
+            return None;
+        }
+        let of_mean = |m2: f32, n: u32| {
+            if n < 2 {
+                0.0
+            } else {
+                m2 / (n - 1) as f32 / n as f32
+            }
+        };
+        let n = &self.aov.hits;
+        let pick = |keep: bool, f: &dyn Fn(&FeatureM2, u32) -> Vec3| {
+            keep.then(|| self.aov.m2.iter().zip(n).map(|(m, &n)| f(m, n)).collect())
+        };
+        let v3 = |v: Vec3, n: u32| v.map(|c| of_mean(c, n));
+        Some(FeatureVariances {
+            albedo: pick(!self.aov.albedo.is_empty(), &|m, n| v3(m.albedo, n)),
+            normal: pick(!self.aov.normal.is_empty(), &|m, n| v3(m.normal, n)),
+            depth: (!self.aov.depth.is_empty()).then(|| {
+                self.aov
+                    .m2
+                    .iter()
+                    .zip(n)
+                    .map(|(m, &n)| of_mean(m.depth, n))
+                    .collect()
+            }),
+            position: pick(!self.aov.position.is_empty(), &|m, n| v3(m.position, n)),
+        })
+    }
+
+    /// The per-pixel means of the lighting split (sums over the pixel's kept samples); `None`
+    /// unless some part of it is kept.
+    pub fn split_images(&self) -> Option<Vec<LightSplit>> {
+        if self.aov.split.is_empty() {
+            return None;
+        }
+        Some(
+            self.aov
+                .split
+                .iter()
+                .zip(&self.mean)
+                .map(|(s, p)| {
+                    if p.n == 0 {
+                        LightSplit::default()
+                    } else {
+                        s.scaled(1.0 / p.n as f32)
+                    }
+                })
+                .collect(),
+        )
+    }
+
     /// Total samples accumulated.
     pub fn total_samples(&self) -> u64 {
         self.mean.iter().map(|p| p.n as u64).sum()
@@ -528,7 +756,7 @@ mod tests {
             depth: true,
             position: true,
             variance: true,
-            blocks: false,
+            ..Default::default()
         })
         .with_halves()
     }

@@ -35,16 +35,20 @@
 
 mod film;
 pub mod input;
+mod noisy_frame;
 pub mod output;
 mod pixel;
 mod splat;
 pub mod stopping;
 
-pub use film::{AovSet, Film, FilmBuffers, FilmMemory, FilmStripe, UnknownAov};
+pub use film::{
+    AovSet, FeatureVariances, Film, FilmBuffers, FilmMemory, FilmStripe, UnknownAov, AOV_NAMES,
+};
 pub use input::{decode_srgb, read_rgb};
+pub use noisy_frame::{Channel, FrameError, NoisyFrame};
 pub use output::{
     copy_atomic, read_exr, write_bytes_atomic, write_image, write_image_with, write_rgb, FilmError,
     OutputOptions,
 };
-pub use pixel::{FirstHit, HalfSums, PixelStats};
+pub use pixel::{FirstHit, HalfSums, LightSplit, PixelStats};
 pub use splat::Splat;

@@ -1,13 +1,14 @@
 //! Writing images: EXR for data, PNG for looking at. Both atomic.
 //!
 //! EXR: linear float32. The beauty image is in channels `R`, `G`, `B`; AOVs are channel groups
-//! `albedo.{R,G,B}`, `normal.{X,Y,Z}`, `depth.Z`, `position.{X,Y,Z}`, `variance.{R,G,B}`
-//! (variance of the pixel mean). Pixels that saw no surface have zero AOVs.
+//! laid out as [`crate::NoisyFrame`] says (`albedo.{R,G,B}`, `normal.{X,Y,Z}`, `depth.Z`,
+//! `variance.{R,G,B}`, `even.{R,G,B}`, the lighting split, ...), so a saved render reads back
+//! as a frame. Pixels that saw no surface have zero first-hit AOVs.
 //!
 //! PNG: 8-bit sRGB. The tone map is deliberately simple and documented: multiply by
 //! `2^exposure`, clamp each channel to [0, 1], apply the sRGB transfer curve.
 
-use crate::Film;
+use crate::{Film, NoisyFrame};
 use exr::prelude::{
     AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, LineOrder,
     SmallVec, WritableImage,
@@ -75,7 +76,7 @@ pub fn write_image_with(
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     match ext.as_deref() {
-        Some("exr") => write_atomic(path, |w| write_exr(w, film, extra)),
+        Some("exr") => NoisyFrame::from_film(film, film.aovs()).write_exr(path, extra),
         Some("png") if !extra.is_empty() => Err(FilmError::Codec {
             path: path.to_path_buf(),
             message: "a PNG holds only the beauty image; write an .exr for extra channels".into(),
@@ -191,36 +192,21 @@ fn rgb_channels(
     }
 }
 
-fn write_exr(
-    w: &mut BufWriter<File>,
-    film: &Film,
-    extra: &[(&str, Vec<f32>)],
-) -> Result<(), String> {
-    let mut chans = Vec::new();
-    rgb_channels(&mut chans, "", ["R", "G", "B"], &film.mean_image());
-    // Each accessor is `None` exactly when the AOV was not asked for (the film allocates the
-    // buffers its outputs need), so these lines write what was requested and nothing else.
-    if let Some(v) = film.albedo_image() {
-        rgb_channels(&mut chans, "albedo.", ["R", "G", "B"], &v);
+/// Writes named float channels of one `size` image to `path` as an EXR, atomically.
+pub(crate) fn write_exr_file(
+    path: &Path,
+    size: (usize, usize),
+    chans: Vec<(String, Vec<f32>)>,
+) -> Result<(), FilmError> {
+    let pixels = size.0 * size.1;
+    if let Some((name, _)) = chans.iter().find(|(_, v)| v.len() != pixels) {
+        return Err(FilmError::Codec {
+            path: path.to_path_buf(),
+            message: format!("channel {name} does not have one value per pixel"),
+        });
     }
-    if let Some(v) = film.normal_image() {
-        rgb_channels(&mut chans, "normal.", ["X", "Y", "Z"], &v);
-    }
-    if let Some(v) = film.depth_image() {
-        chans.push(channel("depth.Z", v));
-    }
-    if let Some(v) = film.position_image() {
-        rgb_channels(&mut chans, "position.", ["X", "Y", "Z"], &v);
-    }
-    if film.aovs().variance {
-        if let Some(v) = film.variance_image() {
-            rgb_channels(&mut chans, "variance.", ["R", "G", "B"], &v);
-        }
-    }
-    for (name, values) in extra {
-        chans.push(channel(name, values.clone()));
-    }
-    write_exr_channels(w, (film.width() as usize, film.height() as usize), chans)
+    let chans = chans.into_iter().map(|(n, v)| channel(&n, v)).collect();
+    write_atomic(path, |w| write_exr_channels(w, size, chans))
 }
 
 fn write_exr_channels(

@@ -154,6 +154,92 @@ impl FirstHit {
     }
 }
 
+/// How one camera sample's radiance divides, for denoisers that filter the parts apart
+/// (seed 002's direct/indirect and diffuse/glossy splits, Dammertz's demodulation). The parts
+/// are partitions: `emission + direct + indirect` and `emission + diffuse + glossy` are both
+/// the sample's radiance.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LightSplit {
+    /// Light seen directly: an emitter or the environment at the first hit.
+    pub emission: Rgb,
+    /// Light reflected once at the first hit.
+    pub direct: Rgb,
+    /// Light reflected at the first hit after further bounces.
+    pub indirect: Rgb,
+    /// Light reflected by the first hit's diffuse layers.
+    pub diffuse: Rgb,
+    /// Light reflected by the first hit's specular layers.
+    pub glossy: Rgb,
+    /// Reflected light (`direct + indirect`) over the first hit's albedo, per channel (zero
+    /// where the albedo is).
+    pub irradiance: Rgb,
+}
+
+impl LightSplit {
+    /// True if every part is finite.
+    #[inline]
+    pub fn is_finite(&self) -> bool {
+        self.emission.is_finite()
+            && self.direct.is_finite()
+            && self.indirect.is_finite()
+            && self.diffuse.is_finite()
+            && self.glossy.is_finite()
+            && self.irradiance.is_finite()
+    }
+
+    #[inline]
+    pub(crate) fn add(&mut self, o: &LightSplit) {
+        self.emission += o.emission;
+        self.direct += o.direct;
+        self.indirect += o.indirect;
+        self.diffuse += o.diffuse;
+        self.glossy += o.glossy;
+        self.irradiance += o.irradiance;
+    }
+
+    #[inline]
+    pub(crate) fn scaled(&self, k: f32) -> LightSplit {
+        LightSplit {
+            emission: self.emission * k,
+            direct: self.direct * k,
+            indirect: self.indirect * k,
+            diffuse: self.diffuse * k,
+            glossy: self.glossy * k,
+            irradiance: self.irradiance * k,
+        }
+    }
+}
+
+/// Welford `M2` of every first-hit feature of one pixel, for the variance of the features'
+/// means (the NFOR/Tungsten buffer convention: each feature with its variance).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct FeatureM2 {
+    pub albedo: Rgb,
+    pub normal: Vec3,
+    pub depth: f32,
+    pub position: Vec3,
+}
+
+/// Welford's update of `m2` for a feature kept as a running sum: `sum` and `n` are the sum and
+/// count before `x` is added.
+#[inline]
+pub(crate) fn welford_on_sums<T>(m2: &mut T, sum: T, n: u32, x: T)
+where
+    T: Copy
+        + std::ops::Add<Output = T>
+        + std::ops::Sub<Output = T>
+        + std::ops::Mul<Output = T>
+        + std::ops::Mul<f32, Output = T>
+        + std::ops::AddAssign,
+{
+    if n == 0 {
+        return;
+    }
+    let old_mean = sum * (1.0 / n as f32);
+    let new_mean = (sum + x) * (1.0 / (n + 1) as f32);
+    *m2 += (x - old_mean) * (x - new_mean);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
