@@ -348,14 +348,7 @@ pub fn render_film(
     spp: u32,
     seed: u32,
 ) -> (Film, rt_integrators::RenderStats) {
-    let aovs = AovSet {
-        albedo: true,
-        normal: true,
-        depth: true,
-        position: true,
-        variance: true,
-        blocks: false,
-    };
+    let aovs = AovSet::DENOISE;
     // Every buffer a film can keep, so that every one is checked for invalid values.
     let buffers = FilmBuffers::for_outputs(aovs).with_variance().with_halves();
     crate::Renderer::new(scene)
