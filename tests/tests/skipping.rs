@@ -223,7 +223,7 @@ fn integrators_compute_first_hits_only_when_wanted() {
             let ray = camera.generate_ray(rt_core::glam::Vec2::new(8.5, 6.5), Default::default());
             let mut aux = SampleAux {
                 want_first_hit: want,
-                first_hit: None,
+                ..Default::default()
             };
             integrator.li(
                 &ctx,

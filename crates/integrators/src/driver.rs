@@ -103,6 +103,9 @@ pub fn render_samples(
     let start = Instant::now();
     let discarded_before = film.discarded();
     let want_first_hit = film.aovs().any_first_hit();
+    // Callers refuse split AOVs for integrators that cannot write them; this keeps a film's
+    // split sums from being filled with zeros if one slips through.
+    let want_split = film.aovs().any_split() && integrator.writes_split();
     let totals = Mutex::new(RayCounters::default());
     let rows_done = std::sync::atomic::AtomicU32::new(0);
     let camera = ctx.camera;
@@ -144,10 +147,12 @@ pub fn render_samples(
                         };
                         let mut aux = SampleAux {
                             want_first_hit,
-                            first_hit: None,
+                            want_split,
+                            ..Default::default()
                         };
                         let l = integrator.li(ctx, ray, &mut sampler, &mut aux, &mut counters);
-                        stripe.add_sample(x, y, i, l, aux.first_hit.as_ref());
+                        let split = want_split.then_some(&aux.split);
+                        stripe.add_sample_split(x, y, i, l, aux.first_hit.as_ref(), split);
                     }
                 }
                 let done = rows_done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;

@@ -42,7 +42,7 @@ pub use spec::{
 pub use technique::{CameraRays, Technique, TechniqueStage};
 
 use rt_core::{Accel, Camera, Rgb, Sampler, Scene};
-use rt_film::FirstHit;
+use rt_film::{FirstHit, LightSplit};
 
 /// What an integrator needs to trace rays: the scene, a structure to query it, the camera.
 #[derive(Clone, Copy)]
@@ -78,6 +78,11 @@ pub struct SampleAux {
     pub want_first_hit: bool,
     /// The first visible surface, if any and if wanted.
     pub first_hit: Option<FirstHit>,
+    /// Fill `split` (only integrators whose [`Integrator::writes_split`] is true do).
+    pub want_split: bool,
+    /// How the sample's radiance divides (emission, direct/indirect, diffuse/glossy,
+    /// irradiance), if wanted.
+    pub split: LightSplit,
 }
 
 /// The first-hit AOVs of surface point `si` seen from direction `wo` (unit, towards the
@@ -101,6 +106,11 @@ pub(crate) fn first_hit(
 pub trait Integrator: Send + Sync {
     /// Short name for reports.
     fn name(&self) -> &str;
+
+    /// True if the integrator fills [`SampleAux::split`] when asked (the lighting-split AOVs).
+    fn writes_split(&self) -> bool {
+        false
+    }
 
     /// Estimates the radiance arriving at the camera along `ray`, drawing random numbers from
     /// `sampler`. Must not allocate: it runs once per sample.

@@ -17,7 +17,64 @@
 
 use crate::transport::{light_visible, survives_roulette};
 use crate::{Ctx, Integrator, RayCounters, SampleAux};
-use rt_core::{lights::LightSampler, material::Bsdf, sampling::power_heuristic, Ray, Rgb, Sampler};
+use rt_core::material::{Bsdf, LayerClass};
+use rt_core::{lights::LightSampler, sampling::power_heuristic, Ray, Rgb, Sampler};
+use rt_film::LightSplit;
+
+/// Where one contribution to a sample goes in its [`LightSplit`]: reflected light carries its
+/// diffuse share (per channel) of the first vertex's BSDF.
+struct SplitTracker {
+    /// Share of the first vertex's BSDF (sampled direction's value) that is diffuse.
+    diffuse_share: Rgb,
+    /// The first hit's albedo.
+    albedo: Rgb,
+}
+
+impl SplitTracker {
+    /// Adds `c`, found after `bounces` reflections (0: seen directly), to `split`.
+    #[inline]
+    fn add(&self, split: &mut LightSplit, c: Rgb, bounces: u32, diffuse_share: Rgb) {
+        match bounces {
+            0 => {
+                split.emission += c;
+                return;
+            }
+            1 => split.direct += c,
+            _ => split.indirect += c,
+        }
+        let d = c * diffuse_share;
+        split.diffuse += d;
+        split.glossy += c - d;
+    }
+
+    /// Sets the irradiance from the reflected parts.
+    fn finish(&self, split: &mut LightSplit) {
+        let reflected = split.direct + split.indirect;
+        split.irradiance = Rgb::from_array(std::array::from_fn(|k| {
+            if self.albedo[k] > IRRADIANCE_MIN_ALBEDO {
+                reflected[k] / self.albedo[k]
+            } else {
+                0.0
+            }
+        }));
+    }
+}
+
+/// Below this albedo a channel's irradiance is written as zero: dividing by it would turn
+/// noise into fireflies, and remodulating multiplies it by (almost) nothing anyway.
+const IRRADIANCE_MIN_ALBEDO: f32 = 1e-3;
+
+/// The per-channel share of `f` that `f_diffuse` is (0 where `f` is 0).
+#[inline]
+fn share(f_diffuse: Rgb, f: Rgb) -> Rgb {
+    Rgb::from_array(std::array::from_fn(|k| {
+        if f[k] > 0.0 {
+            (f_diffuse[k] / f[k]).clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
+    }))
+}
 
 /// Path tracer configuration.
 #[derive(Clone, Debug)]
@@ -76,6 +133,10 @@ impl Integrator for PathIntegrator {
         self.name
     }
 
+    fn writes_split(&self) -> bool {
+        true
+    }
+
     fn li(
         &self,
         ctx: &Ctx<'_>,
@@ -102,6 +163,13 @@ impl Integrator for PathIntegrator {
         let mut depth = 0u32;
         // The path's wavelength once a dispersive event has drawn one (§6.6).
         let mut lambda: Option<f32> = None;
+        // The lighting split, when asked for: every contribution is also filed by bounce and
+        // by the first vertex's lobe class.
+        let want_split = aux.want_split;
+        let mut tracker = SplitTracker {
+            diffuse_share: Rgb::ZERO,
+            albedo: Rgb::ZERO,
+        };
         loop {
             counters.rays += 1;
             let Some(hit) = ctx.accel.intersect(&ray, f32::INFINITY) else {
@@ -113,6 +181,10 @@ impl Integrator for PathIntegrator {
                         power_heuristic(prev_pdf, lights.pdf_env(scene, ray.dir))
                     };
                     l += beta * le * w;
+                    if want_split {
+                        let share = tracker.diffuse_share;
+                        tracker.add(&mut aux.split, beta * le * w, depth, share);
+                    }
                 }
                 break;
             };
@@ -128,6 +200,10 @@ impl Integrator for PathIntegrator {
                     power_heuristic(prev_pdf, pdf_light)
                 };
                 l += beta * le * w;
+                if want_split {
+                    let share = tracker.diffuse_share;
+                    tracker.add(&mut aux.split, beta * le * w, depth, share);
+                }
             }
             let first_hit_wanted = depth == 0 && aux.want_first_hit;
             if depth >= self.max_depth && !first_hit_wanted {
@@ -142,6 +218,9 @@ impl Integrator for PathIntegrator {
             };
             if first_hit_wanted {
                 aux.first_hit = Some(crate::first_hit(&bsdf, &si, wo, hit.t * ray.dir.length()));
+            }
+            if want_split && depth == 0 {
+                tracker.albedo = bsdf.albedo();
             }
             if depth >= self.max_depth {
                 break;
@@ -162,7 +241,18 @@ impl Integrator for PathIntegrator {
                         counters.shadow_rays += 1;
                         if light_visible(ctx, si.p, si.p_error, si.ng, si.time, &ls) {
                             let w = power_heuristic(ls.pdf, bsdf_pdf);
-                            l += beta * f * ls.le * (cos * w / ls.pdf);
+                            let c = beta * f * ls.le * (cos * w / ls.pdf);
+                            l += c;
+                            if want_split {
+                                // At the first vertex the light's own direction decides the
+                                // lobe shares; later, the first bounce's sampled direction.
+                                let share = if depth == 0 {
+                                    share(bsdf.restricted(LayerClass::Diffuse).eval(ls.wi), f)
+                                } else {
+                                    tracker.diffuse_share
+                                };
+                                tracker.add(&mut aux.split, c, depth + 1, share);
+                            }
                         }
                     }
                 }
@@ -171,6 +261,16 @@ impl Integrator for PathIntegrator {
             let Some(s) = bsdf.sample(u_layer, u_bsdf) else {
                 break;
             };
+            if want_split && depth == 0 {
+                tracker.diffuse_share = if s.delta {
+                    Rgb::ZERO
+                } else {
+                    share(
+                        bsdf.restricted(LayerClass::Diffuse).eval(s.wi),
+                        bsdf.eval(s.wi),
+                    )
+                };
+            }
             beta *= s.weight;
             if beta.max_element() <= 0.0 || !beta.is_finite() {
                 break;
@@ -184,6 +284,9 @@ impl Integrator for PathIntegrator {
             if depth > self.rr_depth && !survives_roulette(&mut beta, 1.0, u_rr) {
                 break;
             }
+        }
+        if want_split {
+            tracker.finish(&mut aux.split);
         }
         l
     }

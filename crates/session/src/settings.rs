@@ -132,6 +132,14 @@ pub enum SettingsError {
         /// The technique's name.
         technique: &'static str,
     },
+    /// Lighting-split AOVs asked of a technique that does not write them.
+    #[error("{origin}: the {technique} technique does not write the lighting split (emission, direct, indirect, diffuse, glossy, irradiance); use path, path-bsdf or direct, or drop those AOVs")]
+    SplitUnsupported {
+        /// Where the AOVs were asked for.
+        origin: Origin,
+        /// The technique's name.
+        technique: &'static str,
+    },
     /// An unknown AOV name.
     #[error("{origin}: {source}")]
     Aov {
@@ -228,6 +236,12 @@ impl Overrides {
         };
         if integrator.kind.splats() && per_pixel != AovSet::default() {
             return Err(SettingsError::AovUnsupported {
+                origin: origin(self.aovs.is_some(), "aov", "aov"),
+                technique: integrator.kind.name(),
+            });
+        }
+        if aovs.any_split() && !integrator.kind.writes_split() {
+            return Err(SettingsError::SplitUnsupported {
                 origin: origin(self.aovs.is_some(), "aov", "aov"),
                 technique: integrator.kind.name(),
             });
