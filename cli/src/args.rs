@@ -90,9 +90,13 @@ pub struct Args {
     pub camera: Option<String>,
 
     /// Extra EXR channels, comma separated: albedo, normal, depth, position (at the first
-    /// visible surface, averaged over the pixel's samples), variance (of the pixel mean) and
-    /// blocks (with --error: the stopping criterion's final block index, samples per pixel and
-    /// converged flag per pixel). Only computed when asked for. [default: `[render] aov`, else none]
+    /// visible surface, averaged over the pixel's samples), feature-variance (of each of those
+    /// means), variance (of the pixel mean), halves (the even and odd samples' means), the
+    /// lighting split emission, direct, indirect, diffuse, glossy and irradiance (reflected light
+    /// over albedo; path tracers only), denoise (all of the above) and blocks (with --error: the
+    /// stopping criterion's final block index, samples per pixel and converged flag per pixel).
+    /// Only computed when asked for; `render denoise` reads them back. [default: `[render] aov`,
+    /// else none]
     #[arg(long, value_delimiter = ',')]
     pub aov: Option<Vec<String>>,
 
@@ -198,6 +202,9 @@ pub enum Command {
     /// Compare image A with the reference B: MSE, relMSE, RMSE, PSNR and SSIM, one `name value`
     /// per line (or JSON), optionally a false-colour error image (docs/experiments.md).
     Compare(crate::compare::CompareArgs),
+    /// Apply one denoiser to a saved frame (an EXR written with `--aov`): `render denoise
+    /// IN.exr --denoiser NAME[:options] -o OUT` (docs/denoising.md).
+    Denoise(crate::denoise::DenoiseArgs),
     /// Render a high-sample reference image (its own random streams, independent of any normal
     /// render) or take it from the reference cache; prints the EXR's path (docs/experiments.md).
     Reference(crate::reference::ReferenceArgs),

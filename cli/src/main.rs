@@ -14,6 +14,7 @@ mod args;
 mod bench_accel;
 mod bench_anim;
 mod compare;
+mod denoise;
 mod experiment;
 mod job;
 mod progress;
@@ -37,6 +38,7 @@ fn main() -> ExitCode {
         Some(args::Command::BenchAccel(bench)) => bench_accel::run(bench),
         Some(args::Command::BenchAnim(bench)) => bench_anim::run(bench),
         Some(args::Command::Compare(c)) => compare::run(c),
+        Some(args::Command::Denoise(d)) => denoise::run(d),
         Some(args::Command::Reference(r)) => reference::run(r),
         Some(args::Command::Experiment(x)) => experiment::run(x),
         Some(args::Command::Stress(stress)) => stress::run(stress),

@@ -1,0 +1,105 @@
+//! End-to-end tests of saved frames and `render denoise`: `--aov denoise` writes every channel
+//! and they read back bit for bit; the denoised file is what the library computes from them;
+//! bad specs, missing channels and missing files each give one error line and exit code 1.
+
+mod common;
+
+use rt_denoise::{DenoiserSpec, NoisyFrame};
+use rt_film::Channel;
+use std::process::{Command, Output};
+
+fn render(dir: &std::path::Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_render"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn scene(dir: &std::path::Path) {
+    let camera = "[[camera]]\nname = \"c\"\nposition = [0.0, 1.0, 2.5]\nlook_at = [0.0, 0.0, 0.0]\nfov = 50.0\nresolution = [20, 14]\n";
+    std::fs::write(
+        dir.join("s.toml"),
+        format!("{camera}{}", common::FLOOR_AND_LAMP),
+    )
+    .unwrap();
+}
+
+fn one_error_line(out: &Output) -> String {
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    err
+}
+
+#[test]
+fn saved_frames_denoise_like_the_library_and_bad_input_is_one_line() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    scene(dir);
+    let out = render(
+        dir,
+        &["s.toml", "--spp", "4", "--aov", "denoise", "-o", "f.exr"],
+    );
+    assert!(out.status.success(), "{out:?}");
+    let frame = NoisyFrame::from_exr(&dir.join("f.exr")).unwrap();
+    assert_eq!(frame.channels(), Channel::ALL.to_vec());
+    // The lighting split of a diffuse floor: no glossy light, and the parts add up.
+    let c = frame.colour.pixels();
+    let (e, di, ind) = (
+        frame.emission.as_ref().unwrap().pixels(),
+        frame.direct.as_ref().unwrap().pixels(),
+        frame.indirect.as_ref().unwrap().pixels(),
+    );
+    for i in 0..c.len() {
+        assert!(
+            (e[i] + di[i] + ind[i] - c[i]).abs().max_element() <= 1e-4 * (1.0 + c[i].max_element())
+        );
+    }
+
+    let out = render(
+        dir,
+        &[
+            "denoise",
+            "f.exr",
+            "--denoiser",
+            "box:radius=2",
+            "-o",
+            "d.exr",
+        ],
+    );
+    assert!(out.status.success(), "{out:?}");
+    let want = "box:radius=2"
+        .parse::<DenoiserSpec>()
+        .unwrap()
+        .build()
+        .unwrap();
+    let want = want.denoise(&frame).unwrap();
+    let got = rt_film::read_rgb(&dir.join("d.exr")).unwrap();
+    assert_eq!(got, want);
+
+    let err = one_error_line(&render(
+        dir,
+        &[
+            "denoise",
+            "f.exr",
+            "--denoiser",
+            "box:size=2",
+            "-o",
+            "x.exr",
+        ],
+    ));
+    assert!(err.contains("box: unknown option 'size'"), "{err}");
+    let err = one_error_line(&render(
+        dir,
+        &["denoise", "f.exr", "--denoiser", "nope", "-o", "x.exr"],
+    ));
+    assert!(err.contains("unknown denoiser 'nope'"), "{err}");
+    let err = one_error_line(&render(
+        dir,
+        &["denoise", "gone.exr", "--denoiser", "box", "-o", "x.exr"],
+    ));
+    assert!(err.contains("gone.exr"), "{err}");
+    assert!(!dir.join("x.exr").exists());
+}
