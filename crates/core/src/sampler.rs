@@ -14,11 +14,12 @@ use glam::Vec2;
 
 /// Which family of sample streams a render draws from.
 ///
-/// The two families use disjoint ranges of dimension numbers (a normal render counts from 0, a
-/// reference from 2³¹), so no `(seed, pixel, index, dimension)` point that any normal render
-/// uses, whatever its seed, is ever used by a reference: a reference's error is independent of
-/// the image it is measured against even when both have the same seed. A path would need over
-/// two billion dimensions to reach the reference range.
+/// The families use disjoint ranges of dimension numbers (a normal render counts from 0, GREE's
+/// filter caches from 2³⁰, a reference from 2³¹), so no `(seed, pixel, index, dimension)` point
+/// that any normal render uses, whatever its seed, is ever used by a reference or a cache: a
+/// reference's error is independent of the image it is measured against, and a cache's samples
+/// of the image its filters were run on, even when all have the same seed. A path would need
+/// over a billion dimensions to reach the next range.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum SampleStream {
     /// Every normal render.
@@ -26,6 +27,9 @@ pub enum SampleStream {
     Render,
     /// High-sample reference images (`render reference`, experiments).
     Reference,
+    /// GREE's filter caches: extra samples at chosen pixels that score the filters of an
+    /// image rendered from [`SampleStream::Render`], so they must not share its samples.
+    Cache,
 }
 
 impl SampleStream {
@@ -34,6 +38,7 @@ impl SampleStream {
         match self {
             SampleStream::Render => 0,
             SampleStream::Reference => 1 << 31,
+            SampleStream::Cache => 1 << 30,
         }
     }
 }

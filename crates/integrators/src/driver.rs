@@ -108,11 +108,7 @@ pub fn render_samples(
     let want_split = film.aovs().any_split() && integrator.writes_split();
     let totals = Mutex::new(RayCounters::default());
     let rows_done = std::sync::atomic::AtomicU32::new(0);
-    let camera = ctx.camera;
-    let thin_lens = !camera.is_pinhole();
-    let blurred = ctx.scene.is_motion_blurred(&camera.name);
-    let camera_motion = ctx.scene.camera_motion(&camera.name);
-    let (open, shutter) = (ctx.scene.time, ctx.scene.shutter);
+    let camera = CameraSampling::new(ctx);
     film.stripes_mut(BAND_ROWS)
         .into_par_iter()
         .for_each(|mut stripe| {
@@ -126,31 +122,19 @@ pub fn render_samples(
                         }
                     }
                     for i in pass.indices.clone() {
-                        sampler.start(x, y, i);
-                        let film_pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
-                        let lens = if thin_lens {
-                            sampler.next_2d()
-                        } else {
-                            Vec2::ZERO
-                        };
-                        let ray = if blurred {
-                            let time = sampler.next_1d();
-                            match camera_motion {
-                                Some(m) => {
-                                    let key = m.at(open + time * shutter);
-                                    camera.generate_ray_at(&key, time, film_pos, lens)
-                                }
-                                None => camera.generate_ray(film_pos, lens).at_time(time),
-                            }
-                        } else {
-                            camera.generate_ray(film_pos, lens)
-                        };
                         let mut aux = SampleAux {
                             want_first_hit,
                             want_split,
                             ..Default::default()
                         };
-                        let l = integrator.li(ctx, ray, &mut sampler, &mut aux, &mut counters);
+                        let l = camera.sample(
+                            ctx,
+                            integrator,
+                            &mut sampler,
+                            (x, y, i),
+                            &mut aux,
+                            &mut counters,
+                        );
                         let split = want_split.then_some(&aux.split);
                         stripe.add_sample_split(x, y, i, l, aux.first_hit.as_ref(), split);
                     }
@@ -171,6 +155,132 @@ pub fn render_samples(
         rays,
         discarded: film.discarded() - discarded_before,
     }
+}
+
+/// How camera samples are taken: the film position, then the lens only for a thin lens, then
+/// the shutter time only when something moves while the shutter is open (see the module doc).
+struct CameraSampling<'a> {
+    camera: &'a rt_core::Camera,
+    thin_lens: bool,
+    blurred: bool,
+    camera_motion: Option<&'a rt_core::animation::CameraMotion>,
+    open: f32,
+    shutter: f32,
+}
+
+impl<'a> CameraSampling<'a> {
+    fn new(ctx: &Ctx<'a>) -> Self {
+        let camera = ctx.camera;
+        Self {
+            camera,
+            thin_lens: !camera.is_pinhole(),
+            blurred: ctx.scene.is_motion_blurred(&camera.name),
+            camera_motion: ctx.scene.camera_motion(&camera.name),
+            open: ctx.scene.time,
+            shutter: ctx.scene.shutter,
+        }
+    }
+
+    /// Sample `i` of pixel `(x, y)`: its camera ray, traced by `integrator`.
+    #[inline]
+    fn sample(
+        &self,
+        ctx: &Ctx<'_>,
+        integrator: &dyn Integrator,
+        sampler: &mut Sampler,
+        (x, y, i): (u32, u32, u32),
+        aux: &mut SampleAux,
+        counters: &mut RayCounters,
+    ) -> rt_core::Rgb {
+        sampler.start(x, y, i);
+        let film_pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+        let lens = if self.thin_lens {
+            sampler.next_2d()
+        } else {
+            Vec2::ZERO
+        };
+        let camera = self.camera;
+        let ray = if self.blurred {
+            let time = sampler.next_1d();
+            match self.camera_motion {
+                Some(m) => {
+                    let key = m.at(self.open + time * self.shutter);
+                    camera.generate_ray_at(&key, time, film_pos, lens)
+                }
+                None => camera.generate_ray(film_pos, lens).at_time(time),
+            }
+        } else {
+            camera.generate_ray(film_pos, lens)
+        };
+        integrator.li(ctx, ray, sampler, aux, counters)
+    }
+}
+
+/// The mean radiance of samples `0..spp` of stream `stream` at each pixel of `pixels`, in
+/// order: a sparse re-render (GREE's filter caches render a few pixels with many samples from
+/// [`SampleStream::Cache`], independent of the image's own samples). Samples are taken exactly
+/// as [`render_samples`] takes them, so a pixel's value does not depend on which other pixels
+/// are asked for or on the thread count. Non-finite or negative samples are dropped, as the
+/// film drops them; a pixel whose every sample was dropped is zero.
+pub fn render_pixels(
+    ctx: &Ctx<'_>,
+    integrator: &dyn Integrator,
+    pixels: &[(u32, u32)],
+    spp: u32,
+    seed: u32,
+    stream: SampleStream,
+) -> (Vec<rt_core::Rgb>, RenderStats) {
+    let start = Instant::now();
+    let camera = CameraSampling::new(ctx);
+    let totals = Mutex::new(RayCounters::default());
+    let discarded = std::sync::atomic::AtomicU64::new(0);
+    // Chunks of pixels per work item; each pixel's samples are a function of its coordinates.
+    let means: Vec<rt_core::Rgb> = pixels
+        .par_chunks(64)
+        .flat_map_iter(|chunk| {
+            let mut sampler = Sampler::with_stream(seed, stream);
+            let mut counters = RayCounters::default();
+            let mut dropped = 0u64;
+            let out: Vec<rt_core::Rgb> = chunk
+                .iter()
+                .map(|&(x, y)| {
+                    let (mut sum, mut n) = (rt_core::Rgb::ZERO, 0u32);
+                    for i in 0..spp {
+                        let mut aux = SampleAux::default();
+                        let l = camera.sample(
+                            ctx,
+                            integrator,
+                            &mut sampler,
+                            (x, y, i),
+                            &mut aux,
+                            &mut counters,
+                        );
+                        if l.is_finite() && l.min_element() >= 0.0 {
+                            sum += l;
+                            n += 1;
+                        } else {
+                            dropped += 1;
+                        }
+                    }
+                    if n == 0 {
+                        rt_core::Rgb::ZERO
+                    } else {
+                        sum / n as f32
+                    }
+                })
+                .collect();
+            *totals.lock().unwrap_or_else(|e| e.into_inner()) += counters;
+            discarded.fetch_add(dropped, std::sync::atomic::Ordering::Relaxed);
+            out
+        })
+        .collect();
+    let stats = RenderStats {
+        elapsed: start.elapsed(),
+        samples: pixels.len() as u64 * spp as u64,
+        rays: totals.into_inner().unwrap_or_else(|e| e.into_inner()),
+        discarded: discarded.into_inner(),
+    };
+    (means, stats)
 }
 
 #[cfg(test)]
@@ -243,5 +353,52 @@ mod tests {
             expected(0, 2),
             "the test can tell them apart"
         );
+    }
+
+    #[test]
+    fn sparse_re_renders_match_the_film_and_do_not_share_its_samples() {
+        let scene = Scene::empty();
+        let accel = rt_accel::BruteForce::new(&scene.triangles);
+        let camera = Camera::look_at("c", Vec3::Z, Vec3::ZERO, Vec3::Y, 40.0, 5, 4, 0.0, 1.0);
+        let ctx = Ctx {
+            scene: &scene,
+            accel: &accel,
+            camera: &camera,
+        };
+        let film_of = |stream| {
+            let mut film = Film::new(5, 4, AovSet::default());
+            let pass = SamplePass {
+                indices: 0..6,
+                stream,
+                pixels: None,
+            };
+            render_samples(&ctx, &FirstDimension, &mut film, 3, &pass, &|_| {});
+            film.mean_image()
+        };
+        let cache_film = film_of(SampleStream::Cache);
+        let pixels = [(4, 3), (0, 0), (2, 1)];
+        let (means, stats) =
+            render_pixels(&ctx, &FirstDimension, &pixels, 6, 3, SampleStream::Cache);
+        assert_eq!(stats.samples, 18);
+        for (&(x, y), m) in pixels.iter().zip(&means) {
+            let want = cache_film[(y * 5 + x) as usize];
+            assert!((*m - want).abs().max_element() < 1e-6, "{m} vs {want}");
+        }
+        // Asking for one pixel alone gives its value too.
+        let (alone, _) = render_pixels(
+            &ctx,
+            &FirstDimension,
+            &pixels[2..],
+            6,
+            3,
+            SampleStream::Cache,
+        );
+        assert_eq!(alone[0], means[2]);
+        // The render stream's samples are others.
+        let render_film = film_of(SampleStream::Render);
+        assert!(pixels
+            .iter()
+            .zip(&means)
+            .all(|(&(x, y), m)| *m != render_film[(y * 5 + x) as usize]));
     }
 }

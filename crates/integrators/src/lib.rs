@@ -32,7 +32,7 @@ mod work;
 
 pub use ao::AoIntegrator;
 pub use bdpt::Bdpt;
-pub use driver::{render, render_samples, RenderOptions, RenderStats, SamplePass};
+pub use driver::{render, render_pixels, render_samples, RenderOptions, RenderStats, SamplePass};
 pub use light::LightTracer;
 pub use partitioned::{Culling, PartitionOptions, PartitionStats, Partitioned};
 pub use path::PathIntegrator;
