@@ -339,3 +339,29 @@ fn gltf_sample_models() {
         .fold(f32::MIN, f32::max);
     assert!(top > 3.9, "sparse values not applied: max y = {top}");
 }
+
+#[test]
+fn gree_scenes_load_from_the_shared_data() {
+    // scenes/shared-data/*.toml read their meshes from ../shared/data: with the data there,
+    // each loads whole, with its lamp.
+    for (scene, mesh, triangles) in [
+        ("sibenik.toml", "scenes/sibenik/sibenik.obj", 75_284),
+        (
+            "conference.toml",
+            "scenes/conference/conference.obj",
+            331_179,
+        ),
+    ] {
+        let Some(mesh) = rt_testkit::data::file(mesh) else {
+            return;
+        };
+        let path = rt_testkit::workspace_root()
+            .join("scenes/shared-data")
+            .join(scene);
+        let s = rt_scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let object = s.scene.objects.iter().max_by_key(|o| o.count).unwrap();
+        assert_eq!(object.count, fan_triangles(&mesh), "{scene}");
+        assert_eq!(object.count, triangles, "{scene}");
+        assert!(s.scene.materials.iter().any(|m| m.is_emissive()), "{scene}");
+    }
+}
