@@ -353,3 +353,6 @@ pub fn alpha_expansion(
         accepted,
     }
 }
+
+#[cfg(test)]
+mod tests;
