@@ -64,6 +64,8 @@ pub struct Composite {
     pub argmin_labels: Vec<u16>,
     /// The labelling energy at the argmin and after the graph cut.
     pub energy: (f64, f64),
+    /// α-expansion sweeps run and expansions accepted.
+    pub cut_moves: (u32, u32),
     /// Wall-clock time of each stage.
     pub timings: StageTimes,
     /// Samples the caches traced (`caches · c`).
@@ -199,6 +201,7 @@ pub fn composite<R: CacheRenderer>(
         argmin_image,
         argmin_labels,
         energy: (cut.initial_energy, cut.energy),
+        cut_moves: (cut.sweeps, cut.accepted),
         timings,
         samples_traced,
     })

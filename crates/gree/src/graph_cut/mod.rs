@@ -18,7 +18,10 @@
 //!   same factor leaves the labelling unchanged (for the squared metric).
 //! - The start is the per-pixel argmin. An expansion is accepted only if it strictly lowers
 //!   the energy (computed in full in `f64`), so the energy never rises. Sweeps over all labels
-//!   stop after a sweep with no accepted move or after [`CutOptions::max_sweeps`].
+//!   stop after a sweep that lowered the energy by at most [`CutOptions::tolerance`] of it
+//!   (none accepted included) or after [`CutOptions::max_sweeps`]. A label whose expansion
+//!   failed is not retried until another expansion has been accepted (its proposal would be
+//!   the same).
 //! - Thesis: GPU, on NPP's binary cut. Here: CPU, serial max-flow; the per-pixel parts
 //!   (graph weights, energies) are row-parallel and bit-identical for any thread count.
 
@@ -42,15 +45,21 @@ pub struct LabelProblem<'a> {
 }
 
 /// Settings of [`alpha_expansion`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CutOptions {
-    /// Most sweeps over all labels.
+    /// Most sweeps over all labels (default 4).
     pub max_sweeps: u32,
+    /// Stop after a sweep that lowered the energy by at most this fraction of it (default
+    /// 1e-4; 0 runs to convergence or `max_sweeps`).
+    pub tolerance: f64,
 }
 
 impl Default for CutOptions {
     fn default() -> Self {
-        Self { max_sweeps: 4 }
+        Self {
+            max_sweeps: 4,
+            tolerance: 1e-4,
+        }
     }
 }
 
@@ -225,6 +234,7 @@ struct Buffers {
     right: Vec<EdgeCosts>,
     down: Vec<EdgeCosts>,
     unary: Vec<f64>,
+    own: Vec<f64>,
     proposal: Vec<u16>,
 }
 
@@ -236,13 +246,43 @@ fn expand(problem: &LabelProblem, labels: &[u16], alpha: u16, buf: &mut Buffers)
     buf.right.resize(n, [0.0; 3]);
     buf.down.resize(n, [0.0; 3]);
     buf.unary.resize(n, 0.0);
+    buf.own.resize(n, 0.0);
+    // Each pixel's half of V(l_p, α), reused by its four edges: inside a label region
+    // B = C = V(l, α) needs nothing else.
+    buf.own.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, s) in row.iter_mut().enumerate() {
+            let p = y * w + x;
+            let l = labels[p];
+            *s = if l == alpha || problem.pair_weight == 0.0 {
+                0.0
+            } else {
+                problem.half_seam(p, l, alpha)
+            };
+        }
+    });
+    let own = &buf.own;
+    let pw = problem.pair_weight;
     let costs = |p: usize, q: usize| -> EdgeCosts {
         let (lp, lq) = (labels[p], labels[q]);
-        [
-            problem.pair(p, q, lp, lq),
-            problem.pair(p, q, lp, alpha),
-            problem.pair(p, q, alpha, lq),
-        ]
+        if lp == lq {
+            let b = if lp == alpha {
+                0.0
+            } else {
+                pw * (own[p] + own[q])
+            };
+            return [0.0, b, b];
+        }
+        let b = if lp == alpha {
+            0.0
+        } else {
+            pw * (own[p] + problem.half_seam(q, lp, alpha))
+        };
+        let c = if lq == alpha {
+            0.0
+        } else {
+            pw * (problem.half_seam(p, alpha, lq) + own[q])
+        };
+        [problem.pair(p, q, lp, lq), b, c]
     };
     buf.right
         .par_chunks_mut(w)
@@ -326,22 +366,29 @@ pub fn alpha_expansion(
     let mut sweeps = 0;
     let mut accepted = 0;
     let single = problem.labels() < 2;
+    // Label α's proposal depends only on the labelling, and an exact α-expansion of its own
+    // result changes nothing, so α is not retried until another expansion is accepted.
+    let mut failed_at = vec![u32::MAX; problem.labels()];
     while sweeps < options.max_sweeps && !single {
         sweeps += 1;
+        let sweep_start = energy;
         let mut improved = false;
         for alpha in 0..problem.labels() as u16 {
-            if !expand(problem, &labels, alpha, &mut buf) {
+            if failed_at[alpha as usize] == accepted {
                 continue;
             }
-            let e = problem.energy(&buf.proposal);
-            if e < energy {
-                energy = e;
-                std::mem::swap(&mut labels, &mut buf.proposal);
-                accepted += 1;
-                improved = true;
+            if expand(problem, &labels, alpha, &mut buf) {
+                let e = problem.energy(&buf.proposal);
+                if e < energy {
+                    energy = e;
+                    std::mem::swap(&mut labels, &mut buf.proposal);
+                    accepted += 1;
+                    improved = true;
+                }
             }
+            failed_at[alpha as usize] = accepted;
         }
-        if !improved {
+        if !improved || sweep_start - energy <= options.tolerance * sweep_start.abs() {
             break;
         }
     }

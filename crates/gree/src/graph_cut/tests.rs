@@ -89,7 +89,14 @@ fn converged_labelling_is_a_local_minimum() {
     for seed in 0..4u64 {
         let inst = instance(12, 9, 3 + seed as usize % 2, 40 + seed);
         let problem = LabelProblem::with_scales(&inst.bank, &inst.data, 1.0, 0.2);
-        let out = alpha_expansion(&problem, problem.argmin(), &CutOptions { max_sweeps: 50 });
+        let out = alpha_expansion(
+            &problem,
+            problem.argmin(),
+            &CutOptions {
+                max_sweeps: 50,
+                tolerance: 0.0,
+            },
+        );
         assert!(out.sweeps < 50, "did not converge");
         let mut labels = out.labels.clone();
         for p in 0..labels.len() {
