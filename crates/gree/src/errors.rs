@@ -3,7 +3,7 @@
 //! thesis), or `Σ_c (F_i(p) − C(p))_c² / (C(p)_c² + 0.01)` ([`ErrorMetric::Relative`], ours).
 //!
 //! With C independent of N, `E e_i(p) = true error² + Var(C)`; the second term is the same for
-//! every filter, so the per-pixel choice is unbiased in expectation (digest §2.4 [ours]).
+//! every filter, so the per-pixel choice is unbiased in expectation (not in the thesis).
 
 use crate::params::{ErrorMetric, RELATIVE_EPSILON};
 use rayon::prelude::*;

@@ -4,7 +4,7 @@
 //!
 //! The guidance gradient of the edge p → q is `F_a(q) − F_a(p)` when both pixels carry label
 //! `a`, and the average of `F_a(q) − F_a(p)` and `F_b(q) − F_b(p)` across a seam (`a = L(p)`,
-//! `b = L(q)`; digest §2.7 [ours]; the thesis does not say). One iteration is
+//! `b = L(q)`; not in the thesis; the thesis does not say). One iteration is
 //! `u'_p = u_p + (1/|N(p)|) Σ_q ((u_q − u_p) − g_pq)`: written as a correction, a pixel whose
 //! neighbours all share its label and still hold the composite gets exactly zero correction,
 //! so label interiors are bit-exact fixed points and only pixels within `iters` steps of a

@@ -6,7 +6,7 @@
 //! and barycentric weights; [`Interpolator::apply`] then turns one filter's sparse errors into
 //! a dense map in a single pass, so m filters cost one triangulation and m cheap passes.
 //!
-//! Hull padding (digest §2.6 [ours]; the thesis does not say how it covers pixels outside the
+//! Hull padding (not in the thesis; the thesis does not say how it covers pixels outside the
 //! caches' convex hull): the image corners and border pixels every `≈ sqrt(pixels/caches)`
 //! that lie strictly outside the hull become pseudo-caches carrying the value of their
 //! nearest cache. They are triangulated together with the caches in a *constrained*

@@ -3,7 +3,7 @@
 //! Deviations from the thesis:
 //! - `sigma_r` is relative: it is a standard deviation in units of the mean bank radiance
 //!   (see [`crate::placement`]), not in absolute radiance, so it means the same on LDR and
-//!   HDR scenes (digest §2.5 [ours]). The thesis' 0.15 was absolute.
+//!   HDR scenes. The thesis' 0.15 was absolute.
 //! - `lambda` is dimensionless: the data term is divided by the squared mean bank radiance
 //!   (for [`ErrorMetric::Squared`]) and the pairwise term by the mean bank radiance (see
 //!   [`crate::graph_cut`]). The thesis gives no numeric λ and notes it depends on the
@@ -19,8 +19,8 @@ pub enum ErrorMetric {
     /// `‖F_i(p) − C(p)‖²`, summed over RGB (the thesis).
     #[default]
     Squared,
-    /// `Σ_c (F_i(p) − C(p))_c² / (C(p)_c² + 0.01)`, relMSE-like, for HDR images (digest §5.3
-    /// [ours]).
+    /// `Σ_c (F_i(p) − C(p))_c² / (C(p)_c² + 0.01)`, relMSE-like, for HDR images (not in
+    /// the thesis).
     Relative,
 }
 

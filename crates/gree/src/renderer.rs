@@ -3,7 +3,7 @@
 //!
 //! Independence is the caller's promise, and it matters: a cache that reuses the samples of
 //! the noisy image `N` correlates with every filter output and most with the identity-like
-//! ones, so selection is biased toward the weakest filters (digest §2.4 [ours]; the crate's
+//! ones, so selection is biased toward the weakest filters (not in the thesis; the crate's
 //! `tests/independence.rs` shows it). Render caches from a different sample stream.
 
 use rt_core::Rgb;

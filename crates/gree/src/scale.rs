@@ -1,5 +1,5 @@
-//! The one radiance scale that makes `sigma_r` and `lambda` dimensionless (digest §2.5, §5.5
-//! [ours]): the mean over the bank's filters, pixels and channels.
+//! The one radiance scale that makes `sigma_r` and `lambda` dimensionless (not in the
+//! thesis, whose σ_r and λ are absolute): the mean over the bank's filters, pixels and channels.
 
 use rt_core::RgbImage;
 

@@ -1,4 +1,4 @@
-//! Cache samples must be independent of N (digest §2.4 [ours]). With a bank holding the
+//! Cache samples must be independent of N (not stated in the thesis). With a bank holding the
 //! identity (N itself) and a good filter, a renderer that hands back N's own values makes the
 //! identity's measured error zero at every cache, so GREE picks the identity almost
 //! everywhere; with honest, independent caches it almost never does.

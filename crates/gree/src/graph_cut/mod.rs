@@ -7,7 +7,7 @@
 //! `X = ‖F_a(p) − F_b(p)‖ + ‖F_a(q) − F_b(q)‖` and `Y` the same on image gradients (forward
 //! differences to the right and down, both stacked in one 6-vector; 0 past the last column or
 //! row), unsquared, 0 when `a = b`. V is a sum of norms of label differences, so it is a metric
-//! in the labels and every expansion move is submodular (digest §2.7 [ours]); a term that
+//! in the labels and every expansion move is submodular (not in the thesis); a term that
 //! rounding makes non-submodular is clamped, which only affects the proposal, not the energy.
 //!
 //! Deviations and choices:
@@ -317,7 +317,7 @@ fn expand(problem: &LabelProblem, labels: &[u16], alpha: u16, buf: &mut Buffers)
         });
     let g = &mut buf.flow;
     g.reset(w, h);
-    for p in 0..n {
+    for (p, &l) in labels.iter().enumerate() {
         let u = buf.unary[p];
         // Paid on the sink side (switch): the positive part goes to the source arc.
         if u > 0.0 {
@@ -325,7 +325,7 @@ fn expand(problem: &LabelProblem, labels: &[u16], alpha: u16, buf: &mut Buffers)
         } else {
             g.add_tweights(p, 0.0, -u);
         }
-        if labels[p] == alpha {
+        if l == alpha {
             continue;
         }
         let [a, b, c] = buf.right[p];

@@ -5,8 +5,7 @@
 //!   channels (the thesis writes F_m for F_i, a typo; it does not say how channels are reduced).
 //! - P_N(p) = exp(−v̂(p) / (2σ_r²)) with v̂(p) the variance of N's pixel mean averaged over
 //!   channels and divided by μ², μ the mean bank radiance ([`crate::scale`]). So σ_r is a
-//!   standard deviation relative to μ, not in absolute radiance (deviation; digest §2.5
-//!   [ours]). The Gaussian's constant factor cancels in the normalisation and is dropped.
+//!   standard deviation relative to μ, not in absolute radiance (deviation). The Gaussian's constant factor cancels in the normalisation and is dropped.
 //! - Everything is kept as `ln P_F + ln P_N`, so a strongly peaked P_N never underflows.
 //!
 //! Deviation: the thesis draws with a 2-D CDF and removes duplicates; here the draw is

@@ -1,5 +1,5 @@
 //! Filter-cache placement (thesis §5.1.2): `m_poisson = m − round(κ·m)` blue-noise pixels
-//! ([`blue_noise`]) first, then `round(κ·m)` pixels drawn without replacement from
+//! ([`blue_noise()`]) first, then `round(κ·m)` pixels drawn without replacement from
 //! P_FN = P_F · P_N (Eq. 5.1, [`importance`]) among the pixels not yet taken.
 //!
 //! Deviations: the blue-noise set is generated per image and seed rather than precomputed;
