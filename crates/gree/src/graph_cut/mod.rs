@@ -1,0 +1,405 @@
+//! The filter labelling (thesis §5.1.4, Eq. 5.2–5.4): minimise
+//! `E(L) = Σ_p D_L(p)(p) + λ Σ_{p~q} V(p, q, L(p), L(q))` over a 4-neighbourhood by α-expansion
+//! (Boykov, Veksler and Zabih 2001), each expansion a binary cut solved by our own
+//! Boykov–Kolmogorov max-flow ([`maxflow`]).
+//!
+//! V is the photomontage seam cost (Agarwala et al. 2004): `V = X + Y` with
+//! `X = ‖F_a(p) − F_b(p)‖ + ‖F_a(q) − F_b(q)‖` and `Y` the same on image gradients (forward
+//! differences to the right and down, both stacked in one 6-vector; 0 past the last column or
+//! row), unsquared, 0 when `a = b`. V is a sum of norms of label differences, so it is a metric
+//! in the labels and every expansion move is submodular (not in the thesis); a term that
+//! rounding makes non-submodular is clamped, which only affects the proposal, not the energy.
+//!
+//! Deviations and choices:
+//! - Normalisation ([`LabelProblem::new`]): the data term is divided by μ² for
+//!   [`ErrorMetric::Squared`] (it is a squared radiance) and left as is for
+//!   [`ErrorMetric::Relative`] (already relative); V is divided by μ; μ is the mean bank
+//!   radiance ([`crate::scale`]). So λ is dimensionless and scaling every radiance by the
+//!   same factor leaves the labelling unchanged (for the squared metric).
+//! - The start is the per-pixel argmin. An expansion is accepted only if it strictly lowers
+//!   the energy (computed in full in `f64`), so the energy never rises. Sweeps over all labels
+//!   stop after a sweep that lowered the energy by at most [`CutOptions::tolerance`] of it
+//!   (none accepted included) or after [`CutOptions::max_sweeps`]. A label whose expansion
+//!   failed is not retried until another expansion has been accepted (its proposal would be
+//!   the same).
+//! - Thesis: GPU, on NPP's binary cut. Here: CPU, serial max-flow; the per-pixel parts
+//!   (graph weights, energies) are row-parallel and bit-identical for any thread count.
+
+pub mod maxflow;
+
+use crate::params::ErrorMetric;
+use crate::scale::mean_radiance;
+use maxflow::GridMaxflow;
+use rayon::prelude::*;
+use rt_core::{Rgb, RgbImage};
+
+/// A labelling problem: per-label data costs and the bank that defines the seam cost.
+#[derive(Clone, Debug)]
+pub struct LabelProblem<'a> {
+    width: usize,
+    height: usize,
+    bank: &'a [RgbImage],
+    data: &'a [Vec<f32>],
+    data_scale: f64,
+    pair_weight: f64,
+}
+
+/// Settings of [`alpha_expansion`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CutOptions {
+    /// Most sweeps over all labels (default 4).
+    pub max_sweeps: u32,
+    /// Stop after a sweep that lowered the energy by at most this fraction of it (default
+    /// 1e-4; 0 runs to convergence or `max_sweeps`).
+    pub tolerance: f64,
+}
+
+impl Default for CutOptions {
+    fn default() -> Self {
+        Self {
+            max_sweeps: 4,
+            tolerance: 1e-4,
+        }
+    }
+}
+
+/// The result of [`alpha_expansion`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Labelling {
+    /// One label per pixel, row-major.
+    pub labels: Vec<u16>,
+    /// Its energy.
+    pub energy: f64,
+    /// The energy of the starting labelling.
+    pub initial_energy: f64,
+    /// Sweeps run.
+    pub sweeps: u32,
+    /// Expansions accepted.
+    pub accepted: u32,
+}
+
+impl<'a> LabelProblem<'a> {
+    /// The problem with the normalisation of the module doc: data costs `data[l][p]` (raw
+    /// errors of `metric`), seam costs from `bank`, dimensionless `lambda`.
+    ///
+    /// # Panics
+    /// If `data` and `bank` differ in length, are empty, or a map is not the bank's size.
+    pub fn new(
+        bank: &'a [RgbImage],
+        data: &'a [Vec<f32>],
+        lambda: f32,
+        metric: ErrorMetric,
+    ) -> Self {
+        let mu = mean_radiance(bank);
+        let data_scale = match metric {
+            ErrorMetric::Squared => 1.0 / (mu * mu),
+            ErrorMetric::Relative => 1.0,
+        };
+        Self::with_scales(bank, data, data_scale, lambda as f64 / mu)
+    }
+
+    /// The problem `E = data_scale · Σ D + pair_weight · Σ V` with explicit weights.
+    ///
+    /// # Panics
+    /// As [`LabelProblem::new`].
+    pub fn with_scales(
+        bank: &'a [RgbImage],
+        data: &'a [Vec<f32>],
+        data_scale: f64,
+        pair_weight: f64,
+    ) -> Self {
+        assert!(
+            !bank.is_empty() && bank.len() == data.len(),
+            "one data map per filter"
+        );
+        let (width, height) = (bank[0].width(), bank[0].height());
+        for (f, d) in bank.iter().zip(data) {
+            assert!(f.width() == width && f.height() == height && d.len() == width * height);
+        }
+        Self {
+            width,
+            height,
+            bank,
+            data,
+            data_scale,
+            pair_weight,
+        }
+    }
+
+    /// Number of labels.
+    pub fn labels(&self) -> usize {
+        self.bank.len()
+    }
+
+    /// Scaled data cost of label `l` at pixel `p`.
+    #[inline]
+    pub fn data_cost(&self, p: usize, l: u16) -> f64 {
+        self.data[l as usize][p] as f64 * self.data_scale
+    }
+
+    /// `‖F_a(p) − F_b(p)‖ + ‖∇F_a(p) − ∇F_b(p)‖`, one pixel's half of V.
+    #[inline]
+    fn half_seam(&self, p: usize, a: u16, b: u16) -> f64 {
+        let (fa, fb) = (
+            self.bank[a as usize].pixels(),
+            self.bank[b as usize].pixels(),
+        );
+        let d = fa[p] - fb[p];
+        let x = p % self.width;
+        let gx = if x + 1 < self.width {
+            (fa[p + 1] - fa[p]) - (fb[p + 1] - fb[p])
+        } else {
+            Rgb::ZERO
+        };
+        let q = p + self.width;
+        let gy = if q < fa.len() {
+            (fa[q] - fa[p]) - (fb[q] - fb[p])
+        } else {
+            Rgb::ZERO
+        };
+        d.length() as f64 + ((gx.length_squared() + gy.length_squared()) as f64).sqrt()
+    }
+
+    /// The photomontage seam cost V(p, q, a, b), unscaled (0 for `a == b`).
+    #[inline]
+    pub fn seam_cost(&self, p: usize, q: usize, a: u16, b: u16) -> f64 {
+        if a == b {
+            0.0
+        } else {
+            self.half_seam(p, a, b) + self.half_seam(q, a, b)
+        }
+    }
+
+    /// Scaled pairwise term of the edge (p, q).
+    #[inline]
+    fn pair(&self, p: usize, q: usize, a: u16, b: u16) -> f64 {
+        if a == b || self.pair_weight == 0.0 {
+            0.0
+        } else {
+            self.pair_weight * self.seam_cost(p, q, a, b)
+        }
+    }
+
+    /// `E(labels)`, summed in `f64` per row, then over rows in order.
+    ///
+    /// # Panics
+    /// If `labels` has not one label per pixel.
+    pub fn energy(&self, labels: &[u16]) -> f64 {
+        assert_eq!(labels.len(), self.width * self.height);
+        let w = self.width;
+        let rows: Vec<f64> = (0..self.height)
+            .into_par_iter()
+            .map(|y| {
+                let mut e = 0.0;
+                for x in 0..w {
+                    let p = y * w + x;
+                    e += self.data_cost(p, labels[p]);
+                    if x + 1 < w {
+                        e += self.pair(p, p + 1, labels[p], labels[p + 1]);
+                    }
+                    if y + 1 < self.height {
+                        e += self.pair(p, p + w, labels[p], labels[p + w]);
+                    }
+                }
+                e
+            })
+            .collect();
+        rows.iter().sum()
+    }
+
+    /// The per-pixel argmin of the data cost (ties to the lower label).
+    pub fn argmin(&self) -> Vec<u16> {
+        (0..self.width * self.height)
+            .into_par_iter()
+            .map(|p| {
+                let mut best = 0u16;
+                for l in 1..self.labels() as u16 {
+                    if self.data[l as usize][p] < self.data[best as usize][p] {
+                        best = l;
+                    }
+                }
+                best
+            })
+            .collect()
+    }
+}
+
+/// Per-edge costs of an expansion: A = V(l_p, l_q), B = V(l_p, α), C = V(α, l_q).
+type EdgeCosts = [f64; 3];
+
+/// Reused buffers of [`alpha_expansion`].
+#[derive(Default)]
+struct Buffers {
+    flow: GridMaxflow,
+    right: Vec<EdgeCosts>,
+    down: Vec<EdgeCosts>,
+    unary: Vec<f64>,
+    own: Vec<f64>,
+    proposal: Vec<u16>,
+}
+
+/// Builds the binary problem "keep (source side) or switch to α (sink side)" and cuts it.
+/// Returns whether any pixel switches; the proposal is left in `buf.proposal`.
+fn expand(problem: &LabelProblem, labels: &[u16], alpha: u16, buf: &mut Buffers) -> bool {
+    let (w, h) = (problem.width, problem.height);
+    let n = w * h;
+    buf.right.resize(n, [0.0; 3]);
+    buf.down.resize(n, [0.0; 3]);
+    buf.unary.resize(n, 0.0);
+    buf.own.resize(n, 0.0);
+    // Each pixel's half of V(l_p, α), reused by its four edges: inside a label region
+    // B = C = V(l, α) needs nothing else.
+    buf.own.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, s) in row.iter_mut().enumerate() {
+            let p = y * w + x;
+            let l = labels[p];
+            *s = if l == alpha || problem.pair_weight == 0.0 {
+                0.0
+            } else {
+                problem.half_seam(p, l, alpha)
+            };
+        }
+    });
+    let own = &buf.own;
+    let pw = problem.pair_weight;
+    let costs = |p: usize, q: usize| -> EdgeCosts {
+        let (lp, lq) = (labels[p], labels[q]);
+        if lp == lq {
+            let b = if lp == alpha {
+                0.0
+            } else {
+                pw * (own[p] + own[q])
+            };
+            return [0.0, b, b];
+        }
+        let b = if lp == alpha {
+            0.0
+        } else {
+            pw * (own[p] + problem.half_seam(q, lp, alpha))
+        };
+        let c = if lq == alpha {
+            0.0
+        } else {
+            pw * (problem.half_seam(p, alpha, lq) + own[q])
+        };
+        [problem.pair(p, q, lp, lq), b, c]
+    };
+    buf.right
+        .par_chunks_mut(w)
+        .zip(buf.down.par_chunks_mut(w))
+        .enumerate()
+        .for_each(|(y, (right, down))| {
+            for x in 0..w {
+                let p = y * w + x;
+                right[x] = if x + 1 < w { costs(p, p + 1) } else { [0.0; 3] };
+                down[x] = if y + 1 < h { costs(p, p + w) } else { [0.0; 3] };
+            }
+        });
+    // Unary "cost of switching minus cost of keeping", with the linear parts of the edges:
+    // E(xp, xq) = A + (C − A)·xp + (D − C)·xq + (B + C − A − D)·(1 − xp)·xq, D = V(α, α) = 0.
+    let (right, down) = (&buf.right, &buf.down);
+    buf.unary
+        .par_chunks_mut(w)
+        .enumerate()
+        .for_each(|(y, row)| {
+            for (x, u) in row.iter_mut().enumerate() {
+                let p = y * w + x;
+                let mut e = problem.data_cost(p, alpha) - problem.data_cost(p, labels[p]);
+                e += right[p][2] - right[p][0] + down[p][2] - down[p][0];
+                if x > 0 {
+                    e -= right[p - 1][2];
+                }
+                if y > 0 {
+                    e -= down[p - w][2];
+                }
+                *u = e;
+            }
+        });
+    let g = &mut buf.flow;
+    g.reset(w, h);
+    for (p, &l) in labels.iter().enumerate() {
+        let u = buf.unary[p];
+        // Paid on the sink side (switch): the positive part goes to the source arc.
+        if u > 0.0 {
+            g.add_tweights(p, u, 0.0);
+        } else {
+            g.add_tweights(p, 0.0, -u);
+        }
+        if l == alpha {
+            continue;
+        }
+        let [a, b, c] = buf.right[p];
+        if p % w + 1 < w {
+            g.add_edge(p, false, (b + c - a).max(0.0), 0.0);
+        }
+        let [a, b, c] = buf.down[p];
+        if p + w < n {
+            g.add_edge(p, true, (b + c - a).max(0.0), 0.0);
+        }
+    }
+    // Edges out of α-labelled pixels cost B + C − A = V(α, α) + V(α, l_q) − V(α, l_q) = 0.
+    g.maxflow();
+    buf.proposal.clear();
+    let mut changed = false;
+    for (p, &l) in labels.iter().enumerate() {
+        let switch = l != alpha && buf.flow.in_sink(p);
+        changed |= switch;
+        buf.proposal.push(if switch { alpha } else { l });
+    }
+    changed
+}
+
+/// α-expansion from `initial`: the energy never rises.
+///
+/// # Panics
+/// If `initial` has not one label per pixel or names a label the problem lacks.
+pub fn alpha_expansion(
+    problem: &LabelProblem,
+    initial: Vec<u16>,
+    options: &CutOptions,
+) -> Labelling {
+    assert!(initial.iter().all(|&l| (l as usize) < problem.labels()));
+    let mut labels = initial;
+    let initial_energy = problem.energy(&labels);
+    let mut energy = initial_energy;
+    let mut buf = Buffers::default();
+    let mut sweeps = 0;
+    let mut accepted = 0;
+    let single = problem.labels() < 2;
+    // Label α's proposal depends only on the labelling, and an exact α-expansion of its own
+    // result changes nothing, so α is not retried until another expansion is accepted.
+    let mut failed_at = vec![u32::MAX; problem.labels()];
+    while sweeps < options.max_sweeps && !single {
+        sweeps += 1;
+        let sweep_start = energy;
+        let mut improved = false;
+        for alpha in 0..problem.labels() as u16 {
+            if failed_at[alpha as usize] == accepted {
+                continue;
+            }
+            if expand(problem, &labels, alpha, &mut buf) {
+                let e = problem.energy(&buf.proposal);
+                if e < energy {
+                    energy = e;
+                    std::mem::swap(&mut labels, &mut buf.proposal);
+                    accepted += 1;
+                    improved = true;
+                }
+            }
+            failed_at[alpha as usize] = accepted;
+        }
+        if !improved || sweep_start - energy <= options.tolerance * sweep_start.abs() {
+            break;
+        }
+    }
+    Labelling {
+        labels,
+        energy,
+        initial_energy,
+        sweeps,
+        accepted,
+    }
+}
+
+#[cfg(test)]
+mod tests;
