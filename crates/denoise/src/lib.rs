@@ -25,9 +25,11 @@
 //! ```
 #![forbid(unsafe_code)]
 
+mod bank;
 mod box_blur;
 pub mod spec;
 
+pub use bank::{Bank, BankOutput, DEFAULT_BANK};
 pub use box_blur::BoxBlur;
 pub use rt_film::{Channel, FrameError, NoisyFrame};
 pub use spec::{DenoiserKind, DenoiserSpec, Options};

@@ -125,6 +125,35 @@ impl Channel {
     }
 }
 
+impl AovSet {
+    /// The AOVs a film must keep for a frame to have `channels` (the colour is always there).
+    pub fn for_channels(channels: &[Channel]) -> AovSet {
+        let mut a = AovSet::default();
+        for c in channels {
+            match c {
+                Channel::Colour => {}
+                Channel::Variance => a.variance = true,
+                Channel::Halves => a.halves = true,
+                Channel::Albedo => a.albedo = true,
+                Channel::Normal => a.normal = true,
+                Channel::Position => a.position = true,
+                Channel::Depth => a.depth = true,
+                Channel::AlbedoVariance => (a.albedo, a.feature_variance) = (true, true),
+                Channel::NormalVariance => (a.normal, a.feature_variance) = (true, true),
+                Channel::PositionVariance => (a.position, a.feature_variance) = (true, true),
+                Channel::DepthVariance => (a.depth, a.feature_variance) = (true, true),
+                Channel::Emission => a.emission = true,
+                Channel::Direct => a.direct = true,
+                Channel::Indirect => a.indirect = true,
+                Channel::Diffuse => a.diffuse = true,
+                Channel::Glossy => a.glossy = true,
+                Channel::Irradiance => a.irradiance = true,
+            }
+        }
+        a
+    }
+}
+
 impl fmt::Display for Channel {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
@@ -490,7 +519,11 @@ mod tests {
 
     /// A film with every channel, filled with distinct, awkward values.
     fn full_film() -> Film {
-        let mut film = Film::new(5, 3, FilmBuffers::for_outputs(AovSet::DENOISE));
+        full_film_with(FilmBuffers::for_outputs(AovSet::DENOISE))
+    }
+
+    fn full_film_with(buffers: FilmBuffers) -> Film {
+        let mut film = Film::new(5, 3, buffers);
         let mut state = 7u32;
         let mut next = || {
             state = rt_core::sampler::hash_u32(state);
@@ -571,6 +604,18 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("depth channel is (4, 3)"));
+    }
+
+    #[test]
+    fn the_aovs_for_channels_give_exactly_those_channels() {
+        let film = |aovs| full_film_with(FilmBuffers::for_outputs(aovs));
+        for c in Channel::ALL {
+            let aovs = AovSet::for_channels(&[c]);
+            let frame = NoisyFrame::from_film(&film(aovs), aovs);
+            assert!(frame.has(c), "{c}");
+        }
+        let aovs = AovSet::for_channels(&Channel::ALL);
+        assert_eq!(aovs, AovSet::DENOISE);
     }
 
     #[test]
