@@ -13,7 +13,7 @@
 //! `gaussian:sigma=4` and built, so a program using this crate offers the same choice as
 //! `render denoise --denoiser`.
 //!
-//! Depends on `rt-core` and `rt-film`. The optional feature `oidn` adds [`Oidn`], Intel Open
+//! Depends on `rt-core` and `rt-film`. The optional feature `oidn` adds `Oidn`, Intel Open
 //! Image Denoise loaded at run time (`libloading`); the default build needs nothing native.
 //!
 //! ```

@@ -241,8 +241,8 @@ impl RtFilter {
             shape,
         };
         let f = raw.as_ptr();
-        // SAFETY (three calls): live filter, NUL-terminated parameter names of the RT filter,
-        // plain values.
+        // SAFETY: three calls on a live filter with NUL-terminated parameter names of the RT
+        // filter and plain values.
         unsafe {
             (d.api.set_filter_bool)(f, c"hdr".as_ptr(), params.hdr);
             (d.api.set_filter_bool)(f, c"cleanAux".as_ptr(), params.clean_aux);

@@ -194,7 +194,12 @@ fn output_is_deterministic_across_runs_reuse_and_thread_counts() {
     assert_eq!(d.denoise(&f).unwrap(), first);
     let lib = d.library().to_string();
     for threads in [1, 2] {
-        let t = Oidn::with_library(OidnParams::default(), &[lib.clone()], Some(threads)).unwrap();
+        let t = Oidn::with_library(
+            OidnParams::default(),
+            std::slice::from_ref(&lib),
+            Some(threads),
+        )
+        .unwrap();
         assert_eq!(t.denoise(&f).unwrap(), first, "{threads} threads");
     }
 }
