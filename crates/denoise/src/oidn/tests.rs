@@ -5,6 +5,7 @@
 use super::*;
 use crate::DenoiserSpec;
 use rt_core::glam::Vec3;
+use std::io::Write;
 use std::path::Path;
 use std::process::Command;
 
@@ -98,13 +99,13 @@ fn specs_build_with_defaults_and_refuse_bad_options() {
     let _ = oidn(OidnParams::default()); // the library loads (clear message otherwise)
     let d = "oidn".parse::<DenoiserSpec>().unwrap().build().unwrap();
     assert_eq!(d.name(), "oidn:quality=high:aux=on:hdr=on:clean-aux=off");
-    let s: DenoiserSpec = "oidn:quality=fast:aux=off:hdr=off:clean-aux=on"
-        .parse()
-        .unwrap();
-    assert_eq!(
-        s.build().unwrap().name(),
-        "oidn:quality=fast:aux=off:hdr=off:clean-aux=on"
-    );
+    for text in [
+        "oidn:quality=fast:aux=off:hdr=on:clean-aux=on",
+        "oidn:quality=balanced:aux=on:hdr=off:clean-aux=off",
+    ] {
+        let s: DenoiserSpec = text.parse().unwrap();
+        assert_eq!(s.build().unwrap().name(), text);
+    }
     let err = |t: &str| {
         t.parse::<DenoiserSpec>()
             .unwrap()
@@ -263,8 +264,10 @@ fn matches_pyoidn_on_the_same_exr() {
             std::env::var("RT_REQUIRE_DATA").as_deref() != Ok("1"),
             "RT_REQUIRE_DATA=1 but python3 cannot import pyoidn, OpenEXR, numpy: run tools/oidn/setup.sh"
         );
-        eprintln!(
-            "SKIP matches_pyoidn_on_the_same_exr: python3 with pyoidn/OpenEXR/numpy not found"
+        // Past libtest's capture, so the skip shows on a passing run (as rt_validate::skip).
+        let _ = std::io::stderr().lock().write_all(
+            b"skipping: matches_pyoidn_on_the_same_exr: python3 with pyoidn, OpenEXR, numpy not \
+              found (set RT_REQUIRE_DATA=1 to make this a failure)\n",
         );
         return;
     }
@@ -273,7 +276,7 @@ fn matches_pyoidn_on_the_same_exr() {
     let (mut f, _) = checker_frame(64, 48, 0.5);
     f.colour.pixels_mut()[100] = Rgb::new(f32::NAN, 2.0, 1.0); // sanitised alike on both paths
     f.write_exr(&input, &[]).unwrap();
-    let ours = oidn(OidnParams::default()).denoise(&f).unwrap();
+    let mut outputs = Vec::new();
     for (args, d) in [
         (vec![], oidn(OidnParams::default())),
         (
@@ -281,6 +284,15 @@ fn matches_pyoidn_on_the_same_exr() {
             oidn(OidnParams {
                 aux: false,
                 quality: OidnQuality::Fast,
+                ..OidnParams::default()
+            }),
+        ),
+        (
+            vec!["--ldr", "--clean-aux", "--quality", "balanced"],
+            oidn(OidnParams {
+                hdr: false,
+                clean_aux: true,
+                quality: OidnQuality::Balanced,
                 ..OidnParams::default()
             }),
         ),
@@ -302,6 +314,7 @@ fn matches_pyoidn_on_the_same_exr() {
         assert!(stdout.contains("\"median_s\""), "{stdout}");
         let theirs = NoisyFrame::from_exr(&output).unwrap().colour;
         let mine = d.denoise(&f).unwrap();
+        outputs.push(mine.clone());
         let worst = mine
             .pixels()
             .iter()
@@ -310,14 +323,6 @@ fn matches_pyoidn_on_the_same_exr() {
             .fold(0.0, f32::max);
         assert!(worst < 1e-4, "{args:?}: relative difference {worst}");
     }
-    assert_ne!(
-        ours,
-        oidn(OidnParams {
-            aux: false,
-            quality: OidnQuality::Fast,
-            ..OidnParams::default()
-        })
-        .denoise(&f)
-        .unwrap()
-    );
+    // The three settings are three different filters.
+    assert!(outputs[0] != outputs[1] && outputs[1] != outputs[2] && outputs[0] != outputs[2]);
 }
