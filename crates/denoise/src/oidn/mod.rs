@@ -36,7 +36,8 @@ const NAME: &str = "oidn";
 pub enum OidnQuality {
     /// For interactive preview.
     Fast,
-    /// For interactive final frames.
+    /// For interactive final frames (on the CPU device OIDN 2.5 runs the high network: same
+    /// bits as `High`).
     Balanced,
     /// For final frames (OIDN's default on the CPU).
     High,
