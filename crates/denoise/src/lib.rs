@@ -13,7 +13,8 @@
 //! `gaussian:sigma=4` and built, so a program using this crate offers the same choice as
 //! `render denoise --denoiser`.
 //!
-//! Depends on `rt-core` and `rt-film`.
+//! Depends on `rt-core` and `rt-film`. The optional feature `oidn` adds `Oidn`, Intel Open
+//! Image Denoise loaded at run time (`libloading`); the default build needs nothing native.
 //!
 //! ```
 //! use rt_denoise::{Denoiser, DenoiserSpec, NoisyFrame};
@@ -23,14 +24,21 @@
 //! let out = denoiser.denoise(&frame).unwrap();
 //! assert_eq!(out.pixel(1, 0), Rgb::splat(1.0));
 //! ```
-#![forbid(unsafe_code)]
+// The only unsafe code is the OIDN FFI (module `oidn::ffi`, with the `oidn` feature); without
+// the feature the crate forbids it outright.
+#![cfg_attr(not(feature = "oidn"), forbid(unsafe_code))]
+#![cfg_attr(feature = "oidn", deny(unsafe_code))]
 
 mod bank;
 mod box_blur;
+#[cfg(feature = "oidn")]
+mod oidn;
 pub mod spec;
 
 pub use bank::{Bank, BankOutput, DEFAULT_BANK};
 pub use box_blur::BoxBlur;
+#[cfg(feature = "oidn")]
+pub use oidn::{Oidn, OidnParams, OidnQuality, OIDN_LIB_DEFAULTS, OIDN_LIB_ENV};
 pub use rt_film::{Channel, FrameError, NoisyFrame};
 pub use spec::{DenoiserKind, DenoiserSpec, Options};
 
@@ -56,6 +64,14 @@ pub enum DenoiseError {
     /// A denoiser spec that does not parse.
     #[error("{0}")]
     Spec(String),
+    /// A native library the denoiser calls is missing or failed (e.g. Open Image Denoise).
+    #[error("{denoiser}: {message}")]
+    Native {
+        /// The denoiser.
+        denoiser: &'static str,
+        /// What was tried and what went wrong.
+        message: String,
+    },
 }
 
 /// An image-space denoiser: pure and deterministic (the same frame gives the same bits on any

@@ -6,6 +6,8 @@
 //! kinds, unknown keys, values that do not parse and values out of range are each one error
 //! naming the denoiser and the key.
 
+#[cfg(feature = "oidn")]
+use crate::Oidn;
 use crate::{BoxBlur, DenoiseError, Denoiser};
 use std::fmt;
 use std::str::FromStr;
@@ -16,21 +18,34 @@ use std::str::FromStr;
 pub enum DenoiserKind {
     /// [`BoxBlur`].
     Box,
+    /// `Oidn` (Open Image Denoise; only in builds with the `oidn` feature).
+    #[cfg(feature = "oidn")]
+    Oidn,
 }
 
 impl DenoiserKind {
     /// Every kind, in the order help texts list them.
-    pub const ALL: [DenoiserKind; 1] = [DenoiserKind::Box];
+    pub const ALL: &'static [DenoiserKind] = &[
+        DenoiserKind::Box,
+        #[cfg(feature = "oidn")]
+        DenoiserKind::Oidn,
+    ];
 
     /// The name used in specs.
     pub fn name(self) -> &'static str {
         match self {
             DenoiserKind::Box => "box",
+            #[cfg(feature = "oidn")]
+            DenoiserKind::Oidn => "oidn",
         }
     }
 
     fn names() -> String {
-        Self::ALL.map(Self::name).join(", ")
+        Self::ALL
+            .iter()
+            .map(|k| k.name())
+            .collect::<Vec<_>>()
+            .join(", ")
     }
 }
 
@@ -55,6 +70,8 @@ impl DenoiserSpec {
         let mut o = Options::new(self.kind.name(), &self.options);
         let d: Box<dyn Denoiser> = match self.kind {
             DenoiserKind::Box => Box::new(BoxBlur::from_options(&mut o)?),
+            #[cfg(feature = "oidn")]
+            DenoiserKind::Oidn => Box::new(Oidn::from_options(&mut o)?),
         };
         o.finish()?;
         Ok(d)
@@ -68,9 +85,17 @@ impl FromStr for DenoiserSpec {
         let mut parts = s.trim().split(':');
         let kind_name = parts.next().unwrap_or_default();
         let kind = DenoiserKind::ALL
-            .into_iter()
+            .iter()
+            .copied()
             .find(|k| k.name().eq_ignore_ascii_case(kind_name))
             .ok_or_else(|| {
+                if cfg!(not(feature = "oidn")) && kind_name.eq_ignore_ascii_case("oidn") {
+                    return DenoiseError::Spec(
+                        "denoiser 'oidn' is not in this build: rebuild with the 'oidn' feature \
+                         of rt-denoise (cargo build --features rt-denoise/oidn)"
+                            .into(),
+                    );
+                }
                 DenoiseError::Spec(format!(
                     "unknown denoiser '{kind_name}' (expected one of: {})",
                     DenoiserKind::names()
@@ -236,5 +261,18 @@ mod tests {
         assert_eq!(err("box:size=2"), "box: unknown option 'size'");
         assert_eq!(err("box:radius"), "box: option 'radius' is not key=value");
         assert!(err("box:radius=1:radius=2").contains("given twice"));
+    }
+
+    #[cfg(not(feature = "oidn"))]
+    #[test]
+    fn oidn_in_a_build_without_the_feature_is_one_clear_error() {
+        let e = "oidn:quality=high".parse::<DenoiserSpec>().unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("denoiser 'oidn' is not in this build")
+                && e.to_string().contains("--features rt-denoise/oidn"),
+            "{e}"
+        );
+        assert!(!DenoiserKind::names().contains("oidn"));
     }
 }
