@@ -142,6 +142,31 @@ pub struct Args {
     /// integrator (path, path-bsdf, direct, ao).
     #[arg(long, value_name = "S", default_value_t = 0.0)]
     pub shutter: f64,
+
+    /// Denoise by GREE (Bauszat, thesis ch. 5): --spp is the budget b; render the noisy image
+    /// at n = fraction x b spp, run the filter bank (--bank), render filter caches at a share
+    /// 1 - sparsity of the pixels with independent samples, pick a filter per pixel by the
+    /// caches' errors (graph cut) and fuse. Options `key=value` separated by `:`: fraction
+    /// (0.875), sparsity (0.95), kappa (0.6), sigma-r (0.15), lambda (0.05), jacobi (2), metric
+    /// (squared|relative). Camera-ray integrators only (docs/denoising.md).
+    #[arg(long, value_name = "OPTIONS", num_args = 0..=1, default_missing_value = "")]
+    pub gree: Option<String>,
+
+    /// GREE's filter bank: a TOML file with `denoisers = ["gaussian:sigma=2", ...]`
+    /// [default: the thesis' Gaussians and joint bilateral filters plus identity, À-Trous and
+    /// non-local means]
+    #[arg(long, value_name = "FILE", requires = "gree")]
+    pub bank: Option<PathBuf>,
+
+    /// With --gree: write the chosen filter per pixel as a colour-coded PNG (the legend is
+    /// printed).
+    #[arg(long, value_name = "FILE.png", requires = "gree")]
+    pub labels: Option<PathBuf>,
+
+    /// With --gree: write each filter's interpolated error map (EXR, and PNG in false colour
+    /// on one log scale for all filters) into this directory.
+    #[arg(long, value_name = "DIR", requires = "gree")]
+    pub error_maps: Option<PathBuf>,
 }
 
 /// Frames per second, as `--frames`, `--frame`, `--shutter` and `bench-anim` need it: a

@@ -294,6 +294,9 @@ fn render_one(
         accel,
         camera,
     };
+    if args.gree.is_some() {
+        return pool.install(|| crate::gree::render(args, job, &ctx, integrator.as_ref()));
+    }
     let pass = SamplePass {
         indices: 0..job.settings.spp,
         stream: rt_core::SampleStream::Render,

@@ -16,6 +16,7 @@ mod bench_anim;
 mod compare;
 mod denoise;
 mod experiment;
+mod gree;
 mod job;
 mod progress;
 mod reference;

@@ -41,13 +41,29 @@ impl Bank {
     /// A bank of the denoisers named by `specs` (at least one, each a [`DenoiserSpec`]).
     pub fn from_specs<S: AsRef<str>>(specs: &[S]) -> Result<Self, DenoiseError> {
         if specs.is_empty() {
-            return Err(DenoiseError::Spec("a filter bank needs at least one denoiser".into()));
+            return Err(DenoiseError::Spec(
+                "a filter bank needs at least one denoiser".into(),
+            ));
         }
         let members = specs
             .iter()
             .map(|s| s.as_ref().parse::<DenoiserSpec>()?.build())
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Self { members })
+    }
+
+    /// A bank file: TOML with one key, `denoisers = ["gaussian:sigma=2", ...]`. Every error
+    /// names the file.
+    pub fn from_file(path: &std::path::Path) -> Result<Self, DenoiseError> {
+        #[derive(serde::Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct BankFile {
+            denoisers: Vec<String>,
+        }
+        let at = |m: String| DenoiseError::Spec(format!("{}: {m}", path.display()));
+        let text = std::fs::read_to_string(path).map_err(|e| at(e.to_string()))?;
+        let file: BankFile = toml::from_str(&text).map_err(|e| at(e.message().to_string()))?;
+        Self::from_specs(&file.denoisers).map_err(|e| at(e.to_string()))
     }
 
     /// [`DEFAULT_BANK`].
@@ -101,5 +117,22 @@ mod tests {
         assert!(Bank::from_specs::<&str>(&[]).is_err());
         assert!(Bank::from_specs(&["box", "nope"]).is_err());
         assert!(bank.needs().is_empty());
+
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("bank.toml");
+        std::fs::write(&p, "denoisers = [\"box:radius=0\", \"box:radius=2\"]\n").unwrap();
+        assert_eq!(
+            Bank::from_file(&p).unwrap().members()[1].name(),
+            "box:radius=2"
+        );
+        std::fs::write(&p, "denoisers = [\"box:radius=99\"]\n").unwrap();
+        let e = Bank::from_file(&p).err().unwrap().to_string();
+        assert!(e.contains("bank.toml") && e.contains("at most 64"), "{e}");
+        std::fs::write(&p, "filters = []\n").unwrap();
+        assert!(Bank::from_file(&p)
+            .err()
+            .unwrap()
+            .to_string()
+            .contains("bank.toml"));
     }
 }

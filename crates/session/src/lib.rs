@@ -45,12 +45,14 @@
 
 pub mod adaptive;
 pub mod camera;
+pub mod gree;
 pub mod progressive;
 pub mod report;
 pub mod settings;
 
 pub use adaptive::{render_adaptive, Adaptive, StopReason, StopRule, FIRST_DECISION_SPP};
 pub use camera::{parse_resolution, pick_camera, ImageSize, MAX_SIDE};
+pub use gree::{gree_aovs, parse_gree_options, render_gree, GreeRun, GreeRunError};
 pub use progressive::{Budgets, Checkpoint, Session};
 pub use report::{RenderReport, ReportInputs, Stage, Status};
 pub use settings::{
