@@ -131,6 +131,38 @@ impl fmt::Display for Channel {
     }
 }
 
+impl AovSet {
+    /// The smallest set whose film gives a [`NoisyFrame`] with every channel of `channels`
+    /// (through [`NoisyFrame::from_film`] with the same set): what a consumer that reads those
+    /// channels, e.g. a denoiser's `needs()`, must ask the film for. A feature's variance
+    /// needs the feature too; the colour image is always there.
+    pub fn for_channels(channels: &[Channel]) -> AovSet {
+        let mut s = AovSet::default();
+        for c in channels {
+            match c {
+                Channel::Colour => {}
+                Channel::Variance => s.variance = true,
+                Channel::Halves => s.halves = true,
+                Channel::Albedo => s.albedo = true,
+                Channel::AlbedoVariance => (s.albedo, s.feature_variance) = (true, true),
+                Channel::Normal => s.normal = true,
+                Channel::NormalVariance => (s.normal, s.feature_variance) = (true, true),
+                Channel::Position => s.position = true,
+                Channel::PositionVariance => (s.position, s.feature_variance) = (true, true),
+                Channel::Depth => s.depth = true,
+                Channel::DepthVariance => (s.depth, s.feature_variance) = (true, true),
+                Channel::Emission => s.emission = true,
+                Channel::Direct => s.direct = true,
+                Channel::Indirect => s.indirect = true,
+                Channel::Diffuse => s.diffuse = true,
+                Channel::Glossy => s.glossy = true,
+                Channel::Irradiance => s.irradiance = true,
+            }
+        }
+        s
+    }
+}
+
 /// A frame that cannot serve: a channel is missing or has the wrong size.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 #[non_exhaustive]
@@ -490,7 +522,12 @@ mod tests {
 
     /// A film with every channel, filled with distinct, awkward values.
     fn full_film() -> Film {
-        let mut film = Film::new(5, 3, FilmBuffers::for_outputs(AovSet::DENOISE));
+        film_with(AovSet::DENOISE)
+    }
+
+    /// A film keeping the buffers of `aovs`, filled like [`full_film`].
+    fn film_with(aovs: AovSet) -> Film {
+        let mut film = Film::new(5, 3, FilmBuffers::for_outputs(aovs));
         let mut state = 7u32;
         let mut next = || {
             state = rt_core::sampler::hash_u32(state);
@@ -571,6 +608,30 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("depth channel is (4, 3)"));
+    }
+
+    /// Each channel alone gets a film that keeps it, and nothing beyond it (and, for a
+    /// feature's variance, the feature).
+    #[test]
+    fn aovs_for_channels_give_exactly_those_channels() {
+        assert_eq!(AovSet::for_channels(&[Channel::Colour]), AovSet::default());
+        let all = AovSet::for_channels(&Channel::ALL);
+        assert_eq!(all, AovSet::DENOISE);
+        for c in Channel::ALL {
+            let aovs = AovSet::for_channels(&[c]);
+            let got = NoisyFrame::from_film(&film_with(aovs), aovs).channels();
+            let base = match c {
+                Channel::AlbedoVariance => Channel::Albedo,
+                Channel::NormalVariance => Channel::Normal,
+                Channel::PositionVariance => Channel::Position,
+                Channel::DepthVariance => Channel::Depth,
+                other => other,
+            };
+            let mut want = vec![Channel::Colour, base, c];
+            want.dedup();
+            want.sort_by_key(|w| Channel::ALL.iter().position(|a| a == w));
+            assert_eq!(got, want, "{c}");
+        }
     }
 
     #[test]
