@@ -12,11 +12,16 @@
 //! - [`fit`]: log-log slopes and interpolation; [`report`]: results.csv, slopes.csv, equal-time
 //!   and equal-samples comparisons (the samples adaptive runs actually took), crops and
 //!   report.md; [`plot`]: the log-log error plots.
+//! - [`views`] and [`html`]: report.html, the page with the plots, the tables and a zoomable
+//!   image comparison per scene (display PNGs of the references, the final, noisy and error
+//!   images).
+//! - A method may name a denoiser (`rt-denoise`); its images are denoised after each budget
+//!   and measured as denoised, with the noisy error and the denoising time kept beside.
 //!
 //! [`run`] does all of it into one output folder.
 //!
 //! Depends on `rt-session` (progressive rendering of one configuration), `rt-metrics`
-//! (errors), `rt-film` (image files), `rt-scene`, `rt-accel`, `rt-integrators` and `rt-core`;
+//! (errors, error images), `rt-denoise` (denoisers), `rt-film` (image files), `rt-scene`, `rt-accel`, `rt-integrators` and `rt-core`;
 //! `plotters` draws, `sha2` keys the cache, `toml`/`serde` read the file.
 //!
 //! ```no_run
@@ -36,9 +41,11 @@ pub mod config;
 mod error;
 pub mod fit;
 pub mod grid;
+pub mod html;
 pub mod plot;
 pub mod reference;
 pub mod report;
+pub mod views;
 
 pub use cache::{Cache, ReferenceRequest, CACHE_VERSION, DEFAULT_CACHE_DIR};
 pub use config::Plan;
@@ -130,11 +137,14 @@ pub struct Outcome {
     pub equal_samples: Vec<report::EqualTime>,
     /// The Markdown report (inside the output folder).
     pub report: PathBuf,
+    /// The HTML report (inside the output folder).
+    pub html: PathBuf,
 }
 
 /// Runs `plan` (its file is copied beside the results) into the folder `out`
-/// (see [`prepare_out`]): references, the grid, images, results.csv, slopes.csv, plots, crops
-/// and report.md. Call it inside the thread pool that should do the work.
+/// (see [`prepare_out`]): references, the grid, images, results.csv, slopes.csv, plots, crops,
+/// report.md and report.html with its pictures. Call it inside the thread pool that should do
+/// the work.
 pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> Result<Outcome> {
     let wall = Instant::now();
     let (y, mo, d, h, mi, _) = utc(now_secs());
@@ -169,11 +179,24 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
     );
     let report = out.join("report.md");
     rt_film::write_bytes_atomic(&report, md.as_bytes())?;
+    let views = views::write(plan, &results, out)?;
+    let page = html::page(&html::Page {
+        plan,
+        results: &results,
+        slopes: &slopes,
+        equal_time: &equal_time,
+        equal_samples: &equal_samples,
+        views: &views,
+        info: &info,
+    });
+    let html = out.join("report.html");
+    rt_film::write_bytes_atomic(&html, page.as_bytes())?;
     Ok(Outcome {
         results,
         equal_time,
         equal_samples,
         report,
+        html,
     })
 }
 
