@@ -790,7 +790,8 @@ seconds = [0.5, 0.1]
         assert_eq!((estimator.depth(), *spp), (5, 16));
         assert!(p.warnings.is_empty(), "{:?}", p.warnings);
         assert!(p.methods.iter().all(|m| m.denoiser.is_none()));
-        let p = plan(&GOOD.replace("name = \"b\"", "name = \"b\"\ndenoiser = \"box:radius=2\"")).unwrap();
+        let p = plan(&GOOD.replace("name = \"b\"", "name = \"b\"\ndenoiser = \"box:radius=2\""))
+            .unwrap();
         assert_eq!(
             p.methods[1].denoiser.as_ref().map(|d| d.to_string()),
             Some("box:radius=2".into())
@@ -865,7 +866,10 @@ seconds = [0.5, 0.1]
                 "[[method]] \"b\": denoiser = \"fancy:x=1\": unknown denoiser 'fancy'",
             ),
             (
-                GOOD.replace("name = \"b\"", "name = \"b\"\ndenoiser = \"box:radius=100\""),
+                GOOD.replace(
+                    "name = \"b\"",
+                    "name = \"b\"\ndenoiser = \"box:radius=100\"",
+                ),
                 "[[method]] \"b\": denoiser = \"box:radius=100\": box: radius: must be at most 64",
             ),
             (

@@ -124,11 +124,7 @@ pub fn page(p: &Page<'_>) -> String {
     );
     s.push_str("<nav>Scenes: ");
     for scene in &plan.scenes {
-        let _ = write!(
-            s,
-            "<a href=\"#scene-{0}\">{0}</a>",
-            escape(&scene.name)
-        );
+        let _ = write!(s, "<a href=\"#scene-{0}\">{0}</a>", escape(&scene.name));
     }
     s.push_str("</nav></header>\n");
     if !plan.warnings.is_empty() {
@@ -302,7 +298,12 @@ fn runs(s: &mut String, p: &Page<'_>, si: usize) {
         "SSIM",
     ];
     if denoised {
-        head.extend(["denoiser", "denoise s", "render + denoise s", "noisy relMSE"]);
+        head.extend([
+            "denoiser",
+            "denoise s",
+            "render + denoise s",
+            "noisy relMSE",
+        ]);
     }
     let mut rows = Vec::new();
     for row in p
@@ -464,6 +465,9 @@ mod tests {
         assert_eq!(escape("plain ε"), "plain ε");
         let mut s = String::new();
         table(&mut s, &["<h>"], &[vec![text("a<b")]]);
-        assert!(s.contains("<th>&lt;h&gt;</th>") && s.contains("<td>a&lt;b</td>"), "{s}");
+        assert!(
+            s.contains("<th>&lt;h&gt;</th>") && s.contains("<td>a&lt;b</td>"),
+            "{s}"
+        );
     }
 }

@@ -280,6 +280,97 @@ spp = 4
         assert!(md.contains("blocks left"), "{md}");
     }
 
+    /// A denoised method next to the same method without: its rows carry the denoised error
+    /// (of the image the denoiser makes from the saved noisy frame, bit for bit), the noisy
+    /// error beside it, in results.csv and both reports.
+    #[test]
+    fn denoised_methods_are_measured_after_denoising() {
+        let dir = tempfile::tempdir().unwrap();
+        let config = dir.path().join("x.toml");
+        std::fs::write(
+            &config,
+            r#"
+[[scene]]
+path = "gen:rotated"
+resolution = [24, 16]
+reference = { spp = 32 }
+
+[[method]]
+name = "plain"
+spp = [1, 4]
+
+[[method]]
+name = "boxed"
+spp = [1, 4]
+denoiser = "box:radius=1"
+"#,
+        )
+        .unwrap();
+        let plan = config::load(&config).unwrap();
+        let out = dir.path().join("out");
+        prepare_out(&out).unwrap();
+        let outcome = run(&plan, &out, &Cache::new(&dir.path().join("cache")), &Silent).unwrap();
+        let rows = &outcome.results.rows;
+        assert_eq!(rows.len(), 4);
+        let (plain, boxed) = rows.split_at(2);
+        let denoiser = "box:radius=1"
+            .parse::<rt_denoise::DenoiserSpec>()
+            .unwrap()
+            .build()
+            .unwrap();
+        for (p, b) in plain.iter().zip(boxed) {
+            assert!(p.raw.is_none() && p.denoised_image.is_none() && p.denoise_seconds == 0.0);
+            // Same seed and settings: the noisy images are the same, so the noisy error of
+            // the denoised method is the plain method's error.
+            assert_eq!(b.raw, Some(p.metrics));
+            assert_ne!(b.metrics, p.metrics);
+            assert!(b.denoise_seconds > 0.0);
+            assert_eq!(b.total_seconds(), b.seconds + b.denoise_seconds);
+            let noisy = rt_denoise::NoisyFrame::from_exr(&out.join(&b.image)).unwrap();
+            let want = denoiser.denoise(&noisy).unwrap();
+            let got = rt_film::read_rgb(&out.join(b.denoised_image.as_ref().unwrap())).unwrap();
+            assert_eq!(got, want, "{}", b.image);
+            let reference = &outcome.results.references[0].image;
+            let m = rt_metrics::compare(&got, reference, &Default::default()).unwrap();
+            assert_eq!(m.relmse, b.metrics.relmse);
+        }
+        assert_eq!(outcome.results.finals[1], {
+            let last = &boxed[1];
+            rt_film::read_rgb(&out.join(last.denoised_image.as_ref().unwrap())).unwrap()
+        });
+        assert!(
+            outcome.results.noisy_finals[1].is_some() && outcome.results.noisy_finals[0].is_none()
+        );
+        let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+        let mut lines = csv.lines();
+        let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+        assert!(
+            csv.lines()
+                .next()
+                .unwrap()
+                .ends_with(report::DENOISE_COLUMNS),
+            "{csv}"
+        );
+        let col = |name: &str| head.iter().position(|h| *h == name).unwrap();
+        let cells: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+        assert_eq!(cells[3][col("denoiser")], "box:radius=1");
+        assert_eq!(
+            cells[3][col("raw_relmse")],
+            boxed[1].raw.unwrap().relmse.to_string()
+        );
+        assert_eq!(cells[3][col("relmse")], boxed[1].metrics.relmse.to_string());
+        assert_eq!(cells[1][col("raw_relmse")], "");
+        assert!(cells[3][col("denoised_image")].ends_with("boxed-4spp-denoised.exr"));
+        let md = std::fs::read_to_string(&outcome.report).unwrap();
+        assert!(
+            md.contains("noisy relMSE") && md.contains("### Equal samples"),
+            "{md}"
+        );
+        let html = std::fs::read_to_string(&outcome.html).unwrap();
+        assert!(html.contains("view/rotated/boxed/noisy.png"), "{html}");
+        assert!(!html.contains("view/rotated/plain/noisy.png"));
+    }
+
     #[test]
     fn output_folders_are_never_overwritten() {
         let dir = tempfile::tempdir().unwrap();

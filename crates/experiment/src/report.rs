@@ -137,7 +137,8 @@ pub fn results_csv(plan: &Plan, results: &Results) -> String {
         }
         if denoised {
             let raw = row.raw.as_ref();
-            let cell = |f: fn(&rt_metrics::Metrics) -> f64| raw.map_or(String::new(), |m| num(f(m)));
+            let cell =
+                |f: fn(&rt_metrics::Metrics) -> f64| raw.map_or(String::new(), |m| num(f(m)));
             let _ = write!(
                 s,
                 ",{},{},{},{},{},{},{},{},{}",
@@ -166,15 +167,15 @@ fn adaptive_cells(s: &mut String, row: &Row) {
     let _ = write!(
         s,
         ",{},{},{},{},{},{},{},{}",
-            row.samples,
-            row.mean_spp,
-            a.and_then(|a| a.rule.error)
-                .map_or(String::new(), |e| e.to_string()),
-            a.and_then(|a| a.rule.time_limit)
-                .map_or(String::new(), |t| t.as_secs_f64().to_string()),
-            a.map_or(String::new(), |a| a.rule.max_spp.to_string()),
-            a.map_or(String::new(), |a| a.reason.to_string()),
-            a.map_or(String::new(), |a| a.decide_seconds.to_string()),
+        row.samples,
+        row.mean_spp,
+        a.and_then(|a| a.rule.error)
+            .map_or(String::new(), |e| e.to_string()),
+        a.and_then(|a| a.rule.time_limit)
+            .map_or(String::new(), |t| t.as_secs_f64().to_string()),
+        a.map_or(String::new(), |a| a.rule.max_spp.to_string()),
+        a.map_or(String::new(), |a| a.reason.to_string()),
+        a.map_or(String::new(), |a| a.decide_seconds.to_string()),
         a.map_or(String::new(), |a| a.blocks_left.to_string()),
     );
 }
