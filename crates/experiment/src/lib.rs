@@ -369,6 +369,27 @@ denoiser = "box:radius=1"
         let html = std::fs::read_to_string(&outcome.html).unwrap();
         assert!(html.contains("view/rotated/boxed/noisy.png"), "{html}");
         assert!(!html.contains("view/rotated/plain/noisy.png"));
+
+        // Equal time is at render + denoise time: with render times set to 1 and 4 s for both
+        // methods and 1 s of denoising, the boxed curve spans 2..5 s, so the times compared
+        // start at 2 s, where the boxed error is its first run's.
+        let mut results = outcome.results;
+        for r in &mut results.rows {
+            r.seconds = if r.spp == 1 { 1.0 } else { 4.0 };
+            if r.raw.is_some() {
+                r.denoise_seconds = 1.0;
+            }
+        }
+        let e = &report::equal_time(&plan, &results)[0];
+        assert_eq!(e.table.first().map(|t| t.0), Some(2.0));
+        let boxed_first = results.rows[2].metrics.relmse;
+        assert!((e.table[0].1[1] - boxed_first).abs() <= 1e-9 * boxed_first);
+        // Past every plain run's time, nothing is compared; at equal samples all still is.
+        for r in results.rows.iter_mut().filter(|r| r.raw.is_some()) {
+            r.denoise_seconds = 10.0;
+        }
+        assert!(report::equal_time(&plan, &results)[0].table.is_empty());
+        assert!(!report::equal_samples(&plan, &results)[0].table.is_empty());
     }
 
     #[test]
