@@ -1,6 +1,6 @@
 //! `render experiment CONFIG.toml`: arguments, then `rt_experiment` does the work (a grid of
-//! scenes × methods × budgets measured against references, with CSVs, slopes, plots, crops and
-//! a Markdown report; docs/experiments.md), and this prints what it found.
+//! scenes × methods × budgets measured against references, with CSVs, slopes, plots, crops, a
+//! Markdown report and an HTML one; docs/experiments.md), and this prints what it found.
 
 use crate::progress::Progress;
 use anyhow::{bail, Context, Result};
@@ -96,9 +96,10 @@ pub fn run(args: &ExperimentArgs) -> Result<()> {
         }
     }
     progress.message(&format!(
-        "{} runs in {:.1} s",
+        "{} runs in {:.1} s; to look at them, open {}",
         outcome.results.rows.len(),
-        wall.elapsed().as_secs_f64()
+        wall.elapsed().as_secs_f64(),
+        outcome.html.display()
     ));
     println!("{}", outcome.report.display());
     Ok(())

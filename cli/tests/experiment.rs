@@ -151,6 +151,18 @@ fn experiment_writes_csv_plots_and_report_and_reuses_its_reference() {
     ] {
         assert!(report.contains(needle), "{needle} missing from report.md");
     }
+    let html = read(&out.join("report.html"));
+    for needle in [
+        "plots/room.svg",
+        "view/room/reference.png",
+        "view/room/nee/final.png",
+        "view/room/bsdf/error.png",
+    ] {
+        assert!(html.contains(needle), "{needle} missing from report.html");
+        if needle.starts_with("view/") {
+            image::open(out.join(needle)).unwrap();
+        }
+    }
 
     // Again: the reference comes from the cache, and an existing output folder is refused.
     let o = ok(d.render(&["experiment", "x.toml", "--out", "out2", "-q"]));
@@ -294,6 +306,10 @@ fn bad_experiment_files_give_one_line_naming_the_file() {
     expect_error(
         &CONFIG.replace("\"path-bsdf\"", "\"vcm\""),
         "\"vcm\" is not one of",
+    );
+    expect_error(
+        &CONFIG.replacen("spp = [2, 8]", "spp = [2, 8]\ndenoiser = \"box:radius=-1\"", 1),
+        "[[method]] \"nee\": denoiser = \"box:radius=-1\": box: radius: '-1' is not a non-negative integer",
     );
     let d = Dir::new();
     let o = d.render(&["experiment", "none.toml"]);

@@ -5,6 +5,7 @@
 use crate::{ExperimentError, Result as CrateResult};
 use rt_accel::AccelSpec;
 use rt_core::Camera;
+use rt_denoise::DenoiserSpec;
 use rt_film::read_rgb;
 use rt_integrators::spec::{check_ao_distance, check_max_depth};
 use rt_integrators::IntegratorSpec;
@@ -106,6 +107,7 @@ struct MethodDesc {
     error: Option<OneOrMany<f32>>,
     time_limit: Option<OneOrMany<f64>>,
     scenes: Option<Vec<String>>,
+    denoiser: Option<String>,
 }
 
 /// `key = V` or `key = [V, ...]` of numbers.
@@ -212,6 +214,9 @@ pub struct MethodPlan {
     pub name: String,
     /// What it renders on each scene.
     pub runs: Runs,
+    /// The denoiser applied to each of its images (`denoiser = "kind:key=value"`), already
+    /// checked to build; its output is the method's image and error.
+    pub denoiser: Option<DenoiserSpec>,
 }
 
 /// How a method renders on a scene.
@@ -292,6 +297,14 @@ fn parse_accel(s: &str) -> Result<AccelSpec, String> {
 fn parse_integrator(s: &str) -> Result<IntegratorSpec, String> {
     s.parse::<IntegratorSpec>()
         .map_err(|e| format!("integrator = {e}"))
+}
+
+/// Parses a denoiser spec and builds it once, so bad options are found at load.
+fn parse_denoiser(s: &str) -> Result<DenoiserSpec, String> {
+    let at = |e: rt_denoise::DenoiseError| format!("denoiser = \"{s}\": {e}");
+    let spec = s.parse::<DenoiserSpec>().map_err(at)?;
+    spec.build().map_err(at)?;
+    Ok(spec)
 }
 
 fn check_depth(d: Option<u32>) -> Result<Option<u32>, String> {
@@ -509,7 +522,17 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
                 }
             }
         }
-        methods.push(MethodPlan { name: m.name, runs });
+        let denoiser = m
+            .denoiser
+            .as_deref()
+            .map(parse_denoiser)
+            .transpose()
+            .map_err(at)?;
+        methods.push(MethodPlan {
+            name: m.name,
+            runs,
+            denoiser,
+        });
         method_overrides.push(overrides);
         method_scenes.push(m.scenes);
     }
@@ -766,6 +789,14 @@ seconds = [0.5, 0.1]
         };
         assert_eq!((estimator.depth(), *spp), (5, 16));
         assert!(p.warnings.is_empty(), "{:?}", p.warnings);
+        assert!(p.methods.iter().all(|m| m.denoiser.is_none()));
+        let p = plan(&GOOD.replace("name = \"b\"", "name = \"b\"\ndenoiser = \"box:radius=2\""))
+            .unwrap();
+        assert_eq!(
+            p.methods[1].denoiser.as_ref().map(|d| d.to_string()),
+            Some("box:radius=2".into())
+        );
+        assert!(p.methods[0].denoiser.is_none());
     }
 
     #[test]
@@ -828,6 +859,25 @@ seconds = [0.5, 0.1]
             ("name = \"t\"\n".to_string(), "no [[scene]]"),
             (
                 GOOD.replace("spp = [4, 1, 2, 2]", "spp = \"many\""),
+                "x.toml:",
+            ),
+            (
+                GOOD.replace("name = \"b\"", "name = \"b\"\ndenoiser = \"fancy:x=1\""),
+                "[[method]] \"b\": denoiser = \"fancy:x=1\": unknown denoiser 'fancy'",
+            ),
+            (
+                GOOD.replace(
+                    "name = \"b\"",
+                    "name = \"b\"\ndenoiser = \"box:radius=100\"",
+                ),
+                "[[method]] \"b\": denoiser = \"box:radius=100\": box: radius: must be at most 64",
+            ),
+            (
+                GOOD.replace("name = \"b\"", "name = \"b\"\ndenoiser = \"box:size=2\""),
+                "unknown option 'size'",
+            ),
+            (
+                GOOD.replace("name = \"b\"", "name = \"b\"\ndenoiser = 3"),
                 "x.toml:",
             ),
         ];

@@ -3,18 +3,25 @@
 //! method (`error`, `time_limit`), one render per stopping rule, stopped the way `render --error
 //! --time-limit` stops ([`rt_session::render_adaptive`]). Every stop writes its image and is
 //! measured against the scene's reference.
+//!
+//! A method with a denoiser renders the channels the denoiser reads
+//! ([`AovSet::for_channels`] of [`Denoiser::needs`]), denoises every stop's frame (timed
+//! apart from the render) and is measured by the denoised image; the noisy image's error is
+//! kept beside it.
 
 use crate::cache::{Cache, ReferenceRequest};
 use crate::config::{Plan, ReferencePlan, Runs};
 use crate::error::{io, ExperimentError, Result};
 use crate::Progress;
 use rt_core::{Accel, Rgb, RgbImage, SampleStream};
+use rt_denoise::{Denoiser, NoisyFrame};
 use rt_film::{read_rgb, AovSet, Film, FilmBuffers};
 use rt_integrators::Ctx;
 use rt_metrics::{compare, CompareOptions, Metrics};
 use rt_session::{render_adaptive, Budgets, Session, StopReason, StopRule};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 /// Progress units per run, so the bar moves within long runs.
 const UNITS: u64 = 100;
@@ -46,16 +53,31 @@ pub struct Row {
     pub mean_spp: f64,
     /// How an adaptive run stopped (`None` for a progressive one).
     pub stop: Option<AdaptiveRun>,
-    /// Render time in seconds.
+    /// Render time in seconds (without denoising).
     pub seconds: f64,
+    /// Seconds spent denoising this image (taking the frame from the film and filtering it;
+    /// 0 without a denoiser).
+    pub denoise_seconds: f64,
     /// Rays traced.
     pub rays: u64,
     /// Camera samples per second.
     pub samples_per_second: f64,
-    /// Error against the reference.
+    /// Error against the reference: of the denoised image when the method has a denoiser.
     pub metrics: Metrics,
-    /// The image, relative to the output folder.
+    /// Error of the noisy (rendered, not denoised) image, when the method has a denoiser.
+    pub raw: Option<Metrics>,
+    /// The rendered image (with the channels its denoiser reads), relative to the output
+    /// folder.
     pub image: String,
+    /// The denoised image, relative to the output folder.
+    pub denoised_image: Option<String>,
+}
+
+impl Row {
+    /// Render and denoise time: what the method's image cost.
+    pub fn total_seconds(&self) -> f64 {
+        self.seconds + self.denoise_seconds
+    }
 }
 
 /// What an adaptive run asked for and did.
@@ -77,8 +99,10 @@ pub struct Results {
     pub references: Vec<Reference>,
     /// In run order.
     pub rows: Vec<Row>,
-    /// Each pair's image at its largest budget.
+    /// Each pair's image at its largest budget (denoised, for a method with a denoiser).
     pub finals: Vec<RgbImage>,
+    /// Each pair's noisy image at its largest budget, for a method with a denoiser.
+    pub noisy_finals: Vec<Option<RgbImage>>,
 }
 
 /// The file name of a budget: `16spp`, `0.5s`.
@@ -201,6 +225,7 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
 
     let mut rows = Vec::new();
     let mut finals = Vec::new();
+    let mut noisy_finals = Vec::new();
     let mut accels: HashMap<(usize, String), Box<dyn Accel>> = HashMap::new();
     for (pi, pair) in plan.pairs.iter().enumerate() {
         let scene = &plan.scenes[pair.scene];
@@ -210,6 +235,15 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
             .entry((pair.scene, pair.accel.to_string()))
             .or_insert_with(|| pair.accel.build_scene(&scene.loaded.scene));
         let integrator = pair.estimator.build();
+        let denoiser: Option<Box<dyn Denoiser>> = method
+            .denoiser
+            .as_ref()
+            .map(|d| d.build())
+            .transpose()
+            .map_err(|e| ExperimentError::Run(format!("{}: {e}", method.name)))?;
+        let aovs = denoiser
+            .as_ref()
+            .map_or(AovSet::default(), |d| AovSet::for_channels(d.needs()));
         let session = Session {
             ctx: Ctx {
                 scene: &scene.loaded.scene,
@@ -219,34 +253,55 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
             integrator: integrator.as_ref(),
             seed: pair.seed,
             stream: SampleStream::Render,
-            aovs: AovSet::default(),
+            aovs,
         };
         bar.set_message(format!("{}: {}", scene.name, method.name));
         let runs = method.runs.len() as u64;
         let base = done_runs * UNITS;
         let mut last_image = None;
-        // Writes the image of one stop, measures it and records its row.
+        let mut last_noisy = None;
+        // Writes the image of one stop, denoises it if the method says so, measures it and
+        // records its row.
         let mut record =
             |film: &Film, label: String, row: &dyn Fn(Metrics, String) -> Row| -> Result<()> {
-                let rel: PathBuf = ["images", &scene.name]
-                    .iter()
-                    .collect::<PathBuf>()
-                    .join(format!("{}-{label}.exr", method.name));
+                let dir: PathBuf = ["images", &scene.name].iter().collect();
+                let rel = dir.join(format!("{}-{label}.exr", method.name));
                 rt_film::write_image(&out.join(&rel), film, &Default::default())?;
-                let image = RgbImage::new(
+                let measure = |image: &RgbImage, rel: &Path| {
+                    compare(image, &reference.image, &opts).map_err(|e| {
+                        ExperimentError::Run(format!(
+                            "{} against the reference of {}: {e}",
+                            rel.display(),
+                            scene.name
+                        ))
+                    })
+                };
+                let slash = |p: &Path| p.to_string_lossy().replace('\\', "/");
+                let noisy = RgbImage::new(
                     film.width() as usize,
                     film.height() as usize,
                     film.mean_image(),
                 )?;
-                let metrics = compare(&image, &reference.image, &opts).map_err(|e| {
-                    ExperimentError::Run(format!(
-                        "{} against the reference of {}: {e}",
-                        rel.display(),
-                        scene.name
-                    ))
-                })?;
-                rows.push(row(metrics, rel.to_string_lossy().replace('\\', "/")));
-                last_image = Some(image);
+                let raw = measure(&noisy, &rel)?;
+                let Some(d) = &denoiser else {
+                    rows.push(row(raw, slash(&rel)));
+                    last_image = Some(noisy);
+                    return Ok(());
+                };
+                let t0 = Instant::now();
+                let denoised = d
+                    .denoise(&NoisyFrame::from_film(film, aovs))
+                    .map_err(|e| ExperimentError::Run(format!("{}: {e}", method.name)))?;
+                let denoise_seconds = t0.elapsed().as_secs_f64();
+                let drel = dir.join(format!("{}-{label}-denoised.exr", method.name));
+                rt_film::write_rgb(&out.join(&drel), &denoised, &Default::default())?;
+                let mut r = row(measure(&denoised, &drel)?, slash(&rel));
+                r.raw = Some(raw);
+                r.denoise_seconds = denoise_seconds;
+                r.denoised_image = Some(slash(&drel));
+                rows.push(r);
+                last_image = Some(denoised);
+                last_noisy = Some(noisy);
                 Ok(())
             };
         match &method.runs {
@@ -268,10 +323,13 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
                             mean_spp: f64::from(at.spp),
                             stop: None,
                             seconds: at.seconds,
+                            denoise_seconds: 0.0,
                             rays: at.rays,
                             samples_per_second: at.samples as f64 / at.seconds.max(1e-9),
                             metrics,
+                            raw: None,
                             image,
+                            denoised_image: None,
                         })
                     },
                 )?;
@@ -280,7 +338,7 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
                 let pixels = (scene.camera.width as f64 * scene.camera.height as f64).max(1.0);
                 for (i, rule) in rules.iter().enumerate() {
                     // The criterion reads the even samples' half-buffer.
-                    let mut buffers = FilmBuffers::for_outputs(AovSet::default());
+                    let mut buffers = FilmBuffers::for_outputs(aovs);
                     if rule.error.is_some() {
                         buffers = buffers.with_halves();
                     }
@@ -315,15 +373,19 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
                             blocks_left: a.active_blocks.len(),
                         }),
                         seconds,
+                        denoise_seconds: 0.0,
                         rays: a.stats.rays.rays + a.stats.rays.shadow_rays,
                         samples_per_second: a.stats.samples as f64 / seconds.max(1e-9),
                         metrics,
+                        raw: None,
                         image,
+                        denoised_image: None,
                     })?;
                 }
             }
         }
         finals.push(last_image.expect("every method has at least one budget"));
+        noisy_finals.push(last_noisy);
         done_runs += runs;
         bar.set_position(done_runs * UNITS);
     }
@@ -331,5 +393,6 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
         references,
         rows,
         finals,
+        noisy_finals,
     })
 }

@@ -12,11 +12,16 @@
 //! - [`fit`]: log-log slopes and interpolation; [`report`]: results.csv, slopes.csv, equal-time
 //!   and equal-samples comparisons (the samples adaptive runs actually took), crops and
 //!   report.md; [`plot`]: the log-log error plots.
+//! - [`views`] and [`html`]: report.html, the page with the plots, the tables and a zoomable
+//!   image comparison per scene (display PNGs of the references, the final, noisy and error
+//!   images).
+//! - A method may name a denoiser (`rt-denoise`); its images are denoised after each budget
+//!   and measured as denoised, with the noisy error and the denoising time kept beside.
 //!
 //! [`run`] does all of it into one output folder.
 //!
 //! Depends on `rt-session` (progressive rendering of one configuration), `rt-metrics`
-//! (errors), `rt-film` (image files), `rt-scene`, `rt-accel`, `rt-integrators` and `rt-core`;
+//! (errors, error images), `rt-denoise` (denoisers), `rt-film` (image files), `rt-scene`, `rt-accel`, `rt-integrators` and `rt-core`;
 //! `plotters` draws, `sha2` keys the cache, `toml`/`serde` read the file.
 //!
 //! ```no_run
@@ -36,9 +41,11 @@ pub mod config;
 mod error;
 pub mod fit;
 pub mod grid;
+pub mod html;
 pub mod plot;
 pub mod reference;
 pub mod report;
+pub mod views;
 
 pub use cache::{Cache, ReferenceRequest, CACHE_VERSION, DEFAULT_CACHE_DIR};
 pub use config::Plan;
@@ -130,11 +137,14 @@ pub struct Outcome {
     pub equal_samples: Vec<report::EqualTime>,
     /// The Markdown report (inside the output folder).
     pub report: PathBuf,
+    /// The HTML report (inside the output folder).
+    pub html: PathBuf,
 }
 
 /// Runs `plan` (its file is copied beside the results) into the folder `out`
-/// (see [`prepare_out`]): references, the grid, images, results.csv, slopes.csv, plots, crops
-/// and report.md. Call it inside the thread pool that should do the work.
+/// (see [`prepare_out`]): references, the grid, images, results.csv, slopes.csv, plots, crops,
+/// report.md and report.html with its pictures. Call it inside the thread pool that should do
+/// the work.
 pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> Result<Outcome> {
     let wall = Instant::now();
     let (y, mo, d, h, mi, _) = utc(now_secs());
@@ -169,11 +179,24 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
     );
     let report = out.join("report.md");
     rt_film::write_bytes_atomic(&report, md.as_bytes())?;
+    let views = views::write(plan, &results, out)?;
+    let page = html::page(&html::Page {
+        plan,
+        results: &results,
+        slopes: &slopes,
+        equal_time: &equal_time,
+        equal_samples: &equal_samples,
+        views: &views,
+        info: &info,
+    });
+    let html = out.join("report.html");
+    rt_film::write_bytes_atomic(&html, page.as_bytes())?;
     Ok(Outcome {
         results,
         equal_time,
         equal_samples,
         report,
+        html,
     })
 }
 
@@ -255,6 +278,118 @@ spp = 4
         let md = std::fs::read_to_string(&outcome.report).unwrap();
         assert!(md.contains("### Equal samples"), "{md}");
         assert!(md.contains("blocks left"), "{md}");
+    }
+
+    /// A denoised method next to the same method without: its rows carry the denoised error
+    /// (of the image the denoiser makes from the saved noisy frame, bit for bit), the noisy
+    /// error beside it, in results.csv and both reports.
+    #[test]
+    fn denoised_methods_are_measured_after_denoising() {
+        let dir = tempfile::tempdir().unwrap();
+        let config = dir.path().join("x.toml");
+        std::fs::write(
+            &config,
+            r#"
+[[scene]]
+path = "gen:rotated"
+resolution = [24, 16]
+reference = { spp = 32 }
+
+[[method]]
+name = "plain"
+spp = [1, 4]
+
+[[method]]
+name = "boxed"
+spp = [1, 4]
+denoiser = "box:radius=1"
+"#,
+        )
+        .unwrap();
+        let plan = config::load(&config).unwrap();
+        let out = dir.path().join("out");
+        prepare_out(&out).unwrap();
+        let outcome = run(&plan, &out, &Cache::new(&dir.path().join("cache")), &Silent).unwrap();
+        let rows = &outcome.results.rows;
+        assert_eq!(rows.len(), 4);
+        let (plain, boxed) = rows.split_at(2);
+        let denoiser = "box:radius=1"
+            .parse::<rt_denoise::DenoiserSpec>()
+            .unwrap()
+            .build()
+            .unwrap();
+        for (p, b) in plain.iter().zip(boxed) {
+            assert!(p.raw.is_none() && p.denoised_image.is_none() && p.denoise_seconds == 0.0);
+            // Same seed and settings: the noisy images are the same, so the noisy error of
+            // the denoised method is the plain method's error.
+            assert_eq!(b.raw, Some(p.metrics));
+            assert_ne!(b.metrics, p.metrics);
+            assert!(b.denoise_seconds > 0.0);
+            assert_eq!(b.total_seconds(), b.seconds + b.denoise_seconds);
+            let noisy = rt_denoise::NoisyFrame::from_exr(&out.join(&b.image)).unwrap();
+            let want = denoiser.denoise(&noisy).unwrap();
+            let got = rt_film::read_rgb(&out.join(b.denoised_image.as_ref().unwrap())).unwrap();
+            assert_eq!(got, want, "{}", b.image);
+            let reference = &outcome.results.references[0].image;
+            let m = rt_metrics::compare(&got, reference, &Default::default()).unwrap();
+            assert_eq!(m.relmse, b.metrics.relmse);
+        }
+        assert_eq!(outcome.results.finals[1], {
+            let last = &boxed[1];
+            rt_film::read_rgb(&out.join(last.denoised_image.as_ref().unwrap())).unwrap()
+        });
+        assert!(
+            outcome.results.noisy_finals[1].is_some() && outcome.results.noisy_finals[0].is_none()
+        );
+        let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
+        let mut lines = csv.lines();
+        let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+        assert!(
+            csv.lines()
+                .next()
+                .unwrap()
+                .ends_with(report::DENOISE_COLUMNS),
+            "{csv}"
+        );
+        let col = |name: &str| head.iter().position(|h| *h == name).unwrap();
+        let cells: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+        assert_eq!(cells[3][col("denoiser")], "box:radius=1");
+        assert_eq!(
+            cells[3][col("raw_relmse")],
+            boxed[1].raw.unwrap().relmse.to_string()
+        );
+        assert_eq!(cells[3][col("relmse")], boxed[1].metrics.relmse.to_string());
+        assert_eq!(cells[1][col("raw_relmse")], "");
+        assert!(cells[3][col("denoised_image")].ends_with("boxed-4spp-denoised.exr"));
+        let md = std::fs::read_to_string(&outcome.report).unwrap();
+        assert!(
+            md.contains("noisy relMSE") && md.contains("### Equal samples"),
+            "{md}"
+        );
+        let html = std::fs::read_to_string(&outcome.html).unwrap();
+        assert!(html.contains("view/rotated/boxed/noisy.png"), "{html}");
+        assert!(!html.contains("view/rotated/plain/noisy.png"));
+
+        // Equal time is at render + denoise time: with render times set to 1 and 4 s for both
+        // methods and 1 s of denoising, the boxed curve spans 2..5 s, so the times compared
+        // start at 2 s, where the boxed error is its first run's.
+        let mut results = outcome.results;
+        for r in &mut results.rows {
+            r.seconds = if r.spp == 1 { 1.0 } else { 4.0 };
+            if r.raw.is_some() {
+                r.denoise_seconds = 1.0;
+            }
+        }
+        let e = &report::equal_time(&plan, &results)[0];
+        assert_eq!(e.table.first().map(|t| t.0), Some(2.0));
+        let boxed_first = results.rows[2].metrics.relmse;
+        assert!((e.table[0].1[1] - boxed_first).abs() <= 1e-9 * boxed_first);
+        // Past every plain run's time, nothing is compared; at equal samples all still is.
+        for r in results.rows.iter_mut().filter(|r| r.raw.is_some()) {
+            r.denoise_seconds = 10.0;
+        }
+        assert!(report::equal_time(&plan, &results)[0].table.is_empty());
+        assert!(!report::equal_samples(&plan, &results)[0].table.is_empty());
     }
 
     #[test]

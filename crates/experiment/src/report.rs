@@ -24,6 +24,18 @@ samples_per_second,mse,relmse,rmse,psnr,ssim,budget,max_depth,seed,mse_floor,rel
 pub const ADAPTIVE_COLUMNS: &str =
     "samples,mean_spp,error,time_limit,spp_cap,stop,decide_seconds,blocks_left";
 
+/// The columns appended (after [`ADAPTIVE_COLUMNS`], if those are there) when a method has a
+/// denoiser: its spec (empty for other methods), the denoising time, render plus denoising
+/// time, the noisy image's errors (the main metric columns are the denoised image's) and the
+/// denoised image.
+pub const DENOISE_COLUMNS: &str = "denoiser,denoise_seconds,total_seconds,raw_mse,raw_relmse,\
+raw_rmse,raw_psnr,raw_ssim,denoised_image";
+
+/// True when some method of the plan has a denoiser.
+pub fn any_denoiser(plan: &Plan) -> bool {
+    plan.methods.iter().any(|m| m.denoiser.is_some())
+}
+
 /// The columns of slopes.csv.
 pub const SLOPES_HEADER: &str = "scene,method,metric,floor,points,slope_vs_spp,se_vs_spp,\
 slope_vs_seconds,se_vs_seconds";
@@ -61,6 +73,15 @@ pub fn floor(reference: &Reference, epsilon: f64) -> Option<Floor> {
     })
 }
 
+/// A CSV cell holding `t`, quoted when it has a comma or a quote (RFC 4180).
+fn csv_text(t: &str) -> String {
+    if t.contains([',', '"', '\n']) {
+        format!("\"{}\"", t.replace('"', "\"\""))
+    } else {
+        t.to_string()
+    }
+}
+
 fn num(v: f64) -> String {
     if v.is_nan() {
         String::new()
@@ -75,16 +96,19 @@ pub fn results_csv(plan: &Plan, results: &Results) -> String {
         .methods
         .iter()
         .any(|m| matches!(m.runs, Runs::Adaptive(_)));
-    let mut s = if adaptive {
-        format!("{RESULTS_HEADER},{ADAPTIVE_COLUMNS}\n")
-    } else {
-        format!("{RESULTS_HEADER}\n")
-    };
+    let denoised = any_denoiser(plan);
+    let mut s = RESULTS_HEADER.to_string();
+    if adaptive {
+        s += &format!(",{ADAPTIVE_COLUMNS}");
+    }
+    if denoised {
+        s += &format!(",{DENOISE_COLUMNS}");
+    }
+    s.push('\n');
     for row in &results.rows {
         let pair = &plan.pairs[row.pair];
         let f = floor(&results.references[pair.scene], plan.epsilon);
         let m = &row.metrics;
-        let a = row.stop.as_ref();
         let _ = write!(
             s,
             "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
@@ -108,26 +132,52 @@ pub fn results_csv(plan: &Plan, results: &Results) -> String {
             f.as_ref().map_or(String::new(), |f| num(f.relmse)),
             row.image,
         );
-        if !adaptive {
-            s.push('\n');
-            continue;
+        if adaptive {
+            adaptive_cells(&mut s, row);
         }
-        let _ = writeln!(
-            s,
-            ",{},{},{},{},{},{},{},{}",
-            row.samples,
-            row.mean_spp,
-            a.and_then(|a| a.rule.error)
-                .map_or(String::new(), |e| e.to_string()),
-            a.and_then(|a| a.rule.time_limit)
-                .map_or(String::new(), |t| t.as_secs_f64().to_string()),
-            a.map_or(String::new(), |a| a.rule.max_spp.to_string()),
-            a.map_or(String::new(), |a| a.reason.to_string()),
-            a.map_or(String::new(), |a| a.decide_seconds.to_string()),
-            a.map_or(String::new(), |a| a.blocks_left.to_string()),
-        );
+        if denoised {
+            let raw = row.raw.as_ref();
+            let cell =
+                |f: fn(&rt_metrics::Metrics) -> f64| raw.map_or(String::new(), |m| num(f(m)));
+            let _ = write!(
+                s,
+                ",{},{},{},{},{},{},{},{},{}",
+                plan.methods[pair.method]
+                    .denoiser
+                    .as_ref()
+                    .map_or(String::new(), |d| csv_text(&d.to_string())),
+                row.denoise_seconds,
+                row.total_seconds(),
+                cell(|m| m.mse),
+                cell(|m| m.relmse),
+                cell(|m| m.rmse),
+                cell(|m| m.psnr),
+                cell(|m| m.ssim),
+                row.denoised_image.as_deref().unwrap_or(""),
+            );
+        }
+        s.push('\n');
     }
     s
+}
+
+/// The [`ADAPTIVE_COLUMNS`] of one row (empty rule cells for a progressive row).
+fn adaptive_cells(s: &mut String, row: &Row) {
+    let a = row.stop.as_ref();
+    let _ = write!(
+        s,
+        ",{},{},{},{},{},{},{},{}",
+        row.samples,
+        row.mean_spp,
+        a.and_then(|a| a.rule.error)
+            .map_or(String::new(), |e| e.to_string()),
+        a.and_then(|a| a.rule.time_limit)
+            .map_or(String::new(), |t| t.as_secs_f64().to_string()),
+        a.map_or(String::new(), |a| a.rule.max_spp.to_string()),
+        a.map_or(String::new(), |a| a.reason.to_string()),
+        a.map_or(String::new(), |a| a.decide_seconds.to_string()),
+        a.map_or(String::new(), |a| a.blocks_left.to_string()),
+    );
 }
 
 /// The rate fits of one method on one scene for one metric.
@@ -173,7 +223,7 @@ pub fn slopes(plan: &Plan, results: &Results) -> Vec<Slopes> {
                 };
                 (
                     log_log_slope(&by(|r| r.mean_spp)),
-                    log_log_slope(&by(|r| r.seconds)),
+                    log_log_slope(&by(Row::total_seconds)),
                 )
             };
             out.push(Slopes {
@@ -256,9 +306,9 @@ pub enum Axis {
     Samples,
 }
 
-/// A method's relMSE against `axis`. Time: time budgets at their nominal value (each run stops
-/// within about one sample's time of it), everything else at its measured time. Samples: the
-/// mean samples per pixel taken.
+/// A method's relMSE against `axis`. Time: render plus denoising time, with time budgets at
+/// their nominal value (each run stops within about one sample's time of it), everything else
+/// at its measured time. Samples: the mean samples per pixel taken.
 fn curve(plan: &Plan, results: &Results, pair: usize, axis: Axis) -> Vec<(f64, f64)> {
     let seconds_budgets = matches!(
         plan.methods[plan.pairs[pair].method].runs,
@@ -267,8 +317,8 @@ fn curve(plan: &Plan, results: &Results, pair: usize, axis: Axis) -> Vec<(f64, f
     let mut c: Vec<(f64, f64)> = rows_of(results, pair)
         .map(|r| {
             let x = match axis {
-                Axis::Time if seconds_budgets => r.budget,
-                Axis::Time => r.seconds,
+                Axis::Time if seconds_budgets => r.budget + r.denoise_seconds,
+                Axis::Time => r.total_seconds(),
                 Axis::Samples => r.mean_spp,
             };
             (x, r.metrics.relmse)
@@ -359,11 +409,15 @@ pub fn plots(plan: &Plan, results: &Results, out: &Path) -> Result<()> {
                 .collect()
         };
         let title = format!("{}: relMSE (eps {})", scene.name, plan.epsilon);
-        let time = series(|r| r.seconds);
+        let time = series(Row::total_seconds);
         plot::write(
             &Chart {
                 title: &title,
-                x_label: "render time (s)",
+                x_label: if any_denoiser(plan) {
+                    "render + denoise time (s)"
+                } else {
+                    "render time (s)"
+                },
                 y_label: "relMSE",
                 x_base: 10.0,
                 series: &time,
@@ -481,7 +535,7 @@ pub fn crops(plan: &Plan, results: &Results, out: &Path) -> Result<Vec<(usize, u
     Ok(blocks)
 }
 
-fn sci(v: f64) -> String {
+pub(crate) fn sci(v: f64) -> String {
     if v.is_nan() {
         "–".into()
     } else if v.is_infinite() {
@@ -491,7 +545,7 @@ fn sci(v: f64) -> String {
     }
 }
 
-fn fit_text(f: Option<Fit>) -> String {
+pub(crate) fn fit_text(f: Option<Fit>) -> String {
     match f {
         None => "–".into(),
         Some(f) if f.se.is_nan() => format!("{:.3} ({} pts)", f.slope, f.points),
@@ -541,10 +595,13 @@ pub fn markdown(
     }
 
     let _ = writeln!(s, "## Summary\n");
+    // Equal samples matters where sample counts differ from the budgets (adaptive runs) or
+    // time is not all rendering (denoisers).
     let any_adaptive = plan
         .methods
         .iter()
-        .any(|m| matches!(m.runs, Runs::Adaptive(_)));
+        .any(|m| matches!(m.runs, Runs::Adaptive(_)))
+        || any_denoiser(plan);
     let winner = |e: &EqualTime, what: &str| match e.overall() {
         Some((p, wins)) => format!(
             "{} ({wins} of {} {what})",
@@ -609,6 +666,19 @@ pub fn markdown(
             .pairs
             .iter()
             .any(|p| p.scene == si && matches!(plan.methods[p.method].runs, Runs::Adaptive(_)));
+        let has_denoiser = plan
+            .pairs
+            .iter()
+            .any(|p| p.scene == si && plan.methods[p.method].denoiser.is_some());
+        if has_denoiser {
+            let _ = writeln!(
+                s,
+                "Methods with a denoiser are measured by the denoised image (`MSE` … `SSIM`); \
+                 `noisy relMSE` is the rendered image's before denoising, `denoise s` the \
+                 denoising time (not part of `seconds`, the render time; the equal-time \
+                 comparison and the time plot use their sum).\n"
+            );
+        }
         if has_adaptive {
             let _ = writeln!(
                 s,
@@ -620,11 +690,13 @@ pub fn markdown(
         }
         let _ = writeln!(
             s,
-            "| method | integrator | accel | budget | spp | samples | mean spp | stop | seconds | Msamples/s | MSE | relMSE | PSNR | SSIM |"
+            "| method | integrator | accel | budget | spp | samples | mean spp | stop | seconds | Msamples/s | MSE | relMSE | PSNR | SSIM |{}",
+            if has_denoiser { " denoiser | denoise s | noisy relMSE |" } else { "" }
         );
         let _ = writeln!(
             s,
-            "|---|---|---|---|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|"
+            "|---|---|---|---|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|{}",
+            if has_denoiser { "---|---:|---:|" } else { "" }
         );
         for row in results
             .rows
@@ -649,9 +721,26 @@ pub fn markdown(
                     ),
                 ),
             };
+            let denoise = if has_denoiser {
+                format!(
+                    " {} | {} | {} |",
+                    plan.methods[pair.method]
+                        .denoiser
+                        .as_ref()
+                        .map_or("–".into(), |d| format!("`{d}`")),
+                    if row.raw.is_some() {
+                        format!("{:.3}", row.denoise_seconds)
+                    } else {
+                        "–".into()
+                    },
+                    row.raw.map_or("–".into(), |m| sci(m.relmse))
+                )
+            } else {
+                String::new()
+            };
             let _ = writeln!(
                 s,
-                "| {} | {} | {} | {budget} | {} | {} | {:.2} | {stop} | {:.3} | {:.2} | {} | {} | {:.2} | {:.4} |",
+                "| {} | {} | {} | {budget} | {} | {} | {:.2} | {stop} | {:.3} | {:.2} | {} | {} | {:.2} | {:.4} |{denoise}",
                 plan.methods[pair.method].name,
                 pair.estimator.kind,
                 pair.accel,
@@ -701,10 +790,11 @@ pub fn markdown(
             &equal[si],
             "### Equal time",
             "seconds",
-            "relMSE of each method at the same render time (time budgets at their nominal \
-             value, other runs interpolated linearly in log-log between measured points).",
+            "relMSE of each method at the same render time, plus denoising time for a method \
+             with a denoiser (time budgets at their nominal value, other runs interpolated \
+             linearly in log-log between measured points).",
         );
-        if has_adaptive {
+        if has_adaptive || has_denoiser {
             comparison_table(
                 &mut s,
                 plan,

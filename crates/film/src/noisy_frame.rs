@@ -125,38 +125,41 @@ impl Channel {
     }
 }
 
-impl AovSet {
-    /// The AOVs a film must keep for a frame to have `channels` (the colour is always there).
-    pub fn for_channels(channels: &[Channel]) -> AovSet {
-        let mut a = AovSet::default();
-        for c in channels {
-            match c {
-                Channel::Colour => {}
-                Channel::Variance => a.variance = true,
-                Channel::Halves => a.halves = true,
-                Channel::Albedo => a.albedo = true,
-                Channel::Normal => a.normal = true,
-                Channel::Position => a.position = true,
-                Channel::Depth => a.depth = true,
-                Channel::AlbedoVariance => (a.albedo, a.feature_variance) = (true, true),
-                Channel::NormalVariance => (a.normal, a.feature_variance) = (true, true),
-                Channel::PositionVariance => (a.position, a.feature_variance) = (true, true),
-                Channel::DepthVariance => (a.depth, a.feature_variance) = (true, true),
-                Channel::Emission => a.emission = true,
-                Channel::Direct => a.direct = true,
-                Channel::Indirect => a.indirect = true,
-                Channel::Diffuse => a.diffuse = true,
-                Channel::Glossy => a.glossy = true,
-                Channel::Irradiance => a.irradiance = true,
-            }
-        }
-        a
-    }
-}
-
 impl fmt::Display for Channel {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
+    }
+}
+
+impl AovSet {
+    /// The smallest set whose film gives a [`NoisyFrame`] with every channel of `channels`
+    /// (through [`NoisyFrame::from_film`] with the same set): what a consumer that reads those
+    /// channels, e.g. a denoiser's `needs()`, must ask the film for. A feature's variance
+    /// needs the feature too; the colour image is always there.
+    pub fn for_channels(channels: &[Channel]) -> AovSet {
+        let mut s = AovSet::default();
+        for c in channels {
+            match c {
+                Channel::Colour => {}
+                Channel::Variance => s.variance = true,
+                Channel::Halves => s.halves = true,
+                Channel::Albedo => s.albedo = true,
+                Channel::AlbedoVariance => (s.albedo, s.feature_variance) = (true, true),
+                Channel::Normal => s.normal = true,
+                Channel::NormalVariance => (s.normal, s.feature_variance) = (true, true),
+                Channel::Position => s.position = true,
+                Channel::PositionVariance => (s.position, s.feature_variance) = (true, true),
+                Channel::Depth => s.depth = true,
+                Channel::DepthVariance => (s.depth, s.feature_variance) = (true, true),
+                Channel::Emission => s.emission = true,
+                Channel::Direct => s.direct = true,
+                Channel::Indirect => s.indirect = true,
+                Channel::Diffuse => s.diffuse = true,
+                Channel::Glossy => s.glossy = true,
+                Channel::Irradiance => s.irradiance = true,
+            }
+        }
+        s
     }
 }
 
@@ -519,11 +522,12 @@ mod tests {
 
     /// A film with every channel, filled with distinct, awkward values.
     fn full_film() -> Film {
-        full_film_with(FilmBuffers::for_outputs(AovSet::DENOISE))
+        film_with(AovSet::DENOISE)
     }
 
-    fn full_film_with(buffers: FilmBuffers) -> Film {
-        let mut film = Film::new(5, 3, buffers);
+    /// A film keeping the buffers of `aovs`, filled like [`full_film`].
+    fn film_with(aovs: AovSet) -> Film {
+        let mut film = Film::new(5, 3, FilmBuffers::for_outputs(aovs));
         let mut state = 7u32;
         let mut next = || {
             state = rt_core::sampler::hash_u32(state);
@@ -606,16 +610,28 @@ mod tests {
             .contains("depth channel is (4, 3)"));
     }
 
+    /// Each channel alone gets a film that keeps it, and nothing beyond it (and, for a
+    /// feature's variance, the feature).
     #[test]
-    fn the_aovs_for_channels_give_exactly_those_channels() {
-        let film = |aovs| full_film_with(FilmBuffers::for_outputs(aovs));
+    fn aovs_for_channels_give_exactly_those_channels() {
+        assert_eq!(AovSet::for_channels(&[Channel::Colour]), AovSet::default());
+        let all = AovSet::for_channels(&Channel::ALL);
+        assert_eq!(all, AovSet::DENOISE);
         for c in Channel::ALL {
             let aovs = AovSet::for_channels(&[c]);
-            let frame = NoisyFrame::from_film(&film(aovs), aovs);
-            assert!(frame.has(c), "{c}");
+            let got = NoisyFrame::from_film(&film_with(aovs), aovs).channels();
+            let base = match c {
+                Channel::AlbedoVariance => Channel::Albedo,
+                Channel::NormalVariance => Channel::Normal,
+                Channel::PositionVariance => Channel::Position,
+                Channel::DepthVariance => Channel::Depth,
+                other => other,
+            };
+            let mut want = vec![Channel::Colour, base, c];
+            want.dedup();
+            want.sort_by_key(|w| Channel::ALL.iter().position(|a| a == w));
+            assert_eq!(got, want, "{c}");
         }
-        let aovs = AovSet::for_channels(&Channel::ALL);
-        assert_eq!(aovs, AovSet::DENOISE);
     }
 
     #[test]
