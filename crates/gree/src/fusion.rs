@@ -1,5 +1,5 @@
 //! Gradient-domain (Poisson) fusion of the composite (thesis §5.1.4, "Gradient-Domain
-//! Fusion"): a few Jacobi iterations of the screened-free Poisson equation, started from the
+//! Fusion"): a few Jacobi iterations of the Poisson equation, started from the
 //! composite `u = F_L(p)(p)`, with Neumann boundaries (only neighbours inside the image).
 //!
 //! The guidance gradient of the edge p → q is `F_a(q) − F_a(p)` when both pixels carry label

@@ -92,7 +92,7 @@ fn bad_inputs_are_typed() {
     ));
     let empty = RgbImage::from_fn(0, 0, |_, _| Rgb::ZERO);
     assert!(matches!(
-        composite(&empty, &empty, &[empty.clone()], r, &p),
+        composite(&empty, &empty, std::slice::from_ref(&empty), r, &p),
         Err(GreeError::EmptyImage { .. })
     ));
 }
