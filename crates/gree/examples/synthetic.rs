@@ -4,7 +4,8 @@
 //! level grows to the right, so different filters win in different places. The cache
 //! "renderer" returns the truth plus independent noise of the same per-sample level.
 //!
-//! Run with `cargo run --release -p rt-gree --example synthetic [-- size]`.
+//! Run with `cargo run --release -p rt-gree --example synthetic [-- size [lambda [kappa]]]`
+//! (defaults: 512 and [`GreeParams::default`]'s λ and κ).
 
 use rt_core::rng::SplitMix64;
 use rt_gree::{composite, CacheRenderer, GreeParams, Rgb, RgbImage};
@@ -104,7 +105,17 @@ fn main() {
     let size: usize = std::env::args()
         .nth(1)
         .map_or(512, |s| s.parse().expect("size"));
-    let params = GreeParams::default();
+    let arg = |i: usize, default: f32| {
+        std::env::args()
+            .nth(i)
+            .map_or(default, |s| s.parse().expect("number"))
+    };
+    let defaults = GreeParams::default();
+    let params = GreeParams {
+        lambda: arg(2, defaults.lambda),
+        kappa: arg(3, defaults.kappa),
+        ..defaults
+    };
     let budget = params.budget_split();
     let truth = truth(size);
     let mut rng = SplitMix64::new(1);

@@ -1,5 +1,5 @@
 //! Gradient-domain (Poisson) fusion of the composite (thesis §5.1.4, "Gradient-Domain
-//! Fusion"): a few Jacobi iterations of the screened-free Poisson equation, started from the
+//! Fusion"): a few Jacobi iterations of the Poisson equation, started from the
 //! composite `u = F_L(p)(p)`, with Neumann boundaries (only neighbours inside the image).
 //!
 //! The guidance gradient of the edge p → q is `F_a(q) − F_a(p)` when both pixels carry label
@@ -133,6 +133,34 @@ mod tests {
             }
         }
         assert!(moved > 0, "seams must move");
+    }
+
+    /// One iteration by hand on a 3x1 image labelled [0, 1, 1]: the guidance of the seam edge
+    /// is the average of both filters' gradients, inside label 1 it is filter 1's own.
+    #[test]
+    fn one_iteration_by_hand() {
+        let f0 = RgbImage::new(
+            3,
+            1,
+            vec![Rgb::splat(1.0), Rgb::splat(2.0), Rgb::splat(4.0)],
+        )
+        .unwrap();
+        let f1 = RgbImage::new(
+            3,
+            1,
+            vec![Rgb::splat(0.0), Rgb::splat(8.0), Rgb::splat(16.0)],
+        )
+        .unwrap();
+        let labels = [0u16, 1, 1];
+        let out = fuse(&[f0, f1], &labels, 1);
+        // u = [1, 8, 16]. Seam edge 0 -> 1: g = ((2 − 1) + (8 − 0))/2 = 4.5; edge 1 -> 2: 8.
+        // u0' = 1 + ((8 − 1) − 4.5) = 3.5
+        // u1' = 8 + (((1 − 8) − (−4.5)) + ((16 − 8) − 8)) / 2 = 6.75
+        // u2' = 16 + ((8 − 16) − (−8)) = 16
+        assert_eq!(
+            out.pixels(),
+            &[Rgb::splat(3.5), Rgb::splat(6.75), Rgb::splat(16.0)]
+        );
     }
 
     /// Across a seam between two filters that differ by a constant offset, the averaged

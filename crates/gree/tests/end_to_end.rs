@@ -42,8 +42,10 @@ fn composite_beats_every_filter_and_the_argmin() {
     let m = mse(&out.image, &c.truth);
     eprintln!("A {ma:.2e} B {mb:.2e} argmin {m_argmin:.2e} GREE {m:.2e}");
     assert!(m <= 0.9 * ma.min(mb), "{m} vs {ma}, {mb}");
+    // The graph cut removes isolated wrong picks (fusion alone, on the argmin labels, does not
+    // come close to this).
     assert!(
-        m < m_argmin,
+        m < 0.5 * m_argmin,
         "graph cut should remove isolated wrong picks: {m} vs {m_argmin}"
     );
     assert!(out.energy.1 <= out.energy.0);

@@ -28,6 +28,8 @@ pub struct GridMaxflow {
     cap: Vec<f64>,
     /// Residual terminal capacity: > 0 from the source, < 0 to the sink.
     tr: Vec<f64>,
+    /// Bit d set when arc (node, d) exists (the neighbour is inside the grid).
+    arcs: Vec<u8>,
     parent: Vec<u8>,
     sink: Vec<bool>,
     ts: Vec<u32>,
@@ -48,6 +50,17 @@ impl GridMaxflow {
     /// Clears the graph to `width × height` nodes with no capacities, keeping the buffers.
     pub fn reset(&mut self, width: usize, height: usize) {
         let n = width * height;
+        if (width, height) != (self.width, self.height) || self.arcs.len() != n {
+            self.arcs = (0..n)
+                .map(|p| {
+                    let (x, y) = (p % width, p / width);
+                    u8::from(x + 1 < width)
+                        | u8::from(x > 0) << 1
+                        | u8::from(y + 1 < height) << 2
+                        | u8::from(y > 0) << 3
+                })
+                .collect();
+        }
         self.width = width;
         self.height = height;
         self.cap.clear();
@@ -102,13 +115,7 @@ impl GridMaxflow {
 
     #[inline]
     fn exists(&self, p: usize, d: u8) -> bool {
-        let x = p % self.width;
-        match d {
-            0 => x + 1 < self.width,
-            1 => x > 0,
-            2 => p + self.width < self.width * self.height,
-            _ => p >= self.width,
-        }
+        self.arcs[p] >> d & 1 == 1
     }
 
     fn set_active(&mut self, p: usize) {

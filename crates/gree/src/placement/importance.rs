@@ -14,11 +14,13 @@
 //! density of the pixels not yet drawn. In log form the key is `ln(−ln u) − ln w`, smallest
 //! wins. Pixels of zero density are taken only when the positive ones run out, uniformly.
 
+use rayon::prelude::*;
 use rt_core::rng::SplitMix64;
 use rt_core::RgbImage;
 
 /// `ln(P_F(p) · P_N(p))` per pixel (unnormalised; `−∞` where the bank agrees exactly).
 /// `bank` and `variance_of_mean` must have the same size; `mu` is the radiance scale.
+/// Pixel-parallel; each value is computed alone, so the bits do not depend on threads.
 pub fn log_density(
     bank: &[RgbImage],
     variance_of_mean: &RgbImage,
@@ -29,6 +31,7 @@ pub fn log_density(
     let inv_two_sr2 = 1.0 / (2.0 * sigma_r as f64 * sigma_r as f64);
     let inv_mu2 = 1.0 / (mu * mu);
     (0..variance_of_mean.pixels().len())
+        .into_par_iter()
         .map(|p| {
             let mut mean = [0.0f64; 3];
             for f in bank {
