@@ -25,10 +25,19 @@
 //! ```
 #![forbid(unsafe_code)]
 
+mod bilateral;
+pub mod blocks;
 mod box_blur;
+mod gaussian;
+mod guided;
+mod nlm;
 pub mod spec;
 
+pub use bilateral::{JointBilateral, VarianceUse};
 pub use box_blur::BoxBlur;
+pub use gaussian::Gaussian;
+pub use guided::{Guide, GuidedFilter};
+pub use nlm::Nlm;
 pub use rt_film::{Channel, FrameError, NoisyFrame};
 pub use spec::{DenoiserKind, DenoiserSpec, Options};
 

@@ -6,7 +6,7 @@
 //! kinds, unknown keys, values that do not parse and values out of range are each one error
 //! naming the denoiser and the key.
 
-use crate::{BoxBlur, DenoiseError, Denoiser};
+use crate::{BoxBlur, DenoiseError, Denoiser, Gaussian, GuidedFilter, JointBilateral, Nlm};
 use std::fmt;
 use std::str::FromStr;
 
@@ -16,16 +16,34 @@ use std::str::FromStr;
 pub enum DenoiserKind {
     /// [`BoxBlur`].
     Box,
+    /// [`Gaussian`].
+    Gaussian,
+    /// [`JointBilateral`].
+    Bilateral,
+    /// [`Nlm`].
+    Nlm,
+    /// [`GuidedFilter`].
+    Guided,
 }
 
 impl DenoiserKind {
     /// Every kind, in the order help texts list them.
-    pub const ALL: [DenoiserKind; 1] = [DenoiserKind::Box];
+    pub const ALL: [DenoiserKind; 5] = [
+        DenoiserKind::Box,
+        DenoiserKind::Gaussian,
+        DenoiserKind::Bilateral,
+        DenoiserKind::Nlm,
+        DenoiserKind::Guided,
+    ];
 
     /// The name used in specs.
     pub fn name(self) -> &'static str {
         match self {
             DenoiserKind::Box => "box",
+            DenoiserKind::Gaussian => "gaussian",
+            DenoiserKind::Bilateral => "bilateral",
+            DenoiserKind::Nlm => "nlm",
+            DenoiserKind::Guided => "guided",
         }
     }
 
@@ -55,6 +73,10 @@ impl DenoiserSpec {
         let mut o = Options::new(self.kind.name(), &self.options);
         let d: Box<dyn Denoiser> = match self.kind {
             DenoiserKind::Box => Box::new(BoxBlur::from_options(&mut o)?),
+            DenoiserKind::Gaussian => Box::new(Gaussian::from_options(&mut o)?),
+            DenoiserKind::Bilateral => Box::new(JointBilateral::from_options(&mut o)?),
+            DenoiserKind::Nlm => Box::new(Nlm::from_options(&mut o)?),
+            DenoiserKind::Guided => Box::new(GuidedFilter::from_options(&mut o)?),
         };
         o.finish()?;
         Ok(d)
