@@ -24,10 +24,10 @@
 //! - The colour range term (`colour`, off by default) is in the frame's absolute radiance
 //!   units.
 
-use crate::blocks::{check_positive, check_range};
+use crate::blocks::{check_positive, check_range, exp_neg};
 use crate::{Channel, DenoiseError, Denoiser, NoisyFrame, Options};
 use rayon::prelude::*;
-use rt_core::glam::Vec3;
+use rt_core::glam::{Vec3, Vec4};
 use rt_core::{Image, Rgb, RgbImage};
 
 /// How the filter uses feature variances.
@@ -45,12 +45,27 @@ pub enum VarianceUse {
 const GROUPS: usize = 4;
 
 /// One pixel's scaled guide features (each group divided by its σ) and the scaled variances of
-/// its groups: one 64-byte record, read once per neighbour.
+/// its groups: one 64-byte record, read once per neighbour, laid out by component
+/// (`x[k]` is the x component of group `k`) so the four groups are handled as one 4-lane
+/// vector (glam's `Vec4`, SSE2 on x86-64).
 #[derive(Clone, Copy, Debug, Default)]
 #[repr(align(64))]
 struct Guide {
-    f: [f32; 3 * GROUPS],
-    v: [f32; GROUPS],
+    x: Vec4,
+    y: Vec4,
+    z: Vec4,
+    v: Vec4,
+}
+
+impl Guide {
+    /// `Σ_g max(0, |f_g(p) − f_g(q)|² − (V_g(p) + V_g(q)))`.
+    #[inline]
+    fn distance(&self, q: &Guide) -> f32 {
+        let (dx, dy, dz) = (self.x - q.x, self.y - q.y, self.z - q.z);
+        (dx * dx + dy * dy + dz * dz - (self.v + q.v))
+            .max(Vec4::ZERO)
+            .element_sum()
+    }
 }
 
 /// A guide group's feature image, its variance image, and the unit its values are measured in.
@@ -60,8 +75,10 @@ type FeatureSource<'a> = (Option<&'a Image<Vec3>>, Option<&'a Image<Vec3>>, f32)
 #[derive(Clone, Debug)]
 pub struct JointBilateral {
     radius: usize,
-    /// `-(dx² + dy²) / 2σ²` over the `(2r+1)²` window, row-major, `-inf` outside the disc.
+    /// `-(dx² + dy²) / 2σ²` over the `(2r+1)²` window, row-major.
     spatial: Vec<f32>,
+    /// Half width of the disc of radius `radius` at row offset `|dy|`.
+    half: Vec<usize>,
     /// σ of normal, position, albedo, colour (0: off).
     sigmas: [f32; GROUPS],
     variances: VarianceUse,
@@ -94,14 +111,17 @@ impl JointBilateral {
         let mut spatial = Vec::with_capacity((2 * radius + 1).pow(2));
         for dy in -r..=r {
             for dx in -r..=r {
-                let d2 = (dx * dx + dy * dy) as f32;
-                spatial.push(if dx * dx + dy * dy <= r * r {
-                    d2 * inv
-                } else {
-                    f32::NEG_INFINITY
-                });
+                spatial.push((dx * dx + dy * dy) as f32 * inv);
             }
         }
+        let half = (0..=r)
+            .map(|dy| {
+                (0..=r)
+                    .rev()
+                    .find(|dx| dx * dx + dy * dy <= r * r)
+                    .unwrap_or(0) as usize
+            })
+            .collect();
         let channels = [
             (Channel::Normal, Channel::NormalVariance),
             (Channel::Position, Channel::PositionVariance),
@@ -127,6 +147,7 @@ impl JointBilateral {
         Ok(Self {
             radius,
             spatial,
+            half,
             sigmas,
             variances,
             needs,
@@ -178,7 +199,8 @@ impl JointBilateral {
             };
             let s = 1.0 / (sigma * unit);
             for (gi, f) in g.iter_mut().zip(feat.pixels()) {
-                gi.f[3 * k..3 * k + 3].copy_from_slice(&(*f * s).to_array());
+                let f = *f * s;
+                (gi.x[k], gi.y[k], gi.z[k]) = (f.x, f.y, f.z);
             }
             let var = var.filter(|_| self.variances != VarianceUse::Off);
             if let Some(var) = var {
@@ -237,31 +259,18 @@ impl Denoiser for JointBilateral {
         out.par_chunks_mut(w).enumerate().for_each(|(y, orow)| {
             let (y0, y1) = crate::blocks::window(y, r, h);
             for (x, o) in orow.iter_mut().enumerate() {
-                let (x0, x1) = crate::blocks::window(x, r, w);
                 let gp = &guides[y * w + x];
                 let (mut sum, mut wsum) = (Rgb::ZERO, 0.0f32);
                 for qy in y0..=y1 {
-                    let srow = &self.spatial[(qy + r - y) * side..];
-                    let base = qy * w;
-                    for qx in x0..=x1 {
-                        let s = srow[qx + r - x];
-                        if s == f32::NEG_INFINITY {
-                            continue;
-                        }
-                        let gq = &guides[base + qx];
-                        let mut e = 0.0f32;
-                        for k in 0..GROUPS {
-                            let d = Vec3::from_slice(&gp.f[3 * k..3 * k + 3])
-                                - Vec3::from_slice(&gq.f[3 * k..3 * k + 3]);
-                            e += (d.length_squared() - (gp.v[k] + gq.v[k])).max(0.0);
-                        }
-                        let arg = s - 0.5 * e;
-                        // Below e^-30 a weight cannot change an f32 sum that holds the centre's 1.
-                        if arg > -30.0 {
-                            let wgt = arg.exp();
-                            sum += colour[base + qx] * wgt;
-                            wsum += wgt;
-                        }
+                    // The disc's row at this height, cut at the image border.
+                    let half = self.half[qy.abs_diff(y)];
+                    let (qx0, qx1) = crate::blocks::window(x, half, w);
+                    let srow = &self.spatial[(qy + r - y) * side..][qx0 + r - x..=qx1 + r - x];
+                    let row = qy * w + qx0..=qy * w + qx1;
+                    for ((gq, &c), &s) in guides[row.clone()].iter().zip(&colour[row]).zip(srow) {
+                        let wgt = exp_neg(s - 0.5 * gp.distance(gq));
+                        sum += c * wgt;
+                        wsum += wgt;
                     }
                 }
                 // The centre's weight is 1, so `wsum >= 1`.

@@ -20,9 +20,10 @@
 //! combines two filtered halves, not to this bank member.
 
 use crate::blocks::patch::PatchScratch;
-use crate::blocks::{check_count, check_range, STRIP_ROWS};
+use crate::blocks::{check_count, check_range, exp_neg, STRIP_ROWS};
 use crate::{Channel, DenoiseError, Denoiser, NoisyFrame, Options};
 use rayon::prelude::*;
+use rt_core::glam::Vec3A;
 use rt_core::{Image, Rgb, RgbImage};
 
 /// Non-local means normalised by the variance of the pixel means.
@@ -87,8 +88,15 @@ impl Denoiser for Nlm {
         if w == 0 || h == 0 {
             return frame.colour.clone();
         }
-        let u = frame.colour.pixels();
-        let var = variance.pixels();
+        // SIMD-width copies (glam's Vec3A), the variances made non-negative (a negative or NaN
+        // variance, bad input, counts as 0).
+        let u: Vec<Vec3A> = frame.colour.pixels().iter().map(|&c| c.into()).collect();
+        let var: Vec<Vec3A> = variance
+            .pixels()
+            .iter()
+            .map(|&v| Vec3A::from(v).max(Vec3A::ZERO))
+            .collect();
+        let colour = frame.colour.pixels();
         let k2 = self.k * self.k;
         let (r, eps) = (self.radius as isize, self.eps);
         let mut out = vec![Rgb::ZERO; w * h];
@@ -106,16 +114,18 @@ impl Denoiser for Nlm {
                         // The distance term between pixel (x, y) and its neighbour at the
                         // offset, clamped into the image (only patch pixels near the border
                         // read a clamped neighbour).
-                        let term = |x: usize, y: usize| {
-                            let qx = (x as isize + dx).clamp(0, w as isize - 1) as usize;
+                        let term = |y: usize, row: &mut [f32]| {
                             let qy = (y as isize + dy).clamp(0, h as isize - 1) as usize;
-                            let (p, q) = (y * w + x, qy * w + qx);
-                            // Negative or NaN variances (bad input) count as 0.
-                            let (vp, vq) = (var[p].max(Rgb::ZERO), var[q].max(Rgb::ZERO));
-                            let d = u[p] - u[q];
-                            let num = d * d - (vp + vp.min(vq));
-                            let den = Rgb::splat(eps) + (vp + vq) * k2;
-                            (num / den).element_sum() * (1.0 / 3.0)
+                            let (urow, vrow) = (&u[y * w..][..w], &var[y * w..][..w]);
+                            let (uq, vq) = (&u[qy * w..][..w], &var[qy * w..][..w]);
+                            for (x, t) in row.iter_mut().enumerate() {
+                                let qx = (x as isize + dx).clamp(0, w as isize - 1) as usize;
+                                let (vp, vq) = (vrow[x], vq[qx]);
+                                let d = urow[x] - uq[qx];
+                                let num = d * d - (vp + vp.min(vq));
+                                let den = Vec3A::splat(eps) + (vp + vq) * k2;
+                                *t = (num / den).element_sum() * (1.0 / 3.0);
+                            }
                         };
                         scratch.patch_means((w, h), (y0, y1), self.patch, term, &mut dist);
                         let qx0 = (-dx).max(0) as usize;
@@ -130,9 +140,9 @@ impl Denoiser for Nlm {
                             if qy < 0 || qy >= h as isize || qx0 >= qx1 {
                                 continue;
                             }
-                            let urow = &u[qy as usize * w..][..w];
+                            let urow = &colour[qy as usize * w..][..w];
                             for x in qx0..qx1 {
-                                let wgt = (-drow[x].max(0.0)).exp();
+                                let wgt = exp_neg(-drow[x]);
                                 orow[x] += urow[(x as isize + dx) as usize] * wgt;
                                 wrow[x] += wgt;
                             }

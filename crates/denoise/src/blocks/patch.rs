@@ -17,18 +17,21 @@ pub struct PatchScratch {
     prefix: Vec<f64>,
     hsum: Vec<f32>,
     inv_cols: Vec<f32>,
+    /// Each column's patch range `[a, b]`.
+    cols: Vec<(usize, usize)>,
 }
 
 impl PatchScratch {
-    /// Writes into `dist` (`(y1 - y0) × w`) the mean of `term(x, y)` over the patch of radius
-    /// `patch` around each pixel of rows `y0..y1` of a `w × h` image. `term` is evaluated only
-    /// at pixels inside the image, for rows `y0 - patch ..y1 + patch` (clamped).
+    /// Writes into `dist` (`(y1 - y0) × w`) the mean of the per-pixel term over the patch of
+    /// radius `patch` around each pixel of rows `y0..y1` of a `w × h` image. `term(y, row)`
+    /// fills `row` with the term of the pixels of row `y`; it is called for rows
+    /// `y0 - patch..y1 + patch` (clamped to the image).
     pub fn patch_means(
         &mut self,
         (w, h): (usize, usize),
         (y0, y1): (usize, usize),
         patch: usize,
-        term: impl Fn(usize, usize) -> f32,
+        term: impl Fn(usize, &mut [f32]),
         dist: &mut [f32],
     ) {
         debug_assert_eq!(dist.len(), (y1 - y0) * w);
@@ -38,19 +41,16 @@ impl PatchScratch {
         self.term.resize(rows * w, 0.0);
         self.hsum.resize(rows * w, 0.0);
         self.prefix.resize(w + 1, 0.0);
-        if self.inv_cols.len() != w {
-            self.inv_cols = (0..w)
-                .map(|x| {
-                    let (a, b) = window(x, patch, w);
-                    1.0 / (b - a + 1) as f32
-                })
+        if self.cols.len() != w || self.cols.first() != Some(&window(0, patch, w)) {
+            self.cols = (0..w).map(|x| window(x, patch, w)).collect();
+            self.inv_cols = self
+                .cols
+                .iter()
+                .map(|(a, b)| 1.0 / (b - a + 1) as f32)
                 .collect();
         }
         for (i, row) in self.term.chunks_mut(w).enumerate() {
-            let y = ylo + i;
-            for (x, t) in row.iter_mut().enumerate() {
-                *t = term(x, y);
-            }
+            term(ylo + i, row);
         }
         // Horizontal window sums from a per-row prefix sum (f64: a difference of prefixes).
         for (row, hs) in self.term.chunks(w).zip(self.hsum.chunks_mut(w)) {
@@ -59,8 +59,7 @@ impl PatchScratch {
                 acc += f64::from(t);
                 *p = acc;
             }
-            for (x, o) in hs.iter_mut().enumerate() {
-                let (a, b) = window(x, patch, w);
+            for (o, &(a, b)) in hs.iter_mut().zip(&self.cols) {
                 *o = (self.prefix[b + 1] - self.prefix[a]) as f32;
             }
         }
@@ -98,7 +97,12 @@ mod tests {
             let mut s = PatchScratch::default();
             for (y0, y1) in [(0, 4), (4, 8), (8, 11), (0, 11)] {
                 let mut dist = vec![0.0; (y1 - y0) * w];
-                s.patch_means((w, h), (y0, y1), patch, term, &mut dist);
+                let rows = |y: usize, row: &mut [f32]| {
+                    for (x, t) in row.iter_mut().enumerate() {
+                        *t = term(x, y);
+                    }
+                };
+                s.patch_means((w, h), (y0, y1), patch, rows, &mut dist);
                 for y in y0..y1 {
                     for x in 0..w {
                         let ((xa, xb), (ya, yb)) = (window(x, patch, w), window(y, patch, h));
