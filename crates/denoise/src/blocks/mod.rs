@@ -81,8 +81,9 @@ pub fn exp_neg(x: f32) -> f32 {
     let x = if x > -87.0 { x.min(0.0) } else { -87.0 };
     // n = round(x / ln2) by the 1.5·2^23 trick (no SSE4.1 `round` needed): n ∈ [-126, 0].
     let n = (x * std::f32::consts::LOG2_E + 12_582_912.0) - 12_582_912.0;
-    // f = x − n·ln2 with ln2 split in two (Cody & Waite) so f keeps its digits: |f| ≤ ln2/2.
-    let f = (x - n * 0.693_359_375) + n * 2.121_944_4e-4;
+    // f = x − n·ln2 with ln2 split in two (Cody & Waite: 0.6933594 is 355/512 as an f32, exact
+    // times any n here) so f keeps its digits: |f| ≤ ln2/2.
+    let f = (x - n * 0.693_359_4) + n * 2.121_944_4e-4;
     // e^f by its Taylor series to degree 6 (error < (ln2/2)^7 / 7! ≈ 1.2e-7).
     let p = 1.0
         + f * (1.0
