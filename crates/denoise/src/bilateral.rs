@@ -280,3 +280,51 @@ impl Denoiser for JointBilateral {
         Image::new(w, h, out).unwrap_or_default()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two pixels, colours 0 and 1, normals `n0` and `n1` (other guides off).
+    fn pair(n: [Vec3; 2], nvar: Option<f32>) -> NoisyFrame {
+        let mut f = NoisyFrame::new(Image::new(2, 1, vec![Rgb::ZERO, Rgb::ONE]).unwrap());
+        f.normal = Some(Image::new(2, 1, n.to_vec()).unwrap());
+        f.normal_variance = nvar.map(|v| Image::filled(2, 1, Vec3::splat(v)));
+        f
+    }
+
+    #[test]
+    fn the_weight_is_spatial_times_guide_term_with_lis_variance_cancellation() {
+        let (sigma, sn) = (1.5f32, 0.8f32);
+        let n = [Vec3::Z, Vec3::new(0.0, 0.6, 0.8)];
+        let d2 = (n[0] - n[1]).length_squared(); // 0.4
+        let filter = |v| JointBilateral::new(sigma, [sn, 0.0, 0.0, 0.0], v).unwrap();
+        let out = |f: &NoisyFrame, v| filter(v).denoise(f).unwrap().pixel(0, 0).x;
+        let spatial = -0.5 / (sigma * sigma);
+        let expect = |e: f32| {
+            let w = (spatial - 0.5 * e / (sn * sn)).exp();
+            w / (1.0 + w)
+        };
+        let plain = pair(n, None);
+        assert!((out(&plain, VarianceUse::Auto) - expect(d2)).abs() < 1e-6);
+        // Variance 0.05 per component per pixel: 0.4 - 2·3·0.05 = 0.1 remains.
+        let noisy = pair(n, Some(0.05));
+        assert!((out(&noisy, VarianceUse::Auto) - expect(d2 - 0.3)).abs() < 1e-6);
+        assert!((out(&noisy, VarianceUse::Off) - expect(d2)).abs() < 1e-6);
+        // More variance than difference: the guide costs nothing (clamped at 0).
+        let very = pair(n, Some(1.0));
+        assert!((out(&very, VarianceUse::On) - expect(0.0)).abs() < 1e-6);
+        assert_eq!(
+            filter(VarianceUse::On).needs(),
+            &[Channel::Normal, Channel::NormalVariance]
+        );
+    }
+
+    #[test]
+    fn positions_are_measured_in_their_spread() {
+        let p = Image::new(2, 1, vec![Vec3::ZERO, Vec3::new(6.0, 0.0, 0.0)]).unwrap();
+        assert_eq!(position_spread(Some(&p)), 3.0);
+        assert_eq!(position_spread(Some(&Image::filled(3, 1, Vec3::ONE))), 1.0);
+        assert_eq!(position_spread(None), 1.0);
+    }
+}

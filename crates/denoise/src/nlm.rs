@@ -71,6 +71,16 @@ impl Nlm {
     }
 }
 
+/// Rousselle et al.'s per-pixel distance term between `p` and `q` (colours `up`, `uq`,
+/// variances of the means `vp`, `vq` ≥ 0), averaged over the three channels.
+#[inline]
+fn distance_term(up: Vec3A, uq: Vec3A, vp: Vec3A, vq: Vec3A, k2: f32, eps: f32) -> f32 {
+    let d = up - uq;
+    let num = d * d - (vp + vp.min(vq));
+    let den = Vec3A::splat(eps) + (vp + vq) * k2;
+    (num / den).element_sum() * (1.0 / 3.0)
+}
+
 impl Denoiser for Nlm {
     fn name(&self) -> &str {
         &self.name
@@ -120,11 +130,7 @@ impl Denoiser for Nlm {
                             let (uq, vq) = (&u[qy * w..][..w], &var[qy * w..][..w]);
                             for (x, t) in row.iter_mut().enumerate() {
                                 let qx = (x as isize + dx).clamp(0, w as isize - 1) as usize;
-                                let (vp, vq) = (vrow[x], vq[qx]);
-                                let d = urow[x] - uq[qx];
-                                let num = d * d - (vp + vp.min(vq));
-                                let den = Vec3A::splat(eps) + (vp + vq) * k2;
-                                *t = (num / den).element_sum() * (1.0 / 3.0);
+                                *t = distance_term(urow[x], uq[qx], vrow[x], vq[qx], k2, eps);
                             }
                         };
                         scratch.patch_means((w, h), (y0, y1), self.patch, term, &mut dist);
@@ -155,5 +161,61 @@ impl Denoiser for Nlm {
                 }
             });
         Image::new(w, h, out).unwrap_or_default()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn distance_term_is_rousselles() {
+        let (k, eps) = (0.45f32, 1e-10f32);
+        let up = Vec3A::new(1.0, 2.0, 0.5);
+        let uq = Vec3A::new(1.5, 1.0, 0.5);
+        let vp = Vec3A::new(0.04, 0.01, 0.09);
+        let vq = Vec3A::new(0.01, 0.02, 0.09);
+        let got = distance_term(up, uq, vp, vq, k * k, eps);
+        let mut want = 0.0;
+        for c in 0..3 {
+            let d = up[c] - uq[c];
+            want += (d * d - (vp[c] + vp[c].min(vq[c]))) / (eps + k * k * (vp[c] + vq[c]));
+        }
+        want /= 3.0;
+        assert!((got - want).abs() < 1e-5 * want.abs(), "{got} vs {want}");
+        // Equal colours: never a positive distance, so the centre's weight is 1.
+        assert!(distance_term(up, up, vp, vp, k * k, eps) < 0.0);
+        // Identical noisy-free pixels: 0/eps, not NaN.
+        assert_eq!(
+            distance_term(up, up, Vec3A::ZERO, Vec3A::ZERO, k * k, eps),
+            0.0
+        );
+    }
+
+    #[test]
+    fn weights_are_exp_of_the_patch_mean_distance() {
+        // Two pixels, patch radius 0: pixel 0's output is (u0 + w u1) / (1 + w) with
+        // w = exp(-max(0, d²(0, 1))).
+        let u = [Rgb::splat(0.0), Rgb::new(0.3, 0.2, 0.1)];
+        let v = [Rgb::splat(0.01), Rgb::splat(0.02)];
+        let mut f = NoisyFrame::new(Image::new(2, 1, u.to_vec()).unwrap());
+        f.variance = Some(Image::new(2, 1, v.to_vec()).unwrap());
+        let out = Nlm::new(1, 0, 0.45, 1e-10).unwrap().denoise(&f).unwrap();
+        let d2 = distance_term(
+            u[0].into(),
+            u[1].into(),
+            v[0].into(),
+            v[1].into(),
+            0.2025,
+            1e-10,
+        );
+        let wgt = (-d2.max(0.0)).exp();
+        let want = (u[0] + u[1] * wgt) / (1.0 + wgt);
+        assert!(wgt > 0.01 && wgt < 0.99, "{wgt}");
+        assert!(
+            (out.pixel(0, 0) - want).abs().max_element() < 1e-6,
+            "{}",
+            out.pixel(0, 0)
+        );
     }
 }

@@ -301,6 +301,20 @@ fn nlm_removes_most_of_the_noise_and_its_weights_follow_the_variance() {
 }
 
 #[test]
+fn nlm_is_invariant_to_the_radiance_scale() {
+    // Colour × 10 with variance × 100 gives the same distances, so the output is × 10.
+    let (frame, _) = blocks_frame(0.1, 1.0);
+    let mut bright = frame.clone();
+    bright.colour = frame.colour.map(|c| *c * 10.0);
+    bright.variance = frame.variance.as_ref().map(|v| v.map(|v| *v * 100.0));
+    let nlm = build("nlm");
+    let (a, b) = (nlm.denoise(&frame).unwrap(), nlm.denoise(&bright).unwrap());
+    for (p, q) in a.pixels().iter().zip(b.pixels()) {
+        assert!((*p * 10.0 - *q).abs().max_element() < 1e-4, "{p} {q}");
+    }
+}
+
+#[test]
 fn guided_filter_keeps_a_step_in_its_guide() {
     let (frame, truth) = step_frame("albedo");
     let near = |x: usize, _| (12..20).contains(&x);
@@ -329,6 +343,19 @@ fn guided_filter_keeps_a_step_in_its_guide() {
     let b = g.denoise(&nf).unwrap();
     for (p, q) in a.pixels().iter().zip(b.pixels()) {
         assert!((*p - *q).abs().max_element() < 1e-4, "{p} {q}");
+    }
+}
+
+#[test]
+fn guided_filter_guided_by_its_input_with_tiny_eps_is_the_identity() {
+    // With I = p and ε → 0, a = Σ⁻¹ cov(I, p) = identity and b = 0 in every window: a check on
+    // the covariance assembly and the 3×3 solve.
+    let img = noisy_image(23, 17, 4).map(|c| *c + Vec3::new(0.0, c.x * 0.5, c.y * 0.25));
+    let out = build("guided:guide=colour:radius=2:eps=1e-7")
+        .denoise(&NoisyFrame::new(img.clone()))
+        .unwrap();
+    for (p, q) in img.pixels().iter().zip(out.pixels()) {
+        assert!((*p - *q).abs().max_element() < 1e-3, "{p} {q}");
     }
 }
 
