@@ -359,6 +359,97 @@ fn guided_filter_guided_by_its_input_with_tiny_eps_is_the_identity() {
     }
 }
 
+/// He et al.'s colour-guided filter by direct window sums in f64 (the definition, with windows
+/// cut at the border and ε relative to the guide's frame variance, as documented).
+fn guided_reference(guide: &Image<Vec3>, p: &RgbImage, r: usize, eps: f64) -> RgbImage {
+    use rt_core::glam::{DMat3, DVec3};
+    let (w, h) = p.size();
+    let n = (w * h) as f64;
+    let gm = guide
+        .pixels()
+        .iter()
+        .fold(DVec3::ZERO, |s, v| s + v.as_dvec3())
+        / n;
+    let gvar = guide
+        .pixels()
+        .iter()
+        .map(|v| (v.as_dvec3() - gm).length_squared())
+        .sum::<f64>()
+        / (3.0 * n);
+    let eps = eps * gvar.max(1e-8);
+    let win = |c: usize, len: usize| (c.saturating_sub(r), (c + r).min(len - 1));
+    // Per-window coefficients a (rows per colour channel) and b.
+    let mut coef = vec![(DMat3::ZERO, DVec3::ZERO); w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let ((x0, x1), (y0, y1)) = (win(x, w), win(y, h));
+            let (mut mi, mut mp, mut mii, mut mip) =
+                (DVec3::ZERO, DVec3::ZERO, DMat3::ZERO, DMat3::ZERO);
+            let mut cnt = 0.0;
+            for yy in y0..=y1 {
+                for xx in x0..=x1 {
+                    let (i, q) = (guide.pixel(xx, yy).as_dvec3(), p.pixel(xx, yy).as_dvec3());
+                    mi += i;
+                    mp += q;
+                    mii += DMat3::from_cols(i * i.x, i * i.y, i * i.z);
+                    // Column c holds I·p_c.
+                    mip += DMat3::from_cols(i * q.x, i * q.y, i * q.z);
+                    cnt += 1.0;
+                }
+            }
+            let (mi, mp, mii, mip) = (mi / cnt, mp / cnt, mii * (1.0 / cnt), mip * (1.0 / cnt));
+            let sigma = mii - DMat3::from_cols(mi * mi.x, mi * mi.y, mi * mi.z)
+                + DMat3::from_diagonal(DVec3::splat(eps));
+            let cov = mip - DMat3::from_cols(mi * mp.x, mi * mp.y, mi * mp.z);
+            let a = sigma.inverse() * cov; // column c: a for channel c
+            let b = mp - a.transpose() * mi;
+            coef[y * w + x] = (a, b);
+        }
+    }
+    Image::from_fn(w, h, |x, y| {
+        let ((x0, x1), (y0, y1)) = (win(x, w), win(y, h));
+        let (mut a, mut b, mut cnt) = (DMat3::ZERO, DVec3::ZERO, 0.0);
+        for yy in y0..=y1 {
+            for xx in x0..=x1 {
+                let (ca, cb) = coef[yy * w + xx];
+                a += ca;
+                b += cb;
+                cnt += 1.0;
+            }
+        }
+        let q = (a * (1.0 / cnt)).transpose() * guide.pixel(x, y).as_dvec3() + b / cnt;
+        q.as_vec3()
+    })
+}
+
+#[test]
+fn guided_filter_matches_the_definition_by_direct_sums() {
+    let (w, h) = (19, 14);
+    let p = noisy_image(w, h, 31);
+    let guide = Image::from_fn(w, h, |x, y| {
+        let i = y * w + x;
+        Vec3::new(
+            uniform(40, i as u32),
+            if x < 9 { 0.2 } else { 0.9 },
+            uniform(41, i as u32),
+        )
+    });
+    let mut f = NoisyFrame::new(p.clone());
+    f.albedo = Some(guide.clone());
+    for (r, eps) in [(1, 0.01), (3, 0.1), (30, 0.01)] {
+        let out = build(&format!("guided:radius={r}:eps={eps}"))
+            .denoise(&f)
+            .unwrap();
+        let want = guided_reference(&guide, &p, r, eps);
+        for (a, b) in out.pixels().iter().zip(want.pixels()) {
+            assert!(
+                (*a - *b).abs().max_element() < 1e-4,
+                "r={r} eps={eps}: {a} vs {b}"
+            );
+        }
+    }
+}
+
 #[test]
 fn a_missing_channel_is_one_error_naming_it() {
     let frame = NoisyFrame::new(noisy_image(4, 3, 1));
