@@ -16,6 +16,8 @@
 //!   frame (floored at 1e-8), so scaling or offsetting the guide does not change the output.
 //!   With the default `eps = 0.01`, windows whose guide variance is below 1% of the frame's
 //!   are smoothed as if the guide were flat there.
+//! - Non-finite colour or guide pixels count as the frame's mean (a NaN would otherwise spread
+//!   through the summed-area table to most of the image).
 //! - Windows are cut at the image border (box means over the pixels inside).
 //! - Guide and colour are centred on their frame means before the products are formed, and
 //!   the table sums are `f64`, so the covariances do not lose their digits to large means.
@@ -85,10 +87,17 @@ impl GuidedFilter {
     }
 }
 
-/// Per-channel means of `img` over the frame, in `f64`.
+/// Per-channel means of the finite pixels of `img`, in `f64`.
 fn frame_mean(img: &[Vec3]) -> DVec3 {
-    let sum = img.iter().fold(DVec3::ZERO, |s, v| s + v.as_dvec3());
-    sum / img.len().max(1) as f64
+    let (sum, n) = img
+        .iter()
+        .filter(|v| v.is_finite())
+        .fold((DVec3::ZERO, 0.0), |(s, n), v| (s + v.as_dvec3(), n + 1.0));
+    if n > 0.0 {
+        sum / n
+    } else {
+        DVec3::ZERO
+    }
 }
 
 impl Denoiser for GuidedFilter {
@@ -116,9 +125,19 @@ impl Denoiser for GuidedFilter {
         };
         let (g, p) = (guide.pixels(), frame.colour.pixels());
         let (gm, pm) = (frame_mean(g), frame_mean(p));
-        // Centred guide and colour planes.
+        // Centred guide and colour planes. A non-finite pixel becomes the frame mean: in a
+        // summed-area table it would poison every sum below and right of it, not just its
+        // windows.
         let plane = |img: &[Vec3], m: f64, c: usize| -> Vec<f32> {
-            img.iter().map(|v| (f64::from(v[c]) - m) as f32).collect()
+            img.iter()
+                .map(|v| {
+                    if v.is_finite() {
+                        (f64::from(v[c]) - m) as f32
+                    } else {
+                        0.0
+                    }
+                })
+                .collect()
         };
         let gi: [Vec<f32>; 3] = std::array::from_fn(|c| plane(g, gm[c], c));
         let pi: [Vec<f32>; 3] = std::array::from_fn(|c| plane(p, pm[c], c));

@@ -14,7 +14,8 @@
 //! rows, one rayon task each, with offsets visited in a fixed order, so the result is the same
 //! bits on any thread count.
 //!
-//! Deviations: patches are cut at the image border (mean over the patch pixels inside; the
+//! Deviations: non-finite colours count as black and non-finite or negative variances as 0.
+//! Patches are cut at the image border (mean over the patch pixels inside; the
 //! neighbour's patch reads clamped pixels); search neighbours outside the image are skipped.
 //! Rousselle et al. filter per buffer half and cross-filter; that belongs to a denoiser that
 //! combines two filtered halves, not to this bank member.
@@ -98,15 +99,21 @@ impl Denoiser for Nlm {
         if w == 0 || h == 0 {
             return frame.colour.clone();
         }
-        // SIMD-width copies (glam's Vec3A), the variances made non-negative (a negative or NaN
-        // variance, bad input, counts as 0).
-        let u: Vec<Vec3A> = frame.colour.pixels().iter().map(|&c| c.into()).collect();
+        // SIMD-width copies (glam's Vec3A). A non-finite colour counts as black and a negative
+        // or non-finite variance as 0: the patch sums run along whole rows, so one NaN would
+        // otherwise spoil every patch distance to its right.
+        let finite = |v: Vec3A| if v.is_finite() { v } else { Vec3A::ZERO };
+        let u: Vec<Vec3A> = frame
+            .colour
+            .pixels()
+            .iter()
+            .map(|&c| finite(c.into()))
+            .collect();
         let var: Vec<Vec3A> = variance
             .pixels()
             .iter()
-            .map(|&v| Vec3A::from(v).max(Vec3A::ZERO))
+            .map(|&v| finite(v.into()).max(Vec3A::ZERO))
             .collect();
-        let colour = frame.colour.pixels();
         let k2 = self.k * self.k;
         let (r, eps) = (self.radius as isize, self.eps);
         let mut out = vec![Rgb::ZERO; w * h];
@@ -146,10 +153,10 @@ impl Denoiser for Nlm {
                             if qy < 0 || qy >= h as isize || qx0 >= qx1 {
                                 continue;
                             }
-                            let urow = &colour[qy as usize * w..][..w];
+                            let urow = &u[qy as usize * w..][..w];
                             for x in qx0..qx1 {
                                 let wgt = exp_neg(-drow[x]);
-                                orow[x] += urow[(x as isize + dx) as usize] * wgt;
+                                orow[x] += Rgb::from(urow[(x as isize + dx) as usize]) * wgt;
                                 wrow[x] += wgt;
                             }
                         }

@@ -124,6 +124,28 @@ fn every_denoiser_gives_the_same_bits_twice_and_on_one_thread() {
     }
 }
 
+#[test]
+fn a_nan_or_inf_pixel_stays_local_and_never_reaches_the_output() {
+    let (w, h) = (40, 33);
+    let clean = full_frame(noisy_image(w, h, 8), 9);
+    let mut bad = clean.clone();
+    bad.colour.pixels_mut()[2 * w + 2] = Rgb::new(f32::NAN, 1.0, 1.0);
+    bad.colour.pixels_mut()[3 * w + 5] = Rgb::splat(f32::INFINITY);
+    for spec in SPECS {
+        let d = build(spec);
+        let (a, b) = (d.denoise(&clean).unwrap(), d.denoise(&bad).unwrap());
+        assert!(b.pixels().iter().all(|p| p.is_finite()), "{spec}");
+        // Far from the bad pixels (beyond every filter's reach) nothing changed.
+        for (x, y) in [(39, 32), (39, 0), (0, 32)] {
+            let (p, q) = (a.pixel(x, y), b.pixel(x, y));
+            assert!(
+                (p - q).abs().max_element() < 1e-4,
+                "{spec} ({x}, {y}): {p} vs {q}"
+            );
+        }
+    }
+}
+
 /// Mean squared error over the pixels with `keep(x, y)`.
 fn mse(a: &RgbImage, b: &RgbImage, keep: impl Fn(usize, usize) -> bool) -> f32 {
     let (w, h) = a.size();
