@@ -13,7 +13,13 @@
 //! `gaussian:sigma=4` and built, so a program using this crate offers the same choice as
 //! `render denoise --denoiser`.
 //!
-//! Depends on `rt-core` and `rt-film`.
+//! The filter bank of Bauszat's GREE (thesis ch. 5): [`Gaussian`] (`gaussian`),
+//! [`JointBilateral`] (`bilateral`, guided by normal, position and albedo), [`Nlm`] (`nlm`,
+//! Rousselle et al.'s variance-normalised non-local means) and [`GuidedFilter`] (`guided`),
+//! built on the shared [`blocks`] (separable Gaussian, summed-area-table box mean, per-offset
+//! patch distances), plus the [`BoxBlur`] baseline.
+//!
+//! Depends on `rt-core`, `rt-film` and rayon (rows in parallel, same bits on any pool).
 //!
 //! ```
 //! use rt_denoise::{Denoiser, DenoiserSpec, NoisyFrame};

@@ -81,7 +81,16 @@ fn noisy_image(w: usize, h: usize, seed: u32) -> RgbImage {
 #[test]
 fn constant_colour_stays_constant_at_every_size_including_borders() {
     let c = Rgb::new(0.3, 2.0, 7.5);
-    for (w, h) in [(1, 1), (1, 7), (7, 1), (3, 2), (13, 9), (40, 33)] {
+    for (w, h) in [
+        (0, 0),
+        (0, 3),
+        (1, 1),
+        (1, 7),
+        (7, 1),
+        (3, 2),
+        (13, 9),
+        (40, 33),
+    ] {
         let frame = full_frame(Image::filled(w, h, c), 11);
         for spec in SPECS {
             let out = build(spec).denoise(&frame).unwrap();
