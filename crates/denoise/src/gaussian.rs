@@ -1,6 +1,6 @@
 //! The Gaussian blur: the non-adaptive family of the GREE filter bank (Bauszat's thesis
-//! ch. 5, §5.2: σ = 2, 4, 8, 16 px), and the baseline the edge-aware filters are measured
-//! against.
+//! ch. 5; research digest seed000-denoise.md §2.1: σ = 2, 4, 8, 16 px), and the baseline the
+//! edge-aware filters are measured against.
 //!
 //! Separable, cut at 3σ, and renormalised at the border (see [`crate::blocks::separable`]):
 //! taps outside the image are dropped and the remaining weights rescaled to sum to one, so a

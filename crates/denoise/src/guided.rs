@@ -1,5 +1,5 @@
 //! The guided image filter (He, Sun & Tang, "Guided image filtering", ECCV 2010 / TPAMI
-//! 2013), in its colour-guide form (§3.5 of the TPAMI paper): in every `(2r+1)²` window the
+//! 2013), in its colour-guide form (the TPAMI paper's filtering with a colour guidance image): in every `(2r+1)²` window the
 //! output is an affine function of the three-channel guide `I`, `q = aᵀI + b`, fitted to the
 //! noisy colour `p` by ridge regression,
 //! `a = (Σ + εU)⁻¹ (mean(I p) − μ p̄)`, `b = p̄ − aᵀμ` (Σ, μ: the guide's covariance and mean

@@ -1,5 +1,5 @@
 //! Non-local means with variance-normalised patch distances, after Rousselle, Knaus & Zwicker
-//! 2012, "Adaptive rendering with non-local means filtering" (SIGGRAPH Asia), §4 (Eq. 5–7).
+//! 2012, "Adaptive rendering with non-local means filtering" (SIGGRAPH Asia).
 //! Bauszat's GREE bank (thesis ch. 5) uses NL-means with a search window of 16 px.
 //!
 //! For pixel `p`, neighbour `q` in the `(2·radius+1)²` search window, and colour channel `c`,

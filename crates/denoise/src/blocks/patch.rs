@@ -1,7 +1,7 @@
 //! Patch distances for non-local means, one search offset at a time: the caller gives the
 //! per-pixel distance term between pixel `p` and `p + offset`, and the patch distance is that
 //! term's box mean over the patch around `p` (Buades et al. 2005; computed per offset as in
-//! Darbon et al. 2008 and Rousselle et al. 2012 §5, so the cost per pixel and offset does not
+//! Darbon et al. 2008 and Rousselle et al. 2012, so the cost per pixel and offset does not
 //! grow with the patch size beyond a `2·patch + 1`-row column sum).
 //!
 //! Work is done by horizontal strips of rows: a strip computes the term on its rows plus the
