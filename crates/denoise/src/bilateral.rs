@@ -1,9 +1,9 @@
 //! The joint (cross) bilateral filter guided by first-hit features: the edge-aware family of
 //! the GREE filter bank (Bauszat's thesis ch. 5; research digest seed000-denoise.md §2.1:
 //! σ_domain = 1, 2, 4, 8 px with guides normal σ = 0.8, position σ = 0.6, albedo σ = 0.25),
-//! after Eisemann & Durand 2004 and
-//! Petschnigg et al. 2004, with the feature distance of Li, Wu & Chuang 2012 ("SURE-based
-//! optimization for adaptive sampling and reconstruction", SIGGRAPH Asia).
+//! after Eisemann & Durand 2004 and Petschnigg et al. 2004, with the feature distance of Li,
+//! Wu & Chuang 2012 ("SURE-based optimization for adaptive sampling and reconstruction",
+//! SIGGRAPH Asia).
 //!
 //! The weight of neighbour `q` for pixel `p` is
 //! `exp(-|p - q|² / 2σ² - ½ Σ_g max(0, |f_g(p) - f_g(q)|² - (V_g(p) + V_g(q))) / σ_g²)`
