@@ -13,8 +13,15 @@
 //! `gaussian:sigma=4` and built, so a program using this crate offers the same choice as
 //! `render denoise --denoiser`.
 //!
-//! Depends on `rt-core` and `rt-film`. The optional feature `oidn` adds `Oidn`, Intel Open
-//! Image Denoise loaded at run time (`libloading`); the default build needs nothing native.
+//! The filter bank of Bauszat's GREE (thesis ch. 5): [`Gaussian`] (`gaussian`),
+//! [`JointBilateral`] (`bilateral`, guided by normal, position and albedo), [`Nlm`] (`nlm`,
+//! Rousselle et al.'s variance-normalised non-local means) and [`GuidedFilter`] (`guided`),
+//! built on the shared [`blocks`] (separable Gaussian, summed-area-table box mean, per-offset
+//! patch distances), plus the [`BoxBlur`] baseline; [`Bank`] runs several on one frame.
+//!
+//! Depends on `rt-core`, `rt-film` and rayon (rows in parallel, same bits on any pool). The
+//! optional feature `oidn` adds `Oidn`, Intel Open Image Denoise loaded at run time
+//! (`libloading`); the default build needs nothing native.
 //!
 //! ```
 //! use rt_denoise::{Denoiser, DenoiserSpec, NoisyFrame};
@@ -30,13 +37,22 @@
 #![cfg_attr(feature = "oidn", deny(unsafe_code))]
 
 mod bank;
+mod bilateral;
+pub mod blocks;
 mod box_blur;
+mod gaussian;
+mod guided;
+mod nlm;
 #[cfg(feature = "oidn")]
 mod oidn;
 pub mod spec;
 
 pub use bank::{Bank, BankOutput, DEFAULT_BANK};
+pub use bilateral::{JointBilateral, VarianceUse};
 pub use box_blur::BoxBlur;
+pub use gaussian::Gaussian;
+pub use guided::{Guide, GuidedFilter};
+pub use nlm::Nlm;
 #[cfg(feature = "oidn")]
 pub use oidn::{Oidn, OidnParams, OidnQuality, OIDN_LIB_DEFAULTS, OIDN_LIB_ENV};
 pub use rt_film::{Channel, FrameError, NoisyFrame};

@@ -8,7 +8,7 @@
 
 #[cfg(feature = "oidn")]
 use crate::Oidn;
-use crate::{BoxBlur, DenoiseError, Denoiser};
+use crate::{BoxBlur, DenoiseError, Denoiser, Gaussian, GuidedFilter, JointBilateral, Nlm};
 use std::fmt;
 use std::str::FromStr;
 
@@ -18,6 +18,14 @@ use std::str::FromStr;
 pub enum DenoiserKind {
     /// [`BoxBlur`].
     Box,
+    /// [`Gaussian`].
+    Gaussian,
+    /// [`JointBilateral`].
+    Bilateral,
+    /// [`Nlm`].
+    Nlm,
+    /// [`GuidedFilter`].
+    Guided,
     /// `Oidn` (Open Image Denoise; only in builds with the `oidn` feature).
     #[cfg(feature = "oidn")]
     Oidn,
@@ -27,6 +35,10 @@ impl DenoiserKind {
     /// Every kind, in the order help texts list them.
     pub const ALL: &'static [DenoiserKind] = &[
         DenoiserKind::Box,
+        DenoiserKind::Gaussian,
+        DenoiserKind::Bilateral,
+        DenoiserKind::Nlm,
+        DenoiserKind::Guided,
         #[cfg(feature = "oidn")]
         DenoiserKind::Oidn,
     ];
@@ -35,6 +47,10 @@ impl DenoiserKind {
     pub fn name(self) -> &'static str {
         match self {
             DenoiserKind::Box => "box",
+            DenoiserKind::Gaussian => "gaussian",
+            DenoiserKind::Bilateral => "bilateral",
+            DenoiserKind::Nlm => "nlm",
+            DenoiserKind::Guided => "guided",
             #[cfg(feature = "oidn")]
             DenoiserKind::Oidn => "oidn",
         }
@@ -70,6 +86,10 @@ impl DenoiserSpec {
         let mut o = Options::new(self.kind.name(), &self.options);
         let d: Box<dyn Denoiser> = match self.kind {
             DenoiserKind::Box => Box::new(BoxBlur::from_options(&mut o)?),
+            DenoiserKind::Gaussian => Box::new(Gaussian::from_options(&mut o)?),
+            DenoiserKind::Bilateral => Box::new(JointBilateral::from_options(&mut o)?),
+            DenoiserKind::Nlm => Box::new(Nlm::from_options(&mut o)?),
+            DenoiserKind::Guided => Box::new(GuidedFilter::from_options(&mut o)?),
             #[cfg(feature = "oidn")]
             DenoiserKind::Oidn => Box::new(Oidn::from_options(&mut o)?),
         };
