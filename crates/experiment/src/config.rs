@@ -108,6 +108,8 @@ struct MethodDesc {
     time_limit: Option<OneOrMany<f64>>,
     scenes: Option<Vec<String>>,
     denoiser: Option<String>,
+    gree: Option<String>,
+    bank: Option<Vec<String>>,
 }
 
 /// `key = V` or `key = [V, ...]` of numbers.
@@ -217,6 +219,18 @@ pub struct MethodPlan {
     /// The denoiser applied to each of its images (`denoiser = "kind:key=value"`), already
     /// checked to build; its output is the method's image and error.
     pub denoiser: Option<DenoiserSpec>,
+    /// GREE (`gree = "OPTIONS"`, `bank = [...]`): each `spp` budget is GREE's budget b, spent
+    /// on its noisy image and its filter caches ([`rt_session::render_gree`]).
+    pub gree: Option<GreePlan>,
+}
+
+/// A GREE method's settings, checked at load.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GreePlan {
+    /// `--gree` option text (`key=value:...`).
+    pub options: String,
+    /// The filter bank's denoiser specs.
+    pub bank: Vec<String>,
 }
 
 /// How a method renders on a scene.
@@ -528,10 +542,34 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
             .map(parse_denoiser)
             .transpose()
             .map_err(at)?;
+        let gree = match (m.gree, m.bank) {
+            (None, None) => None,
+            (None, Some(_)) => bail!("{here}: bank is GREE's filter bank: it needs gree = \"...\""),
+            (Some(options), bank) => {
+                if denoiser.is_some() {
+                    bail!("{here}: gree chooses among its bank's denoisers; drop denoiser");
+                }
+                let Runs::Progressive(Budgets::Spp(budgets)) = &runs else {
+                    bail!("{here}: gree spends sample budgets: give spp = [...], not seconds or error");
+                };
+                for &b in budgets {
+                    rt_session::parse_gree_options(&options, b, 0).map_err(at)?;
+                }
+                let bank = bank.unwrap_or_else(|| {
+                    rt_denoise::DEFAULT_BANK
+                        .iter()
+                        .map(|s| s.to_string())
+                        .collect()
+                });
+                rt_denoise::Bank::from_specs(&bank).map_err(|e| at(format!("bank: {e}")))?;
+                Some(GreePlan { options, bank })
+            }
+        };
         methods.push(MethodPlan {
             name: m.name,
             runs,
             denoiser,
+            gree,
         });
         method_overrides.push(overrides);
         method_scenes.push(m.scenes);

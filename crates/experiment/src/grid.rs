@@ -258,6 +258,28 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
         bar.set_message(format!("{}: {}", scene.name, method.name));
         let runs = method.runs.len() as u64;
         let base = done_runs * UNITS;
+        if let Some(g) = &method.gree {
+            let (last, noisy) = run_gree(
+                GreeMethod {
+                    plan: g,
+                    pair: pi,
+                    method: &method.name,
+                    scene: &scene.name,
+                    reference,
+                    opts: &opts,
+                    out,
+                },
+                &session,
+                &method.runs,
+                &mut rows,
+                progress,
+            )?;
+            finals.push(last);
+            noisy_finals.push(Some(noisy));
+            done_runs += runs;
+            bar.set_position(done_runs * UNITS);
+            continue;
+        }
         let mut last_image = None;
         let mut last_noisy = None;
         // Writes the image of one stop, denoises it if the method says so, measures it and
@@ -395,4 +417,115 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
         finals,
         noisy_finals,
     })
+}
+
+/// What [`run_gree`] needs to know about its method.
+struct GreeMethod<'a> {
+    plan: &'a crate::config::GreePlan,
+    pair: usize,
+    method: &'a str,
+    scene: &'a str,
+    reference: &'a Reference,
+    opts: &'a CompareOptions,
+    out: &'a Path,
+}
+
+/// Renders a GREE method at each of its budgets (each from scratch: GREE's split of a budget
+/// is not a prefix of a larger one's), measures the composite and its noisy image, and
+/// records the rows; returns the last composite and noisy image. The row's `samples` are every
+/// sample traced (noisy image and caches), its `seconds` the render of both, its
+/// `denoise_seconds` the bank plus GREE's own stages.
+fn run_gree(
+    m: GreeMethod<'_>,
+    session: &Session<'_>,
+    runs: &Runs,
+    rows: &mut Vec<Row>,
+    progress: &dyn Progress,
+) -> Result<(RgbImage, RgbImage)> {
+    let fail = |e: String| ExperimentError::Run(format!("{}: {e}", m.method));
+    let Some(Budgets::Spp(budgets)) = runs.budgets() else {
+        return Err(fail("GREE needs spp budgets".into()));
+    };
+    let bank = rt_denoise::Bank::from_specs(&m.plan.bank).map_err(|e| fail(e.to_string()))?;
+    let Some(integrator) = session.integrator.camera_integrator() else {
+        return Err(fail(format!(
+            "GREE renders filter caches pixel by pixel, which the {} technique cannot",
+            session.integrator.name()
+        )));
+    };
+    let dir: PathBuf = ["images", m.scene].iter().collect();
+    let slash = |p: &Path| p.to_string_lossy().replace('\\', "/");
+    let measure = |image: &RgbImage| {
+        compare(image, &m.reference.image, m.opts)
+            .map_err(|e| fail(format!("against the reference of {}: {e}", m.scene)))
+    };
+    let mut last = None;
+    for &b in budgets {
+        let params =
+            rt_session::parse_gree_options(&m.plan.options, b, session.seed).map_err(fail)?;
+        let run = rt_session::render_gree(
+            &session.ctx,
+            integrator,
+            &bank,
+            &params,
+            session.seed,
+            &|_| {},
+        )
+        .map_err(|e| fail(e.to_string()))?;
+        let label = format!("{b}spp");
+        let rel = dir.join(format!("{}-{label}.exr", m.method));
+        run.frame.write_exr(&m.out.join(&rel), &[])?;
+        let drel = dir.join(format!("{}-{label}-denoised.exr", m.method));
+        rt_film::write_rgb(
+            &m.out.join(&drel),
+            &run.composite.image,
+            &Default::default(),
+        )?;
+        let metrics = measure(&run.composite.image)?;
+        let raw = measure(&run.frame.colour)?;
+        let argmin = measure(&run.composite.argmin_image)?;
+        // The bank's members on the same noisy image, for the report's reader: how far the
+        // per-pixel choice is from each filter alone (at n spp, not at equal samples).
+        let members: Vec<String> = bank
+            .members()
+            .iter()
+            .zip(&run.bank.images)
+            .map(|(d, img)| Ok(format!("{} {:.4e}", d.name(), measure(img)?.relmse)))
+            .collect::<Result<_>>()?;
+        progress.message(&format!(
+            "{}: {} b={b}: relMSE composite {:.4e}, per-pixel argmin {:.4e}, noisy {:.4e}; bank on the noisy image: {}; GREE's own stages {:.3} s of {:.3} s denoising",
+            m.scene,
+            m.method,
+            metrics.relmse,
+            argmin.relmse,
+            raw.relmse,
+            members.join(", "),
+            run.composite.timings.own().as_secs_f64(),
+            run.denoise_time().as_secs_f64(),
+        ));
+        let seconds = (run.render.elapsed + run.caches.elapsed).as_secs_f64();
+        let samples = run.samples_traced();
+        let pixels = run.frame.colour.len().max(1) as f64;
+        rows.push(Row {
+            pair: m.pair,
+            budget: f64::from(b),
+            spp: b,
+            samples,
+            mean_spp: samples as f64 / pixels,
+            stop: None,
+            seconds,
+            denoise_seconds: run.denoise_time().as_secs_f64(),
+            rays: run.render.rays.rays
+                + run.render.rays.shadow_rays
+                + run.caches.rays.rays
+                + run.caches.rays.shadow_rays,
+            samples_per_second: samples as f64 / seconds.max(1e-9),
+            metrics,
+            raw: Some(raw),
+            image: slash(&rel),
+            denoised_image: Some(slash(&drel)),
+        });
+        last = Some((run.composite.image, run.frame.colour));
+    }
+    last.ok_or_else(|| fail("no budget".into()))
 }
