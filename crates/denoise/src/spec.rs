@@ -6,7 +6,7 @@
 //! kinds, unknown keys, values that do not parse and values out of range are each one error
 //! naming the denoiser and the key.
 
-use crate::{BoxBlur, DenoiseError, Denoiser};
+use crate::{Atrous, BoxBlur, DenoiseError, Denoiser};
 use std::fmt;
 use std::str::FromStr;
 
@@ -16,16 +16,19 @@ use std::str::FromStr;
 pub enum DenoiserKind {
     /// [`BoxBlur`].
     Box,
+    /// [`Atrous`].
+    Atrous,
 }
 
 impl DenoiserKind {
     /// Every kind, in the order help texts list them.
-    pub const ALL: [DenoiserKind; 1] = [DenoiserKind::Box];
+    pub const ALL: [DenoiserKind; 2] = [DenoiserKind::Box, DenoiserKind::Atrous];
 
     /// The name used in specs.
     pub fn name(self) -> &'static str {
         match self {
             DenoiserKind::Box => "box",
+            DenoiserKind::Atrous => "atrous",
         }
     }
 
@@ -55,6 +58,7 @@ impl DenoiserSpec {
         let mut o = Options::new(self.kind.name(), &self.options);
         let d: Box<dyn Denoiser> = match self.kind {
             DenoiserKind::Box => Box::new(BoxBlur::from_options(&mut o)?),
+            DenoiserKind::Atrous => Box::new(Atrous::from_options(&mut o)?),
         };
         o.finish()?;
         Ok(d)
