@@ -23,18 +23,28 @@
 //!   GPU texture fetch of the shader). Skipping them instead would change only which weights
 //!   are renormalised; a constant image stays constant either way.
 //! - **c_phi.** With `scale=relative` (default) `c_phi` is a multiple of the 99th percentile of
-//!   `|c|²` over the signal being filtered (per part), so `c_phi=1` puts `exp(−1)` at a
-//!   difference as large as a bright pixel: the thesis starts σ_rt at the buffer's maximum
-//!   (HDR) intensity so that level 0 is driven by the normal and position weights; the
-//!   percentile keeps a few fireflies from switching the colour weight off.
+//!   `|c|²` over the signal being filtered (per part): the thesis starts σ_rt at the buffer's
+//!   maximum (HDR) intensity so that level 0 is driven by the normal and position weights; the
+//!   percentile keeps a few fireflies from deciding it. The default 4 (σ twice the percentile
+//!   intensity) was the best of 0.25–64 on the Cornell box at 1 spp (relMSE 0.0042 against
+//!   0.016 at 1 and 0.068 at 0.25) and within 3 % of the best at 4 spp.
 //! - **Halving** (errata §6.2): `halve=phi` (default) divides c_phi by 2 per level,
-//!   `halve=sigma` divides σ by 2 (c_phi by 4), `halve=none` keeps it.
+//!   `halve=sigma` divides σ by 2 (c_phi by 4), `halve=none` keeps it. `phi` was better at
+//!   1 spp, `sigma` at 4 spp (relMSE 0.0014 against 0.0016).
 //! - **p_phi** is relative to the squared diagonal of the position buffer's bounding box
 //!   (`scale=relative`), so the result does not change when the scene is scaled (seed 002
-//!   claim 17). Default 0.01: a neighbour a tenth of the scene's extent away gets `exp(−1)`.
-//! - **n_phi** default 0.1 (normals are unit vectors, no scaling): across a 90° crease
-//!   (`|Δn|² = 2`) level 0 gives `exp(−20)`; at level 4 (stepwidth 16) the same crease gives
-//!   0.92, the relaxation the shader builds in.
+//!   claim 17). Default 0.001: a neighbour 3 % of the scene's extent away gets `exp(−1)`; at
+//!   512 pixels across, taps 16 pixels apart on a wall facing the camera keep about 0.4. Of
+//!   0.01, 0.001 and 0.0001 it was best at 1 spp and close to best at 4 spp.
+//! - **n_phi** default 0.01 (normals are unit vectors, no scaling). The shader divides `|Δn|²`
+//!   by `stepwidth²`, so the normal weight tests the normals' gradient: a smooth curve whose
+//!   normal turns by 0.1 rad per pixel keeps `exp(−1)` at every level, while a 90° crease
+//!   (`|Δn|² = 2`) gets `exp(−200)` at level 0 but 0.46 at level 4. Values of 0.1–0.5 leave
+//!   the crease at ≥ 0.73 from level 3 on and scored worse (relMSE 0.0034 against 0.0030 at
+//!   4 spp); 0.01 and 0.001 were equal.
+//! - The defaults were chosen on `scenes/cornell-box.toml` (512², path tracer, `--aov
+//!   denoise`, 1 and 4 spp) against 256 spp, with `examples/atrous_tune.rs`; one untextured
+//!   scene, so they are a starting point rather than a fit.
 //! - **One exponential.** `c_w·n_w·p_w` is computed as `exp(−(d_c + d_n + d_p))`, equal to the
 //!   product of the clamped factors up to rounding since each `d ≥ 0`, with a polynomial `exp`
 //!   of relative error below 4·10⁻⁷.
@@ -127,13 +137,20 @@ pub struct Atrous {
 }
 
 impl Atrous {
-    /// From spec options (defaults in brackets): `iterations` [5], 1–10; the weights `colour`,
-    /// `normal`, `position` [on]; `c_phi` [1], `n_phi` [0.1], `p_phi` [0.01], all positive;
-    /// `scale=relative|absolute` [relative]: c_phi and p_phi relative to the image (see the
-    /// module doc) or absolute; `halve=phi|sigma|none` [phi]; `demodulate=auto|on|off` [auto];
-    /// `split=none|direct-indirect|diffuse-glossy` [none], with `direct_iterations` [3] and
-    /// `indirect_iterations` [5], or `diffuse_iterations` [5] and `glossy_iterations` [2],
-    /// each 0–10; `simd=auto|off` [auto] (off runs the portable code, for comparisons).
+    /// From spec options, validated (see the module doc for their meaning):
+    ///
+    /// | key | values | default |
+    /// |---|---|---|
+    /// | `iterations` | 1–10 | 5 |
+    /// | `colour`, `normal`, `position` (the weights) | on, off | on |
+    /// | `c_phi`, `n_phi`, `p_phi` | positive | 4, 0.01, 0.001 |
+    /// | `scale` (of c_phi and p_phi) | relative, absolute | relative |
+    /// | `halve` | phi, sigma, none | phi |
+    /// | `demodulate` | auto, on, off | auto |
+    /// | `split` | none, direct-indirect, diffuse-glossy | none |
+    /// | `direct_iterations`, `indirect_iterations` (direct-indirect) | 0–10 | 3, 5 |
+    /// | `diffuse_iterations`, `glossy_iterations` (diffuse-glossy) | 0–10 | 5, 2 |
+    /// | `simd` (off: the portable code, for comparisons) | auto, off | auto |
     pub fn from_options(o: &mut Options) -> Result<Self, DenoiseError> {
         let iterations = o.usize("iterations", 5)?;
         if !(1..=MAX_ITERATIONS).contains(&iterations) {
@@ -155,9 +172,9 @@ impl Atrous {
                 Err(o.error(key, format!("must be positive, got {v}")))
             }
         };
-        let c_phi = phi(o, "c_phi", 1.0)?;
-        let n_phi = phi(o, "n_phi", 0.1)?;
-        let p_phi = phi(o, "p_phi", 0.01)?;
+        let c_phi = phi(o, "c_phi", 4.0)?;
+        let n_phi = phi(o, "n_phi", 0.01)?;
+        let p_phi = phi(o, "p_phi", 0.001)?;
         let relative = o.choice("scale", &["relative", "absolute"], "relative")? == "relative";
         let halve = match o.choice("halve", &["phi", "sigma", "none"], "phi")? {
             "sigma" => Halve::Sigma,

@@ -126,9 +126,9 @@ impl<'a> Runs<'a> {
     #[inline(always)]
     fn at<const N: bool, const P: bool>(&self, x: usize) -> Px {
         let mut v = [0.0; 9];
-        for k in 0..9 {
+        for (k, (v, run)) in v.iter_mut().zip(self.0).enumerate() {
             if used::<N, P>(k) {
-                v[k] = self.0[k][x];
+                *v = run[x];
             }
         }
         v
@@ -139,9 +139,9 @@ impl<'a> Runs<'a> {
     #[inline(always)]
     fn window<const N: bool, const P: bool>(&self, start: usize, n: usize) -> Self {
         let mut out: [&[f32]; 9] = [&[]; 9];
-        for k in 0..9 {
+        for (k, (o, run)) in out.iter_mut().zip(self.0).enumerate() {
             if used::<N, P>(k) {
-                out[k] = &self.0[k][start..start + n];
+                *o = &run[start..start + n];
             }
         }
         Self(out)
