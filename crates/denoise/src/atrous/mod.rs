@@ -15,8 +15,8 @@
 //! ```
 //!
 //! The last level is the output (the detail coefficients are dropped). Levels ping-pong between
-//! two buffers; rows run in parallel (same bits on any thread count); see [`pass`](self) for the
-//! inner loop and its AVX2 build.
+//! two buffers; rows run in parallel (same bits on any thread count); the submodules `pass`
+//! (the inner loop) and `simd` (its AVX2 build) say how.
 //!
 //! Choices and deviations (the thesis leaves these open or is ambiguous):
 //! - **Borders.** Taps outside the image read the nearest edge pixel (clamp to edge, as the
@@ -26,22 +26,24 @@
 //!   `|c|²` over the signal being filtered (per part): the thesis starts σ_rt at the buffer's
 //!   maximum (HDR) intensity so that level 0 is driven by the normal and position weights; the
 //!   percentile keeps a few fireflies from deciding it. The default 4 (σ twice the percentile
-//!   intensity) was the best of 0.25–64 on the Cornell box at 1 spp (relMSE 0.0042 against
-//!   0.016 at 1 and 0.068 at 0.25) and within 3 % of the best at 4 spp.
+//!   intensity) is a compromise: of 0.25–64 on the Cornell box it was best at 4 spp (relMSE
+//!   0.00161; 0.00167 at 1, 0.00172 at 64), while 1 spp wanted larger values (0.0042 at 4,
+//!   0.0033 at 64, 0.016 at 1, 0.068 at 0.25).
 //! - **Halving** (errata §6.2): `halve=phi` (default) divides c_phi by 2 per level,
 //!   `halve=sigma` divides σ by 2 (c_phi by 4), `halve=none` keeps it. `phi` was better at
-//!   1 spp, `sigma` at 4 spp (relMSE 0.0014 against 0.0016).
+//!   1 spp (relMSE 0.0042 against 0.0046), `sigma` at 4 spp (0.0014 against 0.0016).
 //! - **p_phi** is relative to the squared diagonal of the position buffer's bounding box
 //!   (`scale=relative`), so the result does not change when the scene is scaled (seed 002
-//!   claim 17). Default 0.001: a neighbour 3 % of the scene's extent away gets `exp(−1)`; at
-//!   512 pixels across, taps 16 pixels apart on a wall facing the camera keep about 0.4. Of
-//!   0.01, 0.001 and 0.0001 it was best at 1 spp and close to best at 4 spp.
+//!   claim 17). Default 0.001: a neighbour 3 % of the scene's extent away gets `exp(−1)`; taps
+//!   16 pixels apart on a surface that spans 512 pixels and the whole extent keep
+//!   `exp(−(1/32)²/0.001)` ≈ 0.38. Of 0.01, 0.001 and 0.0001 it was best at 1 spp and
+//!   within 10 % of the best at 4 spp.
 //! - **n_phi** default 0.01 (normals are unit vectors, no scaling). The shader divides `|Δn|²`
 //!   by `stepwidth²`, so the normal weight tests the normals' gradient: a smooth curve whose
 //!   normal turns by 0.1 rad per pixel keeps `exp(−1)` at every level, while a 90° crease
 //!   (`|Δn|² = 2`) gets `exp(−200)` at level 0 but 0.46 at level 4. Values of 0.1–0.5 leave
-//!   the crease at ≥ 0.73 from level 3 on and scored worse (relMSE 0.0034 against 0.0030 at
-//!   4 spp); 0.01 and 0.001 were equal.
+//!   the crease at ≥ 0.73 from level 3 on and scored worse (relMSE 0.00186 against 0.00167 at
+//!   4 spp); 0.01 and 0.001 were within 1 %.
 //! - The defaults were chosen on `scenes/cornell-box.toml` (512², path tracer, `--aov
 //!   denoise`, 1 and 4 spp) against 256 spp, with `examples/atrous_tune.rs`; one untextured
 //!   scene, so they are a starting point rather than a fit.
@@ -340,7 +342,7 @@ impl Atrous {
         position: &Planes,
     ) -> Planes {
         let isa = Isa::detect(self.simd);
-        let c_scale = if self.relative {
+        let c_scale = if self.relative && self.weights.colour {
             colour_scale(&signal)
         } else {
             1.0
