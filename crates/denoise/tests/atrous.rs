@@ -393,6 +393,25 @@ fn non_finite_input_gives_finite_output() {
 }
 
 #[test]
+fn tiny_and_empty_frames_keep_their_size() {
+    for (w, h) in [(0, 0), (0, 3), (3, 0), (1, 1), (1, 7), (2, 2)] {
+        let f = noisy(w, h);
+        for spec in [
+            "atrous",
+            "atrous:iterations=10:halve=none",
+            "atrous:split=none:demodulate=off",
+        ] {
+            let out = run(spec, &f);
+            assert_eq!(out.size(), (w, h), "{spec}");
+            if w * h == 1 {
+                // 25 taps of the one pixel, normalised: equal up to rounding.
+                assert!(max_diff(&out, &f.colour) < 1e-5, "{spec}");
+            }
+        }
+    }
+}
+
+#[test]
 fn missing_channels_are_one_frame_error_naming_the_channel() {
     let missing = |spec: &str, f: &NoisyFrame| match build(spec).denoise(f) {
         Err(DenoiseError::Frame(FrameError::Missing { channel, .. })) => channel,

@@ -200,7 +200,7 @@ fn span_clamped<const C: bool, const N: bool, const P: bool>(
     }
 }
 
-/// Filters output row `y` into `out` (`3·width` values) with `cum` (`width` values) as scratch.
+/// Filters output row `y` into `out` (`3·stride` values) with `cum` (`width` values) as scratch.
 #[inline(always)]
 pub(crate) fn row<const C: bool, const N: bool, const P: bool>(
     inp: &Inputs<'_>,
@@ -214,10 +214,12 @@ pub(crate) fn row<const C: bool, const N: bool, const P: bool>(
     };
     let lv = inp.level;
     let (w, h) = (inp.colour.width, inp.colour.height);
+    let stride = inp.colour.stride;
     out.fill(0.0);
     cum.fill(0.0);
-    let (or, rest) = out.split_at_mut(w);
-    let (og, ob) = rest.split_at_mut(w);
+    let (or, rest) = out.split_at_mut(stride);
+    let (og, ob) = rest.split_at_mut(stride);
+    let (or, og, ob) = (&mut or[..w], &mut og[..w], &mut ob[..w]);
     let centre = Runs::of::<N, P>(inp, y);
     let mut x0 = 0;
     while x0 < w {

@@ -48,12 +48,12 @@ pub(crate) fn pass(inp: &Inputs<'_>, dst: &mut Planes, wts: Weights, isa: Isa) {
 }
 
 fn rows<const C: bool, const N: bool, const P: bool>(inp: &Inputs<'_>, dst: &mut Planes, isa: Isa) {
-    let w = dst.width;
+    let (w, stride) = (dst.width, dst.stride);
     if w == 0 {
         return;
     }
     dst.data
-        .par_chunks_mut(3 * w)
+        .par_chunks_mut(3 * stride)
         .enumerate()
         // One scratch row per rayon job, not per row or pixel.
         .for_each_init(
