@@ -8,7 +8,7 @@
 
 #[cfg(feature = "oidn")]
 use crate::Oidn;
-use crate::{BoxBlur, DenoiseError, Denoiser, Gaussian, GuidedFilter, JointBilateral, Nlm};
+use crate::{Atrous, BoxBlur, DenoiseError, Denoiser, Gaussian, GuidedFilter, JointBilateral, Nlm};
 use std::fmt;
 use std::str::FromStr;
 
@@ -26,6 +26,8 @@ pub enum DenoiserKind {
     Nlm,
     /// [`GuidedFilter`].
     Guided,
+    /// [`Atrous`].
+    Atrous,
     /// `Oidn` (Open Image Denoise; only in builds with the `oidn` feature).
     #[cfg(feature = "oidn")]
     Oidn,
@@ -39,6 +41,7 @@ impl DenoiserKind {
         DenoiserKind::Bilateral,
         DenoiserKind::Nlm,
         DenoiserKind::Guided,
+        DenoiserKind::Atrous,
         #[cfg(feature = "oidn")]
         DenoiserKind::Oidn,
     ];
@@ -51,6 +54,7 @@ impl DenoiserKind {
             DenoiserKind::Bilateral => "bilateral",
             DenoiserKind::Nlm => "nlm",
             DenoiserKind::Guided => "guided",
+            DenoiserKind::Atrous => "atrous",
             #[cfg(feature = "oidn")]
             DenoiserKind::Oidn => "oidn",
         }
@@ -90,6 +94,7 @@ impl DenoiserSpec {
             DenoiserKind::Bilateral => Box::new(JointBilateral::from_options(&mut o)?),
             DenoiserKind::Nlm => Box::new(Nlm::from_options(&mut o)?),
             DenoiserKind::Guided => Box::new(GuidedFilter::from_options(&mut o)?),
+            DenoiserKind::Atrous => Box::new(Atrous::from_options(&mut o)?),
             #[cfg(feature = "oidn")]
             DenoiserKind::Oidn => Box::new(Oidn::from_options(&mut o)?),
         };
