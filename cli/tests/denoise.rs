@@ -102,4 +102,33 @@ fn saved_frames_denoise_like_the_library_and_bad_input_is_one_line() {
     ));
     assert!(err.contains("gone.exr"), "{err}");
     assert!(!dir.join("x.exr").exists());
+
+    // A frame without a channel the denoiser reads: the file and the channel are named.
+    let out = render(
+        dir,
+        &["s.toml", "--spp", "2", "--aov", "albedo", "-o", "a.exr"],
+    );
+    assert!(out.status.success(), "{out:?}");
+    let err = one_error_line(&render(
+        dir,
+        &["denoise", "a.exr", "--denoiser", "atrous", "-o", "x.exr"],
+    ));
+    assert!(
+        err.contains("a.exr") && err.contains("needs the normal channel"),
+        "{err}"
+    );
+    assert!(!dir.join("x.exr").exists());
+    // With every channel it runs.
+    let out = render(
+        dir,
+        &[
+            "denoise",
+            "f.exr",
+            "--denoiser",
+            "atrous:split=direct-indirect",
+            "-o",
+            "x.png",
+        ],
+    );
+    assert!(out.status.success(), "{out:?}");
 }
