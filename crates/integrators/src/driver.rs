@@ -15,7 +15,7 @@
 use crate::{Ctx, Integrator, RayCounters, SampleAux};
 use rayon::prelude::*;
 use rt_core::{glam::Vec2, SampleStream, Sampler};
-use rt_film::Film;
+use rt_film::{Film, SampleRecords};
 use std::ops::Range;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
@@ -102,7 +102,8 @@ pub fn render_samples(
 ) -> RenderStats {
     let start = Instant::now();
     let discarded_before = film.discarded();
-    let want_first_hit = film.aovs().any_first_hit();
+    let keep_samples = film.buffers().samples;
+    let want_first_hit = film.aovs().any_first_hit() || keep_samples;
     let totals = Mutex::new(RayCounters::default());
     let rows_done = std::sync::atomic::AtomicU32::new(0);
     let camera = ctx.camera;
@@ -110,9 +111,16 @@ pub fn render_samples(
     let blurred = ctx.scene.is_motion_blurred(&camera.name);
     let camera_motion = ctx.scene.camera_motion(&camera.name);
     let (open, shutter) = (ctx.scene.time, ctx.scene.shutter);
-    film.stripes_mut(BAND_ROWS)
+    // Per-sample records: one slot per pass sample of every pixel, filled band by band
+    // alongside the film's stripes, so their order is fixed whatever the thread count.
+    let (w, h) = (film.width(), film.height());
+    let mut records = keep_samples.then(|| SampleRecords::pass(w, h, pass.indices.len() as u32));
+    let bands = records.as_mut().map(|r| r.bands_mut(BAND_ROWS));
+    let bands = bands.into_iter().flatten().map(Some).chain(std::iter::repeat_with(|| None));
+    let stripes: Vec<_> = film.stripes_mut(BAND_ROWS).into_iter().zip(bands).collect();
+    stripes
         .into_par_iter()
-        .for_each(|mut stripe| {
+        .for_each(|(mut stripe, mut record)| {
             let mut sampler = Sampler::with_stream(seed, pass.stream);
             let mut counters = RayCounters::default();
             for y in stripe.y0..stripe.y0 + stripe.rows() {
@@ -148,6 +156,13 @@ pub fn render_samples(
                         };
                         let l = integrator.li(ctx, ray, &mut sampler, &mut aux, &mut counters);
                         stripe.add_sample(x, y, i, l, aux.first_hit.as_ref());
+                        if let Some(r) = &mut record {
+                            let hit = aux.first_hit.as_ref();
+                            let coc = hit.map_or(camera.coc_at_infinity(), |h| {
+                                camera.signed_coc_px(h.position)
+                            });
+                            r.record(x, y, i - pass.indices.start, l, hit, coc);
+                        }
                     }
                 }
                 let done = rows_done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
@@ -155,6 +170,9 @@ pub fn render_samples(
             }
             *totals.lock().unwrap_or_else(|e| e.into_inner()) += counters;
         });
+    if let Some(r) = records {
+        film.add_sample_records(r);
+    }
     let rays = totals.into_inner().unwrap_or_else(|e| e.into_inner());
     let pixels = match &pass.pixels {
         Some(mask) => mask.iter().filter(|&&m| m).count() as u64,
