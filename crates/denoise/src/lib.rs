@@ -13,7 +13,10 @@
 //! `gaussian:sigma=4` and built, so a program using this crate offers the same choice as
 //! `render denoise --denoiser`.
 //!
-//! Depends on `rt-core` and `rt-film`.
+//! [`Sbmf`] (sample-based manifold filtering) filters per-sample records rather than a frame
+//! and has its own entry point, [`Sbmf::filter_samples`].
+//!
+//! Depends on `rt-core`, `rt-film` and `rayon`.
 //!
 //! ```
 //! use rt_denoise::{Denoiser, DenoiserSpec, NoisyFrame};
@@ -26,9 +29,11 @@
 #![forbid(unsafe_code)]
 
 mod box_blur;
+pub mod sbmf;
 pub mod spec;
 
 pub use box_blur::BoxBlur;
+pub use sbmf::{Sbmf, SbmfParams};
 pub use rt_film::{Channel, FrameError, NoisyFrame};
 pub use spec::{DenoiserKind, DenoiserSpec, Options};
 
