@@ -243,6 +243,91 @@ mod tests {
             .collect()
     }
 
+    /// A first hit at a random distance along the ray (misses in column 0), radiance from the
+    /// sampler: every record field depends on the pixel, the sample and the stream.
+    struct FakeHits;
+
+    impl Integrator for FakeHits {
+        fn name(&self) -> &str {
+            "fake-hits"
+        }
+
+        fn li(
+            &self,
+            _: &Ctx<'_>,
+            ray: Ray,
+            sampler: &mut Sampler,
+            aux: &mut SampleAux,
+            _: &mut RayCounters,
+        ) -> Rgb {
+            let t = 0.5 + 4.0 * sampler.next_1d();
+            if aux.want_first_hit && ray.dir.x > -0.3 {
+                aux.first_hit = Some(rt_film::FirstHit {
+                    albedo: Rgb::splat(sampler.next_1d()),
+                    normal: -ray.dir,
+                    depth: t,
+                    position: ray.at(t),
+                });
+            }
+            Rgb::splat(t)
+        }
+    }
+
+    fn records(threads: usize, passes: &[std::ops::Range<u32>]) -> rt_film::SampleRecords {
+        let scene = Scene::empty();
+        let accel = rt_accel::BruteForce::new(&scene.triangles);
+        let camera = Camera::look_at("c", Vec3::Z, Vec3::ZERO, Vec3::Y, 60.0, 7, 5, 0.1, 1.5);
+        let ctx = Ctx {
+            scene: &scene,
+            accel: &accel,
+            camera: &camera,
+        };
+        let buffers = rt_film::FilmBuffers::for_outputs(AovSet::default()).with_samples();
+        let mut film = Film::new(7, 5, buffers);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        for p in passes {
+            let pass = SamplePass {
+                indices: p.clone(),
+                stream: SampleStream::Render,
+                pixels: None,
+            };
+            pool.install(|| render_samples(&ctx, &FakeHits, &mut film, 3, &pass, &|_| {}));
+        }
+        let rec = film.take_sample_records().unwrap();
+        assert_eq!(film.sample_records().unwrap().len(), 0);
+        // The film's own mean is the mean of the recorded radiance.
+        let i = 2 * 7 + 3;
+        let r = rec.pixel_range(i);
+        let mean = rec.radiance()[r.clone()].iter().copied().sum::<Rgb>() / r.len() as f32;
+        assert!((film.pixel(3, 2).mean() - mean).abs().max_element() < 1e-5);
+        rec
+    }
+
+    #[test]
+    fn sample_records_are_the_same_for_any_thread_count_and_pass_split() {
+        let one = records(1, &[0..4]);
+        assert_eq!(one.len(), 7 * 5 * 4);
+        assert!((0..5).all(|y| (0..7).all(|x| one.count(x, y) == 4)));
+        assert_eq!(records(2, &[0..4]), one, "two threads");
+        assert_eq!(records(2, &[0..1, 1..4]), one, "two passes");
+        // Misses (left column) and hits both occur; misses carry the CoC at infinity.
+        let camera = Camera::look_at("c", Vec3::Z, Vec3::ZERO, Vec3::Y, 60.0, 7, 5, 0.1, 1.5);
+        let (hits, misses): (Vec<usize>, Vec<usize>) = (0..one.len()).partition(|&j| one.is_hit(j));
+        assert!(!hits.is_empty() && !misses.is_empty());
+        for &j in &misses {
+            assert_eq!(one.coc()[j], camera.coc_at_infinity());
+        }
+        for &j in &hits {
+            assert_eq!(one.coc()[j], camera.signed_coc_px(one.position()[j]));
+            let x = one.pixel()[j] % 7;
+            assert!(x > 0);
+        }
+        assert!(one.coc().iter().any(|&c| c < 0.0) && one.coc().iter().any(|&c| c > 0.0));
+    }
+
     #[test]
     fn only_thin_lens_cameras_draw_a_lens_sample() {
         for seed in [0, 7] {
