@@ -337,8 +337,14 @@ mod tests {
         let c = cam(0.2);
         let at = |z: f32| c.signed_coc_px(c.position + c.forward * z + c.right * 0.3);
         assert!(at(5.0).abs() < 1e-5, "{}", at(5.0));
-        assert!(at(4.0) < 0.0 && at(3.0) < at(4.0), "in front: negative, growing");
-        assert!(at(6.0) > 0.0 && at(9.0) > at(6.0), "behind: positive, growing");
+        assert!(
+            at(4.0) < 0.0 && at(3.0) < at(4.0),
+            "in front: negative, growing"
+        );
+        assert!(
+            at(6.0) > 0.0 && at(9.0) > at(6.0),
+            "behind: positive, growing"
+        );
         assert!(at(1e9) <= c.coc_at_infinity() && at(1e9) > 0.999 * c.coc_at_infinity());
         assert!(at(-1.0).is_finite() && at(-1.0) < 0.0);
         assert_eq!(cam(0.0).signed_coc_px(Vec3::new(0.0, 0.0, -10.0)), 0.0);
@@ -351,7 +357,10 @@ mod tests {
             c.project(q).unwrap()
         };
         let diameter = (through(0.2) - through(-0.2)).length();
-        assert!((diameter - 2.0 * c.signed_coc_px(p)).abs() < 1e-3, "{diameter}");
+        assert!(
+            (diameter - 2.0 * c.signed_coc_px(p)).abs() < 1e-3,
+            "{diameter}"
+        );
     }
 
     #[test]

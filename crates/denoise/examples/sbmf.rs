@@ -6,7 +6,7 @@
 //! ```text
 //! cargo run --release -p rt-denoise --example sbmf -- [--size 256x192] [--ref-spp 1024]
 //!     [--spp 4] [--timing-size 512x384] [--repeats 5] [--out DIR] [--params k=v:k=v]
-//!     [--ref-cache FILE.exr] [--no-timing]
+//!     [--ref-cache FILE.exr] [--no-timing | --timing-only]
 //! ```
 //!
 //! The quality run and the timing run are separate renders: the reference costs
@@ -15,7 +15,8 @@
 //! (`manifolds=7:sigma_spatial=12`). `--out` writes noisy, SBMF and reference PNGs.
 //! `--ref-cache` reads the reference from an EXR of the right size if there is one, and
 //! writes it there after rendering otherwise (the cache does not know the spp or the scene:
-//! delete it when they change). `--no-timing` stops after the quality run.
+//! delete it when they change). `--no-timing` stops after the quality run, `--timing-only`
+//! skips it (e.g. to count step B's instructions under callgrind).
 
 use rt_denoise::{Options, Sbmf};
 use rt_film::{AovSet, FilmBuffers, OutputOptions};
@@ -41,7 +42,10 @@ fn main() {
     let ref_spp: u32 = arg("--ref-spp", "1024").parse().expect("--ref-spp");
     let spp: u32 = arg("--spp", "4").parse().expect("--spp");
     let repeats: usize = arg("--repeats", "5").parse().expect("--repeats");
-    let out = args.iter().position(|a| a == "--out").and_then(|i| args.get(i + 1));
+    let out = args
+        .iter()
+        .position(|a| a == "--out")
+        .and_then(|i| args.get(i + 1));
     let given: Vec<(String, String)> = arg("--params", "")
         .split(':')
         .filter(|s| !s.is_empty())
@@ -57,24 +61,47 @@ fn main() {
     let integrator = PathIntegrator::new(5);
     let base = rt_testkit::shipped_scene("dof.toml");
 
-    // Quality.
+    if !args.iter().any(|a| a == "--timing-only") {
+        quality(&args, &sbmf, &integrator, &base, (w, h), spp, ref_spp, out);
+    }
+    if args.iter().any(|a| a == "--no-timing") {
+        return;
+    }
+    timing(&sbmf, &integrator, base, (tw, th), spp, repeats);
+}
+
+/// MSE and SSIM of the noisy image, SBMF and step A alone against the reference.
+#[allow(clippy::too_many_arguments)]
+fn quality(
+    args: &[String],
+    sbmf: &Sbmf,
+    integrator: &PathIntegrator,
+    base: &rt_core::Scene,
+    (w, h): (u32, u32),
+    spp: u32,
+    ref_spp: u32,
+    out: Option<&String>,
+) {
     let scene = base.clone().with_resolution(w, h);
     let r = Renderer::new(&scene);
     let t = Instant::now();
     let buffers = FilmBuffers::for_outputs(AovSet::default()).with_samples();
-    let (mut film, _) = r.render(&integrator, buffers, spp, 1);
+    let (mut film, _) = r.render(integrator, buffers, spp, 1);
     let render_s = t.elapsed().as_secs_f64();
     let records = film.take_sample_records().expect("records kept");
     let noisy = rt_core::Image::new(w as usize, h as usize, film.mean_image()).expect("size");
     let t = Instant::now();
-    let cache = args.iter().position(|a| a == "--ref-cache").and_then(|i| args.get(i + 1));
+    let cache = args
+        .iter()
+        .position(|a| a == "--ref-cache")
+        .and_then(|i| args.get(i + 1));
     let cached = cache
         .and_then(|c| rt_film::read_rgb(std::path::Path::new(c)).ok())
         .filter(|i| i.size() == (w as usize, h as usize));
     let reference = match cached {
         Some(img) => img,
         None => {
-            let (film, _) = r.render(&integrator, AovSet::default(), ref_spp, 2);
+            let (film, _) = r.render(integrator, AovSet::default(), ref_spp, 2);
             let img = rt_core::Image::new(w as usize, h as usize, film.mean_image()).expect("size");
             if let Some(c) = cache {
                 rt_film::write_rgb(std::path::Path::new(c), &img, &OutputOptions::default())
@@ -85,10 +112,14 @@ fn main() {
     };
     let ref_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let (colour, a_stats) = sbmf.step_a(&records, w as usize, h as usize).expect("step A");
+    let (colour, a_stats) = sbmf
+        .step_a(&records, w as usize, h as usize)
+        .expect("step A");
     let a_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let (filtered, b_stats) = sbmf.step_b(&records, &colour, w as usize, h as usize).expect("step B");
+    let (filtered, b_stats) = sbmf
+        .step_b(&records, &colour, w as usize, h as usize)
+        .expect("step B");
     let b_s = t.elapsed().as_secs_f64();
     let mse_in = rt_metrics::mse(&noisy, &reference).expect("mse");
     let mse_out = rt_metrics::mse(&filtered, &reference).expect("mse");
@@ -122,38 +153,67 @@ fn main() {
         let dir = std::path::Path::new(dir);
         std::fs::create_dir_all(dir).expect("out dir");
         let o = OutputOptions::default();
-        for (name, img) in [("noisy", &noisy), ("sbmf", &filtered), ("step-a", &step_a_img), ("reference", &reference)] {
+        for (name, img) in [
+            ("noisy", &noisy),
+            ("sbmf", &filtered),
+            ("step-a", &step_a_img),
+            ("reference", &reference),
+        ] {
             rt_film::write_rgb(&dir.join(format!("dof-{name}.png")), img, &o).expect("write");
         }
     }
+}
 
-    if args.iter().any(|a| a == "--no-timing") {
-        return;
-    }
-    // DoF-step time against the maximum CoC.
+/// Step B's time and SAT lookups for a maximum CoC of 4, 8 and 16 pixels.
+fn timing(
+    sbmf: &Sbmf,
+    integrator: &PathIntegrator,
+    base: rt_core::Scene,
+    (tw, th): (u32, u32),
+    spp: u32,
+    repeats: usize,
+) {
     let scene = base.with_resolution(tw, th);
     let r = Renderer::new(&scene);
     let buffers = FilmBuffers::for_outputs(AovSet::default()).with_samples();
-    let (mut film, _) = r.render(&integrator, buffers, spp, 1);
+    let (mut film, _) = r.render(integrator, buffers, spp, 1);
     let records = film.take_sample_records().expect("records kept");
-    let (colour, _) = sbmf.step_a(&records, tw as usize, th as usize).expect("step A");
+    let (colour, _) = sbmf
+        .step_a(&records, tw as usize, th as usize)
+        .expect("step A");
     println!("DoF step at {tw}x{th}, {spp} spp, min of {repeats} runs:");
-    let mut times = Vec::new();
-    for tau in [4.0f32, 8.0, 16.0] {
-        let mut p = sbmf.params().clone();
-        p.max_coc = tau;
-        let s = Sbmf::new(p).expect("params");
-        let mut best = f64::INFINITY;
-        let mut lookups = 0;
-        for _ in 0..repeats {
+    // The radii are interleaved within each round, so that a change of machine load during
+    // the measurement hits all three alike; each keeps its fastest run.
+    let taus = [4.0f32, 8.0, 16.0];
+    let filters: Vec<Sbmf> = taus
+        .iter()
+        .map(|&tau| {
+            let mut p = sbmf.params().clone();
+            p.max_coc = tau;
+            Sbmf::new(p).expect("params")
+        })
+        .collect();
+    let mut times = vec![f64::INFINITY; taus.len()];
+    let mut lookups = vec![0; taus.len()];
+    for _ in 0..repeats {
+        for (k, s) in filters.iter().enumerate() {
             let t = Instant::now();
-            let (_, st) = s.step_b(&records, &colour, tw as usize, th as usize).expect("step B");
-            best = best.min(t.elapsed().as_secs_f64());
-            lookups = st.sat_lookups;
+            let (_, st) = s
+                .step_b(&records, &colour, tw as usize, th as usize)
+                .expect("step B");
+            times[k] = times[k].min(t.elapsed().as_secs_f64());
+            lookups[k] = st.sat_lookups;
         }
-        times.push(best);
-        println!("  max CoC {tau:>4} px: {:.2} ms, {lookups} SAT lookups", best * 1e3);
     }
-    let (lo, hi) = times.iter().fold((f64::INFINITY, 0.0f64), |(a, b), &t| (a.min(t), b.max(t)));
+    for (k, tau) in taus.iter().enumerate() {
+        println!(
+            "  max CoC {tau:>4} px: {:.2} ms, {} SAT lookups",
+            times[k] * 1e3,
+            lookups[k]
+        );
+    }
+    let (lo, hi) = times
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(a, b), &t| (a.min(t), b.max(t)));
     println!("  spread (max/min - 1): {:.1}%", 100.0 * (hi / lo - 1.0));
 }

@@ -33,8 +33,8 @@ pub mod sbmf;
 pub mod spec;
 
 pub use box_blur::BoxBlur;
-pub use sbmf::{Sbmf, SbmfParams};
 pub use rt_film::{Channel, FrameError, NoisyFrame};
+pub use sbmf::{Sbmf, SbmfParams};
 pub use spec::{DenoiserKind, DenoiserSpec, Options};
 
 use rt_core::RgbImage;

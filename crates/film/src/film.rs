@@ -493,9 +493,7 @@ impl Film {
                 split: buffer(a.any_split(), n),
             },
             splats: SplatSums::default(),
-            samples: buffers
-                .samples
-                .then(|| SampleRecords::empty(width, height)),
+            samples: buffers.samples.then(|| SampleRecords::empty(width, height)),
             discarded: AtomicU64::new(0),
         }
     }

@@ -444,7 +444,7 @@ impl NoisyFrame {
                 _ => Err(format!(
                     "channel group '{}' is incomplete: it needs {}",
                     if prefix.is_empty() { "colour" } else { prefix },
-                    names.map(|n| full(n)).join(", ")
+                    names.map(full).join(", ")
                 )),
             }
         };

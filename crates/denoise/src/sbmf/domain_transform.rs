@@ -54,8 +54,8 @@ pub(crate) fn recursive_filter<const C: usize>(
     }
     let n = ITERATIONS as i32;
     for it in 0..ITERATIONS {
-        let sigma_i = sigma_s * 3f32.sqrt() * 2f32.powi(n - it as i32 - 1)
-            / (4f32.powi(n) - 1.0).sqrt();
+        let sigma_i =
+            sigma_s * 3f32.sqrt() * 2f32.powi(n - it as i32 - 1) / (4f32.powi(n) - 1.0).sqrt();
         let ln_a = -std::f32::consts::SQRT_2 / sigma_i;
         let weight = |d: Option<f32>| match d {
             Some(d) => (d * ln_a).exp(),
@@ -117,7 +117,9 @@ mod tests {
         recursive_filter(&mut imp, w, 3.0, None);
         assert!(imp[4 * w + 13][0] > 0.01 && imp[4 * w + 10][0] < 0.5);
         // A guide step between columns 10 and 11 stops the spread.
-        let guide: Vec<[f32; 1]> = (0..w * h).map(|i| [(i % w > 10) as u8 as f32 * 10.0]).collect();
+        let guide: Vec<[f32; 1]> = (0..w * h)
+            .map(|i| [(i % w > 10) as u8 as f32 * 10.0])
+            .collect();
         let d = distances(&guide, w, 3.0);
         let mut imp2 = vec![[0.0f32]; w * h];
         imp2[4 * w + 10] = [1.0];

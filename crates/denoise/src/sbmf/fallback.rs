@@ -11,7 +11,12 @@ use rt_film::SampleRecords;
 
 /// Per pixel, the mean radiance of all samples within the `(2r+1)²` box around it (zero if
 /// none).
-pub(crate) fn box_blurred_pixels(records: &SampleRecords, w: usize, h: usize, r: usize) -> Vec<Rgb> {
+pub(crate) fn box_blurred_pixels(
+    records: &SampleRecords,
+    w: usize,
+    h: usize,
+    r: usize,
+) -> Vec<Rgb> {
     let mut sums: Vec<[f32; 4]> = (0..w * h)
         .map(|i| {
             let mut s = [0.0f32; 4];
@@ -41,7 +46,13 @@ pub(crate) fn box_blurred_pixels(records: &SampleRecords, w: usize, h: usize, r:
 /// Box sums of radius `r` along rows (`horizontal`) or columns, clamped at the border.
 fn box_pass(v: &mut [[f32; 4]], w: usize, h: usize, r: usize, horizontal: bool) {
     let (n, lines) = if horizontal { (w, h) } else { (h, w) };
-    let idx = |line: usize, k: usize| if horizontal { line * w + k } else { k * w + line };
+    let idx = |line: usize, k: usize| {
+        if horizontal {
+            line * w + k
+        } else {
+            k * w + line
+        }
+    };
     let mut line_buf = vec![[0.0f32; 4]; n];
     for line in 0..lines {
         for (k, b) in line_buf.iter_mut().enumerate() {

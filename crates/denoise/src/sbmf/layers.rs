@@ -38,7 +38,9 @@ impl Layers {
             return 0;
         }
         let r = f as f32 * self.tau / self.n_f as f32;
-        ((std::f32::consts::PI.sqrt() * r - 1.0) * 0.5).round().max(0.0) as usize
+        ((std::f32::consts::PI.sqrt() * r - 1.0) * 0.5)
+            .round()
+            .max(0.0) as usize
     }
 
     /// The two nearest layers of a sample with signed CoC `coc` and the linear weight of the
@@ -46,7 +48,7 @@ impl Layers {
     #[inline]
     pub fn classify(&self, coc: f32) -> (usize, usize, f32) {
         let last = 2 * self.n_f;
-        if !(self.tau > 0.0) || !coc.is_finite() {
+        if self.tau.is_nan() || self.tau <= 0.0 || !coc.is_finite() {
             return (self.n_f, self.n_f, 0.0);
         }
         let u = (coc / self.tau * self.n_f as f32 + self.n_f as f32).clamp(0.0, last as f32);
@@ -65,7 +67,11 @@ impl Layers {
 /// other scales' weights are scaled to sum to 1 instead, so the weights are always a partition
 /// of unity (deviation: the thesis only says the weights normalise).
 #[inline]
-pub(crate) fn layer_weights(cov: &[f32; MAX_SCALES], scales: usize, own: usize) -> [f32; MAX_SCALES] {
+pub(crate) fn layer_weights(
+    cov: &[f32; MAX_SCALES],
+    scales: usize,
+    own: usize,
+) -> [f32; MAX_SCALES] {
     let mut w = [0.0; MAX_SCALES];
     let others: f32 = (0..scales).filter(|&f| f != own).map(|f| cov[f]).sum();
     let norm = if others > 1.0 { 1.0 / others } else { 1.0 };

@@ -36,7 +36,9 @@ pub(crate) fn build(
     // Node of every sample at the current level.
     let mut node = vec![0u32; guides.len()];
     let mut manifolds: Vec<Vec<Guide>> = Vec::with_capacity(count);
-    manifolds.push(cluster_mean(records, guides, &node, 0, width, sigma_s, None));
+    manifolds.push(cluster_mean(
+        records, guides, &node, 0, width, sigma_s, None,
+    ));
     let mut level_start = 0;
     while manifolds.len() < count {
         let level_end = manifolds.len();
@@ -62,7 +64,15 @@ pub(crate) fn build(
             .into_par_iter()
             .map(|c| {
                 let parent = &manifolds[(c - 1) / 2];
-                cluster_mean(records, guides, &node, c as u32, width, sigma_s, Some(parent))
+                cluster_mean(
+                    records,
+                    guides,
+                    &node,
+                    c as u32,
+                    width,
+                    sigma_s,
+                    Some(parent),
+                )
             })
             .collect();
         manifolds.extend(children);
@@ -123,15 +133,10 @@ fn dominant_direction(
         }
         let e = &eta[records.pixel()[j] as usize];
         let r: [f64; DIMS] = std::array::from_fn(|d| (g[d] - e[d]) as f64);
-        for a in 0..DIMS {
-            for b in a..DIMS {
-                cov[a][b] += r[a] * r[b];
+        for (row, ra) in cov.iter_mut().zip(&r) {
+            for (c, rb) in row.iter_mut().zip(&r) {
+                *c += ra * rb;
             }
-        }
-    }
-    for a in 0..DIMS {
-        for b in 0..a {
-            cov[a][b] = cov[b][a];
         }
     }
     // Start from the axis of largest variance, tilted towards all axes so that it is not
@@ -147,7 +152,7 @@ fn dominant_direction(
             next[a] = (0..DIMS).map(|b| cov[a][b] * v[b]).sum();
         }
         let len = next.iter().map(|x| x * x).sum::<f64>().sqrt();
-        if !(len > 1e-300) || !len.is_finite() {
+        if !len.is_finite() || len <= 1e-300 {
             break;
         }
         v = next.map(|x| x / len);

@@ -10,10 +10,10 @@
 //! Two steps, in sequence, because the lighting integral is nested inside the lens integral:
 //!
 //! - **Step A** (GI reconstruction, §4.2): sample-based adaptive manifolds. Guides
-//!   ([`guides`]) → manifold tree ([`manifolds`]) → splat and edge-aware blur ([`splat`],
-//!   [`domain_transform`]) → slice with the under-represented-sample fallback ([`slice`],
-//!   [`fallback`]). Every sample gets a filtered colour; samples are never merged per pixel.
-//! - **Step B** (depth of field, §4.3): the fast sweep-blur ([`sweep`], [`layers`], [`sat`])
+//!   (`guides`) → manifold tree (`manifolds`) → splat and edge-aware blur (`splat`,
+//!   `domain_transform`) → slice with the under-represented-sample fallback (`slice`,
+//!   `fallback`). Every sample gets a filtered colour; samples are never merged per pixel.
+//! - **Step B** (depth of field, §4.3): the fast sweep-blur (`sweep`, `layers`, `sat`)
 //!   redistributes those colours over the image by their CoC, at a cost independent of it.
 //!
 //! Deviations are listed in each step's module. The sample colour is not a guide (as in the
@@ -44,7 +44,9 @@ pub struct SbmfParams {
     /// Adaptive manifolds of step A, `2^h − 1` for tree height `h`: 1, 3, 7, 15 (the thesis'
     /// sweet spot, the default), 31 or 63.
     pub manifolds: usize,
-    /// Spatial standard deviation in pixels of step A's blur and of the manifolds' low-pass.
+    /// Spatial standard deviation in pixels of step A's blur and of the manifolds' low-pass
+    /// (default 8; on `scenes/dof.toml` at 256x192, 4–8 worked best and larger values flatten
+    /// the shading of curved surfaces: scale it with the resolution).
     pub sigma_spatial: f32,
     /// Standard deviation of the normal guide (unit normals).
     pub sigma_normal: f32,
@@ -67,7 +69,7 @@ impl Default for SbmfParams {
     fn default() -> Self {
         Self {
             manifolds: 15,
-            sigma_spatial: 16.0,
+            sigma_spatial: 8.0,
             sigma_normal: 0.25,
             sigma_position: 16.0,
             sigma_albedo: 0.1,
@@ -115,13 +117,20 @@ impl Sbmf {
         if !(1..=63).contains(&p.manifolds) || !(p.manifolds + 1).is_power_of_two() {
             return Err(param(
                 "manifolds",
-                format!("must be 2^h - 1 (1, 3, 7, 15, 31 or 63), got {}", p.manifolds),
+                format!(
+                    "must be 2^h - 1 (1, 3, 7, 15, 31 or 63), got {}",
+                    p.manifolds
+                ),
             ));
         }
         if !(p.sigma_spatial > 0.0 && p.sigma_spatial <= Self::MAX_SIGMA_SPATIAL) {
             return Err(param(
                 "sigma_spatial",
-                format!("must be in (0, {}], got {}", Self::MAX_SIGMA_SPATIAL, p.sigma_spatial),
+                format!(
+                    "must be in (0, {}], got {}",
+                    Self::MAX_SIGMA_SPATIAL,
+                    p.sigma_spatial
+                ),
             ));
         }
         for (name, v) in [
@@ -142,7 +151,11 @@ impl Sbmf {
         if p.fallback_radius > Self::MAX_FALLBACK_RADIUS {
             return Err(param(
                 "fallback_radius",
-                format!("must be at most {}, got {}", Self::MAX_FALLBACK_RADIUS, p.fallback_radius),
+                format!(
+                    "must be at most {}, got {}",
+                    Self::MAX_FALLBACK_RADIUS,
+                    p.fallback_radius
+                ),
             ));
         }
         if p.layers != 3 && p.layers != 7 {
@@ -151,7 +164,10 @@ impl Sbmf {
         if !(p.max_coc >= 0.0 && p.max_coc.is_finite()) {
             return Err(param(
                 "max_coc",
-                format!("must be finite and not negative (0: automatic), got {}", p.max_coc),
+                format!(
+                    "must be finite and not negative (0: automatic), got {}",
+                    p.max_coc
+                ),
             ));
         }
         let name = format!(

@@ -71,7 +71,10 @@ fn layer_weights_are_a_partition_of_unity_for_any_coverage() {
         let cov: [f32; MAX_SCALES] = std::array::from_fn(|_| rng.f32() * 0.9);
         let w = layer_weights(&cov, scales, own);
         let sum: f32 = w[..scales].iter().sum();
-        assert!((sum - 1.0).abs() < 1e-5, "{cov:?} own {own}: {w:?} sums to {sum}");
+        assert!(
+            (sum - 1.0).abs() < 1e-5,
+            "{cov:?} own {own}: {w:?} sums to {sum}"
+        );
         assert!(w.iter().all(|&x| x >= 0.0));
         let others: f32 = (0..scales).filter(|&f| f != own).map(|f| cov[f]).sum();
         if others <= 1.0 {
@@ -89,20 +92,33 @@ fn layer_weights_are_a_partition_of_unity_for_any_coverage() {
 fn an_in_focus_image_passes_through_step_b_unchanged() {
     let mut rng = Rng(2);
     let (w, h) = (23, 17);
-    let rec = sample_set(w, h, 4, |_, _, _| Rgb::new(rng.f32(), 3.0 * rng.f32(), 0.1), |_, _, _| 0.0);
+    let rec = sample_set(
+        w,
+        h,
+        4,
+        |_, _, _| Rgb::new(rng.f32(), 3.0 * rng.f32(), 0.1),
+        |_, _, _| 0.0,
+    );
     let colour = rec.radiance().to_vec();
     for layers in [3, 7] {
-        let (img, stats) = sbmf(layers, 0.0).step_b(&rec, &colour, w as usize, h as usize).unwrap();
+        let (img, stats) = sbmf(layers, 0.0)
+            .step_b(&rec, &colour, w as usize, h as usize)
+            .unwrap();
         assert_eq!(stats.tau, 0.0);
         for i in 0..(w * h) as usize {
             let r = rec.pixel_range(i);
             let mean = colour[r.clone()].iter().copied().sum::<Rgb>() / r.len() as f32;
             let got = img.pixels()[i];
-            assert!((got - mean).abs().max_element() <= 1e-6 * mean.max_element().max(1.0), "{i}: {got} vs {mean}");
+            assert!(
+                (got - mean).abs().max_element() <= 1e-6 * mean.max_element().max(1.0),
+                "{i}: {got} vs {mean}"
+            );
         }
     }
     // A set τ with every CoC zero: still all on the focal layer, which is not blurred.
-    let (img, _) = sbmf(7, 16.0).step_b(&rec, &colour, w as usize, h as usize).unwrap();
+    let (img, _) = sbmf(7, 16.0)
+        .step_b(&rec, &colour, w as usize, h as usize)
+        .unwrap();
     let r = rec.pixel_range(40);
     let mean = colour[r.clone()].iter().copied().sum::<Rgb>() / r.len() as f32;
     assert!((img.pixels()[40] - mean).abs().max_element() < 1e-6);
@@ -114,16 +130,27 @@ fn a_uniform_colour_stays_uniform_for_any_coc_distribution() {
     let (w, h) = (40, 30);
     for (seed, spread) in [(3, 2.0), (4, 10.0), (5, 40.0)] {
         let mut rng = Rng(seed);
-        let rec = sample_set(w, h, 4, |_, _, _| c, |x, _, _| {
-            // Depth bands plus noise: fronts, backs and the focal plane side by side.
-            let band = ((x / 7) % 3) as f32 - 1.0;
-            band * spread * rng.f32()
-        });
+        let rec = sample_set(
+            w,
+            h,
+            4,
+            |_, _, _| c,
+            |x, _, _| {
+                // Depth bands plus noise: fronts, backs and the focal plane side by side.
+                let band = ((x / 7) % 3) as f32 - 1.0;
+                band * spread * rng.f32()
+            },
+        );
         for layers in [3, 7] {
             let colour = rec.radiance().to_vec();
-            let (img, _) = sbmf(layers, 0.0).step_b(&rec, &colour, w as usize, h as usize).unwrap();
+            let (img, _) = sbmf(layers, 0.0)
+                .step_b(&rec, &colour, w as usize, h as usize)
+                .unwrap();
             for p in img.pixels() {
-                assert!((*p - c).abs().max_element() < 1e-5, "{p} vs {c} (spread {spread}, {layers} layers)");
+                assert!(
+                    (*p - c).abs().max_element() < 1e-5,
+                    "{p} vs {c} (spread {spread}, {layers} layers)"
+                );
             }
         }
     }
@@ -133,17 +160,35 @@ fn a_uniform_colour_stays_uniform_for_any_coc_distribution() {
 fn step_b_work_does_not_depend_on_the_circle_of_confusion() {
     let mut rng = Rng(6);
     let (w, h) = (48, 32);
-    let rec = sample_set(w, h, 4, |_, _, _| Rgb::splat(rng.f32()), |x, y, _| (x as f32 - 24.0) * 0.7 + y as f32 * 0.1);
+    let rec = sample_set(
+        w,
+        h,
+        4,
+        |_, _, _| Rgb::splat(rng.f32()),
+        |x, y, _| (x as f32 - 24.0) * 0.7 + y as f32 * 0.1,
+    );
     let colour = rec.radiance().to_vec();
     for layers in [3, 7] {
         let lookups: Vec<u64> = [1.0, 4.0, 8.0, 16.0]
             .iter()
-            .map(|&tau| sbmf(layers, tau).step_b(&rec, &colour, w as usize, h as usize).unwrap().1.sat_lookups)
+            .map(|&tau| {
+                sbmf(layers, tau)
+                    .step_b(&rec, &colour, w as usize, h as usize)
+                    .unwrap()
+                    .1
+                    .sat_lookups
+            })
             .collect();
         assert!(lookups[0] > 0);
-        assert!(lookups.iter().all(|&n| n == lookups[0]), "{layers} layers: {lookups:?}");
+        assert!(
+            lookups.iter().all(|&n| n == lookups[0]),
+            "{layers} layers: {lookups:?}"
+        );
         // Four lookups per box: every scale but 0, every layer, every pixel.
-        assert_eq!(lookups[0], (w * h) as u64 * layers as u64 * (layers as u64 / 2) * 4);
+        assert_eq!(
+            lookups[0],
+            (w * h) as u64 * layers as u64 * (layers as u64 / 2) * 4
+        );
     }
 }
 
@@ -159,11 +204,19 @@ fn defocus_spreads_a_bright_sample_by_its_coc_and_keeps_the_in_focus_one_sharp()
             w,
             h,
             2,
-            |x, y, _| if bright(x, y) { Rgb::splat(100.0) } else { Rgb::ZERO },
+            |x, y, _| {
+                if bright(x, y) {
+                    Rgb::splat(100.0)
+                } else {
+                    Rgb::ZERO
+                }
+            },
             |x, y, _| if bright(x, y) { coc } else { 0.0 },
         );
         let colour = rec.radiance().to_vec();
-        let (img, _) = sbmf(7, 6.0).step_b(&rec, &colour, w as usize, h as usize).unwrap();
+        let (img, _) = sbmf(7, 6.0)
+            .step_b(&rec, &colour, w as usize, h as usize)
+            .unwrap();
         let lit = img.pixels().iter().filter(|p| p.x > 1e-3).count();
         if want_spread {
             // Half-width round((√π·6 − 1)/2) = 5: an 11×11 box, 121 ≈ π·6² pixels.
@@ -203,18 +256,29 @@ fn noisy_two_region_set(w: u32, h: u32, spp: u32, seed: u64) -> (SampleRecords, 
                     } else {
                         Vec3::new(0.5, y as f32 * 0.01, x as f32 * 0.01)
                     },
-                    albedo: if left { Rgb::splat(0.8) } else { Rgb::splat(0.2) },
+                    albedo: if left {
+                        Rgb::splat(0.8)
+                    } else {
+                        Rgb::splat(0.2)
+                    },
                     coc: 0.0,
                 });
             }
         }
     }
-    let truth_img = (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).map(|(x, y)| truth(x, y)).collect();
+    let truth_img = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| truth(x, y))
+        .collect();
     (records(w, h, &v), truth_img)
 }
 
 fn mse(a: &[Rgb], b: &[Rgb]) -> f64 {
-    a.iter().zip(b).map(|(p, q)| ((*p - *q) * (*p - *q)).element_sum() as f64).sum::<f64>() / (3 * a.len()) as f64
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| ((*p - *q) * (*p - *q)).element_sum() as f64)
+        .sum::<f64>()
+        / (3 * a.len()) as f64
 }
 
 #[test]
@@ -227,14 +291,25 @@ fn sbmf_removes_most_of_the_noise_of_a_synthetic_sample_set_and_keeps_the_edge()
             rec.radiance()[r.clone()].iter().copied().sum::<Rgb>() / r.len() as f32
         })
         .collect();
-    let out = Sbmf::new(SbmfParams::default()).unwrap().filter_samples(&rec, w as usize, h as usize).unwrap();
+    let out = Sbmf::new(SbmfParams::default())
+        .unwrap()
+        .filter_samples(&rec, w as usize, h as usize)
+        .unwrap();
     let (before, after) = (mse(&noisy, &truth), mse(out.pixels(), &truth));
     assert!(after < 0.02 * before, "MSE {before} -> {after}");
     // The edge between the regions survives: a plain blur of the same reach would mix them.
     let blurred = fallback::box_blurred_pixels(&rec, w as usize, h as usize, 8);
-    assert!(after < 0.2 * mse(&blurred, &truth), "{after} vs box {}", mse(&blurred, &truth));
+    assert!(
+        after < 0.2 * mse(&blurred, &truth),
+        "{after} vs box {}",
+        mse(&blurred, &truth)
+    );
     // One manifold cannot follow both regions: the samples near the edge fall back to the box.
-    let one = Sbmf::new(SbmfParams { manifolds: 1, ..Default::default() }).unwrap();
+    let one = Sbmf::new(SbmfParams {
+        manifolds: 1,
+        ..Default::default()
+    })
+    .unwrap();
     let (_, stats) = one.step_a(&rec, w as usize, h as usize).unwrap();
     let out1 = one.filter_samples(&rec, w as usize, h as usize).unwrap();
     assert!(stats.fallbacks > 0 && mse(out1.pixels(), &truth) > 4.0 * after);
@@ -244,10 +319,18 @@ fn sbmf_removes_most_of_the_noise_of_a_synthetic_sample_set_and_keeps_the_edge()
 fn results_are_the_same_bits_on_one_and_two_threads() {
     let (rec, _) = noisy_two_region_set(37, 29, 3, 8);
     let run = |threads| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
         pool.install(|| {
             let s = sbmf(7, 0.0);
-            let colour = rec.radiance().iter().enumerate().map(|(j, c)| *c * (1.0 + j as f32 * 1e-3)).collect::<Vec<_>>();
+            let colour = rec
+                .radiance()
+                .iter()
+                .enumerate()
+                .map(|(j, c)| *c * (1.0 + j as f32 * 1e-3))
+                .collect::<Vec<_>>();
             let a = s.filter_samples(&rec, 37, 29).unwrap();
             // A non-trivial CoC for step B.
             let mut v: Vec<Sample> = (0..rec.len()).map(|j| rec.sample(j)).collect();
@@ -259,7 +342,12 @@ fn results_are_the_same_bits_on_one_and_two_threads() {
             (a, b)
         })
     };
-    let bits = |i: &RgbImage| i.pixels().iter().map(|p| p.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+    let bits = |i: &RgbImage| {
+        i.pixels()
+            .iter()
+            .map(|p| p.to_array().map(f32::to_bits))
+            .collect::<Vec<_>>()
+    };
     let (one, two) = (run(1), run(2));
     assert_eq!(bits(&one.0), bits(&two.0));
     assert_eq!(bits(&one.1), bits(&two.1));
@@ -269,17 +357,48 @@ fn results_are_the_same_bits_on_one_and_two_threads() {
 fn parameters_are_validated_and_inputs_checked() {
     let bad = |p: SbmfParams| Sbmf::new(p).unwrap_err().to_string();
     let d = SbmfParams::default;
-    assert!(bad(SbmfParams { manifolds: 4, ..d() }).contains("manifolds"));
-    assert!(bad(SbmfParams { manifolds: 0, ..d() }).contains("manifolds"));
+    assert!(bad(SbmfParams {
+        manifolds: 4,
+        ..d()
+    })
+    .contains("manifolds"));
+    assert!(bad(SbmfParams {
+        manifolds: 0,
+        ..d()
+    })
+    .contains("manifolds"));
     assert!(bad(SbmfParams { layers: 5, ..d() }).contains("layers: must be 3 or 7"));
-    assert!(bad(SbmfParams { sigma_spatial: 0.0, ..d() }).contains("sigma_spatial"));
-    assert!(bad(SbmfParams { sigma_normal: f32::NAN, ..d() }).contains("sigma_normal"));
-    assert!(bad(SbmfParams { max_coc: -1.0, ..d() }).contains("max_coc"));
-    assert!(bad(SbmfParams { fallback_radius: 65, ..d() }).contains("fallback_radius"));
+    assert!(bad(SbmfParams {
+        sigma_spatial: 0.0,
+        ..d()
+    })
+    .contains("sigma_spatial"));
+    assert!(bad(SbmfParams {
+        sigma_normal: f32::NAN,
+        ..d()
+    })
+    .contains("sigma_normal"));
+    assert!(bad(SbmfParams {
+        max_coc: -1.0,
+        ..d()
+    })
+    .contains("max_coc"));
+    assert!(bad(SbmfParams {
+        fallback_radius: 65,
+        ..d()
+    })
+    .contains("fallback_radius"));
     for m in [1, 3, 7, 15] {
-        assert!(Sbmf::new(SbmfParams { manifolds: m, ..d() }).is_ok());
+        assert!(Sbmf::new(SbmfParams {
+            manifolds: m,
+            ..d()
+        })
+        .is_ok());
     }
-    let given = [("manifolds".to_string(), "7".to_string()), ("layers".to_string(), "3".to_string())];
+    let given = [
+        ("manifolds".to_string(), "7".to_string()),
+        ("layers".to_string(), "3".to_string()),
+    ];
     let mut o = Options::new("sbmf", &given);
     let s = Sbmf::from_options(&mut o).unwrap();
     o.finish().unwrap();
@@ -287,7 +406,10 @@ fn parameters_are_validated_and_inputs_checked() {
     let rec = SampleRecords::empty(4, 3);
     let s = sbmf(7, 0.0);
     assert!(s.filter_samples(&rec, 3, 4).is_err(), "size mismatch");
-    assert_eq!(s.filter_samples(&rec, 4, 3).unwrap().pixels(), &[Rgb::ZERO; 12]);
+    assert_eq!(
+        s.filter_samples(&rec, 4, 3).unwrap().pixels(),
+        &[Rgb::ZERO; 12]
+    );
     assert!(s.step_b(&rec, &[Rgb::ONE], 4, 3).is_err(), "colour count");
 }
 
@@ -303,4 +425,3 @@ fn layers_classify_linearly_between_the_two_nearest() {
     assert_eq!((l.scale(0), l.scale(3), l.scale(6)), (3, 0, 3));
     assert_eq!(l.half_width(0), 0);
 }
-
