@@ -480,6 +480,25 @@ mod tests {
     }
 
     #[test]
+    fn a_film_keeps_records_only_when_asked_and_reports_their_memory() {
+        let plain = crate::Film::new(2, 2, crate::AovSet::default());
+        assert!(plain.sample_records().is_none() && plain.memory().samples.is_none());
+        let buffers = crate::FilmBuffers::for_outputs(crate::AovSet::default()).with_samples();
+        let mut film = crate::Film::new(2, 2, buffers);
+        assert_eq!(film.memory().samples, Some(5 * 8));
+        let mut pass = SampleRecords::pass(2, 2, 3);
+        for mut band in pass.bands_mut(1) {
+            let y = band.y0();
+            assert!(band.record(1, y, 0, Rgb::ONE, Some(&hit(1.0)), 0.5));
+        }
+        film.add_sample_records(pass);
+        assert_eq!(film.sample_records().unwrap().len(), 2);
+        assert_eq!(film.memory().samples, Some(2 * SAMPLE_RECORD_BYTES + 5 * 8));
+        film.add_sample_records(SampleRecords::pass(3, 2, 1));
+        assert_eq!(film.sample_records().unwrap().len(), 2, "wrong size: ignored");
+    }
+
+    #[test]
     fn from_samples_groups_by_pixel_keeping_order_and_refuses_bad_input() {
         let s = |pixel: u32, v: f32| Sample {
             pixel,
