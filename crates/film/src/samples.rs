@@ -12,7 +12,8 @@
 //! is a unit vector, so [`SampleRecords::is_hit`] tests it), zero albedo and position, and the
 //! circle of confusion of infinite depth ([`rt_core::Camera::coc_at_infinity`]: the largest
 //! positive value). The circle of confusion is in pixels, positive behind the focal plane, and
-//! zero for a pinhole camera. Samples the film drops (non-finite or negative radiance) are not
+//! zero for a pinhole camera; the render driver computes it with the scene's camera at rest
+//! (a camera moving during the shutter is not followed). Samples the film drops (non-finite or negative radiance) are not
 //! recorded either, so counts can be below the pass's samples per pixel.
 //!
 //! The render driver fills a pass ([`SampleRecords::pass`]: slots for `n` samples of every
@@ -495,7 +496,11 @@ mod tests {
         assert_eq!(film.sample_records().unwrap().len(), 2);
         assert_eq!(film.memory().samples, Some(2 * SAMPLE_RECORD_BYTES + 5 * 8));
         film.add_sample_records(SampleRecords::pass(3, 2, 1));
-        assert_eq!(film.sample_records().unwrap().len(), 2, "wrong size: ignored");
+        assert_eq!(
+            film.sample_records().unwrap().len(),
+            2,
+            "wrong size: ignored"
+        );
     }
 
     #[test]

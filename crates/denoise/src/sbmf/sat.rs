@@ -42,7 +42,10 @@ impl Sat {
     pub fn box_mean(&self, x: usize, y: usize, b: usize) -> [f32; 4] {
         let stride = self.w + 1;
         let (x0, y0) = (x.saturating_sub(b), y.saturating_sub(b));
-        let (x1, y1) = ((x + b + 1).min(self.w), (y + b + 1).min(self.h));
+        let (x1, y1) = (
+            x.saturating_add(b).saturating_add(1).min(self.w),
+            y.saturating_add(b).saturating_add(1).min(self.h),
+        );
         let (a, bb, c, d) = (
             self.t[y0 * stride + x0],
             self.t[y0 * stride + x1],

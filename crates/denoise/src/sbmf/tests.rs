@@ -424,4 +424,9 @@ fn layers_classify_linearly_between_the_two_nearest() {
     assert_eq!(l.classify(-100.0), (0, 1, 0.0));
     assert_eq!((l.scale(0), l.scale(3), l.scale(6)), (3, 0, 3));
     assert_eq!(l.half_width(0), 0);
+    // A huge τ (an outlier CoC sets it) clips every box to the image instead of overflowing.
+    let (rec, _) = noisy_two_region_set(8, 6, 2, 9);
+    let colour = rec.radiance().to_vec();
+    let (img, _) = sbmf(7, 1e30).step_b(&rec, &colour, 8, 6).unwrap();
+    assert!(img.pixels().iter().all(|p| p.is_finite()));
 }
