@@ -169,9 +169,9 @@ pub struct FilmBuffers {
     /// Sums and counts of the even- and odd-numbered samples (32 bytes per pixel).
     pub halves: bool,
     /// Every camera sample kept apart ([`SampleRecords`], 56 bytes per sample): radiance,
-    /// first-hit guides and circle of confusion, for sample-space filters (SBMF). The camera
-    /// -sample driver (`rt_integrators::render_samples`) fills them; light-path splats land on
-    /// no pixel's sample list and are not recorded.
+    /// first-hit guides and circle of confusion, for sample-space filters (SBMF). The render
+    /// driver (`rt_integrators::render_samples`) fills them from camera samples; light-path
+    /// splats belong to no pixel's samples and are not recorded.
     pub samples: bool,
 }
 
