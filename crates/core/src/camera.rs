@@ -150,6 +150,37 @@ impl Camera {
         1.0 / (image_area * cos * cos * cos)
     }
 
+    /// Signed circle of confusion of world point `p`, in pixels: the radius of the disc the
+    /// thin lens blurs `p` into on the image, positive behind the focal plane, negative in
+    /// front of it, zero on it and for a pinhole.
+    ///
+    /// With `z` the depth of `p` along the view axis, `z_f` the focus distance and `A` the lens
+    /// radius, the rays from the lens disc through `p` cross the focal plane in a disc of radius
+    /// `A·|z − z_f| / z` (similar triangles: the lens point `l` maps to `l·(1 − z_f/z)`). A pixel
+    /// on the focal plane is `z_f · 2·tan(fov/2) / height` wide, so the radius in pixels is
+    /// `A·(z − z_f)·height / (2·tan(fov/2)·z_f·z)`, signed by `z − z_f`. It tends to
+    /// [`Camera::coc_at_infinity`] far away; points at or behind the lens plane (`z ≤ 0`, which
+    /// no primary ray hits) get the value at `z = 10⁻⁶·z_f` so that the result stays finite.
+    pub fn signed_coc_px(&self, p: Vec3) -> f32 {
+        if self.is_pinhole() {
+            return 0.0;
+        }
+        let fd = self.focus_distance;
+        let z = (p - self.position).dot(self.forward);
+        let z = if z.is_nan() { fd } else { z.max(1e-6 * fd) };
+        self.coc_at_infinity() * (z - fd) / z
+    }
+
+    /// The signed circle of confusion in pixels of a point infinitely far away, the largest
+    /// positive value [`Camera::signed_coc_px`] approaches: `A·height / (2·tan(fov/2)·z_f)`
+    /// (zero for a pinhole). Samples that hit nothing (the environment) are given this.
+    pub fn coc_at_infinity(&self) -> f32 {
+        if self.is_pinhole() {
+            return 0.0;
+        }
+        self.aperture * self.height as f32 / (2.0 * self.tan_half * self.focus_distance)
+    }
+
     /// Raster position (x right, y down) of a world point seen through the pinhole, if it is in
     /// front of the camera. Used by tests and later by splatting integrators.
     pub fn project(&self, p: Vec3) -> Option<Vec2> {
@@ -299,6 +330,37 @@ mod tests {
         assert!(r.dir.y > 0.0 && r.dir.x.abs() < 1e-6);
         // Top edge is fov/2 above the axis.
         assert!((r.dir.y.atan2(-r.dir.z).to_degrees() - 20.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn circle_of_confusion_is_zero_in_focus_and_grows_signed_away_from_it() {
+        let c = cam(0.2);
+        let at = |z: f32| c.signed_coc_px(c.position + c.forward * z + c.right * 0.3);
+        assert!(at(5.0).abs() < 1e-5, "{}", at(5.0));
+        assert!(
+            at(4.0) < 0.0 && at(3.0) < at(4.0),
+            "in front: negative, growing"
+        );
+        assert!(
+            at(6.0) > 0.0 && at(9.0) > at(6.0),
+            "behind: positive, growing"
+        );
+        assert!(at(1e9) <= c.coc_at_infinity() && at(1e9) > 0.999 * c.coc_at_infinity());
+        assert!(at(-1.0).is_finite() && at(-1.0) < 0.0);
+        assert_eq!(cam(0.0).signed_coc_px(Vec3::new(0.0, 0.0, -10.0)), 0.0);
+        // The disc a thin lens actually draws: two lens points at the rim, seen from the
+        // pinhole, land `2·radius` pixels apart on the image.
+        let p = c.position + c.forward * 8.0;
+        let through = |lens_x: f32| {
+            let o = c.position + c.right * lens_x;
+            let q = o + (p - o) * (c.focus_distance / (p - o).dot(c.forward));
+            c.project(q).unwrap()
+        };
+        let diameter = (through(0.2) - through(-0.2)).length();
+        assert!(
+            (diameter - 2.0 * c.signed_coc_px(p)).abs() < 1e-3,
+            "{diameter}"
+        );
     }
 
     #[test]

@@ -19,6 +19,9 @@
 //! built on the shared [`blocks`] (separable Gaussian, summed-area-table box mean, per-offset
 //! patch distances), plus the [`BoxBlur`] baseline; [`Bank`] runs several on one frame.
 //!
+//! [`Sbmf`] (sample-based manifold filtering, Bauszat ch. 4) filters per-sample records rather
+//! than pixels; it reads them from a frame that carries them ([`Channel::Samples`]).
+//!
 //! Depends on `rt-core`, `rt-film` and rayon (rows in parallel, same bits on any pool). The
 //! optional feature `oidn` adds `Oidn`, Intel Open Image Denoise loaded at run time
 //! (`libloading`); the default build needs nothing native.
@@ -45,6 +48,7 @@ mod guided;
 mod nlm;
 #[cfg(feature = "oidn")]
 mod oidn;
+pub mod sbmf;
 pub mod spec;
 
 pub use atrous::{Atrous, Demodulate, Halve, Split};
@@ -57,6 +61,7 @@ pub use nlm::Nlm;
 #[cfg(feature = "oidn")]
 pub use oidn::{Oidn, OidnParams, OidnQuality, OIDN_LIB_DEFAULTS, OIDN_LIB_ENV};
 pub use rt_film::{Channel, FrameError, NoisyFrame};
+pub use sbmf::{Sbmf, SbmfParams};
 pub use spec::{DenoiserKind, DenoiserSpec, Options};
 
 use rt_core::RgbImage;

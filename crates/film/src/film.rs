@@ -3,6 +3,7 @@
 use crate::pixel::{
     add_m2, welford_on_sums, FeatureM2, FirstHit, HalfSums, LightSplit, MeanCount, PixelStats,
 };
+use crate::samples::SampleRecords;
 use crate::splat::{Splat, SplatSums};
 use rt_core::glam::Vec3;
 use rt_core::Rgb;
@@ -167,6 +168,11 @@ pub struct FilmBuffers {
     pub variance: bool,
     /// Sums and counts of the even- and odd-numbered samples (32 bytes per pixel).
     pub halves: bool,
+    /// Every camera sample kept apart ([`SampleRecords`], 56 bytes per sample): radiance,
+    /// first-hit guides and circle of confusion, for sample-space filters (SBMF). The render
+    /// driver (`rt_integrators::render_samples`) fills them from camera samples; light-path
+    /// splats belong to no pixel's samples and are not recorded.
+    pub samples: bool,
 }
 
 impl FilmBuffers {
@@ -176,6 +182,7 @@ impl FilmBuffers {
             aovs,
             variance: aovs.variance,
             halves: aovs.halves,
+            samples: false,
         }
     }
 
@@ -188,6 +195,12 @@ impl FilmBuffers {
     /// Also keep the even/odd half-buffers.
     pub fn with_halves(mut self) -> Self {
         self.halves = true;
+        self
+    }
+
+    /// Also keep every sample's record ([`Film::sample_records`]).
+    pub fn with_samples(mut self) -> Self {
+        self.samples = true;
         self
     }
 }
@@ -224,6 +237,8 @@ pub struct FilmMemory {
     pub split: Option<usize>,
     /// Light-path splat sums (allocated by the first splat).
     pub splats: Option<usize>,
+    /// Per-sample records and their per-pixel offsets.
+    pub samples: Option<usize>,
 }
 
 impl FilmMemory {
@@ -241,6 +256,7 @@ impl FilmMemory {
                 self.feature_variance,
                 self.split,
                 self.splats,
+                self.samples,
             ]
             .iter()
             .flatten()
@@ -303,6 +319,7 @@ pub struct Film {
     halves: Vec<HalfSums>,
     aov: AovBuffers,
     splats: SplatSums,
+    samples: Option<SampleRecords>,
     discarded: AtomicU64,
 }
 
@@ -478,6 +495,7 @@ impl Film {
                 split: buffer(a.any_split(), n),
             },
             splats: SplatSums::default(),
+            samples: buffers.samples.then(|| SampleRecords::empty(width, height)),
             discarded: AtomicU64::new(0),
         }
     }
@@ -516,6 +534,7 @@ impl Film {
             feature_variance: bytes(&self.aov.m2),
             split: bytes(&self.aov.split),
             splats: self.splats.bytes(),
+            samples: self.samples.as_ref().map(SampleRecords::memory_bytes),
         }
     }
 
@@ -616,6 +635,30 @@ impl Film {
             .splats
             .add(n, self.buffers.halves, index, paths, splats);
         self.discarded.fetch_add(dropped, Ordering::Relaxed);
+    }
+
+    /// Appends a render pass's sample records (same size as the film; its unfilled slots are
+    /// dropped) after the samples already kept, pixel by pixel; ignored unless the film keeps
+    /// samples ([`FilmBuffers::samples`]).
+    pub fn add_sample_records(&mut self, pass: SampleRecords) {
+        if let Some(r) = &mut self.samples {
+            if (pass.width(), pass.height()) == (self.width, self.height) {
+                r.append(pass);
+            }
+        }
+    }
+
+    /// Every camera sample's record, grouped by pixel; `None` unless the film keeps them.
+    pub fn sample_records(&self) -> Option<&SampleRecords> {
+        self.samples.as_ref()
+    }
+
+    /// Moves the sample records out (leaving none), to filter them without a copy.
+    pub fn take_sample_records(&mut self) -> Option<SampleRecords> {
+        let (w, h) = (self.width, self.height);
+        self.samples
+            .as_mut()
+            .map(|r| std::mem::replace(r, SampleRecords::empty(w, h)))
     }
 
     /// Light paths taken so far (the splats' divisor).

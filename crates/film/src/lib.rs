@@ -5,8 +5,9 @@
 //! pixel); the Welford `M2` for the variance of the mean (12 bytes); the two half-buffers of
 //! even- and odd-numbered samples that the thesis' stopping criterion (Dammertz §6.2) and the
 //! error estimators of the denoisers compare (32 bytes); each first-hit AOV (albedo, shading
-//! normal, depth, world position) and their shared hit count. [`Film::memory`] reports what is
-//! held. Nothing non-finite ever enters a buffer: such samples are counted and dropped.
+//! normal, depth, world position) and their shared hit count; and, for sample-space filters,
+//! every sample kept apart ([`SampleRecords`], 56 bytes per sample). [`Film::memory`] reports
+//! what is held. Nothing non-finite ever enters a buffer: such samples are counted and dropped.
 //!
 //! Light paths land on any pixel: their [`Splat`]s are summed apart (in `f64`, allocated at the
 //! first splat) and divided by the number of light paths taken; the image is the camera
@@ -38,6 +39,7 @@ pub mod input;
 mod noisy_frame;
 pub mod output;
 mod pixel;
+pub mod samples;
 mod splat;
 pub mod stopping;
 
@@ -51,4 +53,5 @@ pub use output::{
     OutputOptions,
 };
 pub use pixel::{FirstHit, HalfSums, LightSplit, PixelStats};
+pub use samples::{Sample, SampleBand, SampleRecords, SampleRecordsError};
 pub use splat::Splat;

@@ -15,7 +15,7 @@
 use crate::{Ctx, Integrator, RayCounters, SampleAux};
 use rayon::prelude::*;
 use rt_core::{glam::Vec2, SampleStream, Sampler};
-use rt_film::Film;
+use rt_film::{Film, SampleRecords};
 use std::ops::Range;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
@@ -102,16 +102,28 @@ pub fn render_samples(
 ) -> RenderStats {
     let start = Instant::now();
     let discarded_before = film.discarded();
-    let want_first_hit = film.aovs().any_first_hit();
+    let keep_samples = film.buffers().samples;
+    let want_first_hit = film.aovs().any_first_hit() || keep_samples;
     // Callers refuse split AOVs for integrators that cannot write them; this keeps a film's
     // split sums from being filled with zeros if one slips through.
     let want_split = film.aovs().any_split() && integrator.writes_split();
     let totals = Mutex::new(RayCounters::default());
     let rows_done = std::sync::atomic::AtomicU32::new(0);
     let camera = CameraSampling::new(ctx);
-    film.stripes_mut(BAND_ROWS)
+    // Per-sample records: one slot per pass sample of every pixel, filled band by band
+    // alongside the film's stripes, so their order is fixed whatever the thread count.
+    let (w, h) = (film.width(), film.height());
+    let mut records = keep_samples.then(|| SampleRecords::pass(w, h, pass.indices.len() as u32));
+    let bands = records.as_mut().map(|r| r.bands_mut(BAND_ROWS));
+    let bands = bands
+        .into_iter()
+        .flatten()
+        .map(Some)
+        .chain(std::iter::repeat_with(|| None));
+    let stripes: Vec<_> = film.stripes_mut(BAND_ROWS).into_iter().zip(bands).collect();
+    stripes
         .into_par_iter()
-        .for_each(|mut stripe| {
+        .for_each(|(mut stripe, mut record)| {
             let mut sampler = Sampler::with_stream(seed, pass.stream);
             let mut counters = RayCounters::default();
             for y in stripe.y0..stripe.y0 + stripe.rows() {
@@ -137,6 +149,13 @@ pub fn render_samples(
                         );
                         let split = want_split.then_some(&aux.split);
                         stripe.add_sample_split(x, y, i, l, aux.first_hit.as_ref(), split);
+                        if let Some(r) = &mut record {
+                            let hit = aux.first_hit.as_ref();
+                            let coc = hit.map_or(ctx.camera.coc_at_infinity(), |h| {
+                                ctx.camera.signed_coc_px(h.position)
+                            });
+                            r.record(x, y, i - pass.indices.start, l, hit, coc);
+                        }
                     }
                 }
                 let done = rows_done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
@@ -144,6 +163,9 @@ pub fn render_samples(
             }
             *totals.lock().unwrap_or_else(|e| e.into_inner()) += counters;
         });
+    if let Some(r) = records {
+        film.add_sample_records(r);
+    }
     let rays = totals.into_inner().unwrap_or_else(|e| e.into_inner());
     let pixels = match &pass.pixels {
         Some(mask) => mask.iter().filter(|&&m| m).count() as u64,
@@ -338,6 +360,92 @@ mod tests {
                 Rgb::splat(s.next_1d())
             })
             .collect()
+    }
+
+    /// A first hit at a random distance along the ray (misses in column 0), radiance from the
+    /// sampler: every record field depends on the pixel, the sample and the stream.
+    struct FakeHits;
+
+    impl Integrator for FakeHits {
+        fn name(&self) -> &str {
+            "fake-hits"
+        }
+
+        fn li(
+            &self,
+            _: &Ctx<'_>,
+            ray: Ray,
+            sampler: &mut Sampler,
+            aux: &mut SampleAux,
+            _: &mut RayCounters,
+        ) -> Rgb {
+            let t = 0.5 + 4.0 * sampler.next_1d();
+            if aux.want_first_hit && ray.dir.x > -0.3 {
+                aux.first_hit = Some(rt_film::FirstHit {
+                    albedo: Rgb::splat(sampler.next_1d()),
+                    normal: -ray.dir,
+                    depth: t,
+                    position: ray.at(t),
+                });
+            }
+            Rgb::splat(t)
+        }
+    }
+
+    /// Records of the sample indices between consecutive `bounds`, one pass per pair.
+    fn records(threads: usize, bounds: &[u32]) -> rt_film::SampleRecords {
+        let scene = Scene::empty();
+        let accel = rt_accel::BruteForce::new(&scene.triangles);
+        let camera = Camera::look_at("c", Vec3::Z, Vec3::ZERO, Vec3::Y, 60.0, 7, 5, 0.1, 1.5);
+        let ctx = Ctx {
+            scene: &scene,
+            accel: &accel,
+            camera: &camera,
+        };
+        let buffers = rt_film::FilmBuffers::for_outputs(AovSet::default()).with_samples();
+        let mut film = Film::new(7, 5, buffers);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        for p in bounds.windows(2) {
+            let pass = SamplePass {
+                indices: p[0]..p[1],
+                stream: SampleStream::Render,
+                pixels: None,
+            };
+            pool.install(|| render_samples(&ctx, &FakeHits, &mut film, 3, &pass, &|_| {}));
+        }
+        let rec = film.take_sample_records().unwrap();
+        assert_eq!(film.sample_records().unwrap().len(), 0);
+        // The film's own mean is the mean of the recorded radiance.
+        let i = 2 * 7 + 3;
+        let r = rec.pixel_range(i);
+        let mean = rec.radiance()[r.clone()].iter().copied().sum::<Rgb>() / r.len() as f32;
+        assert!((film.pixel(3, 2).mean() - mean).abs().max_element() < 1e-5);
+        rec
+    }
+
+    #[test]
+    fn sample_records_are_the_same_for_any_thread_count_and_pass_split() {
+        let one = records(1, &[0, 4]);
+        assert_eq!(one.len(), 7 * 5 * 4);
+        assert!((0..5).all(|y| (0..7).all(|x| one.count(x, y) == 4)));
+        assert_eq!(records(2, &[0, 4]), one, "two threads");
+        assert_eq!(records(2, &[0, 1, 4]), one, "two passes");
+        // Misses (left column) and hits both occur; misses carry the CoC at infinity.
+        let camera = Camera::look_at("c", Vec3::Z, Vec3::ZERO, Vec3::Y, 60.0, 7, 5, 0.1, 1.5);
+        let (hits, misses): (Vec<usize>, Vec<usize>) = (0..one.len()).partition(|&j| one.is_hit(j));
+        assert!(!hits.is_empty() && !misses.is_empty());
+        for &j in &misses {
+            assert_eq!(one.coc()[j], camera.coc_at_infinity());
+        }
+        for &j in &hits {
+            assert_eq!(one.coc()[j], camera.signed_coc_px(one.position()[j]));
+            let x = one.pixel()[j] % 7;
+            assert!(x > 0);
+        }
+        assert!(one.coc().iter().any(|&c| c < 0.0) && one.coc().iter().any(|&c| c > 0.0));
     }
 
     #[test]
