@@ -143,6 +143,12 @@ pub struct Args {
     #[arg(long, value_name = "S", default_value_t = 0.0)]
     pub shutter: f64,
 
+    /// Denoise the image before writing it, e.g. `atrous`, `sbmf` (filters the samples, which
+    /// only a render has), `nlm:radius=5` (docs/denoising.md). The film keeps what the denoiser
+    /// reads; the output is the denoised image.
+    #[arg(long, value_name = "NAME[:options]", conflicts_with = "gree")]
+    pub denoiser: Option<String>,
+
     /// Denoise by GREE (Bauszat, thesis ch. 5): --spp is the budget b; render the noisy image
     /// at n = fraction x b spp, run the filter bank (--bank), render filter caches at a share
     /// 1 - sparsity of the pixels with independent samples, pick a filter per pixel by the

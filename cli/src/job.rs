@@ -282,9 +282,32 @@ fn render_one(
     let camera = pick_camera(scene, &job.scene_path, job.camera.as_deref())?;
     let build_secs = build_time.as_secs_f64();
     let integrator = job.settings.integrator.build();
-    // Only the buffers the outputs read: no variance or half-buffers unless asked for.
-    // The stopping criterion reads the even samples' half-buffer.
-    let mut buffers = FilmBuffers::for_outputs(job.settings.aovs);
+    let denoiser = match &args.denoiser {
+        None => None,
+        Some(text) => {
+            if job.settings.aovs != AovSet::default() {
+                bail!("--denoiser writes the denoised image only; save a noisy frame's AOVs with a render without it");
+            }
+            let d = text
+                .parse::<rt_denoise::DenoiserSpec>()
+                .and_then(|s| s.build())
+                .map_err(|e| anyhow::anyhow!("--denoiser {text}: {e}"))?;
+            Some(d)
+        }
+    };
+    let denoise_aovs = denoiser
+        .as_ref()
+        .map_or(AovSet::default(), |d| AovSet::for_channels(d.needs()));
+    if denoise_aovs.any_split() && !job.settings.integrator.kind.writes_split() {
+        bail!(
+            "--denoiser {}: it reads the lighting split, which the {} technique does not write",
+            args.denoiser.as_deref().unwrap_or_default(),
+            job.settings.integrator
+        );
+    }
+    // Only the buffers the outputs (and the denoiser) read: no variance or half-buffers unless
+    // asked for. The stopping criterion reads the even samples' half-buffer.
+    let mut buffers = FilmBuffers::for_outputs(job.settings.aovs.union(denoise_aovs));
     if job.stop.is_some_and(|s| s.error.is_some()) {
         buffers = buffers.with_halves();
     }
@@ -342,6 +365,36 @@ fn render_one(
     };
     bar.finish_and_clear();
 
+    if let Some(d) = &denoiser {
+        let t = Instant::now();
+        let frame = rt_film::NoisyFrame::from_film(&film, denoise_aovs);
+        let image = d
+            .denoise(&frame)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", job.scene_path.display()))?;
+        let denoise_time = t.elapsed();
+        rt_film::write_rgb(
+            &job.output,
+            &image,
+            &OutputOptions {
+                exposure: job.exposure,
+            },
+        )?;
+        if !job.quiet {
+            println!(
+                "{}: {}x{} {} spp {} ({:.2} s render), denoised by {} in {:.3} s -> {}",
+                job.scene_path.display(),
+                camera.width,
+                camera.height,
+                stats.samples / (camera.width as u64 * camera.height as u64).max(1),
+                integrator.name(),
+                stats.elapsed.as_secs_f64(),
+                d.name(),
+                denoise_time.as_secs_f64(),
+                job.output.display()
+            );
+        }
+        return Ok(());
+    }
     let t_write = Instant::now();
     let extra = match adaptive.as_ref() {
         Some(a) if job.settings.aovs.blocks => block_channels(a, &film),

@@ -44,7 +44,11 @@ fn saved_frames_denoise_like_the_library_and_bad_input_is_one_line() {
     );
     assert!(out.status.success(), "{out:?}");
     let frame = NoisyFrame::from_exr(&dir.join("f.exr")).unwrap();
-    assert_eq!(frame.channels(), Channel::ALL.to_vec());
+    let saved: Vec<Channel> = Channel::ALL
+        .into_iter()
+        .filter(|&c| c != Channel::Samples)
+        .collect();
+    assert_eq!(frame.channels(), saved);
     // The lighting split of a diffuse floor: no glossy light, and the parts add up.
     let c = frame.colour.pixels();
     let (e, di, ind) = (
@@ -118,6 +122,70 @@ fn saved_frames_denoise_like_the_library_and_bad_input_is_one_line() {
         "{err}"
     );
     assert!(!dir.join("x.exr").exists());
+    // SBMF filters samples, which no file holds: it runs while rendering, not on a saved frame.
+    let err = one_error_line(&render(
+        dir,
+        &["denoise", "f.exr", "--denoiser", "sbmf", "-o", "x.exr"],
+    ));
+    assert!(
+        err.contains("samples") && err.contains("--denoiser"),
+        "{err}"
+    );
+    let out = render(
+        dir,
+        &[
+            "s.toml",
+            "--spp",
+            "2",
+            "--denoiser",
+            "sbmf:manifolds=3",
+            "-o",
+            "s.exr",
+        ],
+    );
+    assert!(out.status.success(), "{out:?}");
+    let sbmf = rt_film::read_rgb(&dir.join("s.exr")).unwrap();
+    assert!(sbmf.pixels().iter().all(|p| p.is_finite()) && sbmf.pixels().iter().any(|p| p.x > 0.0));
+    // A render-time denoiser is the library's on the same film: same seed, same frame.
+    let out = render(
+        dir,
+        &[
+            "s.toml",
+            "--spp",
+            "4",
+            "--denoiser",
+            "box:radius=2",
+            "-o",
+            "b.exr",
+        ],
+    );
+    assert!(out.status.success(), "{out:?}");
+    let got = rt_film::read_rgb(&dir.join("b.exr")).unwrap();
+    let want = "box:radius=2"
+        .parse::<DenoiserSpec>()
+        .unwrap()
+        .build()
+        .unwrap();
+    assert_eq!(
+        got,
+        want.denoise(&NoisyFrame::new(
+            rt_film::read_rgb(&dir.join("f.exr")).unwrap()
+        ))
+        .unwrap()
+    );
+    let err = one_error_line(&render(
+        dir,
+        &[
+            "s.toml",
+            "--denoiser",
+            "atrous:split=direct-indirect",
+            "--integrator",
+            "ao",
+            "-o",
+            "y.exr",
+        ],
+    ));
+    assert!(err.contains("lighting split"), "{err}");
     // With every channel it runs.
     let out = render(
         dir,

@@ -8,7 +8,9 @@
 
 #[cfg(feature = "oidn")]
 use crate::Oidn;
-use crate::{Atrous, BoxBlur, DenoiseError, Denoiser, Gaussian, GuidedFilter, JointBilateral, Nlm};
+use crate::{
+    Atrous, BoxBlur, DenoiseError, Denoiser, Gaussian, GuidedFilter, JointBilateral, Nlm, Sbmf,
+};
 use std::fmt;
 use std::str::FromStr;
 
@@ -28,6 +30,8 @@ pub enum DenoiserKind {
     Guided,
     /// [`Atrous`].
     Atrous,
+    /// [`Sbmf`] (needs the frame's sample records).
+    Sbmf,
     /// `Oidn` (Open Image Denoise; only in builds with the `oidn` feature).
     #[cfg(feature = "oidn")]
     Oidn,
@@ -42,6 +46,7 @@ impl DenoiserKind {
         DenoiserKind::Nlm,
         DenoiserKind::Guided,
         DenoiserKind::Atrous,
+        DenoiserKind::Sbmf,
         #[cfg(feature = "oidn")]
         DenoiserKind::Oidn,
     ];
@@ -55,6 +60,7 @@ impl DenoiserKind {
             DenoiserKind::Nlm => "nlm",
             DenoiserKind::Guided => "guided",
             DenoiserKind::Atrous => "atrous",
+            DenoiserKind::Sbmf => "sbmf",
             #[cfg(feature = "oidn")]
             DenoiserKind::Oidn => "oidn",
         }
@@ -95,6 +101,7 @@ impl DenoiserSpec {
             DenoiserKind::Nlm => Box::new(Nlm::from_options(&mut o)?),
             DenoiserKind::Guided => Box::new(GuidedFilter::from_options(&mut o)?),
             DenoiserKind::Atrous => Box::new(Atrous::from_options(&mut o)?),
+            DenoiserKind::Sbmf => Box::new(Sbmf::from_options(&mut o)?),
             #[cfg(feature = "oidn")]
             DenoiserKind::Oidn => Box::new(Oidn::from_options(&mut o)?),
         };

@@ -45,6 +45,10 @@ pub struct AovSet {
     /// The stopping criterion's final blocks: per pixel its block's index, its sample count and
     /// whether the block met the threshold (an adaptive render's output, not a film buffer).
     pub blocks: bool,
+    /// Every camera sample's record (radiance, first-hit features, signed circle of
+    /// confusion), for SBMF. Kept in memory for a denoiser, never written to a file (so not a
+    /// `--aov` name).
+    pub samples: bool,
 }
 
 /// The names [`AovSet::parse_list`] knows, in the order help texts list them.
@@ -84,6 +88,7 @@ impl AovSet {
         glossy: true,
         irradiance: true,
         blocks: false,
+        samples: false,
     };
 
     /// True if any first-hit quantity is wanted (variance is not a first-hit quantity).
@@ -118,6 +123,7 @@ impl AovSet {
             glossy: self.glossy | o.glossy,
             irradiance: self.irradiance | o.irradiance,
             blocks: self.blocks | o.blocks,
+            samples: self.samples | o.samples,
         }
     }
 
@@ -182,7 +188,7 @@ impl FilmBuffers {
             aovs,
             variance: aovs.variance,
             halves: aovs.halves,
-            samples: false,
+            samples: aovs.samples,
         }
     }
 

@@ -17,7 +17,7 @@
 //! | lighting split | `emission.`, `direct.`, `indirect.`, `diffuse.`, `glossy.`, `irradiance.{R,G,B}` |
 
 use crate::output::{read_exr, write_exr_file, ExrImage};
-use crate::{AovSet, Film, FilmError, LightSplit};
+use crate::{AovSet, Film, FilmError, LightSplit, SampleRecords};
 use rt_core::glam::Vec3;
 use rt_core::{Image, Rgb};
 use std::fmt;
@@ -61,6 +61,8 @@ pub enum Channel {
     Glossy,
     /// Reflected light over albedo.
     Irradiance,
+    /// Every camera sample's record (for SBMF); held in memory, never in a file.
+    Samples,
 }
 
 /// Components of a three-component channel group, by kind.
@@ -69,7 +71,7 @@ const XYZ: [&str; 3] = ["X", "Y", "Z"];
 
 impl Channel {
     /// Every channel, in file order.
-    pub const ALL: [Channel; 17] = [
+    pub const ALL: [Channel; 18] = [
         Channel::Colour,
         Channel::Variance,
         Channel::Halves,
@@ -87,6 +89,7 @@ impl Channel {
         Channel::Diffuse,
         Channel::Glossy,
         Channel::Irradiance,
+        Channel::Samples,
     ];
 
     /// The channel's name in messages and the prefix of its EXR channels.
@@ -109,18 +112,37 @@ impl Channel {
             Channel::Diffuse => "diffuse",
             Channel::Glossy => "glossy",
             Channel::Irradiance => "irradiance",
+            Channel::Samples => "samples",
         }
     }
 
-    /// The `render --aov` name that writes this channel.
-    pub fn aov_name(self) -> &'static str {
+    /// How to get this channel into a frame, for error messages.
+    pub fn hint(self) -> &'static str {
         match self {
-            Channel::Colour => "(always written)",
+            Channel::Colour => "every frame has it",
+            Channel::Samples => {
+                "sample records are never saved to a file: denoise while rendering, render SCENE --denoiser ..."
+            }
             Channel::AlbedoVariance
             | Channel::NormalVariance
             | Channel::PositionVariance
-            | Channel::DepthVariance => "feature-variance",
-            c => c.name(),
+            | Channel::DepthVariance => {
+                "render it with --aov feature-variance and the feature, or --aov denoise for every channel"
+            }
+            Channel::Variance => "render it with --aov variance, or --aov denoise for every channel",
+            Channel::Halves => "render it with --aov halves, or --aov denoise for every channel",
+            Channel::Albedo => "render it with --aov albedo, or --aov denoise for every channel",
+            Channel::Normal => "render it with --aov normal, or --aov denoise for every channel",
+            Channel::Position => "render it with --aov position, or --aov denoise for every channel",
+            Channel::Depth => "render it with --aov depth, or --aov denoise for every channel",
+            Channel::Emission => "render it with --aov emission, or --aov denoise for every channel",
+            Channel::Direct => "render it with --aov direct, or --aov denoise for every channel",
+            Channel::Indirect => "render it with --aov indirect, or --aov denoise for every channel",
+            Channel::Diffuse => "render it with --aov diffuse, or --aov denoise for every channel",
+            Channel::Glossy => "render it with --aov glossy, or --aov denoise for every channel",
+            Channel::Irradiance => {
+                "render it with --aov irradiance, or --aov denoise for every channel"
+            }
         }
     }
 }
@@ -157,6 +179,7 @@ impl AovSet {
                 Channel::Diffuse => s.diffuse = true,
                 Channel::Glossy => s.glossy = true,
                 Channel::Irradiance => s.irradiance = true,
+                Channel::Samples => s.samples = true,
             }
         }
         s
@@ -168,7 +191,7 @@ impl AovSet {
 #[non_exhaustive]
 pub enum FrameError {
     /// A consumer needs a channel the frame lacks.
-    #[error("{consumer} needs the {channel} channel, which the frame does not have (render it with --aov {aov}, or --aov denoise for every channel)", aov = channel.aov_name())]
+    #[error("{consumer} needs the {channel} channel, which the frame does not have ({hint})", hint = channel.hint())]
     Missing {
         /// Who needs it (a denoiser's name).
         consumer: String,
@@ -226,6 +249,9 @@ pub struct NoisyFrame {
     pub glossy: Option<Image<Rgb>>,
     /// Reflected light over albedo.
     pub irradiance: Option<Image<Rgb>>,
+    /// Every camera sample's record, when the film kept them (never read from or written to a
+    /// file).
+    pub samples: Option<SampleRecords>,
 }
 
 /// A channel's data, by kind.
@@ -294,6 +320,7 @@ impl NoisyFrame {
             diffuse: part(aovs.diffuse, |s| s.diffuse),
             glossy: part(aovs.glossy, |s| s.glossy),
             irradiance: part(aovs.irradiance, |s| s.irradiance),
+            samples: film.sample_records().filter(|_| aovs.samples).cloned(),
         }
     }
 
@@ -327,6 +354,7 @@ impl NoisyFrame {
             Channel::Diffuse => three(&self.diffuse),
             Channel::Glossy => three(&self.glossy),
             Channel::Irradiance => three(&self.irradiance),
+            Channel::Samples => None,
         }
     }
 
@@ -345,15 +373,20 @@ impl NoisyFrame {
             Channel::Diffuse => &mut self.diffuse,
             Channel::Glossy => &mut self.glossy,
             Channel::Irradiance => &mut self.irradiance,
-            Channel::Colour | Channel::Halves | Channel::Depth | Channel::DepthVariance => {
-                return None
-            }
+            Channel::Colour
+            | Channel::Halves
+            | Channel::Depth
+            | Channel::DepthVariance
+            | Channel::Samples => return None,
         })
     }
 
     /// True if the frame has channel `c`.
     pub fn has(&self, c: Channel) -> bool {
-        self.data(c).is_some()
+        match c {
+            Channel::Samples => self.samples.is_some(),
+            _ => self.data(c).is_some(),
+        }
     }
 
     /// The channels present, in file order.
@@ -376,6 +409,9 @@ impl NoisyFrame {
             .collect();
         if let Some(h) = &self.halves {
             sizes.push((Channel::Halves, h[1].size()));
+        }
+        if let Some(r) = &self.samples {
+            sizes.push((Channel::Samples, (r.width() as usize, r.height() as usize)));
         }
         match sizes.into_iter().find(|(_, s)| *s != expected) {
             Some((channel, got)) => Err(FrameError::Size {
@@ -563,7 +599,12 @@ mod tests {
     #[test]
     fn exr_round_trip_is_bit_exact_for_every_channel() {
         let frame = NoisyFrame::from_film(&full_film(), AovSet::DENOISE);
-        assert_eq!(frame.channels(), Channel::ALL.to_vec(), "every channel");
+        // Every channel a file can hold (sample records stay in memory).
+        let saved: Vec<Channel> = Channel::ALL
+            .into_iter()
+            .filter(|&c| c != Channel::Samples)
+            .collect();
+        assert_eq!(frame.channels(), saved, "every channel");
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("f.exr");
         frame.write_exr(&p, &[]).unwrap();
@@ -616,7 +657,14 @@ mod tests {
     fn aovs_for_channels_give_exactly_those_channels() {
         assert_eq!(AovSet::for_channels(&[Channel::Colour]), AovSet::default());
         let all = AovSet::for_channels(&Channel::ALL);
-        assert_eq!(all, AovSet::DENOISE);
+        // Everything `--aov denoise` writes, and the in-memory sample records.
+        assert_eq!(
+            all,
+            AovSet {
+                samples: true,
+                ..AovSet::DENOISE
+            }
+        );
         for c in Channel::ALL {
             let aovs = AovSet::for_channels(&[c]);
             let got = NoisyFrame::from_film(&film_with(aovs), aovs).channels();

@@ -2,10 +2,10 @@
 //! thesis ch. 4; Bauszat, Eisemann, Eisemann & Magnor, "Sample-Based Manifold Filtering for
 //! Interactive Global Illumination and Depth of Field", CGF 2015). It filters *samples*, not
 //! pixels: the input is [`SampleRecords`] (per sample radiance, first-hit normal, position,
-//! albedo and signed circle of confusion), which a [`NoisyFrame`](crate::NoisyFrame) does not
-//! carry, so SBMF is not a [`Denoiser`](crate::Denoiser): it is applied through its own entry
-//! point, [`Sbmf::filter_samples`], on the records of a film built with
-//! `FilmBuffers::samples` (the CLI calls it that way).
+//! albedo and signed circle of confusion), which a [`NoisyFrame`](crate::NoisyFrame) carries
+//! in memory when its film kept them (the `samples` channel; never in a file). As a
+//! [`Denoiser`](crate::Denoiser) (`sbmf` in specs) it needs that channel; the sample-level
+//! entry point is [`Sbmf::filter_samples`].
 //!
 //! Two steps, in sequence, because the lighting integral is nested inside the lens integral:
 //!
@@ -212,7 +212,29 @@ impl Sbmf {
     pub fn name(&self) -> &str {
         &self.name
     }
+}
 
+impl crate::Denoiser for Sbmf {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn needs(&self) -> &[crate::Channel] {
+        &[crate::Channel::Samples]
+    }
+
+    fn filter(&self, frame: &crate::NoisyFrame) -> RgbImage {
+        let (w, h) = frame.colour.size();
+        // `denoise` checked that the records are there and of the frame's size.
+        frame
+            .samples
+            .as_ref()
+            .and_then(|r| self.filter_samples(r, w, h).ok())
+            .unwrap_or_else(|| frame.colour.clone())
+    }
+}
+
+impl Sbmf {
     fn check(records: &SampleRecords, width: usize, height: usize) -> Result<(), DenoiseError> {
         if (records.width() as usize, records.height() as usize) != (width, height) {
             return Err(DenoiseError::Spec(format!(
