@@ -20,7 +20,7 @@ pub const DEFAULT_BANK: [&str; 11] = [
     "bilateral:sigma=2",
     "bilateral:sigma=4",
     "bilateral:sigma=8",
-    "atrous",
+    "atrous:demodulate=on",
     "nlm",
 ];
 

@@ -255,7 +255,10 @@ impl Atrous {
             needs.push(Channel::Position);
         }
         if demodulate == Demodulate::On {
-            needs.push(Channel::Albedo);
+            // Demodulation filters reflected light: emitters seen directly (black albedo,
+            // radiance far above their surroundings) are taken out first and added back, or
+            // their light would be spread over the surfaces around them.
+            needs.extend([Channel::Albedo, Channel::Emission]);
         }
         match split {
             Split::None => name.push_str(":split=none"),
