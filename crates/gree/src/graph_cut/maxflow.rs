@@ -15,6 +15,7 @@
 //! Buffers are kept across calls to [`GridMaxflow::reset`], so the α-expansions of one graph
 //! cut reuse them. Capacities are `f64`.
 
+use rayon::prelude::*;
 use std::collections::VecDeque;
 
 /// Arc directions: right (+1), left (−1), down (+stride), up (−stride). `d ^ 1` is the reverse.
@@ -130,27 +131,53 @@ impl GridMaxflow {
         self.nodes[j].cap[(d ^ 1) as usize] += backward;
     }
 
-    /// Sets a whole row at once, for builders that know each node's net terminal capacity
-    /// (`tr[x]`: > 0 paid on the sink side, < 0 on the source side) and the forward capacity
-    /// of its right and down arcs (backward arcs 0). Replaces what the row held. `right`'s
-    /// last entry and, on the last row, `down` are ignored.
-    pub fn set_row(&mut self, y: usize, tr: &[f64], right: &[f64], down: &[f64]) {
-        let (w, s) = (self.width, self.stride);
-        assert!(tr.len() == w && right.len() == w && down.len() == w && y < self.height);
-        let base = (y + 1) * s + 1;
-        let last_row = y + 1 == self.height;
-        for x in 0..w {
-            let i = base + x;
-            self.nodes[i].tr = tr[x];
-            if x + 1 < w {
-                self.nodes[i].cap[RIGHT as usize] = right[x];
-                self.nodes[i + 1].cap[(RIGHT ^ 1) as usize] = 0.0;
-            }
-            if !last_row {
-                self.nodes[i].cap[DOWN as usize] = down[x];
-                self.nodes[i + s].cap[(DOWN ^ 1) as usize] = 0.0;
-            }
+    /// Builds the whole graph at once, row-parallel: `node(x, y)` gives pixel (x, y)'s net
+    /// terminal capacity (> 0: paid when it ends on the sink side; < 0: on the source side)
+    /// and the capacities of its arcs to the right, left, lower and upper neighbour (those
+    /// leaving the grid are ignored). Replaces the graph, and sizes the solver like
+    /// [`GridMaxflow::reset`]. The two capacities of an edge come from different calls, so
+    /// the caller must make them agree (each node reads both of its edge's costs).
+    pub fn build<F>(&mut self, width: usize, height: usize, node: F)
+    where
+        F: Fn(usize, usize) -> (f64, [f64; 4]) + Sync,
+    {
+        if (width, height) != (self.width, self.height) || self.nodes.is_empty() {
+            self.reset(width, height);
         }
+        self.queue.clear();
+        self.orphans.clear();
+        self.time = 0;
+        self.flow = 0.0;
+        let s = self.stride;
+        // Every pixel node is overwritten in full; the padding nodes are never written by
+        // the solver (zero capacity keeps them out of both trees), so they stay as reset.
+        self.nodes
+            .par_chunks_mut(s)
+            .skip(1)
+            .take(height)
+            .enumerate()
+            .for_each(|(y, row)| {
+                for (x, n) in row[1..=width].iter_mut().enumerate() {
+                    let (tr, mut cap) = node(x, y);
+                    if x + 1 == width {
+                        cap[RIGHT as usize] = 0.0;
+                    }
+                    if x == 0 {
+                        cap[(RIGHT ^ 1) as usize] = 0.0;
+                    }
+                    if y + 1 == height {
+                        cap[DOWN as usize] = 0.0;
+                    }
+                    if y == 0 {
+                        cap[(DOWN ^ 1) as usize] = 0.0;
+                    }
+                    *n = Node {
+                        cap,
+                        tr,
+                        ..Node::default()
+                    };
+                }
+            });
     }
 
     #[inline]
@@ -185,18 +212,13 @@ impl GridMaxflow {
     /// Whether `p` is on the sink side of the minimum cut found by [`GridMaxflow::maxflow`]
     /// (free nodes count as source side).
     pub fn in_sink(&self, p: usize) -> bool {
-        let n = &self.nodes[self.index(p)];
-        n.parent != FREE && n.sink
+        self.in_sink_at(p % self.width, p / self.width)
     }
 
-    /// [`GridMaxflow::in_sink`] for every pixel of row `y`, without a division per pixel.
-    pub fn row_in_sink(&self, y: usize, out: &mut [bool]) {
-        assert!(out.len() == self.width && y < self.height);
-        let base = (y + 1) * self.stride + 1;
-        for (x, o) in out.iter_mut().enumerate() {
-            let n = &self.nodes[base + x];
-            *o = n.parent != FREE && n.sink;
-        }
+    /// [`GridMaxflow::in_sink`] of pixel (x, y).
+    pub fn in_sink_at(&self, x: usize, y: usize) -> bool {
+        let n = &self.nodes[(y + 1) * self.stride + x + 1];
+        n.parent != FREE && n.sink
     }
 
     /// Computes the maximum flow (the minimum cut's cost plus the constant of

@@ -233,7 +233,6 @@ struct Buffers {
     flow: GridMaxflow,
     right: Vec<EdgeCosts>,
     down: Vec<EdgeCosts>,
-    unary: Vec<f64>,
     own: Vec<f64>,
     proposal: Vec<u16>,
 }
@@ -245,7 +244,6 @@ fn expand(problem: &LabelProblem, labels: &[u16], alpha: u16, buf: &mut Buffers)
     let n = w * h;
     buf.right.resize(n, [0.0; 3]);
     buf.down.resize(n, [0.0; 3]);
-    buf.unary.resize(n, 0.0);
     buf.own.resize(n, 0.0);
     // Each pixel's half of V(l_p, α), reused by its four edges: inside a label region
     // B = C = V(l, α) needs nothing else.
@@ -295,58 +293,102 @@ fn expand(problem: &LabelProblem, labels: &[u16], alpha: u16, buf: &mut Buffers)
                 down[x] = if y + 1 < h { costs(p, p + w) } else { [0.0; 3] };
             }
         });
-    // Unary "cost of switching minus cost of keeping", with the linear parts of the edges:
-    // E(xp, xq) = A + (C − A)·xp + (D − C)·xq + (B + C − A − D)·(1 − xp)·xq, D = V(α, α) = 0.
+    // Each node's terminal capacity and arcs come from its data term and its four edges,
+    // so the graph is built row-parallel with each node written once.
     let (right, down) = (&buf.right, &buf.down);
-    buf.unary
+    buf.flow.build(w, h, |x, y| {
+        let p = y * w + x;
+        let mut tr = if labels[p] == alpha {
+            0.0
+        } else {
+            problem.data_cost(p, alpha) - problem.data_cost(p, labels[p])
+        };
+        let mut cap = [0.0; 4];
+        if x + 1 < w {
+            let e = split_edge(right[p]);
+            tr += e.first;
+            cap[0] = e.forward;
+        }
+        if x > 0 {
+            let e = split_edge(right[p - 1]);
+            tr += e.second;
+            cap[1] = e.backward;
+        }
+        if y + 1 < h {
+            let e = split_edge(down[p]);
+            tr += e.first;
+            cap[2] = e.forward;
+        }
+        if y > 0 {
+            let e = split_edge(down[p - w]);
+            tr += e.second;
+            cap[3] = e.backward;
+        }
+        (tr, cap)
+    });
+    let g = &mut buf.flow;
+    g.maxflow();
+    let g = &buf.flow;
+    buf.proposal.resize(n, 0);
+    buf.proposal
         .par_chunks_mut(w)
         .enumerate()
-        .for_each(|(y, row)| {
-            for (x, u) in row.iter_mut().enumerate() {
+        .map(|(y, row)| {
+            let mut changed = false;
+            for (x, l) in row.iter_mut().enumerate() {
                 let p = y * w + x;
-                let mut e = problem.data_cost(p, alpha) - problem.data_cost(p, labels[p]);
-                e += right[p][2] - right[p][0] + down[p][2] - down[p][0];
-                if x > 0 {
-                    e -= right[p - 1][2];
-                }
-                if y > 0 {
-                    e -= down[p - w][2];
-                }
-                *u = e;
+                let switch = labels[p] != alpha && g.in_sink_at(x, y);
+                changed |= switch;
+                *l = if switch { alpha } else { labels[p] };
             }
-        });
-    let g = &mut buf.flow;
-    g.reset(w, h);
-    for (p, &l) in labels.iter().enumerate() {
-        let u = buf.unary[p];
-        // Paid on the sink side (switch): the positive part goes to the source arc.
-        if u > 0.0 {
-            g.add_tweights(p, u, 0.0);
-        } else {
-            g.add_tweights(p, 0.0, -u);
+            changed
+        })
+        .reduce(|| false, |a, b| a || b)
+}
+
+/// An edge's share of the expansion graph: terminal capacities for its first and second
+/// node and its two arc capacities.
+struct EdgeSplit {
+    first: f64,
+    second: f64,
+    forward: f64,
+    backward: f64,
+}
+
+/// Kolmogorov and Zabih's (2004) construction of the pairwise term with E(0,0) = A,
+/// E(0,1) = B, E(1,0) = C, E(1,1) = D = V(α, α) = 0 (x = 1: switch to α): A goes to the
+/// first node's terminal; what remains, `[[0, B − A], [C, 0]]`, becomes arcs of capacity
+/// B − A forward and C backward when both are non-negative (always inside a label region,
+/// where A = 0, so such an edge adds nothing to any terminal: the flow only has to carry the
+/// data terms there, which keeps BK's augmenting paths few and short). A term that rounding
+/// makes non-submodular (B + C < A) is clamped, which only affects the proposal.
+#[inline]
+fn split_edge([a, b, c]: EdgeCosts) -> EdgeSplit {
+    let b = b - a;
+    if b < 0.0 {
+        // [[0, b], [c, 0]] = b·(1 − x_p) − b·(1 − x_q) + (b + c)·x_p·(1 − x_q).
+        EdgeSplit {
+            first: -a - b,
+            second: b,
+            forward: 0.0,
+            backward: (b + c).max(0.0),
         }
-        if l == alpha {
-            continue;
+    } else if c < 0.0 {
+        // [[0, b], [c, 0]] = −c·(1 − x_p) + c·(1 − x_q) + (b + c)·(1 − x_p)·x_q.
+        EdgeSplit {
+            first: -a + c,
+            second: -c,
+            forward: (b + c).max(0.0),
+            backward: 0.0,
         }
-        let [a, b, c] = buf.right[p];
-        if p % w + 1 < w {
-            g.add_edge(p, false, (b + c - a).max(0.0), 0.0);
-        }
-        let [a, b, c] = buf.down[p];
-        if p + w < n {
-            g.add_edge(p, true, (b + c - a).max(0.0), 0.0);
+    } else {
+        EdgeSplit {
+            first: -a,
+            second: 0.0,
+            forward: b,
+            backward: c,
         }
     }
-    // Edges out of α-labelled pixels cost B + C − A = V(α, α) + V(α, l_q) − V(α, l_q) = 0.
-    g.maxflow();
-    buf.proposal.clear();
-    let mut changed = false;
-    for (p, &l) in labels.iter().enumerate() {
-        let switch = l != alpha && buf.flow.in_sink(p);
-        changed |= switch;
-        buf.proposal.push(if switch { alpha } else { l });
-    }
-    changed
 }
 
 /// α-expansion from `initial`: the energy never rises.
