@@ -221,6 +221,12 @@ impl GridMaxflow {
         n.parent != FREE && n.sink
     }
 
+    /// The residual capacities of pixel (x, y)'s arcs to the right, left, lower and upper
+    /// neighbour (after [`GridMaxflow::maxflow`]: what the flow left of each).
+    pub fn residual_at(&self, x: usize, y: usize) -> [f64; 4] {
+        self.nodes[(y + 1) * self.stride + x + 1].cap
+    }
+
     /// Computes the maximum flow (the minimum cut's cost plus the constant of
     /// [`GridMaxflow::add_tweights`]).
     pub fn maxflow(&mut self) -> f64 {
