@@ -2,15 +2,21 @@
 //! [`CutOptions`], and reports each one's energy and the MSE of its fused composite, so a
 //! faster but weaker setting shows its quality cost.
 //!
-//! Run with `cargo run --release -p rt-gree --example cut_bench [-- size [repeats]]`
-//! (defaults: 512 and 3; the time is the best of the repeats).
+//! Run with `cargo run --release -p rt-gree --example cut_bench [-- size [repeats
+//! [variant]]]` (defaults: 512, 3 and all variants; the time is the best of the repeats).
+//! The error maps are made as [`rt_gree::composite`] makes them, without its cut, so
+//! `valgrind --tool=callgrind` on one variant minus the variant `none` counts the cut alone.
 
 mod scene;
 
 use rt_core::rng::SplitMix64;
+use rt_gree::errors::sparse_errors;
 use rt_gree::fusion::fuse;
 use rt_gree::graph_cut::{alpha_expansion, CutOptions, LabelProblem};
-use rt_gree::{composite, GreeParams};
+use rt_gree::interpolate::Interpolator;
+use rt_gree::placement::{place, PlacementParams};
+use rt_gree::scale::mean_radiance;
+use rt_gree::{CacheRenderer, GreeParams};
 use scene::{mse, Renderer, Scene};
 use std::time::Instant;
 
@@ -21,21 +27,30 @@ fn main() {
             .map_or(default, |s| s.parse().expect("number"))
     };
     let (size, repeats) = (arg(1, 512), arg(2, 3).max(1));
+    let only = std::env::args().nth(3);
     let params = GreeParams::default();
-    let scene = Scene::new(size, params.budget_split().n);
+    let budget = params.budget_split();
+    let scene = Scene::new(size, budget.n);
     let mut renderer = Renderer {
         truth: &scene.truth,
         rng: SplitMix64::new(2),
     };
-    let out = composite(
-        &scene.noisy,
-        &scene.variance,
+    let caches = place(
         &scene.bank,
-        &mut renderer,
-        &params,
-    )
-    .expect("GREE");
-    let problem = LabelProblem::new(&scene.bank, &out.error_maps, params.lambda, params.metric);
+        &scene.variance,
+        &PlacementParams {
+            count: budget.caches(size * size),
+            kappa: params.kappa,
+            sigma_r: params.sigma_r,
+            mu: mean_radiance(&scene.bank),
+            seed: params.seed,
+        },
+    );
+    let Ok(values) = renderer.render_caches(&caches, budget.c);
+    let sparse = sparse_errors(&scene.bank, &caches, &values, params.metric);
+    let interp = Interpolator::new(size, size, &caches).expect("triangulation");
+    let error_maps: Vec<Vec<f32>> = sparse.iter().map(|e| interp.apply(e)).collect();
+    let problem = LabelProblem::new(&scene.bank, &error_maps, params.lambda, params.metric);
     let argmin = problem.argmin();
     println!(
         "{size}x{size}, {} labels, argmin energy {:.6e}, argmin fused MSE {:.4e}",
@@ -64,10 +79,35 @@ fn main() {
             CutOptions {
                 max_sweeps: 50,
                 tolerance: 0.0,
+                ..CutOptions::default()
+            },
+        ),
+        (
+            "unbanded",
+            CutOptions {
+                band: None,
+                ..CutOptions::default()
+            },
+        ),
+        (
+            "band 2",
+            CutOptions {
+                band: Some(2),
+                ..CutOptions::default()
+            },
+        ),
+        (
+            "band 16",
+            CutOptions {
+                band: Some(16),
+                ..CutOptions::default()
             },
         ),
     ];
     for (name, options) in variants {
+        if only.as_ref().is_some_and(|o| o != name) {
+            continue;
+        }
         let mut best = f64::INFINITY;
         let mut cut = None;
         for _ in 0..repeats {

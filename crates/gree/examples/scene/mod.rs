@@ -3,6 +3,9 @@
 //! in different places; the bank is 8 box filters; the cache "renderer" returns the truth plus
 //! independent noise of the same per-sample level.
 
+// Each example uses a part of the scene.
+#![allow(dead_code)]
+
 use rt_core::rng::SplitMix64;
 use rt_gree::{CacheRenderer, Rgb, RgbImage};
 

@@ -52,6 +52,9 @@ pub struct CutOptions {
     /// Stop after a sweep that lowered the energy by at most this fraction of it (default
     /// 1e-4; 0 runs to convergence or `max_sweeps`).
     pub tolerance: f64,
+    /// After the first sweep, expansions only switch pixels within this many 4-neighbour
+    /// steps of a label boundary (`None`: everywhere). See the module doc.
+    pub band: Option<u32>,
 }
 
 impl Default for CutOptions {
@@ -59,9 +62,13 @@ impl Default for CutOptions {
         Self {
             max_sweeps: 4,
             tolerance: 1e-4,
+            band: BAND,
         }
     }
 }
+
+/// The default [`CutOptions::band`].
+const BAND: Option<u32> = Some(8);
 
 /// The result of [`alpha_expansion`].
 #[derive(Clone, Debug, PartialEq)]
@@ -235,16 +242,32 @@ struct Buffers {
     down: Vec<EdgeCosts>,
     own: Vec<f64>,
     proposal: Vec<u16>,
+    /// Pixels a restricted expansion may switch.
+    free: Vec<bool>,
+    /// Distance to the nearest label boundary, for `free`.
+    dist: Vec<u32>,
     /// Per label, the flow on each pixel's right and down edge after its last expansion
     /// (empty before the first): 16 bytes per pixel and label.
     warm: Vec<Vec<[f64; 2]>>,
 }
 
 /// Builds the binary problem "keep (source side) or switch to α (sink side)" and cuts it.
-/// Returns whether any pixel switches; the proposal is left in `buf.proposal`.
-fn expand(problem: &LabelProblem, labels: &[u16], alpha: u16, buf: &mut Buffers) -> bool {
+/// Returns the energy change of the proposal (left in `buf.proposal`), or `None` if no pixel
+/// switches.
+/// With `restricted`, only pixels with `buf.free` set may switch; the others are left out of
+/// the graph (their edges to free pixels become terminal capacities), so the cut is the best
+/// move among those that keep them, and the max-flow never visits them.
+fn expand(
+    problem: &LabelProblem,
+    labels: &[u16],
+    alpha: u16,
+    restricted: bool,
+    buf: &mut Buffers,
+) -> Option<f64> {
     let (w, h) = (problem.width, problem.height);
     let n = w * h;
+    let free = restricted.then_some(&buf.free[..]);
+    let is_free = |p: usize| free.is_none_or(|f| f[p]);
     buf.right.resize(n, [0.0; 3]);
     buf.down.resize(n, [0.0; 3]);
     buf.own.resize(n, 0.0);
@@ -312,6 +335,9 @@ fn expand(problem: &LabelProblem, labels: &[u16], alpha: u16, buf: &mut Buffers)
     let f = |p: usize, k: usize| warm.get(p).map_or(0.0, |f: &[f64; 2]| f[k]);
     buf.flow.build(w, h, |x, y| {
         let p = y * w + x;
+        if !is_free(p) {
+            return (0.0, [0.0; 4]);
+        }
         let mut tr = if labels[p] == alpha {
             0.0
         } else {
@@ -319,30 +345,40 @@ fn expand(problem: &LabelProblem, labels: &[u16], alpha: u16, buf: &mut Buffers)
         };
         let mut cap = [0.0; 4];
         // Flow f on an edge leaves its first node (−f at its terminal, capacity − f ahead)
-        // and enters its second (+f at its terminal, reverse capacity + f).
+        // and enters its second (+f at its terminal, reverse capacity + f). An edge to a
+        // kept pixel (x = 0 there) is a terminal term: C − A if p is its first node, B − A
+        // if p is its second.
+        let first = |[a, b, c]: EdgeCosts, q: usize, k: usize, tr: &mut f64| {
+            if !is_free(q) {
+                *tr += c - a;
+                return 0.0;
+            }
+            let e = split_edge([a, b, c]);
+            let f = f(p, k).clamp(-e.backward, e.forward);
+            *tr += e.first - f;
+            e.forward - f
+        };
+        let second = |[a, b, c]: EdgeCosts, q: usize, k: usize, tr: &mut f64| {
+            if !is_free(q) {
+                *tr += b - a;
+                return 0.0;
+            }
+            let e = split_edge([a, b, c]);
+            let f = f(q, k).clamp(-e.backward, e.forward);
+            *tr += e.second + f;
+            e.backward + f
+        };
         if x + 1 < w {
-            let e = split_edge(right[p]);
-            let f = f(p, 0).clamp(-e.backward, e.forward);
-            tr += e.first - f;
-            cap[0] = e.forward - f;
+            cap[0] = first(right[p], p + 1, 0, &mut tr);
         }
         if x > 0 {
-            let e = split_edge(right[p - 1]);
-            let f = f(p - 1, 0).clamp(-e.backward, e.forward);
-            tr += e.second + f;
-            cap[1] = e.backward + f;
+            cap[1] = second(right[p - 1], p - 1, 0, &mut tr);
         }
         if y + 1 < h {
-            let e = split_edge(down[p]);
-            let f = f(p, 1).clamp(-e.backward, e.forward);
-            tr += e.first - f;
-            cap[2] = e.forward - f;
+            cap[2] = first(down[p], p + w, 1, &mut tr);
         }
         if y > 0 {
-            let e = split_edge(down[p - w]);
-            let f = f(p - w, 1).clamp(-e.backward, e.forward);
-            tr += e.second + f;
-            cap[3] = e.backward + f;
+            cap[3] = second(down[p - w], p - w, 1, &mut tr);
         }
         (tr, cap)
     });
@@ -357,14 +393,23 @@ fn expand(problem: &LabelProblem, labels: &[u16], alpha: u16, buf: &mut Buffers)
         for (x, f) in row.iter_mut().enumerate() {
             let p = y * w + x;
             let r = g.residual_at(x, y);
+            // Edges to kept pixels carried no flow.
+            let flow = |e: EdgeCosts, q: usize, r: f64| {
+                if is_free(p) && is_free(q) {
+                    split_edge(e).forward - r
+                } else {
+                    0.0
+                }
+            };
             *f = [
-                split_edge(right[p]).forward - r[0],
-                split_edge(down[p]).forward - r[2],
+                if x + 1 < w { flow(right[p], p + 1, r[0]) } else { 0.0 },
+                if y + 1 < h { flow(down[p], p + w, r[2]) } else { 0.0 },
             ];
         }
     });
     buf.proposal.resize(n, 0);
-    buf.proposal
+    let changed = buf
+        .proposal
         .par_chunks_mut(w)
         .enumerate()
         .map(|(y, row)| {
@@ -377,7 +422,42 @@ fn expand(problem: &LabelProblem, labels: &[u16], alpha: u16, buf: &mut Buffers)
             }
             changed
         })
-        .reduce(|| false, |a, b| a || b)
+        .reduce(|| false, |a, b| a || b);
+    if !changed {
+        return None;
+    }
+    // The energy change, from the terms already computed: only switched pixels and their
+    // edges change, so this costs no seam evaluation. The edge terms are the very values
+    // `LabelProblem::energy` adds (V is evaluated by the same expressions), each edge is
+    // counted once from its first node, and rows are summed in order.
+    let proposal = &buf.proposal;
+    let rows: Vec<f64> = (0..h)
+        .into_par_iter()
+        .map(|y| {
+            let mut e = 0.0;
+            for x in 0..w {
+                let p = y * w + x;
+                let sp = proposal[p] != labels[p];
+                if sp {
+                    e += problem.data_cost(p, alpha) - problem.data_cost(p, labels[p]);
+                }
+                let edge = |[a, b, c]: EdgeCosts, sq: bool| match (sp, sq) {
+                    (true, true) => -a,
+                    (true, false) => c - a,
+                    (false, true) => b - a,
+                    (false, false) => 0.0,
+                };
+                if x + 1 < w {
+                    e += edge(right[p], proposal[p + 1] != labels[p + 1]);
+                }
+                if y + 1 < h {
+                    e += edge(down[p], proposal[p + w] != labels[p + w]);
+                }
+            }
+            e
+        })
+        .collect();
+    Some(rows.iter().sum())
 }
 
 /// An edge's share of the expansion graph: terminal capacities for its first and second
@@ -425,6 +505,50 @@ fn split_edge([a, b, c]: EdgeCosts) -> EdgeSplit {
     }
 }
 
+/// Sets `buf.free` to the pixels within `band` 4-neighbour steps of a label boundary (a
+/// pixel with a neighbour of another label), by a two-pass city-block distance transform
+/// (sequential, so the same for any thread count).
+fn near_boundary(labels: &[u16], w: usize, band: u32, buf: &mut Buffers) {
+    let n = labels.len();
+    let dist = &mut buf.dist;
+    dist.clear();
+    dist.resize(n, u32::MAX);
+    for p in 0..n {
+        let (x, l) = (p % w, labels[p]);
+        let edge = (x + 1 < w && labels[p + 1] != l)
+            || (x > 0 && labels[p - 1] != l)
+            || (p + w < n && labels[p + w] != l)
+            || (p >= w && labels[p - w] != l);
+        if edge {
+            dist[p] = 0;
+        }
+    }
+    for p in 0..n {
+        let x = p % w;
+        let mut d = dist[p];
+        if x > 0 {
+            d = d.min(dist[p - 1].saturating_add(1));
+        }
+        if p >= w {
+            d = d.min(dist[p - w].saturating_add(1));
+        }
+        dist[p] = d;
+    }
+    for p in (0..n).rev() {
+        let x = p % w;
+        let mut d = dist[p];
+        if x + 1 < w {
+            d = d.min(dist[p + 1].saturating_add(1));
+        }
+        if p + w < n {
+            d = d.min(dist[p + w].saturating_add(1));
+        }
+        dist[p] = d;
+    }
+    buf.free.clear();
+    buf.free.extend(dist.iter().map(|&d| d <= band));
+}
+
 /// α-expansion from `initial`: the energy never rises.
 ///
 /// # Panics
@@ -447,29 +571,49 @@ pub fn alpha_expansion(
     let single = problem.labels() < 2;
     // Label α's proposal depends only on the labelling, and an exact α-expansion of its own
     // result changes nothing, so α is not retried until another expansion is accepted.
+    // Only unrestricted failures count: a restricted one says nothing about the full move.
     let mut failed_at = vec![u32::MAX; problem.labels()];
+    // A restricted sweep that accepts nothing is followed by an unrestricted one before
+    // stopping, so convergence still means no α-expansion lowers the energy.
+    let mut full = true;
     while sweeps < options.max_sweeps && !single {
         sweeps += 1;
         let sweep_start = energy;
         let mut improved = false;
+        let restricted = options.band.is_some() && sweeps > 1 && !full;
         for alpha in 0..problem.labels() as u16 {
-            if failed_at[alpha as usize] == accepted {
+            if !restricted && failed_at[alpha as usize] == accepted {
                 continue;
             }
-            if expand(problem, &labels, alpha, &mut buf) {
-                let e = problem.energy(&buf.proposal);
-                if e < energy {
-                    energy = e;
+            if restricted {
+                let band = options.band.unwrap_or(u32::MAX);
+                near_boundary(&labels, problem.width, band, &mut buf);
+            }
+            // A gain below the rounding of the energy itself is no gain.
+            if let Some(delta) = expand(problem, &labels, alpha, restricted, &mut buf) {
+                if delta < -1e-12 * energy.abs() {
+                    energy += delta;
                     std::mem::swap(&mut labels, &mut buf.proposal);
                     accepted += 1;
                     improved = true;
                 }
             }
-            failed_at[alpha as usize] = accepted;
+            if !restricted {
+                failed_at[alpha as usize] = accepted;
+            }
         }
+        if !improved && restricted {
+            full = true;
+            continue;
+        }
+        full = false;
         if !improved || sweep_start - energy <= options.tolerance * sweep_start.abs() {
             break;
         }
+    }
+    // The running energy is a sum of changes; report the energy of the result in full.
+    if accepted > 0 {
+        energy = problem.energy(&labels);
     }
     Labelling {
         labels,

@@ -97,6 +97,7 @@ fn converged_labelling_is_a_local_minimum() {
             &CutOptions {
                 max_sweeps: 50,
                 tolerance: 0.0,
+                ..CutOptions::default()
             },
         );
         assert!(out.sweeps < 50, "did not converge");
