@@ -56,7 +56,10 @@ fn main() {
         "{size}x{size}, {} labels, argmin energy {:.6e}, argmin fused MSE {:.4e}",
         scene.bank.len(),
         problem.energy(&argmin),
-        mse(&fuse(&scene.bank, &argmin, params.jacobi_iters), &scene.truth)
+        mse(
+            &fuse(&scene.bank, &argmin, params.jacobi_iters),
+            &scene.truth
+        )
     );
     let variants = [
         ("default", CutOptions::default()),

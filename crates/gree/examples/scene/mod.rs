@@ -99,7 +99,6 @@ pub fn mse(a: &RgbImage, b: &RgbImage) -> f64 {
     sum / (3 * a.pixels().len()) as f64
 }
 
-
 /// The box radii of the bank.
 pub const RADII: [usize; 8] = [0, 1, 2, 3, 5, 8, 12, 16];
 
@@ -124,8 +123,9 @@ impl Scene {
             let s = sigma(x, size) / n_spp.sqrt();
             truth.pixel(x, y) + Rgb::new(normal(&mut rng), normal(&mut rng), normal(&mut rng)) * s
         });
-        let variance =
-            RgbImage::from_fn(size, size, |x, _| Rgb::splat(sigma(x, size).powi(2) / n_spp));
+        let variance = RgbImage::from_fn(size, size, |x, _| {
+            Rgb::splat(sigma(x, size).powi(2) / n_spp)
+        });
         let bank = RADII.iter().map(|&r| box_blur(&noisy, r)).collect();
         Self {
             truth,

@@ -24,6 +24,19 @@
 //!   the same).
 //! - Thesis: GPU, on NPP's binary cut. Here: CPU, serial max-flow; the per-pixel parts
 //!   (graph weights, energies) are row-parallel and bit-identical for any thread count.
+//! - Each expansion graph splits its pairwise terms as Kolmogorov and Zabih (2004) do, and
+//!   starts from the flow of α's previous expansion (Kohli and Torr 2007, dynamic graph cuts;
+//!   see `expand`), which gives the same cut with fewer augmentations.
+//! - An expansion's energy change is summed from its own graph terms over the switched pixels
+//!   and their edges (no seam is evaluated again); it is accepted if it is negative beyond
+//!   1e-12 of the energy (below that it is rounding). The reported energy is recomputed in
+//!   full at the end.
+//! - Optional restriction ([`CutOptions::band`]): after the first sweep, only pixels within a
+//!   band around the label boundaries may switch; the others keep their label and drop out
+//!   of the graph. A restricted move is still a move whose energy change is exact, so the
+//!   energy still never rises; a restricted sweep that accepts nothing is followed by an
+//!   unrestricted one, so convergence still means an α-expansion local minimum. Off by
+//!   default: the seam term dominates, boundaries are dense, and the band saved little.
 
 pub mod maxflow;
 
@@ -53,7 +66,7 @@ pub struct CutOptions {
     /// 1e-4; 0 runs to convergence or `max_sweeps`).
     pub tolerance: f64,
     /// After the first sweep, expansions only switch pixels within this many 4-neighbour
-    /// steps of a label boundary (`None`: everywhere). See the module doc.
+    /// steps of a label boundary (`None`, the default: everywhere). See the module doc.
     pub band: Option<u32>,
 }
 
@@ -67,8 +80,9 @@ impl Default for CutOptions {
     }
 }
 
-/// The default [`CutOptions::band`].
-const BAND: Option<u32> = Some(8);
+/// The default [`CutOptions::band`]: none, since on the synthetic example a band of 8 saved
+/// about 3 % of the instructions for 0.02 % more energy.
+const BAND: Option<u32> = None;
 
 /// The result of [`alpha_expansion`].
 #[derive(Clone, Debug, PartialEq)]
@@ -348,7 +362,8 @@ fn expand(
         // and enters its second (+f at its terminal, reverse capacity + f). An edge to a
         // kept pixel (x = 0 there) is a terminal term: C − A if p is its first node, B − A
         // if p is its second.
-        let first = |[a, b, c]: EdgeCosts, q: usize, k: usize, tr: &mut f64| {
+        let mut mag = tr.abs();
+        let first = |[a, b, c]: EdgeCosts, q: usize, k: usize, tr: &mut f64, mag: &mut f64| {
             if !is_free(q) {
                 *tr += c - a;
                 return 0.0;
@@ -356,9 +371,10 @@ fn expand(
             let e = split_edge([a, b, c]);
             let f = f(p, k).clamp(-e.backward, e.forward);
             *tr += e.first - f;
+            *mag += e.first.abs() + f.abs();
             e.forward - f
         };
-        let second = |[a, b, c]: EdgeCosts, q: usize, k: usize, tr: &mut f64| {
+        let second = |[a, b, c]: EdgeCosts, q: usize, k: usize, tr: &mut f64, mag: &mut f64| {
             if !is_free(q) {
                 *tr += b - a;
                 return 0.0;
@@ -366,19 +382,25 @@ fn expand(
             let e = split_edge([a, b, c]);
             let f = f(q, k).clamp(-e.backward, e.forward);
             *tr += e.second + f;
+            *mag += e.second.abs() + f.abs();
             e.backward + f
         };
         if x + 1 < w {
-            cap[0] = first(right[p], p + 1, 0, &mut tr);
+            cap[0] = first(right[p], p + 1, 0, &mut tr, &mut mag);
         }
         if x > 0 {
-            cap[1] = second(right[p - 1], p - 1, 0, &mut tr);
+            cap[1] = second(right[p - 1], p - 1, 0, &mut tr, &mut mag);
         }
         if y + 1 < h {
-            cap[2] = first(down[p], p + w, 1, &mut tr);
+            cap[2] = first(down[p], p + w, 1, &mut tr, &mut mag);
         }
         if y > 0 {
-            cap[3] = second(down[p - w], p - w, 1, &mut tr);
+            cap[3] = second(down[p - w], p - w, 1, &mut tr, &mut mag);
+        }
+        // A warm start leaves a terminal that the old flow saturated as rounding dust;
+        // BK would root a tree at it and push 1e-17 units through, many thousands of times.
+        if tr.abs() <= 1e-12 * mag {
+            tr = 0.0;
         }
         (tr, cap)
     });
@@ -402,8 +424,16 @@ fn expand(
                 }
             };
             *f = [
-                if x + 1 < w { flow(right[p], p + 1, r[0]) } else { 0.0 },
-                if y + 1 < h { flow(down[p], p + w, r[2]) } else { 0.0 },
+                if x + 1 < w {
+                    flow(right[p], p + 1, r[0])
+                } else {
+                    0.0
+                },
+                if y + 1 < h {
+                    flow(down[p], p + w, r[2])
+                } else {
+                    0.0
+                },
             ];
         }
     });
