@@ -71,12 +71,17 @@ fn energy_never_rises_and_is_reported_truthfully() {
         // term in the expansion graph shows up at one end or the other.
         let pw = [0.0, 0.01, 0.3, 3.0][seed as usize % 4];
         let problem = LabelProblem::with_scales(&inst.bank, &inst.data, 1.0, pw);
+        // Odd seeds restrict the later sweeps to a band around the boundaries.
+        let options = CutOptions {
+            band: (seed % 2 == 1).then_some(1),
+            ..CutOptions::default()
+        };
         for init in [
             problem.argmin(),
             random_labels(inst.w * inst.h, inst.bank.len(), seed + 100),
         ] {
             let e0 = problem.energy(&init);
-            let out = alpha_expansion(&problem, init, &CutOptions::default());
+            let out = alpha_expansion(&problem, init, &options);
             assert_eq!(out.initial_energy, e0);
             assert!(out.energy <= e0, "seed {seed}: {} > {e0}", out.energy);
             assert_eq!(out.energy, problem.energy(&out.labels));
@@ -86,10 +91,12 @@ fn energy_never_rises_and_is_reported_truthfully() {
 
 /// After α-expansion has converged, no single pixel can change label and lower the energy
 /// (a one-pixel relabelling is an expansion move, and each expansion is an exact min cut).
+/// With a band of 0 (only boundary pixels may switch in later sweeps) this holds only
+/// thanks to the unrestricted sweep that must confirm convergence.
 #[test]
 fn converged_labelling_is_a_local_minimum() {
-    for seed in 0..4u64 {
-        let inst = instance(12, 9, 3 + seed as usize % 2, 40 + seed);
+    for seed in 0..8u64 {
+        let inst = instance(12, 9, 3 + seed as usize % 2, 40 + seed % 4);
         let problem = LabelProblem::with_scales(&inst.bank, &inst.data, 1.0, 0.2);
         let out = alpha_expansion(
             &problem,
@@ -97,7 +104,7 @@ fn converged_labelling_is_a_local_minimum() {
             &CutOptions {
                 max_sweeps: 50,
                 tolerance: 0.0,
-                ..CutOptions::default()
+                band: (seed >= 4).then_some(0),
             },
         );
         assert!(out.sweeps < 50, "did not converge");
