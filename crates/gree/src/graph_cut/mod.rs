@@ -17,8 +17,8 @@
 //!   radiance ([`crate::scale`]). So λ is dimensionless and scaling every radiance by the
 //!   same factor leaves the labelling unchanged (for the squared metric).
 //! - The start is the per-pixel argmin. An expansion is accepted only if it strictly lowers
-//!   the energy (its change, in `f64`, see below), so the energy never rises. Sweeps over all labels
-//!   stop after a sweep that lowered the energy by at most [`CutOptions::tolerance`] of it
+//!   the energy (its change, in `f64`, see below), so the energy never rises. Sweeps over all
+//!   labels stop after a sweep that lowered the energy by at most [`CutOptions::tolerance`] of it
 //!   (none accepted included) or after [`CutOptions::max_sweeps`]. A label whose expansion
 //!   failed is not retried until another expansion has been accepted (its proposal would be
 //!   the same).
