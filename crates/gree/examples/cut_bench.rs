@@ -86,9 +86,9 @@ fn main() {
             },
         ),
         (
-            "unbanded",
+            "band 8",
             CutOptions {
-                band: None,
+                band: Some(8),
                 ..CutOptions::default()
             },
         ),
