@@ -186,14 +186,7 @@ pub fn page(p: &Page<'_>) -> String {
 fn summary(s: &mut String, p: &Page<'_>) {
     let plan = p.plan;
     s.push_str("<h2 id=\"summary\">Summary</h2>\n");
-    let winner = |e: &EqualTime, what: &str| match e.overall() {
-        Some((pair, wins)) => format!(
-            "{} ({wins} of {} {what})",
-            plan.methods[plan.pairs[pair].method].name,
-            e.table.len()
-        ),
-        None => "–".into(),
-    };
+    let winner = |e: &EqualTime, what: &str| crate::report::winner(plan, e, what);
     let rows: Vec<Vec<Cell>> = plan
         .scenes
         .iter()

@@ -535,6 +535,18 @@ pub fn crops(plan: &Plan, results: &Results, out: &Path) -> Result<Vec<(usize, u
     Ok(blocks)
 }
 
+/// "METHOD (W of N WHAT)": the method that wins most of a comparison, or "–".
+pub(crate) fn winner(plan: &Plan, e: &EqualTime, what: &str) -> String {
+    match e.overall() {
+        Some((p, wins)) => format!(
+            "{} ({wins} of {} {what})",
+            plan.methods[plan.pairs[p].method].name,
+            e.table.len()
+        ),
+        None => "–".into(),
+    }
+}
+
 pub(crate) fn sci(v: f64) -> String {
     if v.is_nan() {
         "–".into()
@@ -602,14 +614,7 @@ pub fn markdown(
         .iter()
         .any(|m| matches!(m.runs, Runs::Adaptive(_)))
         || any_denoiser(plan);
-    let winner = |e: &EqualTime, what: &str| match e.overall() {
-        Some((p, wins)) => format!(
-            "{} ({wins} of {} {what})",
-            plan.methods[plan.pairs[p].method].name,
-            e.table.len()
-        ),
-        None => "–".into(),
-    };
+    let winner = |e: &EqualTime, what: &str| winner(plan, e, what);
     if any_adaptive {
         let _ = writeln!(
             s,
