@@ -325,14 +325,20 @@ fn bad_experiment_files_give_one_line_naming_the_file() {
 #[test]
 fn shipped_configs_are_valid() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    for name in [
+    let mut names = vec![
         "configs/convergence.toml",
         "configs/accel.toml",
         "configs/light-transport.toml",
         "configs/stopping.toml",
-        // Its last two scenes read meshes from ../shared/data, which CI has.
-        "configs/denoise.toml",
-    ] {
+    ];
+    // Its last two scenes read meshes from ../shared/data (CI has it; elsewhere the file is
+    // skipped with a line saying so, and RT_REQUIRE_DATA=1 makes a missing folder a failure).
+    if rt_validate::data::file("scenes/sibenik/sibenik.obj").is_some()
+        && rt_validate::data::file("scenes/conference/conference.obj").is_some()
+    {
+        names.push("configs/denoise.toml");
+    }
+    for name in names {
         let out = Command::new(env!("CARGO_BIN_EXE_render"))
             .current_dir(&root)
             .args(["experiment", name, "--check"])
