@@ -282,6 +282,14 @@ fn render_one(
     let camera = pick_camera(scene, &job.scene_path, job.camera.as_deref())?;
     let build_secs = build_time.as_secs_f64();
     let integrator = job.settings.integrator.build();
+    let ctx = Ctx {
+        scene,
+        accel,
+        camera,
+    };
+    if args.gree.is_some() {
+        return pool.install(|| crate::gree::render(args, job, &ctx, integrator.as_ref()));
+    }
     let denoiser = match &args.denoiser {
         None => None,
         Some(text) => {
@@ -298,7 +306,7 @@ fn render_one(
     let denoise_aovs = denoiser
         .as_ref()
         .map_or(AovSet::default(), |d| AovSet::for_channels(d.needs()));
-    if denoise_aovs.any_split() && !job.settings.integrator.kind.writes_split() {
+    if denoise_aovs.any_split() && !integrator.writes_split() {
         bail!(
             "--denoiser {}: it reads the lighting split, which the {} technique does not write",
             args.denoiser.as_deref().unwrap_or_default(),
@@ -312,14 +320,6 @@ fn render_one(
         buffers = buffers.with_halves();
     }
     let mut film = Film::new(camera.width, camera.height, buffers);
-    let ctx = Ctx {
-        scene,
-        accel,
-        camera,
-    };
-    if args.gree.is_some() {
-        return pool.install(|| crate::gree::render(args, job, &ctx, integrator.as_ref()));
-    }
     let pass = SamplePass {
         indices: 0..job.settings.spp,
         stream: rt_core::SampleStream::Render,

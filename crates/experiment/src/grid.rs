@@ -244,6 +244,13 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
         let aovs = denoiser
             .as_ref()
             .map_or(AovSet::default(), |d| AovSet::for_channels(d.needs()));
+        if aovs.any_split() && !integrator.writes_split() {
+            return Err(ExperimentError::Run(format!(
+                "{}: its denoiser reads the lighting split, which the {} technique does not write",
+                method.name,
+                integrator.name()
+            )));
+        }
         let session = Session {
             ctx: Ctx {
                 scene: &scene.loaded.scene,

@@ -93,16 +93,6 @@ impl IntegratorKind {
         matches!(self, IntegratorKind::Light | IntegratorKind::Bdpt)
     }
 
-    /// True for the kinds that write the lighting-split AOVs (emission, direct, indirect,
-    /// diffuse, glossy, irradiance): the path tracers, which know at which bounce and through
-    /// which lobe each contribution arrives.
-    pub fn writes_split(self) -> bool {
-        matches!(
-            self,
-            IntegratorKind::Path | IntegratorKind::PathBsdf | IntegratorKind::Direct
-        )
-    }
-
     fn names() -> String {
         Self::ALL.map(Self::name).join(", ")
     }

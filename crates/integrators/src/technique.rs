@@ -62,6 +62,14 @@ pub trait Technique: Send + Sync {
         false
     }
 
+    /// True if the technique writes the lighting-split AOVs (emission, direct, indirect,
+    /// diffuse, glossy, irradiance): a camera-ray estimator whose
+    /// [`Integrator::writes_split`] says so. Callers refuse a film that asks for the split
+    /// otherwise, since the driver would leave its sums at zero.
+    fn writes_split(&self) -> bool {
+        self.camera_integrator().is_some_and(|i| i.writes_split())
+    }
+
     /// The technique's own stages over the passes rendered so far, for reports; none by
     /// default (camera-ray estimators have nothing beyond the render's totals).
     fn stages(&self) -> Vec<TechniqueStage> {

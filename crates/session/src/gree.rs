@@ -22,6 +22,9 @@ pub enum GreeRunError {
     /// The bank could not run on the frame.
     #[error(transparent)]
     Denoise(#[from] DenoiseError),
+    /// The bank reads the lighting split, which the integrator does not write.
+    #[error("the filter bank reads the lighting split, which the {0} integrator does not write")]
+    SplitUnsupported(String),
     /// GREE's own checks or stages failed.
     #[error("GREE: {0}")]
     Gree(#[from] GreeError),
@@ -101,6 +104,11 @@ pub fn render_gree(
     params.validate()?;
     let budget = params.budget_split();
     let aovs = gree_aovs(bank);
+    if aovs.any_split() && !integrator.writes_split() {
+        return Err(GreeRunError::SplitUnsupported(
+            integrator.name().to_string(),
+        ));
+    }
     let camera = ctx.camera;
     let mut film = Film::new(camera.width, camera.height, FilmBuffers::for_outputs(aovs));
     let pass = SamplePass {

@@ -240,7 +240,7 @@ impl Overrides {
                 technique: integrator.kind.name(),
             });
         }
-        if aovs.any_split() && !integrator.kind.writes_split() {
+        if aovs.any_split() && !integrator.build().writes_split() {
             return Err(SettingsError::SplitUnsupported {
                 origin: origin(self.aovs.is_some(), "aov", "aov"),
                 technique: integrator.kind.name(),
