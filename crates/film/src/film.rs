@@ -376,7 +376,7 @@ impl FilmStripe<'_> {
         split: Option<&LightSplit>,
     ) -> bool {
         let i = ((y - self.y0) * self.width + x) as usize;
-        if !radiance.is_finite() || radiance.min_element() < 0.0 {
+        if !crate::accepts_sample(radiance) {
             self.discarded.fetch_add(1, Ordering::Relaxed);
             return false;
         }

@@ -130,6 +130,14 @@ impl PixelStats {
     }
 }
 
+/// True if the film keeps radiance sample `l`: finite and non-negative in every channel.
+/// The one rule for every buffer (means, splats, per-sample records, sparse re-renders):
+/// anything else is dropped and counted.
+#[inline]
+pub fn accepts_sample(l: Rgb) -> bool {
+    l.is_finite() && l.min_element() >= 0.0
+}
+
 /// What the first visible surface of one camera sample looked like.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct FirstHit {

@@ -411,7 +411,7 @@ impl SampleBand<'_> {
             return false;
         };
         let j = start + slot as usize;
-        if j >= end || !radiance.is_finite() || radiance.min_element() < 0.0 {
+        if j >= end || !crate::accepts_sample(radiance) {
             return false;
         }
         let j = j - self.offsets[0];

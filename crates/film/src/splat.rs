@@ -55,7 +55,7 @@ impl SplatSums {
         for s in splats {
             let v = s.value;
             let i = s.pixel as usize;
-            if !v.is_finite() || v.min_element() < 0.0 || i >= self.all.len() {
+            if !crate::accepts_sample(v) || i >= self.all.len() {
                 dropped += 1;
                 continue;
             }

@@ -148,8 +148,9 @@ pub fn render_samples(
                             &mut counters,
                         );
                         let split = want_split.then_some(&aux.split);
-                        stripe.add_sample_split(x, y, i, l, aux.first_hit.as_ref(), split);
-                        if let Some(r) = &mut record {
+                        let kept =
+                            stripe.add_sample_split(x, y, i, l, aux.first_hit.as_ref(), split);
+                        if let (true, Some(r)) = (kept, &mut record) {
                             let hit = aux.first_hit.as_ref();
                             let coc = hit.map_or(ctx.camera.coc_at_infinity(), |h| {
                                 ctx.camera.signed_coc_px(h.position)
@@ -277,7 +278,7 @@ pub fn render_pixels(
                             &mut aux,
                             &mut counters,
                         );
-                        if l.is_finite() && l.min_element() >= 0.0 {
+                        if rt_film::accepts_sample(l) {
                             sum += l;
                             n += 1;
                         } else {
