@@ -30,23 +30,24 @@ struct SplitTracker {
     albedo: Rgb,
 }
 
-impl SplitTracker {
-    /// Adds `c`, found after `bounces` reflections (0: seen directly), to `split`.
-    #[inline]
-    fn add(&self, split: &mut LightSplit, c: Rgb, bounces: u32, diffuse_share: Rgb) {
-        match bounces {
-            0 => {
-                split.emission += c;
-                return;
-            }
-            1 => split.direct += c,
-            _ => split.indirect += c,
+/// Adds `c`, found after `bounces` reflections (0: seen directly), to `split`, its reflected
+/// part shared between the lobe classes by `diffuse_share`.
+#[inline]
+fn file_contribution(split: &mut LightSplit, c: Rgb, bounces: u32, diffuse_share: Rgb) {
+    match bounces {
+        0 => {
+            split.emission += c;
+            return;
         }
-        let d = c * diffuse_share;
-        split.diffuse += d;
-        split.glossy += c - d;
+        1 => split.direct += c,
+        _ => split.indirect += c,
     }
+    let d = c * diffuse_share;
+    split.diffuse += d;
+    split.glossy += c - d;
+}
 
+impl SplitTracker {
     /// Sets the irradiance from the reflected parts.
     fn finish(&self, split: &mut LightSplit) {
         let reflected = split.direct + split.indirect;
@@ -183,7 +184,7 @@ impl Integrator for PathIntegrator {
                     l += beta * le * w;
                     if want_split {
                         let share = tracker.diffuse_share;
-                        tracker.add(&mut aux.split, beta * le * w, depth, share);
+                        file_contribution(&mut aux.split, beta * le * w, depth, share);
                     }
                 }
                 break;
@@ -202,7 +203,7 @@ impl Integrator for PathIntegrator {
                 l += beta * le * w;
                 if want_split {
                     let share = tracker.diffuse_share;
-                    tracker.add(&mut aux.split, beta * le * w, depth, share);
+                    file_contribution(&mut aux.split, beta * le * w, depth, share);
                 }
             }
             let first_hit_wanted = depth == 0 && aux.want_first_hit;
@@ -219,9 +220,11 @@ impl Integrator for PathIntegrator {
             if first_hit_wanted {
                 aux.first_hit = Some(crate::first_hit(&bsdf, &si, wo, hit.t * ray.dir.length()));
             }
-            if want_split && depth == 0 {
+            // The first vertex's diffuse layers alone, to share its light between the classes.
+            let diffuse_part = (want_split && depth == 0).then(|| {
                 tracker.albedo = bsdf.albedo();
-            }
+                bsdf.restricted(LayerClass::Diffuse)
+            });
             if depth >= self.max_depth {
                 break;
             }
@@ -247,11 +250,14 @@ impl Integrator for PathIntegrator {
                                 // At the first vertex the light's own direction decides the
                                 // lobe shares; later, the first bounce's sampled direction.
                                 let share = if depth == 0 {
-                                    share(bsdf.restricted(LayerClass::Diffuse).eval(ls.wi), f)
+                                    share(
+                                        diffuse_part.as_ref().map_or(Rgb::ZERO, |d| d.eval(ls.wi)),
+                                        f,
+                                    )
                                 } else {
                                     tracker.diffuse_share
                                 };
-                                tracker.add(&mut aux.split, c, depth + 1, share);
+                                file_contribution(&mut aux.split, c, depth + 1, share);
                             }
                         }
                     }
@@ -261,14 +267,11 @@ impl Integrator for PathIntegrator {
             let Some(s) = bsdf.sample(u_layer, u_bsdf) else {
                 break;
             };
-            if want_split && depth == 0 {
+            if let Some(d) = &diffuse_part {
                 tracker.diffuse_share = if s.delta {
                     Rgb::ZERO
                 } else {
-                    share(
-                        bsdf.restricted(LayerClass::Diffuse).eval(s.wi),
-                        bsdf.eval(s.wi),
-                    )
+                    share(d.eval(s.wi), bsdf.eval(s.wi))
                 };
             }
             beta *= s.weight;
