@@ -490,21 +490,26 @@ fn run_gree(
         )?;
         let metrics = measure(&run.composite.image)?;
         let raw = measure(&run.frame.colour)?;
-        let argmin = measure(&run.composite.argmin_image)?;
-        // The bank's members on the same noisy image, for the report's reader: how far the
-        // per-pixel choice is from each filter alone (at n spp, not at equal samples).
+        // Only for the message: relMSE alone (no SSIM) of the per-pixel argmin and of the bank's
+        // members on the same noisy image, how far the per-pixel choice is from each filter alone
+        // (at n spp, not at equal samples).
+        let relmse = |image: &RgbImage| {
+            rt_metrics::relmse(image, &m.reference.image, m.opts.epsilon)
+                .map_err(|e| fail(format!("against the reference of {}: {e}", m.scene)))
+        };
+        let argmin = relmse(&run.composite.argmin_image)?;
         let members: Vec<String> = bank
             .members()
             .iter()
             .zip(&run.bank.images)
-            .map(|(d, img)| Ok(format!("{} {:.4e}", d.name(), measure(img)?.relmse)))
+            .map(|(d, img)| Ok(format!("{} {:.4e}", d.name(), relmse(img)?)))
             .collect::<Result<_>>()?;
         progress.message(&format!(
             "{}: {} b={b}: relMSE composite {:.4e}, per-pixel argmin {:.4e}, noisy {:.4e}; bank on the noisy image: {}; GREE's own stages {:.3} s of {:.3} s denoising",
             m.scene,
             m.method,
             metrics.relmse,
-            argmin.relmse,
+            argmin,
             raw.relmse,
             members.join(", "),
             run.composite.timings.own().as_secs_f64(),

@@ -183,7 +183,7 @@ pub fn composite<R: CacheRenderer>(
     timings.interpolation = t.elapsed();
 
     let t = Instant::now();
-    let problem = LabelProblem::new(bank, &error_maps, params.lambda, params.metric);
+    let problem = LabelProblem::with_mean(bank, &error_maps, params.lambda, params.metric, mu);
     let argmin_labels = problem.argmin();
     let cut = alpha_expansion(&problem, argmin_labels.clone(), &CutOptions::default());
     timings.graph_cut = t.elapsed();

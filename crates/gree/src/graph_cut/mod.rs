@@ -110,7 +110,21 @@ impl<'a> LabelProblem<'a> {
         lambda: f32,
         metric: ErrorMetric,
     ) -> Self {
-        let mu = mean_radiance(bank);
+        Self::with_mean(bank, data, lambda, metric, mean_radiance(bank))
+    }
+
+    /// [`LabelProblem::new`] for a caller that already has the bank's mean radiance `mu`
+    /// ([`crate::scale::mean_radiance`]), which is a pass over every bank image.
+    ///
+    /// # Panics
+    /// As [`LabelProblem::new`].
+    pub fn with_mean(
+        bank: &'a [RgbImage],
+        data: &'a [Vec<f32>],
+        lambda: f32,
+        metric: ErrorMetric,
+        mu: f64,
+    ) -> Self {
         let data_scale = match metric {
             ErrorMetric::Squared => 1.0 / (mu * mu),
             ErrorMetric::Relative => 1.0,
