@@ -280,6 +280,69 @@ spp = 4
         assert!(md.contains("blocks left"), "{md}");
     }
 
+    /// A GREE method: each budget is GREE's b, its row counts every sample traced (the noisy
+    /// image's and the caches'), times the denoising apart, and measures the composite, which is
+    /// the image written next to the noisy frame.
+    #[test]
+    fn gree_methods_count_every_sample_and_measure_the_composite() {
+        let dir = tempfile::tempdir().unwrap();
+        let config = dir.path().join("x.toml");
+        std::fs::write(
+            &config,
+            r#"
+[[scene]]
+path = "gen:rotated"
+resolution = [24, 16]
+reference = { spp = 32 }
+
+[[method]]
+name = "g"
+spp = [4, 8]
+gree = "sparsity=0.9"
+bank = ["box:radius=0", "box:radius=2"]
+"#,
+        )
+        .unwrap();
+        let plan = config::load(&config).unwrap();
+        let out = dir.path().join("out");
+        prepare_out(&out).unwrap();
+        let outcome = run(&plan, &out, &Cache::new(&dir.path().join("cache")), &Silent).unwrap();
+        let rows = &outcome.results.rows;
+        assert_eq!(rows.len(), 2);
+        let pixels = 24 * 16;
+        for (r, b) in rows.iter().zip([4u32, 8]) {
+            let params = rt_session::parse_gree_options("sparsity=0.9", b, 0).unwrap();
+            let budget = params.budget_split();
+            assert_eq!(r.spp, b);
+            assert_eq!(r.samples, budget.total_samples(pixels));
+            assert!(
+                r.samples > u64::from(budget.n) * pixels as u64,
+                "caches are counted"
+            );
+            assert!(r.denoise_seconds > 0.0 && r.raw.is_some());
+            let got = rt_film::read_rgb(&out.join(r.denoised_image.as_ref().unwrap())).unwrap();
+            let reference = &outcome.results.references[0].image;
+            let m = rt_metrics::compare(&got, reference, &Default::default()).unwrap();
+            assert_eq!(m.relmse, r.metrics.relmse);
+        }
+        // An unknown GREE option or a bad bank is refused when the file loads.
+        for (bad, says) in [("sparsity=2", "sparsity"), ("colour=1", "unknown option")] {
+            let text = std::fs::read_to_string(&config)
+                .unwrap()
+                .replace("sparsity=0.9", bad);
+            std::fs::write(&config, text).unwrap();
+            let e = config::load(&config).err().unwrap().to_string();
+            assert!(e.contains(says), "{e}");
+            std::fs::write(
+                &config,
+                std::fs::read_to_string(&config)
+                    .unwrap()
+                    .replace(bad, "sparsity=0.9"),
+            )
+            .unwrap();
+        }
+    }
+
     /// A denoised method next to the same method without: its rows carry the denoised error
     /// (of the image the denoiser makes from the saved noisy frame, bit for bit), the noisy
     /// error beside it, in results.csv and both reports.
