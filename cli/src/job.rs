@@ -367,7 +367,7 @@ fn render_one(
 
     if let Some(d) = &denoiser {
         let t = Instant::now();
-        let frame = rt_film::NoisyFrame::from_film(&film, denoise_aovs);
+        let frame = rt_film::NoisyFrame::from_film_taking_samples(&mut film, denoise_aovs);
         let image = d
             .denoise(&frame)
             .map_err(|e| anyhow::anyhow!("{}: {e}", job.scene_path.display()))?;

@@ -324,6 +324,22 @@ impl NoisyFrame {
         }
     }
 
+    /// [`NoisyFrame::from_film`] that moves the film's sample records into the frame instead
+    /// of copying them (56 bytes per sample), for a caller done with the film.
+    pub fn from_film_taking_samples(film: &mut Film, aovs: AovSet) -> Self {
+        let mut frame = Self::from_film(
+            film,
+            AovSet {
+                samples: false,
+                ..aovs
+            },
+        );
+        if aovs.samples {
+            frame.samples = film.take_sample_records();
+        }
+        frame
+    }
+
     /// The three-component channel `c` (every channel but depth and its variance), if present.
     pub fn image(&self, c: Channel) -> Option<&Image<Vec3>> {
         match self.data(c)? {
@@ -680,6 +696,25 @@ mod tests {
             want.sort_by_key(|w| Channel::ALL.iter().position(|a| a == w));
             assert_eq!(got, want, "{c}");
         }
+    }
+
+    #[test]
+    fn taking_the_samples_moves_them_and_changes_nothing_else() {
+        let aovs = AovSet {
+            samples: true,
+            ..AovSet::parse_list(["albedo"]).unwrap()
+        };
+        let mut film = film_with(aovs);
+        let mut records = SampleRecords::pass(5, 3, 1);
+        for mut band in records.bands_mut(3) {
+            band.record(1, 2, 0, Rgb::splat(0.5), None, 1.5);
+        }
+        film.add_sample_records(records);
+        let copied = NoisyFrame::from_film(&film, aovs);
+        assert_eq!(copied.samples.as_ref().map(SampleRecords::len), Some(1));
+        let taken = NoisyFrame::from_film_taking_samples(&mut film, aovs);
+        assert_eq!(taken, copied);
+        assert_eq!(film.sample_records().map(SampleRecords::len), Some(0));
     }
 
     #[test]

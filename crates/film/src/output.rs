@@ -76,7 +76,14 @@ pub fn write_image_with(
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     match ext.as_deref() {
-        Some("exr") => NoisyFrame::from_film(film, film.aovs()).write_exr(path, extra),
+        Some("exr") => {
+            // Sample records are never written: do not copy them into the frame.
+            let aovs = crate::AovSet {
+                samples: false,
+                ..film.aovs()
+            };
+            NoisyFrame::from_film(film, aovs).write_exr(path, extra)
+        }
         Some("png") if !extra.is_empty() => Err(FilmError::Codec {
             path: path.to_path_buf(),
             message: "a PNG holds only the beauty image; write an .exr for extra channels".into(),

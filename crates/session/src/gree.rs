@@ -117,7 +117,7 @@ pub fn render_gree(
         pixels: None,
     };
     let render = rt_integrators::render_samples(ctx, integrator, &mut film, seed, &pass, progress);
-    let frame = NoisyFrame::from_film(&film, aovs);
+    let frame = NoisyFrame::from_film_taking_samples(&mut film, aovs);
     drop(film);
     let bank_out = bank.apply(&frame)?;
     let variance = frame
