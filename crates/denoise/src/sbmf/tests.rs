@@ -5,20 +5,8 @@
 use super::layers::{layer_weights, Layers, MAX_SCALES};
 use super::*;
 use rt_core::glam::Vec3;
+use rt_core::rng::SplitMix64;
 use rt_film::Sample;
-
-/// A small deterministic generator (SplitMix64) so the tests need no dependency.
-struct Rng(u64);
-
-impl Rng {
-    fn f32(&mut self) -> f32 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
 
 fn records(w: u32, h: u32, samples: &[Sample]) -> SampleRecords {
     SampleRecords::from_samples(w, h, samples).unwrap()
@@ -63,7 +51,7 @@ fn sbmf(layers: usize, max_coc: f32) -> Sbmf {
 
 #[test]
 fn layer_weights_are_a_partition_of_unity_for_any_coverage() {
-    let mut rng = Rng(1);
+    let mut rng = SplitMix64::from_state(1);
     let mut clamped = 0;
     for case in 0..10_000 {
         let scales = if case % 2 == 0 { 2 } else { 4 };
@@ -90,7 +78,7 @@ fn layer_weights_are_a_partition_of_unity_for_any_coverage() {
 
 #[test]
 fn an_in_focus_image_passes_through_step_b_unchanged() {
-    let mut rng = Rng(2);
+    let mut rng = SplitMix64::from_state(2);
     let (w, h) = (23, 17);
     let rec = sample_set(
         w,
@@ -129,7 +117,7 @@ fn a_uniform_colour_stays_uniform_for_any_coc_distribution() {
     let c = Rgb::new(0.3, 1.7, 0.05);
     let (w, h) = (40, 30);
     for (seed, spread) in [(3, 2.0), (4, 10.0), (5, 40.0)] {
-        let mut rng = Rng(seed);
+        let mut rng = SplitMix64::from_state(seed);
         let rec = sample_set(
             w,
             h,
@@ -158,7 +146,7 @@ fn a_uniform_colour_stays_uniform_for_any_coc_distribution() {
 
 #[test]
 fn step_b_work_does_not_depend_on_the_circle_of_confusion() {
-    let mut rng = Rng(6);
+    let mut rng = SplitMix64::from_state(6);
     let (w, h) = (48, 32);
     let rec = sample_set(
         w,
@@ -230,7 +218,7 @@ fn defocus_spreads_a_bright_sample_by_its_coc_and_keeps_the_in_focus_one_sharp()
 /// Two regions (normals and albedos differ) with smooth true radiance; samples are the truth
 /// times heavy-tailed noise of mean 1.
 fn noisy_two_region_set(w: u32, h: u32, spp: u32, seed: u64) -> (SampleRecords, Vec<Rgb>) {
-    let mut rng = Rng(seed);
+    let mut rng = SplitMix64::from_state(seed);
     let truth = |x: u32, y: u32| {
         let left = x < w / 2;
         let shade = 0.9 + 0.2 * (y as f32 / h as f32);
