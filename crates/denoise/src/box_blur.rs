@@ -1,7 +1,7 @@
 //! The k×k box filter: the simplest member of a filter bank, and a baseline.
 
 use crate::{DenoiseError, Denoiser, NoisyFrame, Options};
-use rt_core::{Image, Rgb, RgbImage};
+use rt_core::{Image, RgbImage};
 
 /// Mean over a `(2r+1)²` window, clamped at the image border (the window shrinks, so a constant
 /// image stays constant up to the edge).
@@ -44,35 +44,17 @@ impl Denoiser for BoxBlur {
 
     fn filter(&self, frame: &NoisyFrame) -> RgbImage {
         let (w, h) = frame.colour.size();
-        let r = self.radius;
-        // Separable: rows, then columns.
-        let pass = |src: &[Rgb], horizontal: bool| -> Vec<Rgb> {
-            let mut out = vec![Rgb::ZERO; w * h];
-            for y in 0..h {
-                for x in 0..w {
-                    let (c, n) = if horizontal { (x, w) } else { (y, h) };
-                    let (lo, hi) = (c.saturating_sub(r), (c + r).min(n - 1));
-                    let mut sum = Rgb::ZERO;
-                    for k in lo..=hi {
-                        sum += if horizontal {
-                            src[y * w + k]
-                        } else {
-                            src[k * w + x]
-                        };
-                    }
-                    out[y * w + x] = sum / (hi - lo + 1) as f32;
-                }
-            }
-            out
-        };
-        let tmp = pass(frame.colour.pixels(), true);
-        Image::new(w, h, pass(&tmp, false)).unwrap_or_default()
+        // A box is the separable filter with equal taps: the same border cut, rows in parallel.
+        let taps = vec![1.0; self.radius + 1];
+        let out = crate::blocks::separable::convolve(frame.colour.pixels(), w, h, &taps);
+        Image::new(w, h, out).unwrap_or_default()
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rt_core::Rgb;
 
     fn frame(w: usize, h: usize, px: Vec<Rgb>) -> NoisyFrame {
         NoisyFrame::new(Image::new(w, h, px).unwrap())
