@@ -324,6 +324,7 @@ fn render_one(
         indices: 0..job.settings.spp,
         stream: rt_core::SampleStream::Render,
         pixels: None,
+        centre_first: false,
     };
 
     let bar = if job.quiet || !std::io::stderr().is_terminal() {

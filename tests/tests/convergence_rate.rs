@@ -25,6 +25,7 @@ fn render(scene: &Scene, seed: u32, spp: u32, stream: SampleStream) -> Film {
         indices: 0..spp,
         stream,
         pixels: None,
+        centre_first: false,
     };
     renderer.render_pass(&PathIntegrator::new(4), &mut film, seed, &pass);
     film

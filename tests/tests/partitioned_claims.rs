@@ -417,6 +417,7 @@ fn passes_memory(
             indices: index..index + 1,
             stream: SampleStream::Render,
             pixels: None,
+            centre_first: false,
         };
         PEAK.store(LIVE.load(Ordering::Relaxed), Ordering::Relaxed);
         t.render_pass(&ctx, film, 9, &pass, &|_| {});

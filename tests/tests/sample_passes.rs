@@ -33,6 +33,7 @@ fn pass(indices: std::ops::Range<u32>, stream: SampleStream) -> SamplePass {
         indices,
         stream,
         pixels: None,
+        centre_first: false,
     }
 }
 

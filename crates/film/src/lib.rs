@@ -35,6 +35,7 @@
 #![forbid(unsafe_code)]
 
 mod film;
+mod guides;
 pub mod input;
 mod noisy_frame;
 pub mod output;
@@ -46,6 +47,7 @@ pub mod stopping;
 pub use film::{
     AovSet, FeatureVariances, Film, FilmBuffers, FilmMemory, FilmStripe, UnknownAov, AOV_NAMES,
 };
+pub use guides::{GuideBuffers, GuideError, ReflectedGuides, NO_ID};
 pub use input::{decode_srgb, read_rgb};
 pub use noisy_frame::{Channel, FrameError, NoisyFrame};
 pub use output::{

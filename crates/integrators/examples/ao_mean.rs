@@ -23,6 +23,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         indices: 0..4,
         stream: rt_core::SampleStream::Render,
         pixels: None,
+        centre_first: false,
     };
     let stats = spec.build().render_pass(&ctx, &mut film, 0, &pass, &|_| {});
     let mean = film.mean_image().iter().sum::<rt_core::Rgb>() / (64.0 * 48.0);

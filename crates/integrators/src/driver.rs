@@ -70,6 +70,11 @@ pub struct SamplePass {
     /// stopping criterion leaves out the pixels of finished blocks. Light-path techniques
     /// cannot aim their splats and ignore it.
     pub pixels: Option<std::sync::Arc<[bool]>>,
+    /// Sample 0 of every pixel goes through the pixel's centre instead of a jittered point:
+    /// the "guide ray" of a sequence frame (Bauszat et al. 2011), whose first hit is the one
+    /// [`crate::render_guides`] describes. The jitter is still drawn, so every later
+    /// dimension is the same as without it.
+    pub centre_first: bool,
 }
 
 /// Renders `opts.spp` samples into every pixel of `film`. `progress` is called with the number
@@ -85,6 +90,7 @@ pub fn render(
         indices: 0..opts.spp,
         stream: SampleStream::Render,
         pixels: None,
+        centre_first: false,
     };
     render_samples(ctx, integrator, film, opts.seed, &pass, progress)
 }
@@ -109,7 +115,7 @@ pub fn render_samples(
     let want_split = film.aovs().any_split() && integrator.writes_split();
     let totals = Mutex::new(RayCounters::default());
     let rows_done = std::sync::atomic::AtomicU32::new(0);
-    let camera = CameraSampling::new(ctx);
+    let camera = CameraSampling::new(ctx).centre_first(pass.centre_first);
     // Per-sample records: one slot per pass sample of every pixel, filled band by band
     // alongside the film's stripes, so their order is fixed whatever the thread count.
     let (w, h) = (film.width(), film.height());
@@ -189,6 +195,7 @@ struct CameraSampling<'a> {
     camera_motion: Option<&'a rt_core::animation::CameraMotion>,
     open: f32,
     shutter: f32,
+    centre_first: bool,
 }
 
 impl<'a> CameraSampling<'a> {
@@ -201,7 +208,13 @@ impl<'a> CameraSampling<'a> {
             camera_motion: ctx.scene.camera_motion(&camera.name),
             open: ctx.scene.time,
             shutter: ctx.scene.shutter,
+            centre_first: false,
         }
+    }
+
+    fn centre_first(mut self, on: bool) -> Self {
+        self.centre_first = on;
+        self
     }
 
     /// Sample `i` of pixel `(x, y)`: its camera ray, traced by `integrator`.
@@ -216,7 +229,13 @@ impl<'a> CameraSampling<'a> {
         counters: &mut RayCounters,
     ) -> rt_core::Rgb {
         sampler.start(x, y, i);
-        let film_pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+        let jitter = sampler.next_2d();
+        let jitter = if self.centre_first && i == 0 {
+            Vec2::splat(0.5)
+        } else {
+            jitter
+        };
+        let film_pos = Vec2::new(x as f32, y as f32) + jitter;
         let lens = if self.thin_lens {
             sampler.next_2d()
         } else {
@@ -414,6 +433,7 @@ mod tests {
                 indices: p[0]..p[1],
                 stream: SampleStream::Render,
                 pixels: None,
+                centre_first: false,
             };
             pool.install(|| render_samples(&ctx, &FakeHits, &mut film, 3, &pass, &|_| {}));
         }
@@ -480,6 +500,7 @@ mod tests {
                 indices: 0..6,
                 stream,
                 pixels: None,
+                centre_first: false,
             };
             render_samples(&ctx, &FirstDimension, &mut film, 3, &pass, &|_| {});
             film.mean_image()

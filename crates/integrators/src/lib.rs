@@ -22,6 +22,7 @@
 mod ao;
 mod bdpt;
 pub mod driver;
+pub mod guides;
 mod light;
 pub mod partitioned;
 mod path;
@@ -33,6 +34,7 @@ mod work;
 pub use ao::AoIntegrator;
 pub use bdpt::Bdpt;
 pub use driver::{render, render_pixels, render_samples, RenderOptions, RenderStats, SamplePass};
+pub use guides::{render_guides, GuideOptions, PreviousView};
 pub use light::LightTracer;
 pub use partitioned::{Culling, PartitionOptions, PartitionStats, Partitioned};
 pub use path::PathIntegrator;

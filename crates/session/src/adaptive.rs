@@ -121,6 +121,7 @@ pub fn render_adaptive(
             indices: spp..spp + n,
             stream: SampleStream::Render,
             pixels,
+            centre_first: false,
         };
         let s = technique.render_pass(ctx, film, seed, &pass, &|_| {});
         stats.samples += s.samples;

@@ -115,6 +115,7 @@ pub fn render_gree(
         indices: 0..budget.n,
         stream: SampleStream::Render,
         pixels: None,
+        centre_first: false,
     };
     let render = rt_integrators::render_samples(ctx, integrator, &mut film, seed, &pass, progress);
     let frame = NoisyFrame::from_film_taking_samples(&mut film, aovs);

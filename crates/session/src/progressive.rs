@@ -94,6 +94,7 @@ impl Session<'_> {
                 indices: at.spp..at.spp + n,
                 stream: self.stream,
                 pixels: None,
+                centre_first: false,
             };
             let stats = self
                 .integrator

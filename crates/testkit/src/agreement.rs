@@ -122,6 +122,7 @@ pub fn render_in_passes(
             indices: p[0]..p[1],
             stream: SampleStream::Render,
             pixels: None,
+            centre_first: false,
         };
         r.technique_pass(technique, &mut film, 3, &pass);
     }

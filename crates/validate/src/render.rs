@@ -113,6 +113,7 @@ impl<'a> Renderer<'a> {
                 indices: 0..spp,
                 stream: rt_core::SampleStream::Render,
                 pixels: None,
+                centre_first: false,
             },
         );
         (film, stats)
