@@ -1,0 +1,318 @@
+//! Spatiotemporal variance-guided filtering (Schied et al., HPG 2017) with Voorhuis' extensions
+//! for temporally stable reflections (Voorhuis 2018; digest `seed001-svgf.md`).
+//!
+//! Per frame, for the direct and the indirect light separately:
+//!
+//! 1. **Demodulate** by the primary albedo (a mirror: by the product of the albedos along its
+//!    reflection, Voorhuis §4.2), so texture never has to survive the filter.
+//! 2. **Reproject** ([`reproject`]): the history where the surface was (primary motion
+//!    vectors), or for specular pixels with `reflections=reproject` where its reflection was
+//!    (diamond search on reflected hits for mirrors, on representative rays for sharp glossy
+//!    surfaces), fetched bilinearly from taps passing the consistency tests.
+//! 3. **Clip** specular pixels' history to the 5×5 range of the blurred current frame
+//!    ([`clip`]).
+//! 4. **Accumulate** colour and luminance moments: `α_eff = max(α, 1/h)`, so the first frames
+//!    after a disocclusion are a true mean (Voorhuis §2.7 change 1); α is 0.2 on diffuse and
+//!    0.1 on specular pixels.
+//! 5. **Variance** from the moments, or while the history is shorter than 4 frames from the
+//!    neighbours' accumulated moments over a 7×7 depth- and normal-weighted window, scaled by
+//!    4/h as Falcor does.
+//! 6. **À-Trous** ([`atrous`]), 5 iterations; the output of the `feedback`-th is the next
+//!    frame's colour history.
+//! 7. **Remodulate**, add emission; a 3×3 median on diffuse pixels for display only.
+//!
+//! Not done (deviations): TAA after tone mapping (we write linear frames; supersampling with
+//! guide rays is the thesis' alternative and not built yet); fireflies are not clamped.
+
+mod atrous;
+pub mod clip;
+pub mod diamond;
+mod features;
+mod history;
+mod params;
+mod reproject;
+
+pub use atrous::{normal_weight, Signals, KERNEL};
+pub use features::{Class, MIN_ALBEDO};
+pub use params::{Reflections, SvgfParams};
+pub use reproject::ray_distance;
+
+use features::Features;
+use history::History;
+use rayon::prelude::*;
+use rt_core::color::luminance;
+use rt_core::{Image, Rgb, RgbImage};
+use rt_film::GuideBuffers;
+
+/// One frame's input: the guide buffers and the frame's light, split by bounce.
+#[derive(Clone, Copy, Debug)]
+pub struct SvgfInput<'a> {
+    /// Noise-free features and motion.
+    pub guides: &'a GuideBuffers,
+    /// Light after one bounce (not demodulated).
+    pub direct: &'a RgbImage,
+    /// Light after two or more bounces.
+    pub indirect: &'a RgbImage,
+    /// Light emitted toward the camera (the environment's where no surface).
+    pub emission: &'a RgbImage,
+}
+
+/// SVGF with its history.
+#[derive(Clone, Debug)]
+pub struct Svgf {
+    params: SvgfParams,
+    history: Option<History>,
+}
+
+/// Luminance moments of a demodulated colour.
+#[inline]
+fn moments(c: Rgb) -> [f32; 2] {
+    let l = luminance(c);
+    [l, l * l]
+}
+
+/// Radius of the spatial variance estimate's window (7×7).
+const SPATIAL_RADIUS: isize = 3;
+/// History length below which the variance is estimated spatially.
+const SHORT_HISTORY: f32 = 4.0;
+
+impl Svgf {
+    /// A filter with no history.
+    pub fn new(params: SvgfParams) -> Self {
+        Self {
+            params,
+            history: None,
+        }
+    }
+
+    /// Its parameters.
+    pub fn params(&self) -> &SvgfParams {
+        &self.params
+    }
+
+    /// Forgets the history (a cut).
+    pub fn reset(&mut self) {
+        self.history = None;
+    }
+
+    /// History length of every pixel after the last frame (empty before the first).
+    pub fn history_lengths(&self) -> &[f32] {
+        self.history.as_ref().map_or(&[], |h| &h.length)
+    }
+
+    /// Filters one frame of a sequence and keeps its history. The images must all have the
+    /// guides' size (callers check: [`crate::TemporalDenoiser`] does).
+    pub fn push(&mut self, input: &SvgfInput<'_>) -> RgbImage {
+        let p = &self.params;
+        let g = input.guides;
+        let f = Features::new(g, p);
+        let (w, h) = (f.w, f.h);
+        let n = w * h;
+        if self
+            .history
+            .as_ref()
+            .is_some_and(|h| h.w != w || h.h != f.h)
+        {
+            self.history = None;
+        }
+        // 1. Demodulate.
+        let current: Vec<[Rgb; 2]> = (0..n)
+            .map(|i| {
+                if f.class[i] == features::Class::Sky {
+                    return [Rgb::ZERO; 2];
+                }
+                let a = f.albedo[i].max(Rgb::splat(MIN_ALBEDO));
+                [input.direct.pixels()[i] / a, input.indirect.pixels()[i] / a]
+            })
+            .collect();
+        // 2. Reproject.
+        let fetched: Vec<reproject::Fetched> = match &self.history {
+            Some(hist) => (0..n)
+                .into_par_iter()
+                .map(|i| reproject::fetch(&f, g, hist, p, i))
+                .collect(),
+            None => vec![reproject::Fetched::default(); n],
+        };
+        // 3. Clip specular history to the current frame's neighbourhood.
+        let clipping = p.clip
+            && p.reflections == Reflections::Reproject
+            && (0..n).any(|i| f.class[i].specular() && fetched[i].valid);
+        let guides: Option<[Vec<Rgb>; 2]> = clipping.then(|| {
+            [0, 1].map(|s| {
+                let plane: Vec<Rgb> = current.iter().map(|c| c[s]).collect();
+                clip::guide(&plane, w, h)
+            })
+        });
+        // 4. Accumulate.
+        let mut lengths = vec![0.0f32; n];
+        let mut acc = vec![Signals::default(); n];
+        let mut acc_moments = vec![[[0.0f32; 2]; 2]; n];
+        acc.par_iter_mut()
+            .zip(acc_moments.par_iter_mut())
+            .zip(lengths.par_iter_mut())
+            .enumerate()
+            .for_each(|(i, ((out, m), len))| {
+                let fh = &fetched[i];
+                let cur = current[i];
+                let specular = f.class[i].specular();
+                let length = if fh.valid {
+                    (fh.length + 1.0).min(p.max_history)
+                } else {
+                    1.0
+                };
+                let alpha = if specular { p.alpha_specular } else { p.alpha };
+                let (a, am) = if fh.valid {
+                    (alpha.max(1.0 / length), p.alpha_moments.max(1.0 / length))
+                } else {
+                    (1.0, 1.0)
+                };
+                for s in 0..2 {
+                    let mut hist = fh.colour[s];
+                    if let (Some(gd), true) = (&guides, specular && fh.valid) {
+                        hist = clip::clip(hist, clip::range(&gd[s], w, h, i % w, i / w));
+                    }
+                    out.colour[s] = hist.lerp(cur[s], a);
+                    let mc = moments(cur[s]);
+                    m[s] = [
+                        fh.moments[s][0] + (mc[0] - fh.moments[s][0]) * am,
+                        fh.moments[s][1] + (mc[1] - fh.moments[s][1]) * am,
+                    ];
+                    out.variance[s] = (m[s][1] - m[s][0] * m[s][0]).max(0.0);
+                }
+                *len = length;
+            });
+        // 5. Spatial variance while the history is short.
+        let spatial: Vec<Option<[f32; 2]>> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                (f.class[i] != features::Class::Sky && lengths[i] < SHORT_HISTORY)
+                    .then(|| spatial_variance(&f, p, &acc_moments, i, lengths[i]))
+            })
+            .collect();
+        for (a, s) in acc.iter_mut().zip(&spatial) {
+            if let Some(v) = s {
+                a.variance = *v;
+            }
+        }
+        // 6. À-Trous, keeping the feedback tap.
+        let mut ping = acc;
+        let mut pong = vec![Signals::default(); n];
+        let hold = [false, p.hold_indirect_variance];
+        let mut feedback: Option<Vec<Signals>> = (p.feedback == 0).then(|| ping.clone());
+        for it in 0..p.iterations {
+            atrous::iterate(&f, p, &lengths, 1 << it, hold, &ping, &mut pong);
+            std::mem::swap(&mut ping, &mut pong);
+            if it + 1 == p.feedback {
+                feedback = Some(ping.clone());
+            }
+        }
+        let feedback = feedback.unwrap_or_else(|| ping.clone());
+        // 7. Remodulate; median on diffuse pixels for display.
+        let illumination: Vec<Rgb> = ping.iter().map(|s| s.colour[0] + s.colour[1]).collect();
+        let shown = if p.median {
+            median_diffuse(&f, &illumination)
+        } else {
+            illumination
+        };
+        let out = Image::from_fn(w, h, |x, y| {
+            let i = y * w + x;
+            let e = input.emission.pixels()[i];
+            let c = if f.class[i] == features::Class::Sky {
+                e + input.direct.pixels()[i] + input.indirect.pixels()[i]
+            } else {
+                e + f.albedo[i].max(Rgb::splat(MIN_ALBEDO)) * shown[i]
+            };
+            if c.is_finite() {
+                c.max(Rgb::ZERO)
+            } else {
+                Rgb::ZERO
+            }
+        });
+        // Keep the history.
+        let mut next = History::from_frame(&f, g);
+        for i in 0..n {
+            for (s, m) in acc_moments[i].iter().enumerate() {
+                next.colour[s][i] = feedback[i].colour[s];
+                next.moments[s][i] = *m;
+            }
+            next.length[i] = lengths[i];
+        }
+        self.history = Some(next);
+        out
+    }
+}
+
+/// Voorhuis §2.7 change 1: the variance of pixel `i` from its neighbours' accumulated moments
+/// over a 7×7 window weighted by depth and normal, scaled by 4/h as Falcor does.
+fn spatial_variance(
+    f: &Features,
+    p: &SvgfParams,
+    moments: &[[[f32; 2]; 2]],
+    i: usize,
+    length: f32,
+) -> [f32; 2] {
+    let (x, y) = ((i % f.w) as isize, (i / f.w) as isize);
+    let (z, n) = (f.depth[i], f.normal[i]);
+    let z_scale = p.sigma_z * f.depth_step[i];
+    let mirror = f.class[i] == features::Class::Mirror;
+    let mut sum = [[0.0f32; 2]; 2];
+    let mut wsum = 0.0f32;
+    for yy in (y - SPATIAL_RADIUS).max(0)..=(y + SPATIAL_RADIUS).min(f.h as isize - 1) {
+        for xx in (x - SPATIAL_RADIUS).max(0)..=(x + SPATIAL_RADIUS).min(f.w as isize - 1) {
+            let j = yy as usize * f.w + xx as usize;
+            let c = f.class[j];
+            if c == features::Class::Sky || (c == features::Class::Mirror) != mirror {
+                continue;
+            }
+            let dist = (((xx - x).pow(2) + (yy - y).pow(2)) as f32).sqrt();
+            let wz = (-(z - f.depth[j]).abs() / (z_scale * dist + 1e-3 * z)).exp();
+            let w = wz * normal_weight(n.dot(f.normal[j]), p.sigma_n);
+            for s in 0..2 {
+                sum[s][0] += w * moments[j][s][0];
+                sum[s][1] += w * moments[j][s][1];
+            }
+            wsum += w;
+        }
+    }
+    if wsum <= 0.0 {
+        return [0.0; 2];
+    }
+    let boost = SHORT_HISTORY / length.max(1.0);
+    [0, 1].map(|s| {
+        let m1 = sum[s][0] / wsum;
+        let m2 = sum[s][1] / wsum;
+        (m2 - m1 * m1).max(0.0) * boost
+    })
+}
+
+/// Per-channel 3×3 median of diffuse pixels among their diffuse neighbours (Voorhuis §2.7
+/// change 3); other pixels unchanged.
+fn median_diffuse(f: &Features, img: &[Rgb]) -> Vec<Rgb> {
+    (0..f.w * f.h)
+        .into_par_iter()
+        .map(|i| {
+            if f.class[i] != features::Class::Diffuse {
+                return img[i];
+            }
+            let (x, y) = ((i % f.w) as isize, (i / f.w) as isize);
+            let mut vals = [[0.0f32; 9]; 3];
+            let mut k = 0;
+            for yy in (y - 1).max(0)..=(y + 1).min(f.h as isize - 1) {
+                for xx in (x - 1).max(0)..=(x + 1).min(f.w as isize - 1) {
+                    let j = yy as usize * f.w + xx as usize;
+                    if f.class[j] == features::Class::Diffuse {
+                        for (c, v) in vals.iter_mut().enumerate() {
+                            v[k] = img[j][c];
+                        }
+                        k += 1;
+                    }
+                }
+            }
+            Rgb::from_array(std::array::from_fn(|c| {
+                let v = &mut vals[c][..k];
+                v.sort_unstable_by(f32::total_cmp);
+                v[k / 2]
+            }))
+        })
+        .collect()
+}
