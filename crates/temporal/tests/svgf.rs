@@ -27,7 +27,7 @@ fn flat_guides(w: usize, h: usize) -> GuideBuffers {
 
 /// Deterministic "noise" in [0, 1).
 fn hash(x: usize, y: usize, k: usize) -> f32 {
-    let mut v = (x as u64) * 0x9E37_79B9 ^ (y as u64) << 20 ^ (k as u64) << 40;
+    let mut v = ((x as u64) * 0x9E37_79B9) ^ ((y as u64) << 20) ^ ((k as u64) << 40);
     v ^= v >> 33;
     v = v.wrapping_mul(0xff51_afd7_ed55_8ccd);
     v ^= v >> 33;
