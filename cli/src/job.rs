@@ -140,6 +140,9 @@ pub fn run(args: &Args) -> Result<()> {
         job.settings.accel = AccelSpec::default_for_scene(&scene);
     }
     set_shutter(args, &job, &mut scene)?;
+    if let Some(spec) = crate::sequence::temporal_spec(args)? {
+        return crate::sequence::run(args, &job, &spec, &mut scene, &frames);
+    }
 
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(t) = job.settings.threads {

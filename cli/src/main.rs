@@ -20,6 +20,7 @@ mod gree;
 mod job;
 mod progress;
 mod reference;
+mod sequence;
 mod stress;
 
 use clap::Parser;

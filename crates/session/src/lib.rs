@@ -6,6 +6,8 @@
 //! - [`camera`]: which camera renders ([`pick_camera`]) and at what size ([`ImageSize`]).
 //! - [`progressive`]: a list of budgets, samples per pixel or seconds, rendered pass after pass
 //!   into one film ([`Session`], [`Budgets`], [`Checkpoint`]).
+//! - [`sequence`]: an animation rendered frame after frame, denoised by a denoiser that may
+//!   remember earlier frames (SVGF), with the guide pass in between ([`SequenceRenderer`]).
 //! - [`report`]: what a render built and skipped, with time and bytes ([`RenderReport`], the
 //!   table `render --stats` prints).
 //!
@@ -48,6 +50,7 @@ pub mod camera;
 pub mod gree;
 pub mod progressive;
 pub mod report;
+pub mod sequence;
 pub mod settings;
 
 pub use adaptive::{render_adaptive, Adaptive, StopReason, StopRule, FIRST_DECISION_SPP};
@@ -55,6 +58,7 @@ pub use camera::{parse_resolution, pick_camera, ImageSize, MAX_SIDE};
 pub use gree::{gree_aovs, parse_gree_options, render_gree, GreeRun, GreeRunError};
 pub use progressive::{Budgets, Checkpoint, Session};
 pub use report::{RenderReport, ReportInputs, Stage, Status};
+pub use sequence::{FrameTimes, SequenceError, SequenceFrame, SequenceRenderer};
 pub use settings::{
     fold_seed, frame_seed, Origin, Overrides, Settings, SettingsError, DEFAULT_SPP, MAX_SPP,
     MAX_THREADS,

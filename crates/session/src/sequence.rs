@@ -1,0 +1,257 @@
+//! Rendering an animation frame after frame, with a denoiser that may remember earlier frames:
+//! what `render --frames`, `render view` and sequence experiments share.
+//!
+//! Per frame: the scene moves to the frame's time, the structure follows (in place when it
+//! can, rebuilt otherwise), the integrator renders the frame's samples into a film that keeps
+//! only what the denoiser reads, the guide pass describes every pixel's primary hit and its
+//! motion since the previous frame (only for denoisers that read guides), and the denoiser
+//! filters it. A temporal denoiser's sample 0 of every pixel goes through the pixel centre, so
+//! it is the ray the guide buffers describe.
+
+use crate::settings::frame_seed;
+use rt_accel::AccelSpec;
+use rt_core::{Accel, Camera, RgbImage, SampleStream, Scene};
+use rt_film::{AovSet, Film, FilmBuffers, GuideBuffers, NoisyFrame};
+use rt_integrators::{
+    render_guides, Ctx, GuideOptions, PreviousView, RenderStats, SamplePass, Technique,
+};
+use rt_temporal::{TemporalDenoiser, TemporalError, TemporalFrame};
+use std::time::{Duration, Instant};
+
+/// Why a sequence cannot be rendered.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SequenceError {
+    /// The structure cannot be built over the scene.
+    #[error("--accel {accel}: {message}")]
+    Accel {
+        /// The structure asked for.
+        accel: String,
+        /// Why.
+        message: String,
+    },
+    /// No camera of that name (after the scene moved to the frame's time).
+    #[error("no camera named \"{0}\"")]
+    NoCamera(String),
+    /// The denoiser reads the lighting split and the technique does not write it.
+    #[error("{denoiser} reads the lighting split (direct, indirect, emission), which the {technique} technique does not write")]
+    SplitUnsupported {
+        /// The denoiser.
+        denoiser: String,
+        /// The technique.
+        technique: String,
+    },
+    /// The denoiser failed on a frame.
+    #[error(transparent)]
+    Denoise(#[from] TemporalError),
+}
+
+/// How long each stage of a frame took.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameTimes {
+    /// Moving the scene and the structure to the frame's time.
+    pub update: Duration,
+    /// Rendering the samples.
+    pub render: Duration,
+    /// The guide pass.
+    pub guides: Duration,
+    /// The denoiser.
+    pub denoise: Duration,
+}
+
+impl FrameTimes {
+    /// All stages together.
+    pub fn total(&self) -> Duration {
+        self.update + self.render + self.guides + self.denoise
+    }
+}
+
+/// One rendered frame.
+#[derive(Debug)]
+pub struct SequenceFrame {
+    /// Frame number.
+    pub frame: u32,
+    /// The image: denoised if there is a denoiser, else the film's mean.
+    pub image: RgbImage,
+    /// The noisy frame the denoiser read (its colour is the film's mean).
+    pub noisy: NoisyFrame,
+    /// The guide buffers, if the denoiser reads them.
+    pub guides: Option<GuideBuffers>,
+    /// Samples and rays of the render.
+    pub stats: RenderStats,
+    /// Stage times.
+    pub times: FrameTimes,
+}
+
+/// A sequence being rendered: the structure, the denoiser's memory and the previous view carry
+/// from frame to frame.
+pub struct SequenceRenderer {
+    technique: Box<dyn Technique>,
+    accel_spec: AccelSpec,
+    accel: Option<Box<dyn Accel>>,
+    denoiser: Option<Box<dyn TemporalDenoiser>>,
+    aovs: AovSet,
+    guide_options: GuideOptions,
+    camera: Option<String>,
+    spp: u32,
+    seed: u32,
+    fps: f64,
+    previous: Option<(Camera, f32)>,
+}
+
+impl SequenceRenderer {
+    /// A renderer of `spp` samples per pixel per frame with `technique` over `accel`, the
+    /// camera named `camera` (the scene's first without one), frame `f` at time `f / fps`, its
+    /// samples from [`frame_seed`]`(seed, f)`, denoised by `denoiser` if given.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        technique: Box<dyn Technique>,
+        accel: AccelSpec,
+        denoiser: Option<Box<dyn TemporalDenoiser>>,
+        camera: Option<String>,
+        spp: u32,
+        seed: u32,
+        fps: f64,
+    ) -> Result<Self, SequenceError> {
+        let aovs = denoiser
+            .as_ref()
+            .map_or(AovSet::default(), |d| AovSet::for_channels(d.needs()));
+        if let Some(d) = &denoiser {
+            if aovs.any_split() && !technique.writes_split() {
+                return Err(SequenceError::SplitUnsupported {
+                    denoiser: d.name().to_string(),
+                    technique: technique.name().to_string(),
+                });
+            }
+        }
+        Ok(Self {
+            technique,
+            accel_spec: accel,
+            accel: None,
+            denoiser,
+            aovs,
+            guide_options: GuideOptions::default(),
+            camera,
+            spp: spp.max(1),
+            seed,
+            fps,
+            previous: None,
+        })
+    }
+
+    /// The denoiser's name, if any.
+    pub fn denoiser_name(&self) -> Option<&str> {
+        self.denoiser.as_deref().map(|d| d.name())
+    }
+
+    /// Forgets the previous frames (the next frame starts a new history).
+    pub fn reset(&mut self) {
+        self.previous = None;
+        if let Some(d) = &mut self.denoiser {
+            d.reset();
+        }
+    }
+
+    /// The time of frame `f`.
+    pub fn time_of(&self, f: u32) -> f32 {
+        (f64::from(f) / self.fps) as f32
+    }
+
+    /// Renders frame `f` of `scene` (moving it to the frame's time).
+    pub fn render(&mut self, scene: &mut Scene, f: u32) -> Result<SequenceFrame, SequenceError> {
+        self.render_with(scene, f, None)
+    }
+
+    /// Renders frame `f` seen by `camera` instead of the scene's (an interactive viewer's
+    /// orbit), at `camera`'s resolution.
+    pub fn render_with(
+        &mut self,
+        scene: &mut Scene,
+        f: u32,
+        camera: Option<&Camera>,
+    ) -> Result<SequenceFrame, SequenceError> {
+        let mut times = FrameTimes::default();
+        let t = Instant::now();
+        let time = self.time_of(f);
+        scene.set_time(time);
+        let updated = self.accel.as_mut().is_some_and(|a| a.update(scene));
+        if !updated {
+            let built =
+                self.accel_spec
+                    .try_build_scene_mut(scene)
+                    .map_err(|e| SequenceError::Accel {
+                        accel: self.accel_spec.to_string(),
+                        message: e.to_string(),
+                    })?;
+            self.accel = Some(built);
+        }
+        times.update = t.elapsed();
+        let camera = match camera {
+            Some(c) => c.clone(),
+            None => match &self.camera {
+                Some(name) => scene
+                    .cameras
+                    .iter()
+                    .find(|c| &c.name == name)
+                    .cloned()
+                    .ok_or_else(|| SequenceError::NoCamera(name.clone()))?,
+                None => scene
+                    .cameras
+                    .first()
+                    .cloned()
+                    .ok_or_else(|| SequenceError::NoCamera("(none)".into()))?,
+            },
+        };
+        let accel = self.accel.as_deref().expect("built above");
+        let ctx = Ctx {
+            scene,
+            accel,
+            camera: &camera,
+        };
+        let wants_guides = self.denoiser.as_ref().is_some_and(|d| d.needs_guides());
+        let t = Instant::now();
+        let mut film = Film::new(
+            camera.width,
+            camera.height,
+            FilmBuffers::for_outputs(self.aovs),
+        );
+        let pass = SamplePass {
+            indices: 0..self.spp,
+            stream: SampleStream::Render,
+            pixels: None,
+            centre_first: wants_guides,
+        };
+        let stats =
+            self.technique
+                .render_pass(&ctx, &mut film, frame_seed(self.seed, f), &pass, &|_| {});
+        times.render = t.elapsed();
+        let t = Instant::now();
+        let guides = wants_guides.then(|| {
+            let previous = self.previous.as_ref().map(|(c, time)| PreviousView {
+                camera: c,
+                time: *time,
+            });
+            render_guides(&ctx, previous.as_ref(), &self.guide_options)
+        });
+        times.guides = t.elapsed();
+        let noisy = NoisyFrame::from_film(&film, self.aovs);
+        let t = Instant::now();
+        let image = match &mut self.denoiser {
+            Some(d) => d.push(&TemporalFrame {
+                frame: &noisy,
+                guides: guides.as_ref(),
+            })?,
+            None => noisy.colour.clone(),
+        };
+        times.denoise = t.elapsed();
+        self.previous = Some((camera, time));
+        Ok(SequenceFrame {
+            frame: f,
+            image,
+            noisy,
+            guides,
+            stats,
+            times,
+        })
+    }
+}
