@@ -52,7 +52,7 @@ pub fn run(
     let pool = pool.build().context("cannot start worker threads")?;
     let mut renderer = SequenceRenderer::new(
         job.settings.integrator.build(),
-        job.settings.accel.clone(),
+        job.settings.accel,
         Some(denoiser),
         job.camera.clone(),
         job.settings.spp,
