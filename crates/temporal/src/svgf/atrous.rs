@@ -15,6 +15,7 @@
 //! surfaces; Eq. 6's σ is read in units of two taps, so σ = 1 is a mild falloff over the 5×5
 //! footprint and σ → 0 keeps the pixel alone.
 
+use super::fast_exp::exp_neg;
 use super::features::{Class, Features};
 use super::params::SvgfParams;
 use rayon::prelude::*;
@@ -169,14 +170,14 @@ fn pixel(
             if spatial > 0.0 {
                 // Eq. 6's σ in units of two taps ([ours], see the module doc).
                 let s = (2.0 * spatial).max(1e-3);
-                base *= (-taps2 / (2.0 * s * s)).exp();
+                base *= exp_neg(-taps2 / (2.0 * s * s));
             }
             if base <= 0.0 {
                 continue;
             }
             for s in 0..2 {
                 let el = -(lum[s] - luminance(q.colour[s])).abs() * l_scale[s];
-                let w = base * (ez + el).exp();
+                let w = base * exp_neg(ez + el);
                 sum_c[s] += q.colour[s] * w;
                 sum_w[s] += w;
                 sum_v[s] += w * w * q.variance[s];

@@ -27,6 +27,7 @@
 mod atrous;
 pub mod clip;
 pub mod diamond;
+mod fast_exp;
 mod features;
 mod history;
 mod params;
@@ -265,7 +266,7 @@ fn spatial_variance(
                 continue;
             }
             let dist = (((xx - x).pow(2) + (yy - y).pow(2)) as f32).sqrt();
-            let wz = (-(z - f.depth[j]).abs() / (z_scale * dist + 1e-3 * z)).exp();
+            let wz = fast_exp::exp_neg(-(z - f.depth[j]).abs() / (z_scale * dist + 1e-3 * z));
             let w = wz * normal_weight(n.dot(f.normal[j]), p.sigma_n);
             for s in 0..2 {
                 sum[s][0] += w * moments[j][s][0];
