@@ -171,7 +171,9 @@ fn json_has_frames_with_null_steps_first() {
     assert!(close(frames[2]["temporal_error_a"].as_f64().unwrap(), 0.25));
     assert_eq!(frames[1]["mse"].as_f64(), Some(0.015625));
     assert!(close(v["temporal_relmse"].as_f64().unwrap(), 6.25));
+    assert!(close(v["temporal_error_a"].as_f64().unwrap(), 0.25));
     assert_eq!(v["temporal_error_b"].as_f64(), Some(0.0));
+    assert_eq!(v["mean_mse"].as_f64(), Some(0.015625));
     assert!(v["lag"].is_null());
     assert_eq!(v["relmse_epsilon"].as_f64(), Some(0.01));
 }
