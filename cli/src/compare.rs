@@ -62,11 +62,11 @@ pub struct CompareArgs {
 
     /// The lag's steady state: the median per-frame relMSE over this many frames before
     /// --event.
-    #[arg(long, value_name = "N", default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
+    #[arg(long, value_name = "N", default_value_t = 10, requires = "event", value_parser = clap::value_parser!(u32).range(1..))]
     pub lag_window: u32,
 
     /// The lag's threshold: recovered when relMSE <= factor x the steady state.
-    #[arg(long, value_name = "FACTOR", default_value_t = 2.0, value_parser = positive)]
+    #[arg(long, value_name = "FACTOR", default_value_t = 2.0, requires = "event", value_parser = positive)]
     pub lag_factor: f64,
 }
 

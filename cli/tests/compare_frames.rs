@@ -307,6 +307,13 @@ fn bad_sequences_are_one_error_line_naming_the_file() {
             .code(),
         Some(2)
     );
-    let zero = [&pats[..], &["--frames", "3..7", "--lag-window", "0"]].concat();
+    let zero = [
+        &pats[..],
+        &["--frames", "3..7", "--event", "5", "--lag-window", "0"],
+    ]
+    .concat();
     assert_eq!(d.compare(&zero).status.code(), Some(2));
+    // Lag settings without --event would be ignored, so they are refused.
+    let no_event = [&pats[..], &["--frames", "3..7", "--lag-factor", "3"]].concat();
+    assert_eq!(d.compare(&no_event).status.code(), Some(2));
 }

@@ -28,16 +28,28 @@ pub(crate) fn check_frame(
         }));
     }
     if let Some(p) = previous {
-        if size(p) != size(frame) {
-            return Err(TemporalError::FrameSize {
-                role,
-                frame: index,
-                size: size(frame),
-                previous: size(p),
-            });
-        }
+        check_same_size(role, index, frame, p)?;
     }
     check_finite(frame, role).map_err(bad)
+}
+
+/// Checks that frame `index` has the size of the frame before it.
+pub(crate) fn check_same_size(
+    role: Role,
+    index: usize,
+    frame: &RgbImage,
+    previous: &RgbImage,
+) -> Result<()> {
+    if size(previous) == size(frame) {
+        Ok(())
+    } else {
+        Err(TemporalError::FrameSize {
+            role,
+            frame: index,
+            size: size(frame),
+            previous: size(previous),
+        })
+    }
 }
 
 /// Checks a whole sequence: at least `needed` frames (for `what`), each valid and of one size.

@@ -2,7 +2,7 @@
 //! pair of frames: what `render compare --frames` streams through.
 
 use super::error::{positive, Result, TemporalError};
-use super::frames::check_frame;
+use super::frames::check_same_size;
 use super::temporal_error::mean_luminance_change;
 use super::temporal_relmse::{difference_relmse, Step};
 use super::TemporalSeries;
@@ -96,8 +96,9 @@ impl SequenceComparison {
         let step = match &self.previous {
             None => None,
             Some((t0, r0)) => {
-                check_frame(Role::Test, index, &test, Some(t0))?;
-                check_frame(Role::Reference, index, &reference, Some(r0))?;
+                // `compare` has checked each image on its own; only the sizes are left.
+                check_same_size(Role::Test, index, &test, t0)?;
+                check_same_size(Role::Reference, index, &reference, r0)?;
                 let step = Step {
                     test: [t0, &test],
                     reference: [r0, &reference],
