@@ -31,7 +31,7 @@ pub(crate) fn mean_luminance_change(previous: &RgbImage, current: &RgbImage) -> 
 /// the absolute difference of their luminances, and the mean of those over the pairs.
 ///
 /// This is the temporal-stability measure of Schied et al., "Spatiotemporal Variance-Guided
-/// Filtering" (HPG 2017), as Voorhuis ("Beyond SVGF", 2018, §5) uses it over 60 frames of a
+/// Filtering" (HPG 2017), as Voorhuis ("Beyond SVGF", MSc thesis, Utrecht 2018) uses it over 60 frames of a
 /// fixed camera and a static scene, where an ideal denoiser would output the same image every
 /// frame and any change is flicker. Luminance is Rec. 709, `0.2126 R + 0.7152 G + 0.0722 B`, of
 /// the *linear* values, neither clamped nor tone-mapped (the sources do not say which they
