@@ -122,3 +122,46 @@ fn a_frame_without_a_lit_emitter_renders_black_with_every_technique() {
         );
     }
 }
+
+#[test]
+fn motion_blur_is_refused_while_a_keyed_emission_changes() {
+    use rt_core::scene::MotionBlurError;
+    let mut s = scene_from_toml(&format!("{COMMON}{TOGGLE}"));
+    s.shutter = 0.1;
+    // The shutter [0.95, 1.05] holds the switch at t = 1.
+    s.set_time(0.95);
+    assert_eq!(
+        s.motion_blur_error(),
+        Some(MotionBlurError::AnimatedEmission("lamp".into()))
+    );
+    let message = s.motion_blur_error().unwrap().to_string();
+    assert!(
+        message.contains("lamp") && !message.contains('\n'),
+        "{message}"
+    );
+    // Opening at the switch or after it, the lamp stays as it is while the shutter is open.
+    for t in [1.0, 1.2] {
+        s.set_time(t);
+        assert_eq!(s.motion_blur_error(), None, "t = {t}");
+    }
+    // A linear fade changes all the time between its keys.
+    let mut fade = scene_from_toml(&format!(
+        "{COMMON}{}",
+        TOGGLE.replace("interpolate = \"step\"", "interpolate = \"linear\"")
+    ));
+    fade.shutter = 0.1;
+    fade.set_time(1.2);
+    assert!(fade.motion_blur_error().is_some());
+    // Halfway between the keys at 1 (off) and 2 (6): 3, where the step holds 0.
+    fade.set_time(1.5);
+    s.set_time(1.5);
+    let lamp = |s: &rt_core::Scene| {
+        s.materials
+            .iter()
+            .find(|m| m.name == "lamp")
+            .unwrap()
+            .emission
+    };
+    assert_eq!(lamp(&fade), rt_core::Rgb::splat(3.0));
+    assert_eq!(lamp(&s), rt_core::Rgb::ZERO);
+}
