@@ -39,8 +39,9 @@ pub struct GuideBuffers {
     pub object: Image<u32>,
     /// Instance index of the hit in `Scene::instances`, or [`NO_ID`].
     pub instance: Image<u32>,
-    /// Roughness of the hit's material in [0, 1]: 1 − the layers' weighted mean hardness, so a
-    /// mirror is 0 and a Lambertian surface 1 (1 where no surface).
+    /// Roughness of the hit's material in [0, 1] on Beckmann's scale: its sharpest significant
+    /// layer's (`rt_integrators::guides::roughness`), so a mirror is 0 and a Lambertian
+    /// surface 1 (1 where no surface).
     pub roughness: Image<f32>,
     /// Features along the mirror direction, for pixels whose primary hit is specular (roughness
     /// below the classifier's glossy limit); `None` when not asked for.

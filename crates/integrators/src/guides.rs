@@ -55,16 +55,29 @@ impl Default for GuideOptions {
 /// previous camera). Finite, so no NaN or Inf reaches a buffer.
 const OFF_SCREEN: f32 = 1.0e7;
 
-/// Roughness of material `m`: 1 − the weighted mean of its layers' hardness.
+/// Layers lighter than this share of a material's weight do not decide its roughness.
+const SIGNIFICANT_LAYER: f32 = 0.1;
+
+/// Roughness of material `m` for classifying its pixels, on Beckmann's scale: that of its
+/// sharpest layer holding at least a tenth of its weight, a Blinn-Phong lobe of exponent
+/// `n = 1024κ + 1` taken as Beckmann `α = √(2 / (n + 2))` (Walter et al. 2007's correspondence);
+/// 0 for a delta layer, 1 for a Lambertian one (κ = 0). A coated or layered surface with a
+/// visible sharp lobe is thereby glossy, not the blend of its layers' hardness.
 pub fn roughness(m: &Material) -> f32 {
-    let (w, wk) = m.layers.iter().fold((0.0f32, 0.0f32), |(w, wk), l| {
-        (w + l.weight, wk + l.weight * l.hardness)
-    });
-    if w > 0.0 {
-        (1.0 - wk / w).clamp(0.0, 1.0)
-    } else {
-        1.0
-    }
+    let total: f32 = m.layers.iter().map(|l| l.weight).sum();
+    m.layers
+        .iter()
+        .filter(|l| total > 0.0 && l.weight >= SIGNIFICANT_LAYER * total)
+        .map(|l| {
+            if l.is_delta() {
+                0.0
+            } else if l.hardness <= 0.0 {
+                1.0
+            } else {
+                (2.0 / (1024.0 * l.hardness + 3.0)).sqrt().min(1.0)
+            }
+        })
+        .fold(1.0f32, f32::min)
 }
 
 /// True if every layer of `m` is a delta lobe (a pure mirror or smooth glass).
@@ -289,4 +302,25 @@ fn reflected(
         return;
     }
     t.r_albedo = albedo;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rt_core::Layer;
+
+    #[test]
+    fn roughness_is_that_of_the_sharpest_significant_layer() {
+        let white = Rgb::splat(0.8);
+        assert_eq!(roughness(&Material::diffuse("d", white)), 1.0);
+        assert_eq!(roughness(&Material::mirror("m", white)), 0.0);
+        // A glossy lobe of hardness 0.3 over a diffuse base: Beckmann ≈ 0.08, not the blend.
+        let mut floor = Material::diffuse("f", white);
+        floor.layers = vec![Layer::new(0.4, white, 0.3), Layer::new(0.6, white, 0.0)];
+        let r = roughness(&floor);
+        assert!((r - (2.0f32 / 310.2).sqrt()).abs() < 1e-4, "{r}");
+        // A lobe with 5 % of the weight does not decide.
+        floor.layers = vec![Layer::new(0.05, white, 1.0), Layer::new(0.95, white, 0.0)];
+        assert_eq!(roughness(&floor), 1.0);
+    }
 }
