@@ -25,12 +25,16 @@
 //! guide rays is the thesis' alternative and not built yet); fireflies are not clamped.
 
 mod atrous;
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+mod atrous_avx2;
 pub mod clip;
 pub mod diamond;
 mod fast_exp;
 mod features;
 mod history;
 mod params;
+mod planes;
 mod reproject;
 
 pub use atrous::{normal_weight, Signals, KERNEL};
@@ -63,6 +67,9 @@ pub struct SvgfInput<'a> {
 pub struct Svgf {
     params: SvgfParams,
     history: Option<History>,
+    /// Whether the AVX2 code may run (where the CPU has it).
+    simd: bool,
+    scratch: atrous::Scratch,
 }
 
 /// Luminance moments of a demodulated colour.
@@ -83,7 +90,21 @@ impl Svgf {
         Self {
             params,
             history: None,
+            simd: true,
+            scratch: atrous::Scratch::default(),
         }
+    }
+
+    /// The same filter with the AVX2 code allowed (the default, used where the CPU has it) or
+    /// not. Both give the same bits; this is for comparing them.
+    pub fn with_simd(mut self, allow: bool) -> Self {
+        self.simd = allow;
+        self
+    }
+
+    /// True if [`Svgf::push`] runs AVX2 code on this CPU.
+    pub fn uses_simd(&self) -> bool {
+        self.simd && atrous::simd_available()
     }
 
     /// Its parameters.
@@ -196,18 +217,19 @@ impl Svgf {
             }
         }
         // 6. À-Trous, keeping the feedback tap.
-        let mut ping = acc;
-        let mut pong = vec![Signals::default(); n];
         let hold = [false, p.hold_indirect_variance];
-        let mut feedback: Option<Vec<Signals>> = (p.feedback == 0).then(|| ping.clone());
-        for it in 0..p.iterations {
-            atrous::iterate(&f, p, &lengths, 1 << it, hold, &ping, &mut pong);
-            std::mem::swap(&mut ping, &mut pong);
-            if it + 1 == p.feedback {
-                feedback = Some(ping.clone());
-            }
-        }
-        let feedback = feedback.unwrap_or_else(|| ping.clone());
+        let mut ping = acc;
+        let mut feedback = vec![Signals::default(); n];
+        atrous::run(
+            &f,
+            p,
+            &lengths,
+            hold,
+            self.simd,
+            &mut self.scratch,
+            &mut ping,
+            &mut feedback,
+        );
         // 7. Remodulate; median on diffuse pixels for display.
         let illumination: Vec<Rgb> = ping.iter().map(|s| s.colour[0] + s.colour[1]).collect();
         let shown = if p.median {

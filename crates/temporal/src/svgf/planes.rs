@@ -1,0 +1,196 @@
+//! Structure-of-arrays copies of what the À-Trous iterations read, for the row code of
+//! [`super::atrous_avx2`]: per frame the guide features ([`GuidePlanes`]), per level both
+//! signals' colour, variance and luminance ([`LevelPlanes`]).
+//!
+//! A level's rows are interleaved: row `y` of plane `k` starts at `(y·planes + k)·stride`, so
+//! one output row of every plane is one contiguous slice that rayon can hand to a thread.
+//! `stride` is the width rounded up to 8 (one AVX2 vector); the padding is never read as a tap.
+//! The buffers are kept across frames and only resized when the size changes.
+
+use super::atrous::{sigma_l, Signals};
+use super::features::{Class, Features};
+use super::params::SvgfParams;
+use rt_core::color::luminance;
+
+/// Planes of [`GuidePlanes`].
+pub(crate) const GROUP: usize = 0;
+pub(crate) const DEPTH: usize = 1;
+pub(crate) const Z_SCALE: usize = 2;
+pub(crate) const Z_EPS: usize = 3;
+pub(crate) const NX: usize = 4;
+pub(crate) const NY: usize = 5;
+pub(crate) const NZ: usize = 6;
+pub(crate) const SPATIAL: usize = 7;
+pub(crate) const SIGMA_L: usize = 8;
+const GUIDE_PLANES: usize = 9;
+
+/// Planes of one signal in [`LevelPlanes`]: red, green, blue, variance, luminance.
+pub(crate) const LEVEL_PLANES: usize = 10;
+/// Offset of signal `s`'s planes.
+pub(crate) const fn signal(s: usize) -> usize {
+    5 * s
+}
+pub(crate) const R: usize = 0;
+pub(crate) const G: usize = 1;
+pub(crate) const B: usize = 2;
+pub(crate) const VAR: usize = 3;
+pub(crate) const LUM: usize = 4;
+
+/// Group of a pixel as the À-Trous compares it: taps count only within one group.
+fn group(c: Class) -> f32 {
+    match c {
+        Class::Sky => 0.0,
+        Class::Mirror => 2.0,
+        _ => 1.0,
+    }
+}
+
+/// Width rounded up to whole vectors.
+fn stride_of(w: usize) -> usize {
+    w.div_ceil(8) * 8
+}
+
+/// Per-pixel constants of every iteration of one frame.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct GuidePlanes {
+    pub(crate) w: usize,
+    pub(crate) h: usize,
+    pub(crate) stride: usize,
+    /// `GUIDE_PLANES` interleaved planes: [`GROUP`] (0 sky, 1 surface, 2 mirror), [`DEPTH`],
+    /// [`Z_SCALE`] (σ_z·|∇z|), [`Z_EPS`] (10⁻³·z), the normal [`NX`], [`NY`], [`NZ`],
+    /// [`SPATIAL`] (`2s²` of Eq. 6's Gaussian, 0 where none) and [`SIGMA_L`] (Eq. 8's σ_l).
+    pub(crate) data: Vec<f32>,
+    /// Whether any pixel has an Eq. 6 Gaussian.
+    pub(crate) any_spatial: bool,
+}
+
+impl GuidePlanes {
+    /// Start of row `y` of plane `k`.
+    #[inline]
+    pub(crate) fn row(&self, k: usize, y: usize) -> usize {
+        (y * GUIDE_PLANES + k) * self.stride
+    }
+
+    /// Fills the planes from the frame's features (the same arithmetic as the per-pixel
+    /// code of [`super::atrous`], so both give the same bits).
+    pub(crate) fn fill(&mut self, f: &Features, p: &SvgfParams, lengths: &[f32]) {
+        let (w, h) = (f.w, f.h);
+        self.w = w;
+        self.h = h;
+        self.stride = stride_of(w);
+        self.data.clear();
+        self.data.resize(GUIDE_PLANES * h * self.stride, 0.0);
+        self.any_spatial = false;
+        for y in 0..h {
+            for x in 0..w {
+                let i = y * w + x;
+                let at = |k: usize| (y * GUIDE_PLANES + k) * self.stride + x;
+                let z = f.depth[i];
+                let n = f.normal[i];
+                let spatial = f.sigma_spatial[i];
+                let d = if spatial > 0.0 {
+                    let s = (2.0 * spatial).max(1e-3);
+                    self.any_spatial = true;
+                    2.0 * s * s
+                } else {
+                    0.0
+                };
+                let values = [
+                    group(f.class[i]),
+                    z,
+                    p.sigma_z * f.depth_step[i],
+                    1e-3 * z,
+                    n.x,
+                    n.y,
+                    n.z,
+                    d,
+                    sigma_l(p, lengths[i]),
+                ];
+                for (k, v) in values.into_iter().enumerate() {
+                    let a = at(k);
+                    self.data[a] = v;
+                }
+            }
+        }
+    }
+}
+
+/// Both signals of one level.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct LevelPlanes {
+    pub(crate) w: usize,
+    pub(crate) h: usize,
+    pub(crate) stride: usize,
+    /// `LEVEL_PLANES` interleaved planes, per signal `s` at [`signal`]`(s)` + [`R`], [`G`],
+    /// [`B`], [`VAR`], [`LUM`].
+    pub(crate) data: Vec<f32>,
+}
+
+impl LevelPlanes {
+    /// Start of row `y` of plane `k`.
+    #[inline]
+    pub(crate) fn row(&self, k: usize, y: usize) -> usize {
+        (y * LEVEL_PLANES + k) * self.stride
+    }
+
+    /// Makes room for a `w`×`h` level (contents unspecified).
+    pub(crate) fn resize(&mut self, w: usize, h: usize) {
+        self.w = w;
+        self.h = h;
+        self.stride = stride_of(w);
+        self.data.resize(LEVEL_PLANES * h * self.stride, 0.0);
+    }
+
+    /// Copies `signals` in, with their luminances.
+    pub(crate) fn load(&mut self, w: usize, h: usize, signals: &[Signals]) {
+        self.resize(w, h);
+        for y in 0..h {
+            for x in 0..w {
+                let px = &signals[y * w + x];
+                for s in 0..2 {
+                    let c = px.colour[s];
+                    let values = [c.x, c.y, c.z, px.variance[s], luminance(c)];
+                    for (k, v) in values.into_iter().enumerate() {
+                        let a = self.row(signal(s) + k, y) + x;
+                        self.data[a] = v;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Pixel `(x, y)` as [`Signals`].
+    #[inline]
+    pub(crate) fn get(&self, x: usize, y: usize) -> Signals {
+        let v = |k: usize| self.data[self.row(k, y) + x];
+        let colour = |s: usize| {
+            let o = signal(s);
+            rt_core::Rgb::new(v(o + R), v(o + G), v(o + B))
+        };
+        Signals {
+            colour: [colour(0), colour(1)],
+            variance: [v(signal(0) + VAR), v(signal(1) + VAR)],
+        }
+    }
+
+    /// Copies the level out.
+    pub(crate) fn store(&self, out: &mut [Signals]) {
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = self.get(i % self.w, i / self.w);
+        }
+    }
+
+    /// True if every colour and variance is finite: then a tap whose weight is 0 adds exactly
+    /// nothing, which the vector code relies on instead of skipping it as the per-pixel code
+    /// does.
+    pub(crate) fn finite(&self) -> bool {
+        (0..self.h).all(|y| {
+            (0..2).all(|s| {
+                (R..=VAR).all(|k| {
+                    let a = self.row(signal(s) + k, y);
+                    self.data[a..a + self.w].iter().all(|v| v.is_finite())
+                })
+            })
+        })
+    }
+}
