@@ -142,8 +142,8 @@ pub(crate) fn run(
                 pong,
                 aos,
             } = scratch;
-            guide.fill(f, p, lengths);
-            ping.load(f.w, f.h, signals);
+            guide.fill(f, p, lengths, 1 << (p.iterations - 1));
+            ping.load(guide.layout, signals);
             for it in 0..p.iterations {
                 let step = 1usize << it;
                 if ping.finite() {
@@ -154,7 +154,7 @@ pub(crate) fn run(
                     aos.resize(signals.len(), Signals::default());
                     ping.store(signals);
                     iterate_portable(f, p, lengths, step, hold, signals, aos);
-                    pong.load(f.w, f.h, aos);
+                    pong.load(guide.layout, aos);
                 }
                 std::mem::swap(ping, pong);
                 if it + 1 == p.feedback {
@@ -198,9 +198,9 @@ pub fn iterate(
     #[cfg(target_arch = "x86_64")]
     if simd_available() {
         let mut g = GuidePlanes::default();
-        g.fill(f, p, lengths);
+        g.fill(f, p, lengths, step);
         let (mut a, mut b) = (LevelPlanes::default(), LevelPlanes::default());
-        a.load(f.w, f.h, input);
+        a.load(g.layout, input);
         assert!(a.finite());
         super::atrous_avx2::iterate(&g, p.sigma_n, step, hold, &a, &mut b);
         b.store(output);

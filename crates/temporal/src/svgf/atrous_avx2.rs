@@ -35,11 +35,10 @@ pub(crate) fn iterate(
     output: &mut LevelPlanes,
 ) {
     assert!(available(), "AVX2 row code called on a CPU without AVX2");
-    output.resize(g.w, g.h);
-    let stride = g.stride;
+    output.reshape(g.layout);
     output
         .data
-        .par_chunks_mut(LEVEL_PLANES * stride)
+        .par_chunks_mut(LEVEL_PLANES * g.layout.len)
         .enumerate()
         .for_each(|(y, out)| {
             // SAFETY: `available()` was asserted above: the CPU has AVX2.
@@ -50,35 +49,7 @@ pub(crate) fn iterate(
         });
 }
 
-/// Eight values of plane row `run` starting at column `xs` (may be outside `0..w`): lanes
-/// outside the image read 0, which for the group plane means sky, a group no tap is taken from.
-#[target_feature(enable = "avx2")]
-#[inline]
-fn load(run: &[f32], xs: isize, w: usize) -> __m256 {
-    if xs >= 0 && xs as usize + 8 <= w {
-        let v = &run[xs as usize..xs as usize + 8];
-        // SAFETY: `v` holds exactly 8 floats; the load is unaligned.
-        #[allow(unsafe_code)]
-        unsafe {
-            _mm256_loadu_ps(v.as_ptr())
-        }
-    } else {
-        let mut t = [0.0f32; 8];
-        for (k, t) in t.iter_mut().enumerate() {
-            let x = xs + k as isize;
-            if x >= 0 && (x as usize) < w {
-                *t = run[x as usize];
-            }
-        }
-        // SAFETY: `t` holds 8 floats.
-        #[allow(unsafe_code)]
-        unsafe {
-            _mm256_loadu_ps(t.as_ptr())
-        }
-    }
-}
-
-/// The 8 values at `at` (a padded row, so whole vectors are in bounds).
+/// The 8 values at `at`.
 #[target_feature(enable = "avx2")]
 #[inline]
 fn load8(data: &[f32], at: usize) -> __m256 {
@@ -88,6 +59,29 @@ fn load8(data: &[f32], at: usize) -> __m256 {
     unsafe {
         _mm256_loadu_ps(v.as_ptr())
     }
+}
+
+/// The 8 values at `at + k·l` for each `k` of `ks`, with one bounds check.
+#[target_feature(enable = "avx2")]
+#[inline]
+fn gather<const N: usize>(data: &[f32], at: usize, l: usize, ks: [usize; N]) -> [__m256; N] {
+    let mut kmax = 0;
+    for &k in &ks {
+        kmax = kmax.max(k);
+    }
+    // Saturating: an overflow gives an end past `data`, and the slice panics.
+    let end = at.saturating_add(kmax.saturating_mul(l).saturating_add(8));
+    let win = &data[at..end];
+    let mut out = [_mm256_setzero_ps(); N];
+    for (o, &k) in out.iter_mut().zip(&ks) {
+        // SAFETY: `k ≤ kmax`, so `k·l + 8 ≤ kmax·l + 8 = win.len()`: the unaligned 8-float
+        // load is inside `win`.
+        #[allow(unsafe_code)]
+        unsafe {
+            *o = _mm256_loadu_ps(win.as_ptr().add(k * l));
+        }
+    }
+    out
 }
 
 #[target_feature(enable = "avx2")]
@@ -142,11 +136,10 @@ pub(crate) fn exp_neg(x: __m256) -> __m256 {
 #[target_feature(enable = "avx2")]
 #[inline]
 fn normal_weight8(c: __m256, e: f32) -> __m256 {
-    let square = |v: __m256| _mm256_mul_ps(v, v);
     if e == 64.0 || e == 128.0 {
         let mut v = _mm256_max_ps(c, _mm256_setzero_ps());
         for _ in 0..if e == 64.0 { 6 } else { 7 } {
-            v = square(v);
+            v = _mm256_mul_ps(v, v);
         }
         v
     } else {
@@ -167,7 +160,18 @@ fn normal_weight8(c: __m256, e: f32) -> __m256 {
     }
 }
 
-/// Output row `y` (all planes of the row: `LEVEL_PLANES · stride` floats).
+/// What the luminance-independent part of one tap gives eight pixels.
+#[derive(Clone, Copy)]
+struct Tap {
+    /// Index of the tap's 8 values in the input's plane 0.
+    at: usize,
+    /// `h_x·h_y·w_n` (times Eq. 6's Gaussian), 0 where no tap is taken.
+    base: __m256,
+    /// The depth term's exponent.
+    ez: __m256,
+}
+
+/// Output row `y` (all planes of the row: `LEVEL_PLANES · len` floats, margins untouched).
 #[target_feature(enable = "avx2")]
 fn row(
     g: &GuidePlanes,
@@ -178,144 +182,171 @@ fn row(
     y: usize,
     out: &mut [f32],
 ) {
-    let (w, h, stride) = (g.w, g.h, g.stride);
+    let lay = g.layout;
+    let (w, h) = (lay.w, lay.h);
+    debug_assert!(lay.margin >= 2 * step && input.layout == lay);
     let gd = &g.data;
     let id = &input.data;
     let zero = _mm256_setzero_ps();
     let one = _mm256_set1_ps(1.0);
-    let grow = |k: usize, yy: usize| &gd[g.row(k, yy)..g.row(k, yy) + stride];
-    let irow = |k: usize, yy: usize| &id[input.row(k, yy)..input.row(k, yy) + stride];
     const GAUSS3: [f32; 3] = [0.25, 0.5, 0.25];
+    let l = lay.len;
+    let mut taps = [Tap {
+        at: 0,
+        base: zero,
+        ez: zero,
+    }; 25];
     for x0 in (0..w).step_by(8) {
-        let c = |k: usize| load8(gd, g.row(k, y) + x0);
-        let ci = |k: usize| load8(id, input.row(k, y) + x0);
-        let grp = c(planes::GROUP);
+        // Centre values; `at(k)` is the index of this vector in guide or level plane `k`'s
+        // row `yy`, shifted by `dx` (the margins make every tap's load in bounds).
+        let gat = |k: usize, yy: usize, dx: isize| (g.row(k, yy) + x0).wrapping_add_signed(dx);
+        let iat = |k: usize, yy: usize, dx: isize| (input.row(k, yy) + x0).wrapping_add_signed(dx);
+        let grp = load8(gd, gat(planes::GROUP, y, 0));
+        let centre = iat(0, y, 0);
         let surface = _mm256_cmp_ps::<_CMP_NEQ_OQ>(grp, zero);
-        let outk = |k: usize| k * stride + x0;
+        let outk = |k: usize| k * lay.len + lay.margin + x0;
         if _mm256_movemask_ps(surface) == 0 {
             // All sky (or padding): passed through.
             for k in 0..LEVEL_PLANES {
-                store8(out, outk(k), ci(k));
+                store8(out, outk(k), load8(id, iat(k, y, 0)));
             }
             continue;
         }
-        let z = c(planes::DEPTH);
-        let z_scale = c(planes::Z_SCALE);
-        let z_eps = c(planes::Z_EPS);
-        let (nx, ny, nz) = (c(planes::NX), c(planes::NY), c(planes::NZ));
-        let spatial = c(planes::SPATIAL);
-        let has_spatial = _mm256_cmp_ps::<_CMP_GT_OQ>(spatial, zero);
-        let any_spatial = g.any_spatial && _mm256_movemask_ps(has_spatial) != 0;
-        let sl = c(planes::SIGMA_L);
-        // The 3×3-Gaussian-prefiltered variances and the luminance scales.
-        let mut vsum = [zero; 2];
+        // The luminance-independent part of every tap.
+        let mut n_taps = 0;
+        {
+            use planes::{DEPTH, GROUP, NX, NY, NZ, SPATIAL, Z_EPS, Z_SCALE};
+            let [z, z_scale, z_eps, nx, ny, nz, spatial] = gather(
+                gd,
+                gat(0, y, 0),
+                l,
+                [DEPTH, Z_SCALE, Z_EPS, NX, NY, NZ, SPATIAL],
+            );
+            let has_spatial = _mm256_cmp_ps::<_CMP_GT_OQ>(spatial, zero);
+            let any_spatial = g.any_spatial && _mm256_movemask_ps(has_spatial) != 0;
+            for (ky, hy) in KERNEL.iter().enumerate() {
+                let dy = ky as isize - 2;
+                let yy = y as isize + dy * step as isize;
+                if yy < 0 || yy >= h as isize {
+                    continue;
+                }
+                let yy = yy as usize;
+                for (kx, hx) in KERNEL.iter().enumerate() {
+                    let dx = (kx as isize - 2) * step as isize;
+                    let xs = x0 as isize + dx;
+                    if xs + 8 <= 0 || xs >= w as isize {
+                        continue;
+                    }
+                    let [q_group, q_depth, q_nx, q_ny, q_nz] =
+                        gather(gd, gat(0, yy, dx), l, [GROUP, DEPTH, NX, NY, NZ]);
+                    let same = _mm256_cmp_ps::<_CMP_EQ_OQ>(q_group, grp);
+                    let taps2 = ((kx as isize - 2).pow(2) + dy * dy) as f32;
+                    let dist = step as f32 * taps2.sqrt();
+                    let ez = _mm256_div_ps(
+                        neg_abs_diff(z, q_depth),
+                        _mm256_add_ps(_mm256_mul_ps(z_scale, _mm256_set1_ps(dist)), z_eps),
+                    );
+                    let dot = _mm256_add_ps(
+                        _mm256_add_ps(_mm256_mul_ps(nx, q_nx), _mm256_mul_ps(ny, q_ny)),
+                        _mm256_mul_ps(nz, q_nz),
+                    );
+                    let mut base =
+                        _mm256_mul_ps(_mm256_set1_ps(hx * hy), normal_weight8(dot, sigma_n));
+                    if any_spatial {
+                        let gauss = exp_neg(_mm256_div_ps(_mm256_set1_ps(-taps2), spatial));
+                        base = _mm256_mul_ps(base, _mm256_blendv_ps(one, gauss, has_spatial));
+                    }
+                    taps[n_taps] = Tap {
+                        at: iat(0, yy, dx),
+                        base: _mm256_and_ps(base, same),
+                        ez,
+                    };
+                    n_taps += 1;
+                }
+            }
+        }
+        // The 3×3-Gaussian-prefiltered variances' weights.
         let mut vw = zero;
+        let mut oks = [zero; 9];
         for (dy, wy) in GAUSS3.iter().enumerate() {
             let yy = y as isize + dy as isize - 1;
             if yy < 0 || yy >= h as isize {
                 continue;
             }
-            let yy = yy as usize;
             for (dx, wx) in GAUSS3.iter().enumerate() {
-                let xs = x0 as isize + dx as isize - 1;
-                let ok = _mm256_cmp_ps::<_CMP_NEQ_OQ>(load(grow(planes::GROUP, yy), xs, w), zero);
-                let wxy = _mm256_set1_ps(wx * wy);
-                for (s, sum) in vsum.iter_mut().enumerate() {
-                    let v = load(irow(planes::signal(s) + planes::VAR, yy), xs, w);
-                    *sum = _mm256_add_ps(*sum, _mm256_and_ps(_mm256_mul_ps(wxy, v), ok));
-                }
-                vw = _mm256_add_ps(vw, _mm256_and_ps(wxy, ok));
+                let q = load8(gd, gat(planes::GROUP, yy as usize, dx as isize - 1));
+                let ok = _mm256_cmp_ps::<_CMP_NEQ_OQ>(q, zero);
+                oks[3 * dy + dx] = ok;
+                vw = _mm256_add_ps(vw, _mm256_and_ps(_mm256_set1_ps(wx * wy), ok));
             }
         }
         let vw_pos = _mm256_cmp_ps::<_CMP_GT_OQ>(vw, zero);
-        let lum = [0, 1].map(|s| ci(planes::signal(s) + planes::LUM));
-        let l_scale = vsum.map(|sum| {
-            let pv = _mm256_and_ps(_mm256_div_ps(sum, vw), vw_pos);
-            _mm256_div_ps(
-                one,
-                _mm256_add_ps(_mm256_mul_ps(sl, _mm256_sqrt_ps(pv)), _mm256_set1_ps(1e-10)),
-            )
-        });
-        // Σ w·c (r, g, b), Σ w, Σ w²·Var per signal.
-        let mut acc = [[zero; 5]; 2];
-        for (ky, hy) in KERNEL.iter().enumerate() {
-            let dy = ky as isize - 2;
-            let yy = y as isize + dy * step as isize;
-            if yy < 0 || yy >= h as isize {
-                continue;
-            }
-            let yy = yy as usize;
-            for (kx, hx) in KERNEL.iter().enumerate() {
-                let dx = kx as isize - 2;
-                let xs = x0 as isize + dx * step as isize;
-                if xs + 8 <= 0 || xs >= w as isize {
+        let sl = load8(gd, gat(planes::SIGMA_L, y, 0));
+        for (s, &held) in hold.iter().enumerate() {
+            let o = planes::signal(s);
+            let mut vsum = zero;
+            for (dy, wy) in GAUSS3.iter().enumerate() {
+                let yy = y as isize + dy as isize - 1;
+                if yy < 0 || yy >= h as isize {
                     continue;
                 }
-                let q = |k: usize| load(grow(k, yy), xs, w);
-                let same = _mm256_cmp_ps::<_CMP_EQ_OQ>(q(planes::GROUP), grp);
-                let taps2 = (dx * dx + dy * dy) as f32;
-                let dist = step as f32 * taps2.sqrt();
-                let ez = _mm256_div_ps(
-                    neg_abs_diff(z, q(planes::DEPTH)),
-                    _mm256_add_ps(_mm256_mul_ps(z_scale, _mm256_set1_ps(dist)), z_eps),
-                );
-                let dot = _mm256_add_ps(
-                    _mm256_add_ps(
-                        _mm256_mul_ps(nx, q(planes::NX)),
-                        _mm256_mul_ps(ny, q(planes::NY)),
-                    ),
-                    _mm256_mul_ps(nz, q(planes::NZ)),
-                );
-                let mut base = _mm256_mul_ps(_mm256_set1_ps(hx * hy), normal_weight8(dot, sigma_n));
-                if any_spatial {
-                    let gauss = exp_neg(_mm256_div_ps(_mm256_set1_ps(-taps2), spatial));
-                    base = _mm256_mul_ps(base, _mm256_blendv_ps(one, gauss, has_spatial));
-                }
-                let base = _mm256_and_ps(base, same);
-                for (s, a) in acc.iter_mut().enumerate() {
-                    let o = planes::signal(s);
-                    let qs = |k: usize| load(irow(o + k, yy), xs, w);
-                    let el = _mm256_mul_ps(neg_abs_diff(lum[s], qs(planes::LUM)), l_scale[s]);
-                    let wgt = _mm256_mul_ps(base, exp_neg(_mm256_add_ps(ez, el)));
-                    for (ch, k) in [planes::R, planes::G, planes::B].into_iter().enumerate() {
-                        a[ch] = _mm256_add_ps(a[ch], _mm256_mul_ps(qs(k), wgt));
-                    }
-                    a[3] = _mm256_add_ps(a[3], wgt);
-                    a[4] = _mm256_add_ps(
-                        a[4],
-                        _mm256_mul_ps(_mm256_mul_ps(wgt, wgt), qs(planes::VAR)),
-                    );
+                for (dx, wx) in GAUSS3.iter().enumerate() {
+                    let v = load8(id, iat(o + planes::VAR, yy as usize, dx as isize - 1));
+                    let wv = _mm256_mul_ps(_mm256_set1_ps(wx * wy), v);
+                    vsum = _mm256_add_ps(vsum, _mm256_and_ps(wv, oks[3 * dy + dx]));
                 }
             }
-        }
-        for (s, a) in acc.iter().enumerate() {
-            let o = planes::signal(s);
+            let pv = _mm256_and_ps(_mm256_div_ps(vsum, vw), vw_pos);
+            let l_scale = _mm256_div_ps(
+                one,
+                _mm256_add_ps(_mm256_mul_ps(sl, _mm256_sqrt_ps(pv)), _mm256_set1_ps(1e-10)),
+            );
+            let lum = load8(id, centre + (o + planes::LUM) * l);
+            // Σ w·c (r, g, b), Σ w, Σ w²·Var.
+            let (mut sr, mut sg, mut sb, mut sw, mut sv) = (zero, zero, zero, zero, zero);
+            for t in &taps[..n_taps] {
+                let [qr, qg, qb, qv, ql] = gather(
+                    id,
+                    t.at + o * l,
+                    l,
+                    [planes::R, planes::G, planes::B, planes::VAR, planes::LUM],
+                );
+                let el = _mm256_mul_ps(neg_abs_diff(lum, ql), l_scale);
+                let wgt = _mm256_mul_ps(t.base, exp_neg(_mm256_add_ps(t.ez, el)));
+                sr = _mm256_add_ps(sr, _mm256_mul_ps(qr, wgt));
+                sg = _mm256_add_ps(sg, _mm256_mul_ps(qg, wgt));
+                sb = _mm256_add_ps(sb, _mm256_mul_ps(qb, wgt));
+                sw = _mm256_add_ps(sw, wgt);
+                sv = _mm256_add_ps(sv, _mm256_mul_ps(_mm256_mul_ps(wgt, wgt), qv));
+            }
             // Filtered where the sum of weights is positive (the per-pixel code's test) and
             // the pixel is no sky; the centre elsewhere.
-            let take = _mm256_and_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(a[3], zero), surface);
-            let mut rgb = [zero; 3];
-            for (ch, k) in [planes::R, planes::G, planes::B].into_iter().enumerate() {
-                rgb[ch] = _mm256_blendv_ps(ci(o + k), _mm256_div_ps(a[ch], a[3]), take);
-                store8(out, outk(o + k), rgb[ch]);
-            }
-            let var = if hold[s] {
-                ci(o + planes::VAR)
+            let ci = |k: usize| load8(id, centre + (o + k) * l);
+            let take = _mm256_and_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(sw, zero), surface);
+            let r = _mm256_blendv_ps(ci(planes::R), _mm256_div_ps(sr, sw), take);
+            let gr = _mm256_blendv_ps(ci(planes::G), _mm256_div_ps(sg, sw), take);
+            let b = _mm256_blendv_ps(ci(planes::B), _mm256_div_ps(sb, sw), take);
+            let var = if held {
+                ci(planes::VAR)
             } else {
                 _mm256_blendv_ps(
-                    ci(o + planes::VAR),
-                    _mm256_div_ps(a[4], _mm256_mul_ps(a[3], a[3])),
+                    ci(planes::VAR),
+                    _mm256_div_ps(sv, _mm256_mul_ps(sw, sw)),
                     take,
                 )
             };
-            store8(out, outk(o + planes::VAR), var);
             // luminance(c) = 0.2126·r + 0.7152·g + 0.0722·b, summed left to right.
             let l = _mm256_add_ps(
                 _mm256_add_ps(
-                    _mm256_mul_ps(_mm256_set1_ps(0.2126), rgb[0]),
-                    _mm256_mul_ps(_mm256_set1_ps(0.7152), rgb[1]),
+                    _mm256_mul_ps(_mm256_set1_ps(0.2126), r),
+                    _mm256_mul_ps(_mm256_set1_ps(0.7152), gr),
                 ),
-                _mm256_mul_ps(_mm256_set1_ps(0.0722), rgb[2]),
+                _mm256_mul_ps(_mm256_set1_ps(0.0722), b),
             );
+            store8(out, outk(o + planes::R), r);
+            store8(out, outk(o + planes::G), gr);
+            store8(out, outk(o + planes::B), b);
+            store8(out, outk(o + planes::VAR), var);
             store8(out, outk(o + planes::LUM), l);
         }
     }

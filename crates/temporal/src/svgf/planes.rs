@@ -2,10 +2,12 @@
 //! [`super::atrous_avx2`]: per frame the guide features ([`GuidePlanes`]), per level both
 //! signals' colour, variance and luminance ([`LevelPlanes`]).
 //!
-//! A level's rows are interleaved: row `y` of plane `k` starts at `(y·planes + k)·stride`, so
-//! one output row of every plane is one contiguous slice that rayon can hand to a thread.
-//! `stride` is the width rounded up to 8 (one AVX2 vector); the padding is never read as a tap.
-//! The buffers are kept across frames and only resized when the size changes.
+//! Rows are interleaved: row `y` of plane `k` is the `(y·planes + k)`-th run of `len` floats,
+//! so one output row of every plane is one contiguous slice that rayon can hand to a thread.
+//! A run is a zero margin, the row padded to whole vectors of 8 (`stride`), another margin: a
+//! tap up to `margin` pixels left or right of a vector is an in-bounds load that reads group 0
+//! (no tap is taken from it) and finite zeros outside the image. The buffers are kept across
+//! frames and only reallocated (zeroed) when the size changes; margins are never written.
 
 use super::atrous::{sigma_l, Signals};
 use super::features::{Class, Features};
@@ -50,12 +52,56 @@ fn stride_of(w: usize) -> usize {
     w.div_ceil(8) * 8
 }
 
+/// Margin for taps up to `2·max_step` pixels from a pixel.
+pub(crate) fn margin_for(max_step: usize) -> usize {
+    (2 * max_step).max(8).div_ceil(8) * 8
+}
+
+/// Layout of a set of interleaved planes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Layout {
+    pub(crate) w: usize,
+    pub(crate) h: usize,
+    /// Row length padded to whole vectors.
+    pub(crate) stride: usize,
+    /// Zero columns left and right of each row.
+    pub(crate) margin: usize,
+    /// `margin + stride + margin`.
+    pub(crate) len: usize,
+}
+
+impl Layout {
+    fn new(w: usize, h: usize, margin: usize) -> Self {
+        let stride = stride_of(w);
+        Self {
+            w,
+            h,
+            stride,
+            margin,
+            len: stride + 2 * margin,
+        }
+    }
+
+    /// Index of column 0 of row `y` of plane `k` of `planes`.
+    #[inline]
+    fn at(&self, planes: usize, k: usize, y: usize) -> usize {
+        (y * planes + k) * self.len + self.margin
+    }
+}
+
+/// Reallocates `data` zeroed for `size` floats if `layout` changed.
+fn reshape(current: &mut Layout, data: &mut Vec<f32>, layout: Layout, size: usize) {
+    if *current != layout || data.len() != size {
+        *current = layout;
+        data.clear();
+        data.resize(size, 0.0);
+    }
+}
+
 /// Per-pixel constants of every iteration of one frame.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct GuidePlanes {
-    pub(crate) w: usize,
-    pub(crate) h: usize,
-    pub(crate) stride: usize,
+    pub(crate) layout: Layout,
     /// `GUIDE_PLANES` interleaved planes: [`GROUP`] (0 sky, 1 surface, 2 mirror), [`DEPTH`],
     /// [`Z_SCALE`] (σ_z·|∇z|), [`Z_EPS`] (10⁻³·z), the normal [`NX`], [`NY`], [`NZ`],
     /// [`SPATIAL`] (`2s²` of Eq. 6's Gaussian, 0 where none) and [`SIGMA_L`] (Eq. 8's σ_l).
@@ -65,26 +111,29 @@ pub(crate) struct GuidePlanes {
 }
 
 impl GuidePlanes {
-    /// Start of row `y` of plane `k`.
+    /// Index of column 0 of row `y` of plane `k`.
     #[inline]
     pub(crate) fn row(&self, k: usize, y: usize) -> usize {
-        (y * GUIDE_PLANES + k) * self.stride
+        self.layout.at(GUIDE_PLANES, k, y)
     }
 
     /// Fills the planes from the frame's features (the same arithmetic as the per-pixel
-    /// code of [`super::atrous`], so both give the same bits).
-    pub(crate) fn fill(&mut self, f: &Features, p: &SvgfParams, lengths: &[f32]) {
+    /// code of [`super::atrous`], so both give the same bits), with margins for taps up to
+    /// `2·max_step` pixels away.
+    pub(crate) fn fill(&mut self, f: &Features, p: &SvgfParams, lengths: &[f32], max_step: usize) {
         let (w, h) = (f.w, f.h);
-        self.w = w;
-        self.h = h;
-        self.stride = stride_of(w);
-        self.data.clear();
-        self.data.resize(GUIDE_PLANES * h * self.stride, 0.0);
+        let layout = Layout::new(w, h, margin_for(max_step));
+        reshape(
+            &mut self.layout,
+            &mut self.data,
+            layout,
+            GUIDE_PLANES * h * layout.len,
+        );
         self.any_spatial = false;
         for y in 0..h {
             for x in 0..w {
                 let i = y * w + x;
-                let at = |k: usize| (y * GUIDE_PLANES + k) * self.stride + x;
+                let at = |k: usize| layout.at(GUIDE_PLANES, k, y) + x;
                 let z = f.depth[i];
                 let n = f.normal[i];
                 let spatial = f.sigma_spatial[i];
@@ -118,32 +167,33 @@ impl GuidePlanes {
 /// Both signals of one level.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct LevelPlanes {
-    pub(crate) w: usize,
-    pub(crate) h: usize,
-    pub(crate) stride: usize,
+    pub(crate) layout: Layout,
     /// `LEVEL_PLANES` interleaved planes, per signal `s` at [`signal`]`(s)` + [`R`], [`G`],
     /// [`B`], [`VAR`], [`LUM`].
     pub(crate) data: Vec<f32>,
 }
 
 impl LevelPlanes {
-    /// Start of row `y` of plane `k`.
+    /// Index of column 0 of row `y` of plane `k`.
     #[inline]
     pub(crate) fn row(&self, k: usize, y: usize) -> usize {
-        (y * LEVEL_PLANES + k) * self.stride
+        self.layout.at(LEVEL_PLANES, k, y)
     }
 
-    /// Makes room for a `w`×`h` level (contents unspecified).
-    pub(crate) fn resize(&mut self, w: usize, h: usize) {
-        self.w = w;
-        self.h = h;
-        self.stride = stride_of(w);
-        self.data.resize(LEVEL_PLANES * h * self.stride, 0.0);
+    /// Makes room for a level of `layout` (contents unspecified, margins zero).
+    pub(crate) fn reshape(&mut self, layout: Layout) {
+        reshape(
+            &mut self.layout,
+            &mut self.data,
+            layout,
+            LEVEL_PLANES * layout.h * layout.len,
+        );
     }
 
-    /// Copies `signals` in, with their luminances.
-    pub(crate) fn load(&mut self, w: usize, h: usize, signals: &[Signals]) {
-        self.resize(w, h);
+    /// Copies `signals` (of the size of `layout`) in, with their luminances.
+    pub(crate) fn load(&mut self, layout: Layout, signals: &[Signals]) {
+        self.reshape(layout);
+        let (w, h) = (layout.w, layout.h);
         for y in 0..h {
             for x in 0..w {
                 let px = &signals[y * w + x];
@@ -176,7 +226,7 @@ impl LevelPlanes {
     /// Copies the level out.
     pub(crate) fn store(&self, out: &mut [Signals]) {
         for (i, o) in out.iter_mut().enumerate() {
-            *o = self.get(i % self.w, i / self.w);
+            *o = self.get(i % self.layout.w, i / self.layout.w);
         }
     }
 
@@ -184,11 +234,14 @@ impl LevelPlanes {
     /// nothing, which the vector code relies on instead of skipping it as the per-pixel code
     /// does.
     pub(crate) fn finite(&self) -> bool {
-        (0..self.h).all(|y| {
+        (0..self.layout.h).all(|y| {
             (0..2).all(|s| {
                 (R..=VAR).all(|k| {
                     let a = self.row(signal(s) + k, y);
-                    self.data[a..a + self.w].iter().all(|v| v.is_finite())
+                    // A fold, not `all`: it vectorises.
+                    self.data[a..a + self.layout.w]
+                        .iter()
+                        .fold(true, |ok, v| ok & (v - v == 0.0))
                 })
             })
         })
