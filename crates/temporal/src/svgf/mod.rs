@@ -139,6 +139,7 @@ impl Svgf {
         }
         // 1. Demodulate.
         let current: Vec<[Rgb; 2]> = (0..n)
+            .into_par_iter()
             .map(|i| {
                 if f.class[i] == features::Class::Sky {
                     return [Rgb::ZERO; 2];
@@ -211,11 +212,11 @@ impl Svgf {
                     .then(|| spatial_variance(&f, p, &acc_moments, i, lengths[i]))
             })
             .collect();
-        for (a, s) in acc.iter_mut().zip(&spatial) {
+        acc.par_iter_mut().zip(&spatial).for_each(|(a, s)| {
             if let Some(v) = s {
                 a.variance = *v;
             }
-        }
+        });
         // 6. À-Trous, keeping the feedback tap.
         let hold = [false, p.hold_indirect_variance];
         let mut ping = acc;
@@ -231,35 +232,56 @@ impl Svgf {
             &mut feedback,
         );
         // 7. Remodulate; median on diffuse pixels for display.
-        let illumination: Vec<Rgb> = ping.iter().map(|s| s.colour[0] + s.colour[1]).collect();
+        let illumination: Vec<Rgb> = ping
+            .par_iter()
+            .map(|s| s.colour[0] + s.colour[1])
+            .collect();
         let shown = if p.median {
             median_diffuse(&f, &illumination)
         } else {
             illumination
         };
-        let out = Image::from_fn(w, h, |x, y| {
-            let i = y * w + x;
-            let e = input.emission.pixels()[i];
-            let c = if f.class[i] == features::Class::Sky {
-                e + input.direct.pixels()[i] + input.indirect.pixels()[i]
-            } else {
-                e + f.albedo[i].max(Rgb::splat(MIN_ALBEDO)) * shown[i]
-            };
-            if c.is_finite() {
-                c.max(Rgb::ZERO)
-            } else {
-                Rgb::ZERO
-            }
-        });
+        let pixels: Vec<Rgb> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let e = input.emission.pixels()[i];
+                let c = if f.class[i] == features::Class::Sky {
+                    e + input.direct.pixels()[i] + input.indirect.pixels()[i]
+                } else {
+                    e + f.albedo[i].max(Rgb::splat(MIN_ALBEDO)) * shown[i]
+                };
+                if c.is_finite() {
+                    c.max(Rgb::ZERO)
+                } else {
+                    Rgb::ZERO
+                }
+            })
+            .collect();
+        let out = Image::new(w, h, pixels).expect("one output pixel per pixel");
         // Keep the history.
-        let mut next = History::from_frame(&f, g);
-        for i in 0..n {
-            for (s, m) in acc_moments[i].iter().enumerate() {
-                next.colour[s][i] = feedback[i].colour[s];
-                next.moments[s][i] = *m;
+        // The previous history has been read: its buffers take the new one.
+        let mut next = match self.history.take() {
+            Some(mut old) => {
+                old.refill(&f, g);
+                old
             }
-            next.length[i] = lengths[i];
-        }
+            None => History::from_frame(&f, g),
+        };
+        let [c0, c1] = &mut next.colour;
+        let [m0, m1] = &mut next.moments;
+        c0.par_iter_mut()
+            .zip(c1.par_iter_mut())
+            .zip(m0.par_iter_mut())
+            .zip(m1.par_iter_mut())
+            .zip(next.length.par_iter_mut())
+            .enumerate()
+            .for_each(|(i, ((((c0, c1), m0), m1), len))| {
+                *c0 = feedback[i].colour[0];
+                *c1 = feedback[i].colour[1];
+                *m0 = acc_moments[i][0];
+                *m1 = acc_moments[i][1];
+                *len = lengths[i];
+            });
         self.history = Some(next);
         out
     }
