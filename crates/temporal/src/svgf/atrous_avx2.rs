@@ -61,25 +61,18 @@ fn load8(data: &[f32], at: usize) -> __m256 {
     }
 }
 
-/// The 8 values at `at + k·l` for each `k` of `ks`, with one bounds check.
+/// The 8 values at `at + k·l` for each `k` of `ks`, unchecked.
+///
+/// # Safety
+/// `at + k·l + 8 ≤ data.len()` for every `k` of `ks`.
 #[target_feature(enable = "avx2")]
 #[inline]
-fn gather<const N: usize>(data: &[f32], at: usize, l: usize, ks: [usize; N]) -> [__m256; N] {
-    let mut kmax = 0;
-    for &k in &ks {
-        kmax = kmax.max(k);
-    }
-    // Saturating: an overflow gives an end past `data`, and the slice panics.
-    let end = at.saturating_add(kmax.saturating_mul(l).saturating_add(8));
-    let win = &data[at..end];
+unsafe fn gather<const N: usize>(data: &[f32], at: usize, l: usize, ks: [usize; N]) -> [__m256; N] {
     let mut out = [_mm256_setzero_ps(); N];
     for (o, &k) in out.iter_mut().zip(&ks) {
-        // SAFETY: `k ≤ kmax`, so `k·l + 8 ≤ kmax·l + 8 = win.len()`: the unaligned 8-float
-        // load is inside `win`.
-        #[allow(unsafe_code)]
-        unsafe {
-            *o = _mm256_loadu_ps(win.as_ptr().add(k * l));
-        }
+        debug_assert!(at + k * l + 8 <= data.len());
+        // SAFETY: in bounds by the caller's contract.
+        *o = unsafe { _mm256_loadu_ps(data.as_ptr().add(at + k * l)) };
     }
     out
 }
@@ -171,6 +164,45 @@ struct Tap {
     ez: __m256,
 }
 
+/// Σ w·c (r, g, b), Σ w and (if `VAR`) Σ w²·Var of signal planes `o..` over `taps`, for
+/// centre luminance `lum` and luminance scale `l_scale`.
+#[target_feature(enable = "avx2")]
+#[inline]
+fn accumulate<const VAR: bool>(
+    id: &[f32],
+    l: usize,
+    o: usize,
+    lum: __m256,
+    l_scale: __m256,
+    taps: &[Tap],
+) -> [__m256; 5] {
+    let zero = _mm256_setzero_ps();
+    let (mut sr, mut sg, mut sb, mut sw, mut sv) = (zero, zero, zero, zero, zero);
+    for t in taps {
+        // SAFETY: `t.at` is a tap of `row` (row `0 ≤ yy < h`, offset `|dx| ≤ 2·step`), and
+        // `o + LUM < LEVEL_PLANES`: in bounds by `row`'s assertions.
+        #[allow(unsafe_code)]
+        let [qr, qg, qb, qv, ql] = unsafe {
+            gather(
+                id,
+                t.at + o * l,
+                l,
+                [planes::R, planes::G, planes::B, planes::VAR, planes::LUM],
+            )
+        };
+        let el = _mm256_mul_ps(neg_abs_diff(lum, ql), l_scale);
+        let wgt = _mm256_mul_ps(t.base, exp_neg(_mm256_add_ps(t.ez, el)));
+        sr = _mm256_add_ps(sr, _mm256_mul_ps(qr, wgt));
+        sg = _mm256_add_ps(sg, _mm256_mul_ps(qg, wgt));
+        sb = _mm256_add_ps(sb, _mm256_mul_ps(qb, wgt));
+        sw = _mm256_add_ps(sw, wgt);
+        if VAR {
+            sv = _mm256_add_ps(sv, _mm256_mul_ps(_mm256_mul_ps(wgt, wgt), qv));
+        }
+    }
+    [sr, sg, sb, sw, sv]
+}
+
 /// Output row `y` (all planes of the row: `LEVEL_PLANES · len` floats, margins untouched).
 #[target_feature(enable = "avx2")]
 fn row(
@@ -184,7 +216,13 @@ fn row(
 ) {
     let lay = g.layout;
     let (w, h) = (lay.w, lay.h);
-    debug_assert!(lay.margin >= 2 * step && input.layout == lay);
+    // What makes every `gather` in bounds: plane `k < planes` of row `0 ≤ yy < h` at column
+    // `x0 + dx` with `0 ≤ x0 ≤ stride − 8` and `|dx| ≤ 2·step ≤ margin` is a run of 8 inside
+    // the row's `len = margin + stride + margin` floats, and the data holds `planes·h` rows.
+    assert!(lay.margin >= 2 * step && lay.len == lay.stride + 2 * lay.margin);
+    assert!(input.layout == lay && lay.stride % 8 == 0 && lay.stride >= lay.w);
+    assert!(g.data.len() >= planes::GUIDE_PLANES * lay.h * lay.len);
+    assert!(input.data.len() >= LEVEL_PLANES * lay.h * lay.len);
     let gd = &g.data;
     let id = &input.data;
     let zero = _mm256_setzero_ps();
@@ -216,12 +254,16 @@ fn row(
         let mut n_taps = 0;
         {
             use planes::{DEPTH, GROUP, NX, NY, NZ, SPATIAL, Z_EPS, Z_SCALE};
-            let [z, z_scale, z_eps, nx, ny, nz, spatial] = gather(
-                gd,
-                gat(0, y, 0),
-                l,
-                [DEPTH, Z_SCALE, Z_EPS, NX, NY, NZ, SPATIAL],
-            );
+            // SAFETY (here and for every `gather` below): `row`'s assertions, see there.
+            #[allow(unsafe_code)]
+            let [z, z_scale, z_eps, nx, ny, nz, spatial] = unsafe {
+                gather(
+                    gd,
+                    gat(0, y, 0),
+                    l,
+                    [DEPTH, Z_SCALE, Z_EPS, NX, NY, NZ, SPATIAL],
+                )
+            };
             let has_spatial = _mm256_cmp_ps::<_CMP_GT_OQ>(spatial, zero);
             let any_spatial = g.any_spatial && _mm256_movemask_ps(has_spatial) != 0;
             for (ky, hy) in KERNEL.iter().enumerate() {
@@ -237,8 +279,10 @@ fn row(
                     if xs + 8 <= 0 || xs >= w as isize {
                         continue;
                     }
+                    // SAFETY: `row`'s assertions; `0 ≤ yy < h` and `|dx| ≤ 2·step`.
+                    #[allow(unsafe_code)]
                     let [q_group, q_depth, q_nx, q_ny, q_nz] =
-                        gather(gd, gat(0, yy, dx), l, [GROUP, DEPTH, NX, NY, NZ]);
+                        unsafe { gather(gd, gat(0, yy, dx), l, [GROUP, DEPTH, NX, NY, NZ]) };
                     let same = _mm256_cmp_ps::<_CMP_EQ_OQ>(q_group, grp);
                     let taps2 = ((kx as isize - 2).pow(2) + dy * dy) as f32;
                     let dist = step as f32 * taps2.sqrt();
@@ -256,9 +300,14 @@ fn row(
                         let gauss = exp_neg(_mm256_div_ps(_mm256_set1_ps(-taps2), spatial));
                         base = _mm256_mul_ps(base, _mm256_blendv_ps(one, gauss, has_spatial));
                     }
+                    let base = _mm256_and_ps(base, same);
+                    if _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_NEQ_OQ>(base, zero)) == 0 {
+                        // Weight 0 in every lane: it would add +0 everywhere.
+                        continue;
+                    }
                     taps[n_taps] = Tap {
                         at: iat(0, yy, dx),
-                        base: _mm256_and_ps(base, same),
+                        base,
                         ez,
                     };
                     n_taps += 1;
@@ -302,23 +351,11 @@ fn row(
                 _mm256_add_ps(_mm256_mul_ps(sl, _mm256_sqrt_ps(pv)), _mm256_set1_ps(1e-10)),
             );
             let lum = load8(id, centre + (o + planes::LUM) * l);
-            // Σ w·c (r, g, b), Σ w, Σ w²·Var.
-            let (mut sr, mut sg, mut sb, mut sw, mut sv) = (zero, zero, zero, zero, zero);
-            for t in &taps[..n_taps] {
-                let [qr, qg, qb, qv, ql] = gather(
-                    id,
-                    t.at + o * l,
-                    l,
-                    [planes::R, planes::G, planes::B, planes::VAR, planes::LUM],
-                );
-                let el = _mm256_mul_ps(neg_abs_diff(lum, ql), l_scale);
-                let wgt = _mm256_mul_ps(t.base, exp_neg(_mm256_add_ps(t.ez, el)));
-                sr = _mm256_add_ps(sr, _mm256_mul_ps(qr, wgt));
-                sg = _mm256_add_ps(sg, _mm256_mul_ps(qg, wgt));
-                sb = _mm256_add_ps(sb, _mm256_mul_ps(qb, wgt));
-                sw = _mm256_add_ps(sw, wgt);
-                sv = _mm256_add_ps(sv, _mm256_mul_ps(_mm256_mul_ps(wgt, wgt), qv));
-            }
+            let [sr, sg, sb, sw, sv] = if held {
+                accumulate::<false>(id, l, o, lum, l_scale, &taps[..n_taps])
+            } else {
+                accumulate::<true>(id, l, o, lum, l_scale, &taps[..n_taps])
+            };
             // Filtered where the sum of weights is positive (the per-pixel code's test) and
             // the pixel is no sky; the centre elsewhere.
             let ci = |k: usize| load8(id, centre + (o + k) * l);

@@ -73,7 +73,8 @@ impl History {
         match &g.reflected {
             Some(r) => {
                 self.reflected_position.copy_from_slice(r.position.pixels());
-                self.reflected_direction.copy_from_slice(r.direction.pixels());
+                self.reflected_direction
+                    .copy_from_slice(r.direction.pixels());
                 self.reflected_distance.copy_from_slice(r.distance.pixels());
             }
             None => {

@@ -232,10 +232,7 @@ impl Svgf {
             &mut feedback,
         );
         // 7. Remodulate; median on diffuse pixels for display.
-        let illumination: Vec<Rgb> = ping
-            .par_iter()
-            .map(|s| s.colour[0] + s.colour[1])
-            .collect();
+        let illumination: Vec<Rgb> = ping.par_iter().map(|s| s.colour[0] + s.colour[1]).collect();
         let shown = if p.median {
             median_diffuse(&f, &illumination)
         } else {

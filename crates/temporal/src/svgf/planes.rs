@@ -24,7 +24,7 @@ pub(crate) const NY: usize = 5;
 pub(crate) const NZ: usize = 6;
 pub(crate) const SPATIAL: usize = 7;
 pub(crate) const SIGMA_L: usize = 8;
-const GUIDE_PLANES: usize = 9;
+pub(crate) const GUIDE_PLANES: usize = 9;
 
 /// Planes of one signal in [`LevelPlanes`]: red, green, blue, variance, luminance.
 pub(crate) const LEVEL_PLANES: usize = 10;
