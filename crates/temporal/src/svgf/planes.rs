@@ -12,6 +12,7 @@
 use super::atrous::{sigma_l, Signals};
 use super::features::{Class, Features};
 use super::params::SvgfParams;
+use rayon::prelude::*;
 use rt_core::color::luminance;
 
 /// Planes of [`GuidePlanes`].
@@ -129,38 +130,43 @@ impl GuidePlanes {
             layout,
             GUIDE_PLANES * h * layout.len,
         );
-        self.any_spatial = false;
-        for y in 0..h {
-            for x in 0..w {
-                let i = y * w + x;
-                let at = |k: usize| layout.at(GUIDE_PLANES, k, y) + x;
-                let z = f.depth[i];
-                let n = f.normal[i];
-                let spatial = f.sigma_spatial[i];
-                let d = if spatial > 0.0 {
-                    let s = (2.0 * spatial).max(1e-3);
-                    self.any_spatial = true;
-                    2.0 * s * s
-                } else {
-                    0.0
-                };
-                let values = [
-                    group(f.class[i]),
-                    z,
-                    p.sigma_z * f.depth_step[i],
-                    1e-3 * z,
-                    n.x,
-                    n.y,
-                    n.z,
-                    d,
-                    sigma_l(p, lengths[i]),
-                ];
-                for (k, v) in values.into_iter().enumerate() {
-                    let a = at(k);
-                    self.data[a] = v;
+        let (len, margin) = (layout.len, layout.margin);
+        self.any_spatial = self
+            .data
+            .par_chunks_mut(GUIDE_PLANES * len)
+            .enumerate()
+            .map(|(y, rows)| {
+                let mut any = false;
+                for x in 0..w {
+                    let i = y * w + x;
+                    let z = f.depth[i];
+                    let n = f.normal[i];
+                    let spatial = f.sigma_spatial[i];
+                    let d = if spatial > 0.0 {
+                        let s = (2.0 * spatial).max(1e-3);
+                        any = true;
+                        2.0 * s * s
+                    } else {
+                        0.0
+                    };
+                    let values = [
+                        group(f.class[i]),
+                        z,
+                        p.sigma_z * f.depth_step[i],
+                        1e-3 * z,
+                        n.x,
+                        n.y,
+                        n.z,
+                        d,
+                        sigma_l(p, lengths[i]),
+                    ];
+                    for (k, v) in values.into_iter().enumerate() {
+                        rows[k * len + margin + x] = v;
+                    }
                 }
-            }
-        }
+                any
+            })
+            .reduce(|| false, |a, b| a | b);
     }
 }
 
@@ -193,20 +199,22 @@ impl LevelPlanes {
     /// Copies `signals` (of the size of `layout`) in, with their luminances.
     pub(crate) fn load(&mut self, layout: Layout, signals: &[Signals]) {
         self.reshape(layout);
-        let (w, h) = (layout.w, layout.h);
-        for y in 0..h {
-            for x in 0..w {
-                let px = &signals[y * w + x];
-                for s in 0..2 {
-                    let c = px.colour[s];
-                    let values = [c.x, c.y, c.z, px.variance[s], luminance(c)];
-                    for (k, v) in values.into_iter().enumerate() {
-                        let a = self.row(signal(s) + k, y) + x;
-                        self.data[a] = v;
+        let (w, len, margin) = (layout.w, layout.len, layout.margin);
+        self.data
+            .par_chunks_mut(LEVEL_PLANES * len)
+            .enumerate()
+            .for_each(|(y, rows)| {
+                for x in 0..w {
+                    let px = &signals[y * w + x];
+                    for s in 0..2 {
+                        let c = px.colour[s];
+                        let values = [c.x, c.y, c.z, px.variance[s], luminance(c)];
+                        for (k, v) in values.into_iter().enumerate() {
+                            rows[(signal(s) + k) * len + margin + x] = v;
+                        }
                     }
                 }
-            }
-        }
+            });
     }
 
     /// Pixel `(x, y)` as [`Signals`].
@@ -225,16 +233,19 @@ impl LevelPlanes {
 
     /// Copies the level out.
     pub(crate) fn store(&self, out: &mut [Signals]) {
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = self.get(i % self.layout.w, i / self.layout.w);
-        }
+        let w = self.layout.w;
+        out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+            for (x, o) in row.iter_mut().enumerate() {
+                *o = self.get(x, y);
+            }
+        });
     }
 
     /// True if every colour and variance is finite: then a tap whose weight is 0 adds exactly
     /// nothing, which the vector code relies on instead of skipping it as the per-pixel code
     /// does.
     pub(crate) fn finite(&self) -> bool {
-        (0..self.layout.h).all(|y| {
+        (0..self.layout.h).into_par_iter().all(|y| {
             (0..2).all(|s| {
                 (R..=VAR).all(|k| {
                     let a = self.row(signal(s) + k, y);
