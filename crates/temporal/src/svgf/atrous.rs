@@ -9,6 +9,10 @@
 //! reflection's world footprint grows. The variance is carried along with squared weights
 //! (`Var' = Σ h²w² Var / (Σ h w)²`), so it shrinks from iteration to iteration.
 //!
+//! Two builds of the same arithmetic: the per-pixel code here (portable, and the reference),
+//! and [`super::atrous_avx2`], eight pixels at a time on structure-of-arrays planes
+//! ([`super::planes`]) where the CPU has AVX2; they give the same bits (tests/svgf_bits.rs).
+//!
 //! Deviations ([ours]): |∇z| is the largest depth step to a 4-neighbour of the same kind, not a
 //! screen-space derivative; the depth term's ε is relative to depth; taps across the edge of a
 //! mirror (mirror vs non-mirror) get no weight, since their features describe different

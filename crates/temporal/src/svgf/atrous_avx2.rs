@@ -9,9 +9,12 @@
 //! unchanged as long as colours and variances are finite; callers check that
 //! ([`super::planes::LevelPlanes::finite`]) and otherwise run the per-pixel code.
 //!
+//! The rows read [`super::planes`] with zero margins of at least two tap steps, so every tap
+//! is a whole-vector load; out of the image it reads group 0, and no tap is taken from it.
+//!
 //! The only `unsafe` of the crate: the call into the `#[target_feature]` row function after
-//! runtime detection, and the unaligned vector loads and stores, each on a slice whose length
-//! is checked just before.
+//! runtime detection, the unaligned vector loads and stores on slices of checked length, and
+//! the taps' loads, unchecked under the layout assertions made once per row.
 
 use super::atrous::{normal_weight, KERNEL};
 use super::fast_exp::CUTOFF;
@@ -41,8 +44,8 @@ pub(crate) fn iterate(
         .par_chunks_mut(LEVEL_PLANES * g.layout.len)
         .enumerate()
         .for_each(|(y, out)| {
-            // SAFETY: `available()` was asserted above: the CPU has AVX2.
             #[allow(unsafe_code)]
+            // SAFETY: `available()` was asserted above: the CPU has AVX2.
             unsafe {
                 row(g, sigma_n, step, hold, input, y, out)
             }
@@ -54,8 +57,8 @@ pub(crate) fn iterate(
 #[inline]
 fn load8(data: &[f32], at: usize) -> __m256 {
     let v = &data[at..at + 8];
-    // SAFETY: `v` holds exactly 8 floats; the load is unaligned.
     #[allow(unsafe_code)]
+    // SAFETY: `v` holds exactly 8 floats; the load is unaligned.
     unsafe {
         _mm256_loadu_ps(v.as_ptr())
     }
@@ -81,8 +84,8 @@ unsafe fn gather<const N: usize>(data: &[f32], at: usize, l: usize, ks: [usize; 
 #[inline]
 fn store8(data: &mut [f32], at: usize, v: __m256) {
     let d = &mut data[at..at + 8];
-    // SAFETY: `d` holds exactly 8 floats; the store is unaligned.
     #[allow(unsafe_code)]
+    // SAFETY: `d` holds exactly 8 floats; the store is unaligned.
     unsafe {
         _mm256_storeu_ps(d.as_mut_ptr(), v)
     }
@@ -137,16 +140,16 @@ fn normal_weight8(c: __m256, e: f32) -> __m256 {
         v
     } else {
         let mut t = [0.0f32; 8];
-        // SAFETY: `t` holds 8 floats.
         #[allow(unsafe_code)]
+        // SAFETY: `t` holds 8 floats.
         unsafe {
             _mm256_storeu_ps(t.as_mut_ptr(), c)
         };
         for t in &mut t {
             *t = normal_weight(*t, e);
         }
-        // SAFETY: `t` holds 8 floats.
         #[allow(unsafe_code)]
+        // SAFETY: `t` holds 8 floats.
         unsafe {
             _mm256_loadu_ps(t.as_ptr())
         }
@@ -179,9 +182,9 @@ fn accumulate<const VAR: bool>(
     let zero = _mm256_setzero_ps();
     let (mut sr, mut sg, mut sb, mut sw, mut sv) = (zero, zero, zero, zero, zero);
     for t in taps {
+        #[allow(unsafe_code)]
         // SAFETY: `t.at` is a tap of `row` (row `0 ≤ yy < h`, offset `|dx| ≤ 2·step`), and
         // `o + LUM < LEVEL_PLANES`: in bounds by `row`'s assertions.
-        #[allow(unsafe_code)]
         let [qr, qg, qb, qv, ql] = unsafe {
             gather(
                 id,
@@ -220,7 +223,7 @@ fn row(
     // `x0 + dx` with `0 ≤ x0 ≤ stride − 8` and `|dx| ≤ 2·step ≤ margin` is a run of 8 inside
     // the row's `len = margin + stride + margin` floats, and the data holds `planes·h` rows.
     assert!(lay.margin >= 2 * step && lay.len == lay.stride + 2 * lay.margin);
-    assert!(input.layout == lay && lay.stride % 8 == 0 && lay.stride >= lay.w);
+    assert!(input.layout == lay && lay.stride.is_multiple_of(8) && lay.stride >= lay.w);
     assert!(g.data.len() >= planes::GUIDE_PLANES * lay.h * lay.len);
     assert!(input.data.len() >= LEVEL_PLANES * lay.h * lay.len);
     let gd = &g.data;
@@ -254,8 +257,8 @@ fn row(
         let mut n_taps = 0;
         {
             use planes::{DEPTH, GROUP, NX, NY, NZ, SPATIAL, Z_EPS, Z_SCALE};
-            // SAFETY (here and for every `gather` below): `row`'s assertions, see there.
             #[allow(unsafe_code)]
+            // SAFETY: `row`'s assertions (the centre: `y < h`, `dx = 0`).
             let [z, z_scale, z_eps, nx, ny, nz, spatial] = unsafe {
                 gather(
                     gd,
@@ -279,8 +282,8 @@ fn row(
                     if xs + 8 <= 0 || xs >= w as isize {
                         continue;
                     }
-                    // SAFETY: `row`'s assertions; `0 ≤ yy < h` and `|dx| ≤ 2·step`.
                     #[allow(unsafe_code)]
+                    // SAFETY: `row`'s assertions; `0 ≤ yy < h` and `|dx| ≤ 2·step`.
                     let [q_group, q_depth, q_nx, q_ny, q_nz] =
                         unsafe { gather(gd, gat(0, yy, dx), l, [GROUP, DEPTH, NX, NY, NZ]) };
                     let same = _mm256_cmp_ps::<_CMP_EQ_OQ>(q_group, grp);

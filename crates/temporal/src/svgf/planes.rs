@@ -252,7 +252,7 @@ impl LevelPlanes {
                     // A fold, not `all`: it vectorises.
                     self.data[a..a + self.layout.w]
                         .iter()
-                        .fold(true, |ok, v| ok & (v - v == 0.0))
+                        .fold(true, |ok, v| ok & v.is_finite())
                 })
             })
         })
