@@ -374,18 +374,19 @@ fn median_diffuse(f: &Features, img: &[Rgb]) -> Vec<Rgb> {
                 for xx in (x - 1).max(0)..=(x + 1).min(f.w as isize - 1) {
                     let j = yy as usize * f.w + xx as usize;
                     if f.class[j] == features::Class::Diffuse {
-                        for (c, v) in vals.iter_mut().enumerate() {
-                            v[k] = img[j][c];
-                        }
+                        let c = img[j];
+                        vals[0][k] = c.x;
+                        vals[1][k] = c.y;
+                        vals[2][k] = c.z;
                         k += 1;
                     }
                 }
             }
-            Rgb::from_array(std::array::from_fn(|c| {
-                if k == 9 {
-                    return median9(vals[c]);
-                }
-                let v = &mut vals[c][..k];
+            if k == 9 {
+                return Rgb::new(median9(vals[0]), median9(vals[1]), median9(vals[2]));
+            }
+            Rgb::from_array(vals.map(|mut v| {
+                let v = &mut v[..k];
                 v.sort_unstable_by(f32::total_cmp);
                 v[k / 2]
             }))
