@@ -9,6 +9,10 @@
 //! reflection's world footprint grows. The variance is carried along with squared weights
 //! (`Var' = Σ h²w² Var / (Σ h w)²`), so it shrinks from iteration to iteration.
 //!
+//! Two builds of the same arithmetic: the per-pixel code here (portable, and the reference),
+//! and [`super::atrous_avx2`], eight pixels at a time on structure-of-arrays planes
+//! ([`super::planes`]) where the CPU has AVX2; they give the same bits (tests/svgf_bits.rs).
+//!
 //! Deviations ([ours]): |∇z| is the largest depth step to a 4-neighbour of the same kind, not a
 //! screen-space derivative; the depth term's ε is relative to depth; taps across the edge of a
 //! mirror (mirror vs non-mirror) get no weight, since their features describe different
@@ -18,6 +22,7 @@
 use super::fast_exp::exp_neg;
 use super::features::{Class, Features};
 use super::params::SvgfParams;
+use super::planes::{GuidePlanes, LevelPlanes};
 use rayon::prelude::*;
 use rt_core::color::luminance;
 use rt_core::Rgb;
@@ -94,9 +99,123 @@ fn prefiltered_variance(f: &Features, input: &[Signals], x: usize, y: usize, s: 
     }
 }
 
-/// One iteration with taps `step` pixels apart, from `input` into `output`. `hold[s]` keeps
-/// signal `s`'s variance as it was instead of propagating it.
+/// Buffers of the iterations, kept across frames.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Scratch {
+    guide: GuidePlanes,
+    ping: LevelPlanes,
+    pong: LevelPlanes,
+    /// A level as [`Signals`], for iterations the vector code does not take.
+    aos: Vec<Signals>,
+}
+
+/// True if [`run`] with `simd` uses the AVX2 row code on this CPU.
+pub(crate) fn simd_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        super::atrous_avx2::available()
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    false
+}
+
+/// All `p.iterations` iterations on `signals` (in place: on return the last level), the
+/// output of iteration `p.feedback` copied into `feedback` (the input if 0, the last level if
+/// there is no such iteration). `simd` allows the AVX2 row code; both paths give the same
+/// bits.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn run(
+    f: &Features,
+    p: &SvgfParams,
+    lengths: &[f32],
+    hold: [bool; 2],
+    simd: bool,
+    scratch: &mut Scratch,
+    signals: &mut [Signals],
+    feedback: &mut [Signals],
+) {
+    if p.feedback == 0 || p.feedback > p.iterations {
+        feedback.copy_from_slice(signals);
+    }
+    if simd && simd_available() && p.iterations > 0 {
+        #[cfg(target_arch = "x86_64")]
+        {
+            let Scratch {
+                guide,
+                ping,
+                pong,
+                aos,
+            } = scratch;
+            guide.fill(f, p, lengths, 1 << (p.iterations - 1));
+            ping.load(guide.layout, signals);
+            for it in 0..p.iterations {
+                let step = 1usize << it;
+                if ping.finite() {
+                    super::atrous_avx2::iterate(guide, p.sigma_n, step, hold, ping, pong);
+                } else {
+                    // A non-finite value: the per-pixel code, which skips what the vector
+                    // code would multiply by zero.
+                    aos.resize(signals.len(), Signals::default());
+                    ping.store(signals);
+                    iterate_portable(f, p, lengths, step, hold, signals, aos);
+                    pong.load(guide.layout, aos);
+                }
+                std::mem::swap(ping, pong);
+                if it + 1 == p.feedback {
+                    ping.store(feedback);
+                }
+            }
+            ping.store(signals);
+            if p.feedback > p.iterations {
+                feedback.copy_from_slice(signals);
+            }
+            return;
+        }
+    }
+    let aos = &mut scratch.aos;
+    aos.resize(signals.len(), Signals::default());
+    for it in 0..p.iterations {
+        iterate_portable(f, p, lengths, 1 << it, hold, signals, aos);
+        signals.copy_from_slice(aos);
+        if it + 1 == p.feedback {
+            feedback.copy_from_slice(signals);
+        }
+    }
+    if p.feedback > p.iterations {
+        feedback.copy_from_slice(signals);
+    }
+}
+
+/// One iteration with taps `step` pixels apart, from `input` into `output` (the vector code
+/// where it runs, else the per-pixel code). `hold[s]` keeps signal `s`'s variance as it was
+/// instead of propagating it.
+#[cfg(test)]
 pub fn iterate(
+    f: &Features,
+    p: &SvgfParams,
+    lengths: &[f32],
+    step: usize,
+    hold: [bool; 2],
+    input: &[Signals],
+    output: &mut [Signals],
+) {
+    #[cfg(target_arch = "x86_64")]
+    if simd_available() {
+        let mut g = GuidePlanes::default();
+        g.fill(f, p, lengths, step);
+        let (mut a, mut b) = (LevelPlanes::default(), LevelPlanes::default());
+        a.load(g.layout, input);
+        assert!(a.finite());
+        super::atrous_avx2::iterate(&g, p.sigma_n, step, hold, &a, &mut b);
+        b.store(output);
+        return;
+    }
+    iterate_portable(f, p, lengths, step, hold, input, output);
+}
+
+/// The per-pixel code of one iteration with taps `step` pixels apart, from `input` into
+/// `output`. `hold[s]` keeps signal `s`'s variance as it was instead of propagating it.
+pub(crate) fn iterate_portable(
     f: &Features,
     p: &SvgfParams,
     lengths: &[f32],

@@ -3,6 +3,7 @@
 //! and the depth and normal its edge-stopping compares.
 
 use super::params::SvgfParams;
+use rayon::prelude::*;
 use rt_core::glam::Vec3;
 use rt_core::Rgb;
 use rt_film::GuideBuffers;
@@ -104,7 +105,7 @@ impl Features {
         let (w, h) = g.size();
         let n = w * h;
         let reflect = p.reflections == super::params::Reflections::Reproject;
-        let class: Vec<Class> = (0..n).map(|i| class_of(g, i, p)).collect();
+        let class: Vec<Class> = (0..n).into_par_iter().map(|i| class_of(g, i, p)).collect();
         let refl = g.reflected.as_ref();
         let mirror_features = |i: usize| {
             reflect
@@ -112,18 +113,21 @@ impl Features {
                 && refl.is_some_and(|r| r.distance.pixels()[i] > 0.0)
         };
         let albedo = (0..n)
+            .into_par_iter()
             .map(|i| match (class[i], refl) {
                 (Class::Mirror, Some(r)) if reflect => r.albedo.pixels()[i],
                 _ => g.albedo.pixels()[i],
             })
             .collect();
         let depth: Vec<f32> = (0..n)
+            .into_par_iter()
             .map(|i| match refl {
                 Some(r) if mirror_features(i) => g.depth.pixels()[i] + r.distance.pixels()[i],
                 _ => g.depth.pixels()[i],
             })
             .collect();
         let normal = (0..n)
+            .into_par_iter()
             .map(|i| match refl {
                 Some(r) if mirror_features(i) => r.normal.pixels()[i],
                 _ => g.normal.pixels()[i],
@@ -131,6 +135,7 @@ impl Features {
             .collect();
         let mirror_group = |i: usize| class[i] == Class::Mirror;
         let depth_step = (0..n)
+            .into_par_iter()
             .map(|i| {
                 step_of(w, h, &depth, i, |j| {
                     class[j] != Class::Sky && mirror_group(j) == mirror_group(i)
@@ -139,10 +144,12 @@ impl Features {
             .collect();
         let primary_depth = g.depth.pixels().to_vec();
         let primary_step = (0..n)
+            .into_par_iter()
             .map(|i| step_of(w, h, &primary_depth, i, |j| class[j] != Class::Sky))
             .collect();
         let sigma_spatial = match refl {
             Some(r) if reflect => (0..n)
+                .into_par_iter()
                 .map(|i| {
                     if class[i] != Class::SharpGlossy || r.distance.pixels()[i] <= 0.0 {
                         return 0.0;

@@ -60,4 +60,28 @@ impl History {
             length: vec![0.0; n],
         }
     }
+
+    /// Overwrites the part [`History::from_frame`] makes with frame `f`'s, reusing the
+    /// buffers (a history of the same size).
+    pub fn refill(&mut self, f: &Features, g: &GuideBuffers) {
+        assert_eq!((self.w, self.h), (f.w, f.h), "history of another size");
+        self.class.copy_from_slice(&f.class);
+        self.depth.copy_from_slice(&f.primary_depth);
+        self.normal.copy_from_slice(g.normal.pixels());
+        self.object.copy_from_slice(&f.object);
+        self.position.copy_from_slice(g.position.pixels());
+        match &g.reflected {
+            Some(r) => {
+                self.reflected_position.copy_from_slice(r.position.pixels());
+                self.reflected_direction
+                    .copy_from_slice(r.direction.pixels());
+                self.reflected_distance.copy_from_slice(r.distance.pixels());
+            }
+            None => {
+                self.reflected_position.fill(Vec3::ZERO);
+                self.reflected_direction.fill(Vec3::ZERO);
+                self.reflected_distance.fill(0.0);
+            }
+        }
+    }
 }

@@ -25,12 +25,16 @@
 //! guide rays is the thesis' alternative and not built yet); fireflies are not clamped.
 
 mod atrous;
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+mod atrous_avx2;
 pub mod clip;
 pub mod diamond;
 mod fast_exp;
 mod features;
 mod history;
 mod params;
+mod planes;
 mod reproject;
 
 pub use atrous::{normal_weight, Signals, KERNEL};
@@ -63,6 +67,9 @@ pub struct SvgfInput<'a> {
 pub struct Svgf {
     params: SvgfParams,
     history: Option<History>,
+    /// Whether the AVX2 code may run (where the CPU has it).
+    simd: bool,
+    scratch: atrous::Scratch,
 }
 
 /// Luminance moments of a demodulated colour.
@@ -83,7 +90,21 @@ impl Svgf {
         Self {
             params,
             history: None,
+            simd: true,
+            scratch: atrous::Scratch::default(),
         }
+    }
+
+    /// The same filter with the AVX2 code allowed (the default, used where the CPU has it) or
+    /// not. Both give the same bits; this is for comparing them.
+    pub fn with_simd(mut self, allow: bool) -> Self {
+        self.simd = allow;
+        self
+    }
+
+    /// True if [`Svgf::push`] runs AVX2 code on this CPU.
+    pub fn uses_simd(&self) -> bool {
+        self.simd && atrous::simd_available()
     }
 
     /// Its parameters.
@@ -118,6 +139,7 @@ impl Svgf {
         }
         // 1. Demodulate.
         let current: Vec<[Rgb; 2]> = (0..n)
+            .into_par_iter()
             .map(|i| {
                 if f.class[i] == features::Class::Sky {
                     return [Rgb::ZERO; 2];
@@ -190,54 +212,73 @@ impl Svgf {
                     .then(|| spatial_variance(&f, p, &acc_moments, i, lengths[i]))
             })
             .collect();
-        for (a, s) in acc.iter_mut().zip(&spatial) {
+        acc.par_iter_mut().zip(&spatial).for_each(|(a, s)| {
             if let Some(v) = s {
                 a.variance = *v;
             }
-        }
+        });
         // 6. À-Trous, keeping the feedback tap.
-        let mut ping = acc;
-        let mut pong = vec![Signals::default(); n];
         let hold = [false, p.hold_indirect_variance];
-        let mut feedback: Option<Vec<Signals>> = (p.feedback == 0).then(|| ping.clone());
-        for it in 0..p.iterations {
-            atrous::iterate(&f, p, &lengths, 1 << it, hold, &ping, &mut pong);
-            std::mem::swap(&mut ping, &mut pong);
-            if it + 1 == p.feedback {
-                feedback = Some(ping.clone());
-            }
-        }
-        let feedback = feedback.unwrap_or_else(|| ping.clone());
+        let mut ping = acc;
+        let mut feedback = vec![Signals::default(); n];
+        atrous::run(
+            &f,
+            p,
+            &lengths,
+            hold,
+            self.simd,
+            &mut self.scratch,
+            &mut ping,
+            &mut feedback,
+        );
         // 7. Remodulate; median on diffuse pixels for display.
-        let illumination: Vec<Rgb> = ping.iter().map(|s| s.colour[0] + s.colour[1]).collect();
+        let illumination: Vec<Rgb> = ping.par_iter().map(|s| s.colour[0] + s.colour[1]).collect();
         let shown = if p.median {
             median_diffuse(&f, &illumination)
         } else {
             illumination
         };
-        let out = Image::from_fn(w, h, |x, y| {
-            let i = y * w + x;
-            let e = input.emission.pixels()[i];
-            let c = if f.class[i] == features::Class::Sky {
-                e + input.direct.pixels()[i] + input.indirect.pixels()[i]
-            } else {
-                e + f.albedo[i].max(Rgb::splat(MIN_ALBEDO)) * shown[i]
-            };
-            if c.is_finite() {
-                c.max(Rgb::ZERO)
-            } else {
-                Rgb::ZERO
-            }
-        });
+        let pixels: Vec<Rgb> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let e = input.emission.pixels()[i];
+                let c = if f.class[i] == features::Class::Sky {
+                    e + input.direct.pixels()[i] + input.indirect.pixels()[i]
+                } else {
+                    e + f.albedo[i].max(Rgb::splat(MIN_ALBEDO)) * shown[i]
+                };
+                if c.is_finite() {
+                    c.max(Rgb::ZERO)
+                } else {
+                    Rgb::ZERO
+                }
+            })
+            .collect();
+        let out = Image::new(w, h, pixels).expect("one output pixel per pixel");
         // Keep the history.
-        let mut next = History::from_frame(&f, g);
-        for i in 0..n {
-            for (s, m) in acc_moments[i].iter().enumerate() {
-                next.colour[s][i] = feedback[i].colour[s];
-                next.moments[s][i] = *m;
+        // The previous history has been read: its buffers take the new one.
+        let mut next = match self.history.take() {
+            Some(mut old) => {
+                old.refill(&f, g);
+                old
             }
-            next.length[i] = lengths[i];
-        }
+            None => History::from_frame(&f, g),
+        };
+        let [c0, c1] = &mut next.colour;
+        let [m0, m1] = &mut next.moments;
+        c0.par_iter_mut()
+            .zip(c1.par_iter_mut())
+            .zip(m0.par_iter_mut())
+            .zip(m1.par_iter_mut())
+            .zip(next.length.par_iter_mut())
+            .enumerate()
+            .for_each(|(i, ((((c0, c1), m0), m1), len))| {
+                *c0 = feedback[i].colour[0];
+                *c1 = feedback[i].colour[1];
+                *m0 = acc_moments[i][0];
+                *m1 = acc_moments[i][1];
+                *len = lengths[i];
+            });
         self.history = Some(next);
         out
     }
@@ -286,6 +327,37 @@ fn spatial_variance(
     })
 }
 
+/// The key whose integer order is `f32::total_cmp`'s order.
+#[inline]
+fn total_key(x: f32) -> i32 {
+    let b = x.to_bits() as i32;
+    b ^ (((b >> 31) as u32) >> 1) as i32
+}
+
+#[allow(unused_assignments)]
+/// The median of 9 values in `f32::total_cmp`'s order: the 19 compare-exchanges of the
+/// median-of-9 network (Paeth 1990, as in Devillard's `opt_med9`) on order keys, branch-free.
+#[inline]
+fn median9(v: [f32; 9]) -> f32 {
+    let [mut p0, mut p1, mut p2, mut p3, mut p4, mut p5, mut p6, mut p7, mut p8] = v.map(total_key);
+    macro_rules! sort {
+        ($($a:ident $b:ident),*) => {
+            $(
+                let (x, y) = ($a, $b);
+                $a = x.min(y);
+                $b = x.max(y);
+            )*
+        };
+    }
+    sort!(
+        p1 p2, p4 p5, p7 p8, p0 p1, p3 p4, p6 p7, p1 p2, p4 p5, p7 p8, p0 p3, p5 p8, p4 p7,
+        p3 p6, p1 p4, p2 p5, p4 p7, p4 p2, p6 p4, p4 p2
+    );
+    let _ = (p0, p1, p3, p5, p7, p8);
+    // The key is its own inverse.
+    f32::from_bits(total_key(f32::from_bits(p4 as u32)) as u32)
+}
+
 /// Per-channel 3×3 median of diffuse pixels among their diffuse neighbours (Voorhuis §2.7
 /// change 3); other pixels unchanged.
 fn median_diffuse(f: &Features, img: &[Rgb]) -> Vec<Rgb> {
@@ -302,18 +374,62 @@ fn median_diffuse(f: &Features, img: &[Rgb]) -> Vec<Rgb> {
                 for xx in (x - 1).max(0)..=(x + 1).min(f.w as isize - 1) {
                     let j = yy as usize * f.w + xx as usize;
                     if f.class[j] == features::Class::Diffuse {
-                        for (c, v) in vals.iter_mut().enumerate() {
-                            v[k] = img[j][c];
-                        }
+                        let c = img[j];
+                        vals[0][k] = c.x;
+                        vals[1][k] = c.y;
+                        vals[2][k] = c.z;
                         k += 1;
                     }
                 }
             }
-            Rgb::from_array(std::array::from_fn(|c| {
-                let v = &mut vals[c][..k];
+            if k == 9 {
+                return Rgb::new(median9(vals[0]), median9(vals[1]), median9(vals[2]));
+            }
+            Rgb::from_array(vals.map(|mut v| {
+                let v = &mut v[..k];
                 v.sort_unstable_by(f32::total_cmp);
                 v[k / 2]
             }))
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median9_is_the_middle_of_the_total_order() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let pool = [
+            0.0f32,
+            -0.0,
+            1.0,
+            -1.0,
+            0.5,
+            2.5,
+            f32::INFINITY,
+            1e-30,
+            -7.0,
+        ];
+        for _ in 0..20_000 {
+            let v: [f32; 9] = std::array::from_fn(|_| {
+                let r = next();
+                if r % 3 == 0 {
+                    pool[(r >> 8) as usize % pool.len()]
+                } else {
+                    (r >> 16) as u16 as f32 / 997.0 - 30.0
+                }
+            });
+            let mut sorted = v;
+            sorted.sort_unstable_by(f32::total_cmp);
+            assert_eq!(median9(v).to_bits(), sorted[4].to_bits(), "{v:?}");
+        }
+    }
 }
