@@ -15,7 +15,7 @@ use rt_film::{AovSet, Film, FilmBuffers, GuideBuffers, NoisyFrame};
 use rt_integrators::{
     render_guides, Ctx, GuideOptions, PreviousView, RenderStats, SamplePass, Technique,
 };
-use rt_temporal::{TemporalDenoiser, TemporalError, TemporalFrame};
+use rt_temporal::{TemporalDenoiser, TemporalError, TemporalFrame, EXTRA_SAMPLE_CHANNELS};
 use std::time::{Duration, Instant};
 
 /// Why a sequence cannot be rendered.
@@ -210,20 +210,50 @@ impl SequenceRenderer {
         };
         let wants_guides = self.denoiser.as_ref().is_some_and(|d| d.needs_guides());
         let t = Instant::now();
+        // A guide-sampling denoiser at several samples per pixel gets sample 0 (the guide
+        // ray) in the frame and every further sample as a one-sample frame of its own.
+        let apart = wants_guides
+            && self.spp > 1
+            && self.denoiser.as_ref().is_some_and(|d| d.guide_samples());
+        let first = if apart { 1 } else { self.spp };
         let mut film = Film::new(
             camera.width,
             camera.height,
             FilmBuffers::for_outputs(self.aovs),
         );
         let pass = SamplePass {
-            indices: 0..self.spp,
+            indices: 0..first,
             stream: SampleStream::Render,
             pixels: None,
             centre_first: wants_guides,
         };
-        let stats =
-            self.technique
-                .render_pass(&ctx, &mut film, frame_seed(self.seed, f), &pass, &|_| {});
+        let seed = frame_seed(self.seed, f);
+        let mut stats = self
+            .technique
+            .render_pass(&ctx, &mut film, seed, &pass, &|_| {});
+        let extra_aovs = AovSet::for_channels(&EXTRA_SAMPLE_CHANNELS);
+        let mut extra = Vec::new();
+        for k in first..self.spp {
+            let mut one = Film::new(
+                camera.width,
+                camera.height,
+                FilmBuffers::for_outputs(extra_aovs),
+            );
+            let pass = SamplePass {
+                indices: k..k + 1,
+                stream: SampleStream::Render,
+                pixels: None,
+                centre_first: false,
+            };
+            let s = self
+                .technique
+                .render_pass(&ctx, &mut one, seed, &pass, &|_| {});
+            stats.elapsed += s.elapsed;
+            stats.samples += s.samples;
+            stats.rays += s.rays;
+            stats.discarded += s.discarded;
+            extra.push(NoisyFrame::from_film(&one, extra_aovs));
+        }
         times.render = t.elapsed();
         let t = Instant::now();
         let guides = wants_guides.then(|| {
@@ -234,12 +264,21 @@ impl SequenceRenderer {
             render_guides(&ctx, previous.as_ref(), &self.guide_options)
         });
         times.guides = t.elapsed();
-        let noisy = NoisyFrame::from_film(&film, self.aovs);
+        let mut noisy = NoisyFrame::from_film(&film, self.aovs);
+        if !extra.is_empty() {
+            // The noisy image is the mean of all the frame's samples, as without the split.
+            let n = 1.0 + extra.len() as f32;
+            for (i, c) in noisy.colour.pixels_mut().iter_mut().enumerate() {
+                let sum: rt_core::Rgb = extra.iter().map(|e| e.colour.pixels()[i]).sum();
+                *c = (*c + sum) / n;
+            }
+        }
         let t = Instant::now();
         let image = match &mut self.denoiser {
             Some(d) => d.push(&TemporalFrame {
                 frame: &noisy,
                 guides: guides.as_ref(),
+                extra: &extra,
             })?,
             None => noisy.colour.clone(),
         };

@@ -44,6 +44,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         d.push(&TemporalFrame {
             frame: &frame,
             guides: Some(&guides),
+            extra: &[],
         })?;
         times.push(t.elapsed().as_secs_f64());
     }

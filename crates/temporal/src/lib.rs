@@ -40,7 +40,7 @@
 //!     frame.direct = Some(frame.colour.clone());
 //!     frame.indirect = Some(Image::filled(w, h, Rgb::ZERO));
 //!     frame.emission = Some(Image::filled(w, h, Rgb::ZERO));
-//!     let out = svgf.push(&TemporalFrame { frame: &frame, guides: Some(&guides) })?;
+//!     let out = svgf.push(&TemporalFrame { frame: &frame, guides: Some(&guides), extra: &[] })?;
 //!     assert_eq!(out.size(), (w, h));
 //! }
 //! # Ok::<(), rt_temporal::TemporalError>(())
@@ -68,7 +68,21 @@ pub struct TemporalFrame<'a> {
     pub frame: &'a NoisyFrame,
     /// Its guide buffers, if rendered.
     pub guides: Option<&'a GuideBuffers>,
+    /// Samples 1, 2, ... of every pixel as one-sample frames, when `frame` holds only the
+    /// guide ray's sample 0 (denoisers whose [`TemporalDenoiser::guide_samples`] is true);
+    /// empty otherwise.
+    pub extra: &'a [NoisyFrame],
 }
+
+/// The channels of each further sample a guide-sampling denoiser reads.
+pub const EXTRA_SAMPLE_CHANNELS: [Channel; 6] = [
+    Channel::Direct,
+    Channel::Indirect,
+    Channel::Emission,
+    Channel::Albedo,
+    Channel::Normal,
+    Channel::Position,
+];
 
 /// Why a sequence cannot be denoised.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -107,6 +121,13 @@ pub trait TemporalDenoiser: Send {
     /// True if it reads the guide buffers.
     fn needs_guides(&self) -> bool;
 
+    /// True if, at more than one sample per pixel, it wants the guide ray's sample 0 in the
+    /// frame and every further sample apart in [`TemporalFrame::extra`] (supersampling with
+    /// guide rays), each with the channels of [`EXTRA_SAMPLE_CHANNELS`].
+    fn guide_samples(&self) -> bool {
+        false
+    }
+
     /// Filters a frame that has what [`TemporalDenoiser::needs`] (callers go through
     /// [`TemporalDenoiser::push`], which checks).
     fn filter(&mut self, frame: &TemporalFrame<'_>) -> Result<RgbImage, TemporalError>;
@@ -117,6 +138,15 @@ pub trait TemporalDenoiser: Send {
     /// Checks the frame, filters it, and replaces any non-finite output pixel by zero.
     fn push(&mut self, frame: &TemporalFrame<'_>) -> Result<RgbImage, TemporalError> {
         frame.frame.require(self.name(), self.needs())?;
+        for (k, e) in frame.extra.iter().enumerate() {
+            e.require(self.name(), &EXTRA_SAMPLE_CHANNELS)?;
+            if e.colour.size() != frame.frame.colour.size() {
+                return Err(TemporalError::Guides {
+                    denoiser: self.name().to_string(),
+                    message: format!("sample {} has another size than the frame", k + 1),
+                });
+            }
+        }
         if self.needs_guides() {
             let g = frame.guides.ok_or_else(|| TemporalError::MissingGuides {
                 denoiser: self.name().to_string(),

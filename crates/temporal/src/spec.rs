@@ -2,6 +2,7 @@
 //! single-frame denoiser spec (`atrous:demodulate=on`) run per frame. Errors are one line naming
 //! the denoiser and the option.
 
+use crate::svgf::supersample::ExtraSample;
 use crate::svgf::{Svgf, SvgfInput, SvgfParams};
 use crate::{PerFrame, TemporalDenoiser, TemporalError, TemporalFrame};
 use rt_core::RgbImage;
@@ -109,6 +110,10 @@ impl TemporalDenoiser for NamedSvgf {
         true
     }
 
+    fn guide_samples(&self) -> bool {
+        true
+    }
+
     fn filter(&mut self, frame: &TemporalFrame<'_>) -> Result<RgbImage, TemporalError> {
         let missing = || TemporalError::MissingGuides {
             denoiser: self.name.clone(),
@@ -120,7 +125,22 @@ impl TemporalDenoiser for NamedSvgf {
             indirect: f.indirect.as_ref().ok_or_else(missing)?,
             emission: f.emission.as_ref().ok_or_else(missing)?,
         };
-        Ok(self.svgf.push(&input))
+        // `push` checked every extra sample's channels.
+        let extra: Vec<ExtraSample<'_>> = frame
+            .extra
+            .iter()
+            .filter_map(|e| {
+                Some(ExtraSample {
+                    direct: e.direct.as_ref()?,
+                    indirect: e.indirect.as_ref()?,
+                    emission: e.emission.as_ref()?,
+                    albedo: e.albedo.as_ref()?,
+                    normal: e.normal.as_ref()?,
+                    position: e.position.as_ref()?,
+                })
+            })
+            .collect();
+        Ok(self.svgf.push_supersampled(&input, &extra))
     }
 
     fn reset(&mut self) {

@@ -238,6 +238,7 @@ fn bad_options_and_missing_guides_give_one_clear_line() {
         .push(&TemporalFrame {
             frame: &frame,
             guides: None,
+            extra: &[],
         })
         .unwrap_err()
         .to_string();
@@ -249,6 +250,7 @@ fn bad_options_and_missing_guides_give_one_clear_line() {
         .push(&TemporalFrame {
             frame: &frame,
             guides: None,
+            extra: &[],
         })
         .unwrap_err()
         .to_string();
@@ -258,9 +260,70 @@ fn bad_options_and_missing_guides_give_one_clear_line() {
         .push(&TemporalFrame {
             frame: &frame,
             guides: Some(&g),
+            extra: &[],
         })
         .unwrap_err()
         .to_string();
     assert!(e.contains("guide buffers are 5x3, the frame is 4x3"), "{e}");
     assert!(!e.contains('\n'));
+}
+
+#[test]
+fn guide_ray_supersampling_gives_a_partly_covered_pixel_both_sides() {
+    // Left half: albedo 0.2, lit 1; right half: albedo 0.8, lit 2, facing another way. The
+    // extra sample of boundary pixel (7, y) sees the right surface (lit 3 in its sample), so it
+    // belongs to guide (8, y), whose input becomes the mean (2 + 2 + 3) / 3 of its own, its
+    // pixel's extra sample and this one; pixel 7 is then (0.2 · 1 + 0.8 · 7/3) / 2. Kept apart
+    // (no guide found) it would be (0.2 + 2.4) / 2; given to its own guide (0.2 + 0.8) · 2 / 2.
+    let (w, h) = (16, 4);
+    let right = |x: usize| x >= 8;
+    let mut g = flat_guides(w, h);
+    for y in 0..h {
+        for x in 8..w {
+            g.normal.pixels_mut()[y * w + x] = Vec3::X;
+            g.albedo.pixels_mut()[y * w + x] = Rgb::splat(0.8);
+            g.object.pixels_mut()[y * w + x] = 1;
+        }
+    }
+    let lit = |x: usize| if right(x) { 1.6 } else { 0.2 };
+    let direct = Image::from_fn(w, h, |x, _| Rgb::splat(lit(x)));
+    // The extra sample: as its own guide everywhere except on the boundary column.
+    let seen = |x: usize| if x == 7 { 8 } else { x };
+    let e_direct = Image::from_fn(w, h, |x, _| Rgb::splat(if x == 7 { 2.4 } else { lit(x) }));
+    let e_albedo = Image::from_fn(w, h, |x, y| g.albedo.pixel(seen(x), y));
+    let e_normal = Image::from_fn(w, h, |x, y| g.normal.pixel(seen(x), y));
+    let e_position = Image::from_fn(w, h, |x, y| g.position.pixel(seen(x), y));
+    let zero = Image::filled(w, h, Rgb::ZERO);
+    let extra = rt_temporal::svgf::supersample::ExtraSample {
+        direct: &e_direct,
+        indirect: &zero,
+        emission: &zero,
+        albedo: &e_albedo,
+        normal: &e_normal,
+        position: &e_position,
+    };
+    let mut svgf = Svgf::new(SvgfParams {
+        iterations: 0,
+        feedback: 0,
+        median: false,
+        ..SvgfParams::default()
+    });
+    let input = SvgfInput {
+        guides: &g,
+        direct: &direct,
+        indirect: &zero,
+        emission: &zero,
+    };
+    let out = svgf.push_supersampled(&input, &[extra]);
+    for y in 0..h {
+        let expected = (0.2 + 0.8 * 7.0 / 3.0) / 2.0;
+        assert!(
+            (out.pixel(7, y).x - expected).abs() < 1e-5,
+            "{}",
+            out.pixel(7, y)
+        );
+        assert!((out.pixel(3, y).x - 0.2).abs() < 1e-5);
+        assert!((out.pixel(8, y).x - 0.8 * 7.0 / 3.0).abs() < 1e-5);
+        assert!((out.pixel(12, y).x - 1.6).abs() < 1e-5);
+    }
 }

@@ -36,6 +36,7 @@ mod history;
 mod params;
 mod planes;
 mod reproject;
+pub mod supersample;
 
 pub use atrous::{normal_weight, Signals, KERNEL};
 pub use features::{Class, MIN_ALBEDO};
@@ -125,6 +126,17 @@ impl Svgf {
     /// Filters one frame of a sequence and keeps its history. The images must all have the
     /// guides' size (callers check: [`crate::TemporalDenoiser`] does).
     pub fn push(&mut self, input: &SvgfInput<'_>) -> RgbImage {
+        self.push_supersampled(input, &[])
+    }
+
+    /// [`Svgf::push`] with further samples of every pixel besides the guide ray's: each is
+    /// assigned to a neighbouring guide, averaged into its input and remodulated from its
+    /// filtered light ([`supersample`], Voorhuis Eq. 7).
+    pub fn push_supersampled(
+        &mut self,
+        input: &SvgfInput<'_>,
+        extra: &[supersample::ExtraSample<'_>],
+    ) -> RgbImage {
         let p = &self.params;
         let g = input.guides;
         let f = Features::new(g, p);
@@ -138,7 +150,7 @@ impl Svgf {
             self.history = None;
         }
         // 1. Demodulate.
-        let current: Vec<[Rgb; 2]> = (0..n)
+        let mut current: Vec<[Rgb; 2]> = (0..n)
             .into_par_iter()
             .map(|i| {
                 if f.class[i] == features::Class::Sky {
@@ -148,6 +160,7 @@ impl Svgf {
                 [input.direct.pixels()[i] / a, input.indirect.pixels()[i] / a]
             })
             .collect();
+        let gathered = (!extra.is_empty()).then(|| supersample::gather(&f, g, extra, &mut current));
         // 2. Reproject.
         let fetched: Vec<reproject::Fetched> = match &self.history {
             Some(hist) => (0..n)
@@ -238,7 +251,7 @@ impl Svgf {
         } else {
             illumination
         };
-        let pixels: Vec<Rgb> = (0..n)
+        let mut pixels: Vec<Rgb> = (0..n)
             .into_par_iter()
             .map(|i| {
                 let e = input.emission.pixels()[i];
@@ -254,6 +267,9 @@ impl Svgf {
                 }
             })
             .collect();
+        if let Some(gathered) = &gathered {
+            supersample::resolve(extra, gathered, &shown, &mut pixels);
+        }
         let out = Image::new(w, h, pixels).expect("one output pixel per pixel");
         // Keep the history.
         // The previous history has been read: its buffers take the new one.
