@@ -1,0 +1,96 @@
+//! The seam between the point sets and everything else: a [`Discretisation`] enumerates the
+//! cached points around a position. Selection, the table and the Shepard reconstruction are
+//! written once against it, so an A/B test of implicit points against the fixed grid changes
+//! nothing but the point set.
+
+use crate::key::{Key, KeyKind};
+use glam::{IVec3, Vec3};
+
+/// Which neighbouring voxels (or grid cells) the selection scans besides the one holding the
+/// query: none, the 6 face neighbours, the 18 face and edge neighbours, or all 26.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Connectivity {
+    /// The query's own voxel only.
+    C0,
+    /// Plus the 6 face neighbours.
+    C6,
+    /// Plus the 12 edge neighbours.
+    C18,
+    /// Plus the 8 corner neighbours: 27 voxels, the thesis' choice.
+    C26,
+}
+
+impl Connectivity {
+    /// From the number of neighbours (0, 6, 18 or 26).
+    pub fn from_neighbours(n: u32) -> Option<Self> {
+        Some(match n {
+            0 => Connectivity::C0,
+            6 => Connectivity::C6,
+            18 => Connectivity::C18,
+            26 => Connectivity::C26,
+            _ => return None,
+        })
+    }
+
+    /// The number of neighbours.
+    pub fn neighbours(self) -> u32 {
+        match self {
+            Connectivity::C0 => 0,
+            Connectivity::C6 => 6,
+            Connectivity::C18 => 18,
+            Connectivity::C26 => 26,
+        }
+    }
+
+    /// True if offset `d` (each component in -1..=1) belongs to the neighbourhood.
+    #[inline]
+    pub fn contains(self, d: IVec3) -> bool {
+        let manhattan = d.x.abs() + d.y.abs() + d.z.abs();
+        match self {
+            Connectivity::C0 => manhattan == 0,
+            Connectivity::C6 => manhattan <= 1,
+            Connectivity::C18 => manhattan <= 2,
+            Connectivity::C26 => true,
+        }
+    }
+}
+
+/// A set of implicit or explicit points, each with an exact [`Key`], that a cache stores
+/// values at.
+pub trait Discretisation: Send + Sync {
+    /// Which key space the points use.
+    fn kind(&self) -> KeyKind;
+
+    /// Mean distance between neighbouring points (world units): one point per cube of this
+    /// edge.
+    fn spacing(&self) -> f32;
+
+    /// Edge of the voxels (or cells) the points are generated in.
+    fn voxel_edge(&self) -> f32;
+
+    /// Calls `f(position, key)` for every point of the voxel holding `x` and of its
+    /// neighbours under `c`.
+    fn for_each_candidate<F: FnMut(Vec3, Key)>(&self, x: Vec3, c: Connectivity, f: F);
+
+    /// Calls `f(position, key)` for a set of points that includes every point closer to `x`
+    /// than `distance` (and some farther ones, which callers cull).
+    fn for_each_near<F: FnMut(Vec3, Key)>(&self, x: Vec3, distance: f32, f: F);
+}
+
+/// The integer voxel of edge `edge` holding `x`.
+#[inline]
+pub(crate) fn voxel_of(x: Vec3, edge: f32) -> IVec3 {
+    (x / edge).floor().as_ivec3()
+}
+
+/// Calls `f(d)` for every offset `d` of the cube `[-ring, ring]^3`.
+#[inline]
+pub(crate) fn for_each_offset(ring: i32, mut f: impl FnMut(IVec3)) {
+    for dz in -ring..=ring {
+        for dy in -ring..=ring {
+            for dx in -ring..=ring {
+                f(IVec3::new(dx, dy, dz));
+            }
+        }
+    }
+}
