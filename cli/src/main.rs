@@ -13,6 +13,7 @@
 mod args;
 mod bench_accel;
 mod bench_anim;
+mod cache;
 mod compare;
 mod denoise;
 mod experiment;

@@ -72,8 +72,8 @@ pub trait Discretisation: Send + Sync {
     /// neighbours under `c`.
     fn for_each_candidate<F: FnMut(Vec3, Key)>(&self, x: Vec3, c: Connectivity, f: F);
 
-    /// Calls `f(position, key)` for a set of points that includes every point closer to `x`
-    /// than `distance` (and some farther ones, which callers cull).
+    /// Calls `f(position, key)` for the points of the voxels (cells) that can hold a point
+    /// within `distance` of `x`: every such point, and some farther ones, which callers cull.
     fn for_each_near<F: FnMut(Vec3, Key)>(&self, x: Vec3, distance: f32, f: F);
 }
 
@@ -90,6 +90,18 @@ pub(crate) fn for_each_offset(ring: i32, mut f: impl FnMut(IVec3)) {
         for dy in -ring..=ring {
             for dx in -ring..=ring {
                 f(IVec3::new(dx, dy, dz));
+            }
+        }
+    }
+}
+
+/// Calls `f(v)` for every `v` with `lo <= v <= hi` componentwise.
+#[inline]
+pub(crate) fn for_each_in_range(lo: IVec3, hi: IVec3, mut f: impl FnMut(IVec3)) {
+    for z in lo.z..=hi.z {
+        for y in lo.y..=hi.y {
+            for x in lo.x..=hi.x {
+                f(IVec3::new(x, y, z));
             }
         }
     }

@@ -287,6 +287,20 @@ fn claim5_27_voxels_find_the_true_nearest() {
         mismatches.insert(c.neighbours(), m);
     }
     assert_eq!(mismatches[&26], 0);
+    // All three nearest (the selection's fast path included) equal the 27-voxel scan's.
+    for &x in &xs {
+        let mut all = Vec::new();
+        pts.for_each_candidate(x, Connectivity::C26, |p, k| {
+            all.push(((p - x).length_squared(), k))
+        });
+        all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let top: Vec<Key> = all[..3].iter().map(|a| a.1).collect();
+        assert_eq!(
+            nearest3(&pts, x, Connectivity::C26).key.to_vec(),
+            top,
+            "at {x}"
+        );
+    }
     assert!(mismatches[&0] > mismatches[&6] && mismatches[&6] > 0);
     assert!(mismatches[&18] <= mismatches[&6]);
     // The grid: the nearest centre is the own cell's, whatever the connectivity.

@@ -12,7 +12,9 @@
 //! are an option of the cache), and no screen-space filter: reconstruction is the same
 //! world-space Shepard filter as for implicit points (as in the thesis' comparison).
 
-use crate::discretisation::{for_each_offset, voxel_of, Connectivity, Discretisation};
+use crate::discretisation::{
+    for_each_in_range, for_each_offset, voxel_of, Connectivity, Discretisation,
+};
 use crate::key::{Key, KeyKind, KeyParts, MAX_LEVEL};
 use glam::{IVec3, Vec3};
 
@@ -81,12 +83,16 @@ impl Discretisation for FixedGrid {
 
     #[inline]
     fn for_each_near<F: FnMut(Vec3, Key)>(&self, x: Vec3, distance: f32, mut f: F) {
+        // Exactly the cells whose centre lies in the box [x - distance, x + distance].
         let edge = self.edge();
-        // The centre of cell c + d is at least (|d| - 1/2) edges from x along that axis.
-        let ring = (((distance / edge) + 0.5).ceil() as i32 - 1).max(1);
-        let cell = voxel_of(x, edge);
-        for_each_offset(ring, |d| {
-            if let Some((p, k)) = self.cell_point(cell + d) {
+        let lo = ((x - Vec3::splat(distance)) / edge - Vec3::splat(0.5))
+            .ceil()
+            .as_ivec3();
+        let hi = ((x + Vec3::splat(distance)) / edge - Vec3::splat(0.5))
+            .floor()
+            .as_ivec3();
+        for_each_in_range(lo, hi, |c| {
+            if let Some((p, k)) = self.cell_point(c) {
                 f(p, k);
             }
         });

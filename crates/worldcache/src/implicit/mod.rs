@@ -17,7 +17,9 @@
 //! instead of limiting the world to 31 bits. The cross-LOD variant (Appendix A) is not built
 //! (the thesis rejects it as 3× slower).
 
-use crate::discretisation::{for_each_offset, voxel_of, Connectivity, Discretisation};
+use crate::discretisation::{
+    for_each_in_range, for_each_offset, voxel_of, Connectivity, Discretisation,
+};
 use crate::hash::{pcg, pcg3_to_1, unit3};
 use crate::key::{Key, KeyKind, KeyParts, MAX_LEVEL};
 use glam::{I64Vec3, IVec3, Vec3};
@@ -82,13 +84,14 @@ impl ImplicitPoints {
     #[inline]
     pub fn point(&self, v: IVec3, seed: u32, q: u32) -> Vec3 {
         let u = unit3(seed.wrapping_add(q));
+        let u = Vec3::from_array(u);
         let o = Vec3::new((q & 1) as f32, ((q >> 1) & 1) as f32, ((q >> 2) & 1) as f32);
         let half = self.edge() * 0.5;
         let lo = v.as_vec3() * self.edge() + o * half;
         // f32 rounding of lo + u·half may land on the octant's far face; keep the point
         // inside its octant (stratification, claim 3).
         let hi = (lo + Vec3::splat(half)).to_array().map(f32::next_down);
-        (lo + Vec3::from_array(u) * half).min(Vec3::from_array(hi))
+        (lo + u * half).min(Vec3::from_array(hi))
     }
 
     /// The unit offset of point `q` inside its octant, in [0, 1)^3.
@@ -113,11 +116,20 @@ impl ImplicitPoints {
         }))
     }
 
+    #[inline]
     fn visit<F: FnMut(Vec3, Key)>(&self, v: IVec3, f: &mut F) {
-        if let Some(points) = self.voxel_points(v) {
-            for (p, k) in points {
-                f(p, k);
-            }
+        let Some(base) = Key::pack(KeyParts {
+            kind: KeyKind::Implicit,
+            level: self.lod,
+            voxel: v,
+            octant: 0,
+            normal_bin: 0,
+        }) else {
+            return;
+        };
+        let seed = self.voxel_seed(v, self.lod);
+        for q in 0..8 {
+            f(self.point(v, seed, q), Key(base.0 | u64::from(q) << 54));
         }
     }
 }
@@ -163,10 +175,11 @@ impl Discretisation for ImplicitPoints {
 
     #[inline]
     fn for_each_near<F: FnMut(Vec3, Key)>(&self, x: Vec3, distance: f32, mut f: F) {
+        // Exactly the voxels that meet the box [x - distance, x + distance]: every point
+        // within `distance` lies in one of them.
         let edge = self.edge();
-        // A point of voxel v + d is at least (|d| - 1) edges from x along that axis.
-        let ring = ((distance / edge).ceil() as i32).max(1);
-        let v = voxel_of(x, edge);
-        for_each_offset(ring, |d| self.visit(v + d, &mut f));
+        let lo = voxel_of(x - Vec3::splat(distance), edge);
+        let hi = voxel_of(x + Vec3::splat(distance), edge);
+        for_each_in_range(lo, hi, |v| self.visit(v, &mut f));
     }
 }
