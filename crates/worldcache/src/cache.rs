@@ -219,6 +219,19 @@ impl Discretisation for AnyPoints {
     }
 
     #[inline]
+    fn for_each_candidate_pruned<F: FnMut(Vec3, Key) -> f32>(
+        &self,
+        x: Vec3,
+        c: Connectivity,
+        f: F,
+    ) {
+        match self {
+            AnyPoints::Implicit(p) => p.for_each_candidate_pruned(x, c, f),
+            AnyPoints::Grid(p) => p.for_each_candidate_pruned(x, c, f),
+        }
+    }
+
+    #[inline]
     fn for_each_near<F: FnMut(Vec3, Key)>(&self, x: Vec3, distance: f32, f: F) {
         match self {
             AnyPoints::Implicit(p) => p.for_each_near(x, distance, f),

@@ -42,23 +42,16 @@ pub struct Nearest3 {
 /// The three candidates nearest to `x` under connectivity `c`. Ties are broken by key, so the
 /// result does not depend on the enumeration order.
 ///
-/// With 26-connectivity the points within one point spacing are scanned first (the voxels
-/// meeting that box: at most 8 for implicit points instead of 27); when the third nearest of
-/// those lies within that spacing, no unscanned point can be nearer, and the result equals
-/// the full 27-voxel scan (claim 5's test checks this against brute force). Otherwise the
-/// 27 voxels are scanned.
+/// Voxels are visited nearest first and skipped once they lie wholly beyond the current
+/// third-nearest distance, which gives the same three as scanning every voxel of the
+/// neighbourhood (claim 5's test checks this against a full scan and brute force).
 #[inline]
 pub fn nearest3<D: Discretisation>(points: &D, x: Vec3, c: Connectivity) -> Nearest3 {
-    if c == Connectivity::C26 {
-        let r = points.spacing();
-        let mut n = Nearest3::EMPTY;
-        points.for_each_near(x, r, |p, k| n.insert(x, p, k));
-        if n.d2[2] <= r * r {
-            return n;
-        }
-    }
     let mut n = Nearest3::EMPTY;
-    points.for_each_candidate(x, c, |p, k| n.insert(x, p, k));
+    points.for_each_candidate_pruned(x, c, |p, k| {
+        n.insert(x, p, k);
+        n.d2[2]
+    });
     n
 }
 

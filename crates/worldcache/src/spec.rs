@@ -14,8 +14,8 @@
 //! | `radius`      | Shepard search distance in point spacings, (0, 4]         | 2 |
 //! | `normals`     | normal bin in the key: `true`/`false`                     | false |
 //! | `min-samples` | lookups with fewer stored samples are misses              | 0 |
-//! | `capacity`    | persistent entries, a power of two                        | 2^20 |
-//! | `pass-capacity` | per-pass accumulator slots, a power of two              | 2^20 |
+//! | `capacity`    | persistent entries, a power of two                        | 2^18 (6 MiB) |
+//! | `pass-capacity` | per-pass accumulator slots, a power of two              | 2^18 (10 MiB) |
 
 use crate::cache::{AnyPoints, CacheParams, WorldCache};
 use crate::discretisation::Connectivity;
@@ -156,8 +156,8 @@ impl FromStr for CacheSpec {
             },
             s0: None,
             params: CacheParams::default(),
-            capacity: 1 << 20,
-            pass_capacity: 1 << 20,
+            capacity: 1 << 18,
+            pass_capacity: 1 << 18,
             text: s.to_string(),
         };
         for opt in rest

@@ -13,7 +13,7 @@
 //! world-space Shepard filter as for implicit points (as in the thesis' comparison).
 
 use crate::discretisation::{
-    for_each_in_range, for_each_offset, voxel_of, Connectivity, Discretisation,
+    for_each_in_range, for_each_offset, visit_pruned, voxel_of, Connectivity, Discretisation,
 };
 use crate::key::{Key, KeyKind, KeyParts, MAX_LEVEL};
 use glam::{IVec3, Vec3};
@@ -78,6 +78,22 @@ impl Discretisation for FixedGrid {
                     f(p, k);
                 }
             }
+        });
+    }
+
+    #[inline]
+    fn for_each_candidate_pruned<F: FnMut(Vec3, Key) -> f32>(
+        &self,
+        x: Vec3,
+        c: Connectivity,
+        mut f: F,
+    ) {
+        let mut bound = f32::INFINITY;
+        visit_pruned(x, self.edge(), c, |cell| {
+            if let Some((p, k)) = self.cell_point(cell) {
+                bound = f(p, k);
+            }
+            bound
         });
     }
 

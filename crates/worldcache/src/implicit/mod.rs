@@ -18,7 +18,7 @@
 //! (the thesis rejects it as 3× slower).
 
 use crate::discretisation::{
-    for_each_in_range, for_each_offset, voxel_of, Connectivity, Discretisation,
+    for_each_in_range, for_each_offset, visit_pruned, voxel_of, Connectivity, Discretisation,
 };
 use crate::hash::{pcg, pcg3_to_1, unit3};
 use crate::key::{Key, KeyKind, KeyParts, MAX_LEVEL};
@@ -174,12 +174,34 @@ impl Discretisation for ImplicitPoints {
     }
 
     #[inline]
+    fn for_each_candidate_pruned<F: FnMut(Vec3, Key) -> f32>(
+        &self,
+        x: Vec3,
+        c: Connectivity,
+        mut f: F,
+    ) {
+        let mut bound = f32::INFINITY;
+        visit_pruned(x, self.edge(), c, |v| {
+            self.visit(v, &mut |p, k| bound = f(p, k));
+            bound
+        });
+    }
+
+    #[inline]
     fn for_each_near<F: FnMut(Vec3, Key)>(&self, x: Vec3, distance: f32, mut f: F) {
-        // Exactly the voxels that meet the box [x - distance, x + distance]: every point
-        // within `distance` lies in one of them.
+        // The voxels that meet the ball of radius `distance` around x: every point within
+        // `distance` lies in one of them.
         let edge = self.edge();
         let lo = voxel_of(x - Vec3::splat(distance), edge);
         let hi = voxel_of(x + Vec3::splat(distance), edge);
-        for_each_in_range(lo, hi, |v| self.visit(v, &mut f));
+        let d2 = distance * distance;
+        for_each_in_range(lo, hi, |v| {
+            // Skip voxels of the box that miss the ball: no point of theirs is near enough.
+            let min = v.as_vec3() * edge;
+            let gap = (min - x).max(x - (min + Vec3::splat(edge))).max(Vec3::ZERO);
+            if gap.length_squared() < d2 {
+                self.visit(v, &mut f)
+            }
+        });
     }
 }
