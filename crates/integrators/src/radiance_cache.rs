@@ -182,3 +182,95 @@ impl CacheTrail {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{CameraRays, PathIntegrator};
+    use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
+
+    /// A cache that answers every lookup with `value` and counts what it is asked.
+    struct Fixed {
+        value: Option<Rgb>,
+        records: AtomicU64,
+        passes: AtomicU64,
+    }
+
+    impl RadianceCache for Fixed {
+        fn lookup(&self, _: Vec3, _: Vec3) -> Option<Rgb> {
+            self.value
+        }
+        fn record(&self, _: Vec3, _: Vec3, value: Rgb, _: u32) {
+            assert!(value.is_finite() && value.min_element() >= 0.0, "{value}");
+            self.records.fetch_add(1, Relaxed);
+        }
+        fn end_pass(&self) {
+            self.passes.fetch_add(1, Relaxed);
+        }
+    }
+
+    fn fixed(value: Option<Rgb>) -> Arc<Fixed> {
+        Arc::new(Fixed {
+            value,
+            records: AtomicU64::new(0),
+            passes: AtomicU64::new(0),
+        })
+    }
+
+    fn image(t: &dyn Technique, spp: u32) -> Vec<[u32; 3]> {
+        let scene = rt_scene::procedural::generate("worst-case").unwrap();
+        let mut camera = scene.cameras[0].clone();
+        (camera.width, camera.height) = (24, 16);
+        let accel = rt_accel::AccelSpec::default().build(&scene.triangles);
+        let ctx = Ctx {
+            scene: &scene,
+            accel: accel.as_ref(),
+            camera: &camera,
+        };
+        let mut film = Film::new(24, 16, rt_film::FilmBuffers::default());
+        let pass = SamplePass {
+            indices: 0..spp,
+            stream: rt_core::SampleStream::Render,
+            pixels: None,
+        };
+        t.render_pass(&ctx, &mut film, 3, &pass, &|_| {});
+        film.mean_image()
+            .iter()
+            .map(|c| c.to_array().map(f32::to_bits))
+            .collect()
+    }
+
+    fn cached(path: PathIntegrator, cache: Arc<Fixed>) -> CachedPasses {
+        let c: Arc<dyn RadianceCache> = cache;
+        CachedPasses::new(
+            Box::new(CameraRays(Box::new(path.with_cache(c.clone())))),
+            c,
+        )
+    }
+
+    /// A cache with nothing in it changes nothing: the same bits as plain path tracing,
+    /// while every pass is ended and paths record their vertices.
+    #[test]
+    fn an_empty_cache_leaves_the_path_tracer_unchanged() {
+        let plain = CameraRays(Box::new(PathIntegrator::new(5)));
+        let cache = fixed(None);
+        let with = cached(PathIntegrator::new(5), cache.clone());
+        assert_eq!(image(&plain, 3), image(&with, 3));
+        assert_eq!(cache.passes.load(Relaxed), 3);
+        assert!(cache.records.load(Relaxed) > 24 * 16);
+    }
+
+    /// A cache holding zero everywhere ends every path at its first secondary (diffuse)
+    /// vertex after that vertex's emission: exactly direct lighting (the scene is diffuse).
+    #[test]
+    fn a_zero_cache_turns_path_tracing_into_direct_lighting() {
+        let direct = CameraRays(Box::new(PathIntegrator::direct()));
+        let with = cached(PathIntegrator::new(5), fixed(Some(Rgb::ZERO)));
+        let (a, b) = (image(&direct, 2), image(&with, 2));
+        assert_eq!(a, b);
+        // And a non-zero cache adds light.
+        let lit = cached(PathIntegrator::new(5), fixed(Some(Rgb::splat(0.5))));
+        let sum = |img: &[[u32; 3]]| -> f32 { img.iter().map(|p| f32::from_bits(p[0])).sum() };
+        assert!(sum(&image(&lit, 2)) > sum(&a) * 1.01);
+    }
+}

@@ -21,12 +21,17 @@ pub fn pcg3_to_1(x: u32, y: u32, z: u32) -> u32 {
 /// (216 points per 27-voxel query), and 1/1024 of a half-voxel is finer than any use needs.
 #[inline]
 pub fn unit3(seed: u32) -> [f32; 3] {
-    let h = pcg(seed);
-    [
+    unit3_of_hash(pcg(seed)).to_array()
+}
+
+/// The split of [`unit3`] applied to an already hashed `h`.
+#[inline]
+pub fn unit3_of_hash(h: u32) -> glam::Vec3 {
+    glam::Vec3::new(
         (h & 0x7ff) as f32 * (1.0 / 2048.0),
         ((h >> 11) & 0x7ff) as f32 * (1.0 / 2048.0),
         (h >> 22) as f32 * (1.0 / 1024.0),
-    ]
+    )
 }
 
 /// The top 24 bits of `h` as a number in [0, 1).

@@ -19,9 +19,10 @@
 //! Keys are exact: a 64-bit packing of (point set, level, voxel, octant, normal bin), stored
 //! whole in the table, so distinct points never share an entry ([`key`]).
 //!
-//! Depends on `rt-core` (frames), `glam`, `rayon`-free code paths (callers parallelise) and
-//! `thiserror`. What is reconstructed from the thesis' prose rather than read from its (lost)
-//! equations is marked in each module.
+//! Depends on `rt-core` (shading frames), `glam` and `thiserror`; callers parallelise
+//! (`record` and `lookup` take `&self` and are lock-free, `end_pass` takes `&mut self`).
+//! What is reconstructed from the thesis' prose rather than read from its (lost) equations is
+//! marked in each module. Design notes, tests and results: `docs/worldcache.md`.
 //!
 //! ```
 //! use rt_worldcache::{CacheSpec, glam::Vec3};

@@ -20,7 +20,7 @@
 use crate::discretisation::{
     for_each_in_range, for_each_offset, visit_pruned, voxel_of, Connectivity, Discretisation,
 };
-use crate::hash::{pcg, pcg3_to_1, unit3};
+use crate::hash::{pcg, pcg3_to_1, unit3_of_hash};
 use crate::key::{Key, KeyKind, KeyParts, MAX_LEVEL};
 use glam::{I64Vec3, IVec3, Vec3};
 
@@ -80,40 +80,16 @@ impl ImplicitPoints {
         pcg3_to_1(fixed_word(f.x), fixed_word(f.y), fixed_word(f.z))
     }
 
-    /// Point `q` (octant `q`: bit 0 x, bit 1 y, bit 2 z) of voxel `v` with seed `seed`.
-    #[inline]
-    pub fn point(&self, v: IVec3, seed: u32, q: u32) -> Vec3 {
-        let u = unit3(seed.wrapping_add(q));
-        let u = Vec3::from_array(u);
-        let o = Vec3::new((q & 1) as f32, ((q >> 1) & 1) as f32, ((q >> 2) & 1) as f32);
-        let half = self.edge() * 0.5;
-        let lo = v.as_vec3() * self.edge() + o * half;
-        // f32 rounding of lo + u·half may land on the octant's far face; keep the point
-        // inside its octant (stratification, claim 3).
-        let hi = (lo + Vec3::splat(half)).to_array().map(f32::next_down);
-        (lo + u * half).min(Vec3::from_array(hi))
-    }
-
-    /// The unit offset of point `q` inside its octant, in [0, 1)^3.
-    pub fn octant_offset(seed: u32, q: u32) -> Vec3 {
-        Vec3::from_array(unit3(seed.wrapping_add(q)))
-    }
-
-    /// The 8 points of voxel `v` with their keys (`None`: the voxel is outside the key range).
-    #[inline]
+    /// The 8 points of voxel `v` with their keys, point `q` in octant `q` (bit 0 x, bit 1 y,
+    /// bit 2 z); `None`: the voxel is outside the key range.
     pub fn voxel_points(&self, v: IVec3) -> Option<[(Vec3, Key); 8]> {
-        let base = Key::pack(KeyParts {
-            kind: KeyKind::Implicit,
-            level: self.lod,
-            voxel: v,
-            octant: 0,
-            normal_bin: 0,
-        })?;
-        let seed = self.voxel_seed(v, self.lod);
-        Some(std::array::from_fn(|q| {
-            let q = q as u32;
-            (self.point(v, seed, q), Key(base.0 | u64::from(q) << 54))
-        }))
+        let mut out = [(Vec3::ZERO, Key(0)); 8];
+        let mut n = 0;
+        self.visit(v, &mut |p, k| {
+            out[n] = (p, k);
+            n += 1;
+        });
+        (n == 8).then_some(out)
     }
 
     #[inline]
@@ -128,8 +104,25 @@ impl ImplicitPoints {
             return;
         };
         let seed = self.voxel_seed(v, self.lod);
-        for q in 0..8 {
-            f(self.point(v, seed, q), Key(base.0 | u64::from(q) << 54));
+        // The hot loop of every query: hash all 8 points first (a loop the compiler can
+        // vectorise), then place them; the far-face clamps are computed once per voxel.
+        let hashes: [u32; 8] = std::array::from_fn(|q| pcg(seed.wrapping_add(q as u32)));
+        let half = self.edge() * 0.5;
+        let lo = v.as_vec3() * self.edge();
+        let mid = lo + Vec3::splat(half);
+        let hi = [mid, mid + Vec3::splat(half)]
+            .map(|b| Vec3::from_array(b.to_array().map(f32::next_down)));
+        for (q, h) in hashes.into_iter().enumerate() {
+            let u = unit3_of_hash(h);
+            let o = [q & 1, (q >> 1) & 1, (q >> 2) & 1];
+            let start = Vec3::new(
+                if o[0] == 1 { mid.x } else { lo.x },
+                if o[1] == 1 { mid.y } else { lo.y },
+                if o[2] == 1 { mid.z } else { lo.z },
+            );
+            let cap = Vec3::new(hi[o[0]].x, hi[o[1]].y, hi[o[2]].z);
+            let p = (start + u * half).min(cap);
+            f(p, Key(base.0 | (q as u64) << 54));
         }
     }
 }
