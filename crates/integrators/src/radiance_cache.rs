@@ -248,6 +248,41 @@ mod tests {
         )
     }
 
+    /// What a path records at each vertex: the radiance found beyond it over the throughput
+    /// up to it (zero where the throughput is).
+    #[test]
+    fn trail_records_radiance_beyond_each_vertex_over_its_throughput() {
+        struct Log(std::sync::Mutex<Vec<(Vec3, Rgb)>>);
+        impl RadianceCache for Log {
+            fn lookup(&self, _: Vec3, _: Vec3) -> Option<Rgb> {
+                None
+            }
+            fn record(&self, p: Vec3, _: Vec3, value: Rgb, _: u32) {
+                self.0.lock().unwrap().push((p, value));
+            }
+            fn end_pass(&self) {}
+        }
+        let log = Log(Default::default());
+        let mut trail = CacheTrail::new();
+        trail.push(Vec3::X, Vec3::Z, Rgb::ONE, Rgb::splat(0.5), [0.1, 0.2]);
+        trail.push(
+            Vec3::Y,
+            Vec3::Z,
+            Rgb::new(0.5, 0.25, 0.0),
+            Rgb::splat(1.0),
+            [0.3, 0.4],
+        );
+        trail.record(&log, Rgb::splat(2.0));
+        let got = log.0.into_inner().unwrap();
+        assert_eq!(
+            got,
+            vec![
+                (Vec3::X, Rgb::splat(1.5)),
+                (Vec3::Y, Rgb::new(2.0, 4.0, 0.0)),
+            ]
+        );
+    }
+
     /// A cache with nothing in it changes nothing: the same bits as plain path tracing,
     /// while every pass is ended and paths record their vertices.
     #[test]
