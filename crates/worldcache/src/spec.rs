@@ -12,7 +12,7 @@
 //! | `select`      | `barycentric`, `nearest` or `jitter`                      | barycentric |
 //! | `jitter`      | jitter radius in point spacings (implies `select=jitter`) | 1 |
 //! | `radius`      | Shepard search distance in point spacings, (0, 4]         | 2 |
-//! | `normals`     | normal bin in the key: `true`/`false`                     | false |
+//! | `normals`     | normal bin in the key: `true`/`false` (the thesis: false) | true |
 //! | `min-samples` | lookups with fewer stored samples are misses              | 0 |
 //! | `capacity`    | persistent entries, a power of two                        | 2^18 (6 MiB) |
 //! | `pass-capacity` | per-pass accumulator slots, a power of two              | 2^18 (10 MiB) |
