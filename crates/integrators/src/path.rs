@@ -187,7 +187,8 @@ impl Integrator for PathIntegrator {
         };
         // Radiance cache: the diffuse vertices this path records.
         let cache = self.cache.as_ref().map(|c| c.0.as_ref());
-        let mut trail = CacheTrail::new();
+        // Only a cached render pays for the trail's array.
+        let mut trail = cache.is_some().then(CacheTrail::new);
         loop {
             counters.rays += 1;
             let Some(hit) = ctx.accel.intersect(&ray, f32::INFINITY) else {
@@ -266,8 +267,8 @@ impl Integrator for PathIntegrator {
             let u_layer = sampler.next_1d();
             let u_bsdf = sampler.next_2d();
             let u_rr = sampler.next_1d();
-            if cached_vertex {
-                trail.push(si.p, n_cache, beta, l, [u_layer, u_rr]);
+            if let (true, Some(t)) = (cached_vertex, trail.as_mut()) {
+                t.push(si.p, n_cache, beta, l, [u_layer, u_rr]);
             }
 
             if use_nee && bsdf.has_non_delta() {
@@ -325,8 +326,8 @@ impl Integrator for PathIntegrator {
         if want_split {
             tracker.finish(&mut aux.split);
         }
-        if let Some(c) = cache {
-            trail.record(c, l);
+        if let (Some(c), Some(t)) = (cache, &trail) {
+            t.record(c, l);
         }
         l
     }
