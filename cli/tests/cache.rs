@@ -117,6 +117,30 @@ fn cached_renders_do_not_depend_on_the_thread_count() {
         assert!(o.status.success(), "{args:?}: {o:?}");
     }
     assert!(dir.join("f_1.exr").exists());
+    // The second frame's cache has merged both frames' passes.
+    let o = render(
+        dir,
+        &[
+            "s.toml",
+            "--spp",
+            "2",
+            "--frames",
+            "0..2",
+            "--cache",
+            "worldspace",
+            "--stats",
+            "-o",
+            "h_{frame}.exr",
+        ],
+    );
+    let stats =
+        String::from_utf8_lossy(&o.stderr).into_owned() + &String::from_utf8_lossy(&o.stdout);
+    let passes: Vec<&str> = stats
+        .lines()
+        .filter(|l| l.starts_with("radiance cache"))
+        .filter_map(|l| l.split(": ").nth(1)?.split(" passes").next())
+        .collect();
+    assert_eq!(passes, ["2", "4"], "{stats}");
 }
 
 #[test]
