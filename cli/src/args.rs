@@ -149,6 +149,15 @@ pub struct Args {
     #[arg(long, value_name = "NAME[:options]", conflicts_with = "gree")]
     pub denoiser: Option<String>,
 
+    /// A world-space shading cache (Delaere 2021; docs/worldcache.md), kept across the passes
+    /// of a frame and the frames of a sequence: `worldspace[:options]` (implicit points) or
+    /// `grid[:options]` (fixed grid), options `key=value` separated by `,` or `:`: lod, s0,
+    /// kappa, connectivity, select, jitter, radius, normals, min-samples, capacity,
+    /// pass-capacity. The path tracers end secondary paths at cached diffuse vertices; ao shows
+    /// the cache's reconstruction. Renders one sample index per pass, merging after each.
+    #[arg(long, value_name = "NAME[:options]", conflicts_with = "gree")]
+    pub cache: Option<String>,
+
     /// Denoise by GREE (Bauszat, thesis ch. 5): --spp is the budget b; render the noisy image
     /// at n = fraction x b spp, run the filter bank (--bank), render filter caches at a share
     /// 1 - sparsity of the pixels with independent samples, pick a filter per pixel by the

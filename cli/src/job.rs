@@ -7,7 +7,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rt_accel::AccelSpec;
 use rt_core::{Accel, Scene};
 use rt_film::{AovSet, Film, FilmBuffers, OutputOptions};
-use rt_integrators::{Ctx, RenderStats, SamplePass, Technique};
+use rt_integrators::{Ctx, RadianceCache, RenderStats, SamplePass, Technique};
 use rt_scene::{LoadedScene, RenderDesc};
 use rt_session::{
     frame_seed, pick_camera, render_adaptive, Adaptive, Overrides, RenderReport, ReportInputs,
@@ -15,6 +15,7 @@ use rt_session::{
 };
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Fully resolved settings of one render: the library's [`Settings`] plus what only the
@@ -150,6 +151,20 @@ pub fn run(args: &Args) -> Result<()> {
         pool = pool.num_threads(t);
     }
     let pool = pool.build().context("cannot start worker threads")?;
+    // One cache for the whole job: it persists across passes and frames.
+    let cache: Option<Arc<dyn RadianceCache>> = match &args.cache {
+        None => None,
+        Some(text) => {
+            let c = crate::cache::build(text, &scene)?;
+            if job.settings.integrator.build_cached(c.clone()).is_none() {
+                bail!(
+                    "--cache {text}: the {} technique cannot use a cache (path, path-bsdf or ao can)",
+                    job.settings.integrator
+                );
+            }
+            Some(c)
+        }
+    };
     let (pattern, seed) = (job.output.clone(), job.settings.seed);
     let mut accel: Option<Box<dyn Accel>> = None;
     for frame in frames {
@@ -184,6 +199,7 @@ pub fn run(args: &Args) -> Result<()> {
             &scene,
             &pool,
             built,
+            cache.clone(),
             (load_time, t_build.elapsed()),
         )?;
     }
@@ -251,12 +267,21 @@ fn render_one(
     scene: &Scene,
     pool: &rayon::ThreadPool,
     accel: &dyn Accel,
+    cache: Option<Arc<dyn RadianceCache>>,
     (load_time, build_time): (std::time::Duration, std::time::Duration),
 ) -> Result<()> {
     let load_secs = load_time.as_secs_f64();
     let camera = pick_camera(scene, &job.scene_path, job.camera.as_deref())?;
     let build_secs = build_time.as_secs_f64();
-    let integrator = job.settings.integrator.build();
+    let integrator = match cache {
+        // Checked in `run`: the technique takes a cache.
+        Some(c) => job
+            .settings
+            .integrator
+            .build_cached(c)
+            .ok_or_else(|| anyhow::anyhow!("--cache: the technique cannot use a cache"))?,
+        None => job.settings.integrator.build(),
+    };
     let ctx = Ctx {
         scene,
         accel,

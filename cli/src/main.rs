@@ -14,6 +14,7 @@
 mod args;
 mod bench_accel;
 mod bench_anim;
+mod cache;
 mod compare;
 mod compare_frames;
 mod denoise;

@@ -56,3 +56,48 @@ impl Integrator for AoIntegrator {
         }
     }
 }
+
+/// Ambient occlusion through a world-space cache, as Delaere's thesis caches it: every sample
+/// records its one-ray AO at the first hit, and the pixel gets the cache's reconstruction
+/// there (from earlier passes; the raw sample where the cache has nothing yet). Render through
+/// [`crate::CachedPasses`].
+pub struct CachedAo {
+    /// The estimator whose samples are cached.
+    pub ao: AoIntegrator,
+    /// The cache.
+    pub cache: crate::CacheRef,
+}
+
+impl Integrator for CachedAo {
+    fn name(&self) -> &str {
+        "ao"
+    }
+
+    fn li(
+        &self,
+        ctx: &Ctx<'_>,
+        ray: Ray,
+        sampler: &mut Sampler,
+        aux: &mut SampleAux,
+        counters: &mut RayCounters,
+    ) -> Rgb {
+        let want_first_hit = aux.want_first_hit;
+        aux.want_first_hit = true;
+        let v = self.ao.li(ctx, ray, sampler, aux, counters);
+        let hit = if want_first_hit {
+            aux.first_hit
+        } else {
+            aux.first_hit.take()
+        };
+        aux.want_first_hit = want_first_hit;
+        let Some(hit) = hit else {
+            return v;
+        };
+        let cache = self.cache.0.as_ref();
+        let cached = cache.lookup(hit.position, hit.normal);
+        let xi = v.x.to_bits() ^ hit.position.x.to_bits().rotate_left(7) ^ hit.depth.to_bits();
+        let xi = xi ^ sampler.next_1d().to_bits().wrapping_mul(0x9e37_79b1);
+        cache.record(hit.position, hit.normal, v, xi);
+        cached.unwrap_or(v)
+    }
+}

@@ -26,18 +26,20 @@ pub mod guides;
 mod light;
 pub mod partitioned;
 mod path;
+pub mod radiance_cache;
 pub mod spec;
 pub mod technique;
 mod transport;
 mod work;
 
-pub use ao::AoIntegrator;
+pub use ao::{AoIntegrator, CachedAo};
 pub use bdpt::Bdpt;
 pub use driver::{render, render_pixels, render_samples, RenderOptions, RenderStats, SamplePass};
 pub use guides::{render_guides, GuideOptions, PreviousView};
 pub use light::LightTracer;
 pub use partitioned::{Culling, PartitionOptions, PartitionStats, Partitioned};
 pub use path::PathIntegrator;
+pub use radiance_cache::{CacheRef, CachedPasses, RadianceCache};
 pub use spec::{
     IntegratorKind, IntegratorSpec, IntegratorSpecError, Target, DEFAULT_MAX_DEPTH, MAX_DEPTH,
 };

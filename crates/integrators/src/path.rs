@@ -15,6 +15,7 @@
 //! every later vertex's BSDF gets that wavelength. Light sampling needs none: dispersive lobes
 //! are delta lobes, which light sampling skips.
 
+use crate::radiance_cache::{CacheRef, CacheTrail, RadianceCache, DIFFUSE_DOMINATED};
 use crate::transport::{light_visible, survives_roulette};
 use crate::{Ctx, Integrator, RayCounters, SampleAux};
 use rt_core::material::{Bsdf, LayerClass};
@@ -91,6 +92,9 @@ pub struct PathIntegrator {
     /// the renderer had no spectral code; for tests).
     #[doc(hidden)]
     pub spectral: bool,
+    /// A world-space radiance cache read at secondary diffuse vertices and written by every
+    /// path ([`crate::radiance_cache`]); `None`: plain path tracing.
+    pub cache: Option<CacheRef>,
     name: &'static str,
 }
 
@@ -102,6 +106,7 @@ impl PathIntegrator {
             next_event: true,
             rr_depth: 3,
             spectral: true,
+            cache: None,
             name: "path",
         }
     }
@@ -113,8 +118,16 @@ impl PathIntegrator {
             next_event: false,
             rr_depth: 3,
             spectral: true,
+            cache: None,
             name: "path-bsdf",
         }
+    }
+
+    /// The same estimator reading and writing `cache` (render it through
+    /// [`crate::CachedPasses`], which merges the cache's passes).
+    pub fn with_cache(mut self, cache: std::sync::Arc<dyn RadianceCache>) -> Self {
+        self.cache = Some(CacheRef(cache));
+        self
     }
 
     /// Direct lighting: one bounce, NEE and MIS.
@@ -124,6 +137,7 @@ impl PathIntegrator {
             next_event: true,
             rr_depth: u32::MAX,
             spectral: true,
+            cache: None,
             name: "direct",
         }
     }
@@ -171,6 +185,10 @@ impl Integrator for PathIntegrator {
             diffuse_share: Rgb::ZERO,
             albedo: Rgb::ZERO,
         };
+        // Radiance cache: the diffuse vertices this path records.
+        let cache = self.cache.as_ref().map(|c| c.0.as_ref());
+        // Only a cached render pays for the trail's array.
+        let mut trail = cache.is_some().then(CacheTrail::new);
         loop {
             counters.rays += 1;
             let Some(hit) = ctx.accel.intersect(&ray, f32::INFINITY) else {
@@ -228,6 +246,20 @@ impl Integrator for PathIntegrator {
             if depth >= self.max_depth {
                 break;
             }
+            // Radiance cache: end a secondary path at a cached diffuse vertex.
+            let cached_vertex =
+                cache.is_some() && bsdf.share(LayerClass::Diffuse) >= DIFFUSE_DOMINATED;
+            let n_cache = if si.ns.dot(wo) < 0.0 { -si.ns } else { si.ns };
+            if let (true, true, Some(c)) = (cached_vertex, depth >= 1, cache) {
+                if let Some(lr) = c.lookup(si.p, n_cache) {
+                    l += beta * lr;
+                    if want_split {
+                        let share = tracker.diffuse_share;
+                        file_contribution(&mut aux.split, beta * lr, depth + 1, share);
+                    }
+                    break;
+                }
+            }
             // Draw the vertex's random numbers in a fixed order, used or not, so the dimension
             // index of a bounce does not depend on which branches earlier bounces took.
             let u_light_sel = sampler.next_1d();
@@ -235,6 +267,9 @@ impl Integrator for PathIntegrator {
             let u_layer = sampler.next_1d();
             let u_bsdf = sampler.next_2d();
             let u_rr = sampler.next_1d();
+            if let (true, Some(t)) = (cached_vertex, trail.as_mut()) {
+                t.push(si.p, n_cache, beta, l, [u_layer, u_rr]);
+            }
 
             if use_nee && bsdf.has_non_delta() {
                 if let Some(ls) = lights.sample(scene, si.p, u_light_sel, u_light) {
@@ -290,6 +325,9 @@ impl Integrator for PathIntegrator {
         }
         if want_split {
             tracker.finish(&mut aux.split);
+        }
+        if let (Some(c), Some(t)) = (cache, &trail) {
+            t.record(c, l);
         }
         l
     }

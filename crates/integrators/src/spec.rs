@@ -249,6 +249,35 @@ impl IntegratorSpec {
         }
     }
 
+    /// The technique reading and writing the world-space `cache` ([`crate::radiance_cache`]):
+    /// path tracers end secondary paths at cached diffuse vertices, ambient occlusion shows the
+    /// cache's reconstruction. `None` for techniques that cannot use a cache (direct lighting
+    /// has no secondary vertices; light-path techniques are not camera-ray estimators).
+    pub fn build_cached(
+        &self,
+        cache: std::sync::Arc<dyn crate::RadianceCache>,
+    ) -> Option<Box<dyn Technique>> {
+        let integrator: Box<dyn crate::Integrator> = match self.kind {
+            IntegratorKind::Path => {
+                Box::new(PathIntegrator::new(self.depth()).with_cache(cache.clone()))
+            }
+            IntegratorKind::PathBsdf => {
+                Box::new(PathIntegrator::bsdf_only(self.depth()).with_cache(cache.clone()))
+            }
+            IntegratorKind::Ao => Box::new(crate::CachedAo {
+                ao: AoIntegrator {
+                    max_distance: self.ao_distance,
+                },
+                cache: crate::CacheRef(cache.clone()),
+            }),
+            _ => return None,
+        };
+        Some(Box::new(crate::CachedPasses::new(
+            Box::new(CameraRays(integrator)),
+            cache,
+        )))
+    }
+
     /// What the integrator converges to.
     pub fn target(&self) -> Target {
         match self.kind {

@@ -1,0 +1,162 @@
+//! `render --cache`: a cached render is the same image for any thread count, a cache carries
+//! over a sequence's frames, and bad options give one error line naming the option.
+
+mod common;
+
+use std::process::{Command, Output};
+
+fn render(dir: &std::path::Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_render"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn scene(dir: &std::path::Path) {
+    let camera = "[[camera]]\nname = \"c\"\nposition = [0.0, 1.0, 2.5]\nlook_at = [0.0, 0.0, 0.0]\nfov = 50.0\nresolution = [24, 16]\n";
+    std::fs::write(
+        dir.join("s.toml"),
+        format!("{camera}{}", common::FLOOR_AND_LAMP),
+    )
+    .unwrap();
+}
+
+fn one_error_line(out: &Output) -> String {
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    err
+}
+
+fn pixels(path: &std::path::Path) -> Vec<f32> {
+    use exr::prelude::*;
+    let img = read_first_rgba_layer_from_file(
+        path,
+        |res, _| vec![[0f32; 3]; res.width() * res.height()],
+        |px: &mut Vec<[f32; 3]>, pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            px[pos.y() * 24 + pos.x()] = [r, g, b]
+        },
+    )
+    .unwrap();
+    img.layer_data.channel_data.pixels.concat()
+}
+
+#[test]
+fn cached_renders_do_not_depend_on_the_thread_count() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    scene(dir);
+    for (threads, out) in [("1", "a.exr"), ("2", "b.exr")] {
+        let o = render(
+            dir,
+            &[
+                "s.toml",
+                "--spp",
+                "6",
+                "--threads",
+                threads,
+                "--cache",
+                "worldspace:lod=4",
+                "-q",
+                "-o",
+                out,
+            ],
+        );
+        assert!(o.status.success(), "{o:?}");
+    }
+    let (a, b) = (pixels(&dir.join("a.exr")), pixels(&dir.join("b.exr")));
+    assert!(a.iter().all(|v| v.is_finite()));
+    assert_eq!(
+        a.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+        b.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+    );
+    // The cache changes the image (paths end at cached vertices after the first pass).
+    let o = render(dir, &["s.toml", "--spp", "6", "-q", "-o", "c.exr"]);
+    assert!(o.status.success());
+    assert_ne!(a, pixels(&dir.join("c.exr")));
+    // Grid and AO variants run too; a sequence keeps one cache over its frames.
+    for args in [
+        &[
+            "s.toml",
+            "--spp",
+            "2",
+            "--cache",
+            "grid:jitter=1",
+            "-q",
+            "-o",
+            "g.exr",
+        ][..],
+        &[
+            "s.toml",
+            "--spp",
+            "2",
+            "--integrator",
+            "ao",
+            "--cache",
+            "worldspace",
+            "-q",
+            "-o",
+            "ao.exr",
+        ],
+        &[
+            "s.toml",
+            "--spp",
+            "1",
+            "--frames",
+            "0..2",
+            "--cache",
+            "worldspace",
+            "-q",
+            "-o",
+            "f_{frame}.exr",
+        ],
+    ] {
+        let o = render(dir, args);
+        assert!(o.status.success(), "{args:?}: {o:?}");
+    }
+    assert!(dir.join("f_1.exr").exists());
+    // The second frame's cache has merged both frames' passes.
+    let o = render(
+        dir,
+        &[
+            "s.toml",
+            "--spp",
+            "2",
+            "--frames",
+            "0..2",
+            "--cache",
+            "worldspace",
+            "--stats",
+            "-o",
+            "h_{frame}.exr",
+        ],
+    );
+    let stats =
+        String::from_utf8_lossy(&o.stderr).into_owned() + &String::from_utf8_lossy(&o.stdout);
+    let passes: Vec<&str> = stats
+        .lines()
+        .filter(|l| l.starts_with("radiance cache"))
+        .filter_map(|l| l.split(": ").nth(1)?.split(" passes").next())
+        .collect();
+    assert_eq!(passes, ["2", "4"], "{stats}");
+}
+
+#[test]
+fn bad_cache_options_are_one_line_naming_the_option() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    scene(dir);
+    let err = |spec: &str, extra: &[&str]| {
+        let mut args = vec!["s.toml", "--spp", "1", "-o", "x.exr", "--cache", spec];
+        args.extend_from_slice(extra);
+        one_error_line(&render(dir, &args))
+    };
+    assert!(err("worldspace:lod=x", &[]).contains("option `lod`: `x` is not an integer"));
+    assert!(err("octree", &[]).contains("unknown cache `octree`"));
+    assert!(err("grid:bogus=1", &[]).contains("unknown option `bogus`"));
+    assert!(err("worldspace:capacity=100", &[]).contains("`capacity`"));
+    assert!(err("worldspace", &["--integrator", "light"]).contains("cannot use a cache"));
+    assert!(!dir.join("x.exr").exists());
+}
