@@ -7,6 +7,15 @@
 //! motion since the previous frame (only for denoisers that read guides), and the denoiser
 //! filters it. A temporal denoiser's sample 0 of every pixel goes through the pixel centre, so
 //! it is the ray the guide buffers describe.
+//!
+//! **Time budget** ([`SequenceRenderer::set_budget`], `render view --frame-budget`): the
+//! frame's samples are then rendered as 1-spp passes, indices `0..1`, `1..2`, ..., into one
+//! film, which gives the same bits as one pass `0..n` (`SamplePass`). The first pass always
+//! runs; pass `k + 1` runs while `spent + last + reserve <= budget`, where `spent` is the time
+//! since the frame started (the update included), `last` the duration of pass `k` and
+//! `reserve` the previous frame's guide and denoise time (the stages still to come; zero on
+//! the first frame), and never beyond `spp` passes. How many passes fit depends on the clock,
+//! so budgeted frames are not deterministic; without a budget they are.
 
 use crate::settings::frame_seed;
 use rt_accel::AccelSpec;
@@ -81,6 +90,9 @@ pub struct SequenceFrame {
     pub stats: RenderStats,
     /// Stage times.
     pub times: FrameTimes,
+    /// Samples per pixel rendered (fewer than the renderer's `spp` when a time budget stopped
+    /// the passes early).
+    pub spp: u32,
 }
 
 /// A sequence being rendered: the structure, the denoiser's memory and the previous view carry
@@ -97,6 +109,9 @@ pub struct SequenceRenderer {
     seed: u32,
     fps: f64,
     previous: Option<(Camera, f32)>,
+    budget: Option<Duration>,
+    /// The last frame's guide and denoise time: what a budgeted frame keeps free for them.
+    reserve: Duration,
 }
 
 impl SequenceRenderer {
@@ -136,7 +151,15 @@ impl SequenceRenderer {
             seed,
             fps,
             previous: None,
+            budget: None,
+            reserve: Duration::ZERO,
         })
+    }
+
+    /// Renders every later frame within `budget` (`None`: always `spp` samples per pixel), as
+    /// the module documentation describes; `spp` is then the most passes a frame takes.
+    pub fn set_budget(&mut self, budget: Option<Duration>) {
+        self.budget = budget;
     }
 
     /// The denoiser's name, if any.
@@ -171,7 +194,8 @@ impl SequenceRenderer {
         camera: Option<&Camera>,
     ) -> Result<SequenceFrame, SequenceError> {
         let mut times = FrameTimes::default();
-        let t = Instant::now();
+        let frame_start = Instant::now();
+        let t = frame_start;
         let time = self.time_of(f);
         scene.set_time(time);
         let updated = self.accel.as_mut().is_some_and(|a| a.update(scene));
@@ -215,15 +239,23 @@ impl SequenceRenderer {
             camera.height,
             FilmBuffers::for_outputs(self.aovs),
         );
-        let pass = SamplePass {
-            indices: 0..self.spp,
-            stream: SampleStream::Render,
-            pixels: None,
-            centre_first: wants_guides,
+        let (stats, spp) = match self.budget {
+            None => (
+                render_samples(
+                    &*self.technique,
+                    &ctx,
+                    &mut film,
+                    self.seed,
+                    f,
+                    0..self.spp,
+                    wants_guides,
+                ),
+                self.spp,
+            ),
+            Some(budget) => {
+                self.render_budgeted(&ctx, &mut film, f, wants_guides, budget, frame_start)
+            }
         };
-        let stats =
-            self.technique
-                .render_pass(&ctx, &mut film, frame_seed(self.seed, f), &pass, &|_| {});
         times.render = t.elapsed();
         let t = Instant::now();
         let guides = wants_guides.then(|| {
@@ -244,6 +276,7 @@ impl SequenceRenderer {
             None => noisy.colour.clone(),
         };
         times.denoise = t.elapsed();
+        self.reserve = times.guides + times.denoise;
         self.previous = Some((camera, time));
         Ok(SequenceFrame {
             frame: f,
@@ -252,6 +285,158 @@ impl SequenceRenderer {
             guides,
             stats,
             times,
+            spp,
         })
+    }
+
+    /// 1-spp passes while the next one fits the budget (the rule in the module documentation);
+    /// the stats of all passes together and how many ran.
+    fn render_budgeted(
+        &self,
+        ctx: &Ctx<'_>,
+        film: &mut Film,
+        f: u32,
+        centre_first: bool,
+        budget: Duration,
+        frame_start: Instant,
+    ) -> (RenderStats, u32) {
+        let mut total = RenderStats::default();
+        let mut done = 0;
+        while done < self.spp {
+            let t = Instant::now();
+            let stats = render_samples(
+                &*self.technique,
+                ctx,
+                film,
+                self.seed,
+                f,
+                done..done + 1,
+                centre_first,
+            );
+            let last = t.elapsed();
+            total.elapsed += stats.elapsed;
+            total.samples += stats.samples;
+            total.rays += stats.rays;
+            total.discarded += stats.discarded;
+            done += 1;
+            if frame_start.elapsed() + last + self.reserve > budget {
+                break;
+            }
+        }
+        (total, done)
+    }
+}
+
+/// Samples `indices` of every pixel of frame `f` into `film`.
+fn render_samples(
+    technique: &dyn Technique,
+    ctx: &Ctx<'_>,
+    film: &mut Film,
+    seed: u32,
+    f: u32,
+    indices: std::ops::Range<u32>,
+    centre_first: bool,
+) -> RenderStats {
+    let pass = SamplePass {
+        indices,
+        stream: SampleStream::Render,
+        pixels: None,
+        centre_first,
+    };
+    technique.render_pass(ctx, film, frame_seed(seed, f), &pass, &|_| {})
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rt_core::Rgb;
+    use rt_integrators::IntegratorSpec;
+    use rt_temporal::TemporalSpec;
+    use std::path::Path;
+
+    /// A small moving scene at a small resolution.
+    fn scene() -> Scene {
+        let toml = r#"
+            [[camera]]
+            name = "c"
+            position = [0, 1, 4]
+            look_at = [0, 0.5, 0]
+            resolution = [24, 16]
+            [[material]]
+            name = "white"
+            color = [0.7, 0.7, 0.7]
+            [[material]]
+            name = "lamp"
+            color = [0, 0, 0]
+            emission = [8, 8, 8]
+            [[geometry]]
+            name = "floor"
+            shape = "quad"
+            vertices = [[-3, 0, 3], [3, 0, 3], [3, 0, -3], [-3, 0, -3]]
+            material = "white"
+            [[geometry]]
+            name = "lamp"
+            shape = "quad"
+            vertices = [[-0.5, 2, -0.5], [0.5, 2, -0.5], [0.5, 2, 0.5], [-0.5, 2, 0.5]]
+            material = "lamp"
+            [[geometry]]
+            name = "ball"
+            shape = "sphere"
+            center = [0, 0.3, 0]
+            radius = 0.3
+            material = "white"
+            [[animation]]
+            target = "ball"
+            keys = [ { time = 0.0 }, { time = 1.0, translate = [0.5, 0, 0] } ]
+        "#;
+        rt_scene::load_str(toml, Path::new("."), Path::new("test.toml"))
+            .unwrap()
+            .scene
+    }
+
+    fn renderer(spp: u32, budget: Option<Duration>) -> SequenceRenderer {
+        let technique = "path".parse::<IntegratorSpec>().unwrap().build();
+        let svgf = "svgf".parse::<TemporalSpec>().unwrap().build().unwrap();
+        let mut r = SequenceRenderer::new(
+            technique,
+            AccelSpec::default(),
+            Some(svgf),
+            None,
+            spp,
+            7,
+            24.0,
+        )
+        .unwrap();
+        r.set_budget(budget);
+        r
+    }
+
+    /// Three frames' (spp, noisy colour, denoised image).
+    fn frames(spp: u32, budget: Option<Duration>) -> Vec<(u32, Vec<Rgb>, Vec<Rgb>)> {
+        let mut scene = scene();
+        let mut r = renderer(spp, budget);
+        (0..3)
+            .map(|f| {
+                let out = r.render(&mut scene, f).unwrap();
+                let noisy = out.noisy.colour.pixels().to_vec();
+                (out.spp, noisy, out.image.pixels().to_vec())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_budget_that_never_runs_out_gives_the_bits_of_one_multi_spp_pass() {
+        let plain = frames(3, None);
+        let budgeted = frames(3, Some(Duration::from_secs(3600)));
+        assert!(plain.iter().all(|f| f.0 == 3));
+        assert_eq!(plain, budgeted);
+    }
+
+    #[test]
+    fn an_exhausted_budget_still_renders_one_pass() {
+        let one = frames(1, None);
+        let budgeted = frames(16, Some(Duration::ZERO));
+        assert!(budgeted.iter().all(|f| f.0 == 1), "spp per frame must be 1");
+        assert_eq!(one, budgeted);
     }
 }
