@@ -249,7 +249,7 @@ pub enum Command {
     /// Real-time mode: a window that path traces the animated scene at 1 spp per frame,
     /// denoises with SVGF, plays the animation and orbits the camera with the mouse (drag,
     /// wheel); or --headless, a sequence within a per-frame --frame-budget that reports frames
-    /// per second (docs/cli.md, "render view").
+    /// per second (docs/real-time.md).
     View(crate::view::ViewArgs),
     /// Write a procedural scene's triangles to a Wavefront OBJ file (one `o` per part), e.g.
     /// to benchmark other ray tracers on the same geometry.

@@ -79,7 +79,7 @@ pub struct ViewArgs {
 
     /// With --headless: per-frame time budget in milliseconds. A frame renders one 1-spp pass,
     /// then more while the last pass's time says the next fits the budget minus the previous
-    /// frame's guide and denoise time (docs/cli.md). Frames are then not deterministic.
+    /// frame's guide and denoise time (docs/real-time.md). Frames are then not deterministic.
     #[arg(
         long,
         value_name = "MS",
