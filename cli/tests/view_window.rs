@@ -1,7 +1,7 @@
 //! `render view`'s window on a virtual X server (Xvfb): it opens at the asked size, shows a
 //! rendered image (a screenshot of its region is neither uniform nor black), puts frames per
-//! second in its title, and exits 0 when the window is closed (WM_DELETE_WINDOW, as a window
-//! manager's close button sends it).
+//! second in its title, zooms out on the mouse wheel (synthetic XTEST events), and exits 0
+//! when the window is closed (WM_DELETE_WINDOW, as a window manager's close button sends it).
 //!
 //! Xvfb is installed by `.ci/setup`; without it the test fails unless `RT_SKIP_XVFB=1`, in
 //! which case it prints `skipping: ...` and passes. The screenshot is taken over the X protocol (x11rb,
@@ -13,8 +13,9 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 use x11rb::connection::Connection;
 use x11rb::protocol::xproto::{
-    AtomEnum, ClientMessageEvent, ConnectionExt, EventMask, ImageFormat, MapState, Window,
+    self, AtomEnum, ClientMessageEvent, ConnectionExt, EventMask, ImageFormat, MapState, Window,
 };
+use x11rb::protocol::xtest;
 use x11rb::rust_connection::RustConnection;
 
 const SIZE: u16 = 256;
@@ -193,6 +194,33 @@ fn the_window_shows_a_rendered_image_and_closes_cleanly() {
         png.display()
     );
 
+    // The wheel zooms: forty lines out (XTEST button 5 over the window) put the camera at the
+    // farthest distance, where the scene is a small patch in the dark environment, so the mean
+    // falls well below what it was.
+    let (wx, wy) = {
+        let g = conn.get_geometry(window).unwrap().reply().unwrap();
+        (g.x, g.y)
+    };
+    let centre = (wx + SIZE as i16 / 2, wy + SIZE as i16 / 2);
+    fake_input(&conn, xproto::MOTION_NOTIFY_EVENT, 0, root_window, centre);
+    for _ in 0..40 {
+        fake_input(&conn, xproto::BUTTON_PRESS_EVENT, 5, root_window, centre);
+        fake_input(&conn, xproto::BUTTON_RELEASE_EVENT, 5, root_window, centre);
+    }
+    conn.flush().unwrap();
+    let zooming = Instant::now();
+    let zoomed_mean = loop {
+        let (m, _) = mean_and_sd(&screenshot(&conn, root_window, wx, wy));
+        if m < 0.5 * mean || zooming.elapsed() > PATIENCE {
+            break m;
+        }
+        std::thread::sleep(Duration::from_millis(250));
+    };
+    assert!(
+        zoomed_mean < 0.5 * mean,
+        "zooming out did not shrink the scene: mean {mean:.1} before, {zoomed_mean:.1} after"
+    );
+
     // Close it as a window manager would; it must exit 0 on its own.
     let protocols = conn
         .intern_atom(false, b"WM_PROTOCOLS")
@@ -223,6 +251,11 @@ fn the_window_shows_a_rendered_image_and_closes_cleanly() {
     // `procs` kills Xvfb (and the viewer, if it is still there) by pid.
     let status = status.expect("the viewer did not exit within 10 s of WM_DELETE_WINDOW");
     assert!(status.success(), "closing the window exited with {status}");
+}
+
+/// One synthetic input event (XTEST) at root position `at`.
+fn fake_input(conn: &RustConnection, kind: u8, detail: u8, root: Window, at: (i16, i16)) {
+    xtest::fake_input(conn, kind, detail, 0, root, at.0, at.1, 0).unwrap();
 }
 
 fn workspace_root() -> PathBuf {
