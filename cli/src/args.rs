@@ -255,6 +255,11 @@ pub enum Command {
     /// self-intersection counts, bad geometry and bad values (docs/experiments.md, "Numerical
     /// stress tests"). One line per case; exit code 1 if any fails.
     Stress(crate::stress::StressArgs),
+    /// Real-time mode: a window that path traces the animated scene at 1 spp per frame,
+    /// denoises with SVGF, plays the animation and orbits the camera with the mouse (drag,
+    /// wheel); or --headless, a sequence within a per-frame --frame-budget that reports frames
+    /// per second (docs/real-time.md).
+    View(crate::view::ViewArgs),
     /// Write a procedural scene's triangles to a Wavefront OBJ file (one `o` per part), e.g.
     /// to benchmark other ray tracers on the same geometry.
     GenScene {

@@ -9,7 +9,8 @@
 //! the per-frame and temporal errors of a sequence; `render reference` and
 //! `render experiment` (`reference/`, `experiment/`) render references and measured grids,
 //! sharing `session.rs` (one configuration, rendered progressively) with plain rendering;
-//! `render stress` (`stress.rs`) runs the numerical stress suite.
+//! `render stress` (`stress.rs`) runs the numerical stress suite; `render view` (`view/`) is
+//! the real-time mode: a window, or a headless sequence within a per-frame time budget.
 
 mod args;
 mod bench_accel;
@@ -26,6 +27,7 @@ mod progress;
 mod reference;
 mod sequence;
 mod stress;
+mod view;
 
 use clap::Parser;
 use std::process::ExitCode;
@@ -48,6 +50,7 @@ fn main() -> ExitCode {
         Some(args::Command::Reference(r)) => reference::run(r),
         Some(args::Command::Experiment(x)) => experiment::run(x),
         Some(args::Command::Stress(stress)) => stress::run(stress),
+        Some(args::Command::View(v)) => view::run(v),
         Some(args::Command::GenScene { name, output }) => {
             bench_accel::input::write_obj(name, output)
         }

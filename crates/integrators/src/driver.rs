@@ -42,6 +42,16 @@ pub struct RenderStats {
     pub discarded: u64,
 }
 
+impl std::ops::AddAssign for RenderStats {
+    /// The stats of two passes together (their times add: passes run one after another).
+    fn add_assign(&mut self, other: Self) {
+        self.elapsed += other.elapsed;
+        self.samples += other.samples;
+        self.rays += other.rays;
+        self.discarded += other.discarded;
+    }
+}
+
 impl RenderStats {
     /// Camera samples per second.
     pub fn samples_per_second(&self) -> f64 {

@@ -88,10 +88,7 @@ impl Technique for CachedPasses {
                 progress(((done + u64::from(r)) / n) as u32)
             });
             self.cache.end_pass();
-            total.elapsed += s.elapsed;
-            total.samples += s.samples;
-            total.rays += s.rays;
-            total.discarded += s.discarded;
+            total += s;
         }
         total
     }

@@ -7,6 +7,15 @@
 //! motion since the previous frame (only for denoisers that read guides), and the denoiser
 //! filters it. A temporal denoiser's sample 0 of every pixel goes through the pixel centre, so
 //! it is the ray the guide buffers describe.
+//!
+//! **Time budget** ([`SequenceRenderer::set_budget`], `render view --frame-budget`): the
+//! frame's samples are then rendered as 1-spp passes, indices `0..1`, `1..2`, ..., into one
+//! film, which gives the same bits as one pass `0..n` (`SamplePass`). The first pass always
+//! runs; pass `k + 1` runs while `spent + last + reserve <= budget`, where `spent` is the time
+//! since the frame started (the update included), `last` the duration of pass `k` and
+//! `reserve` the previous frame's guide and denoise time (the stages still to come; zero on
+//! the first frame), and never beyond `spp` passes. How many passes fit depends on the clock,
+//! so budgeted frames are not deterministic; without a budget they are.
 
 use crate::settings::frame_seed;
 use rt_accel::AccelSpec;
@@ -16,6 +25,7 @@ use rt_integrators::{
     render_guides, Ctx, GuideOptions, PreviousView, RenderStats, SamplePass, Technique,
 };
 use rt_temporal::{TemporalDenoiser, TemporalError, TemporalFrame, EXTRA_SAMPLE_CHANNELS};
+use std::ops::Range;
 use std::time::{Duration, Instant};
 
 /// Why a sequence cannot be rendered.
@@ -81,6 +91,9 @@ pub struct SequenceFrame {
     pub stats: RenderStats,
     /// Stage times.
     pub times: FrameTimes,
+    /// Samples per pixel rendered (fewer than the renderer's `spp` when a time budget stopped
+    /// the passes early).
+    pub spp: u32,
 }
 
 /// A sequence being rendered: the structure, the denoiser's memory and the previous view carry
@@ -97,6 +110,9 @@ pub struct SequenceRenderer {
     seed: u32,
     fps: f64,
     previous: Option<(Camera, f32)>,
+    budget: Option<Duration>,
+    /// The last frame's guide and denoise time: what a budgeted frame keeps free for them.
+    reserve: Duration,
 }
 
 impl SequenceRenderer {
@@ -136,7 +152,15 @@ impl SequenceRenderer {
             seed,
             fps,
             previous: None,
+            budget: None,
+            reserve: Duration::ZERO,
         })
+    }
+
+    /// Renders every later frame within `budget` (`None`: always `spp` samples per pixel), as
+    /// the module documentation describes; `spp` is then the most passes a frame takes.
+    pub fn set_budget(&mut self, budget: Option<Duration>) {
+        self.budget = budget;
     }
 
     /// The denoiser's name, if any.
@@ -171,7 +195,8 @@ impl SequenceRenderer {
         camera: Option<&Camera>,
     ) -> Result<SequenceFrame, SequenceError> {
         let mut times = FrameTimes::default();
-        let t = Instant::now();
+        let frame_start = Instant::now();
+        let t = frame_start;
         let time = self.time_of(f);
         scene.set_time(time);
         let updated = self.accel.as_mut().is_some_and(|a| a.update(scene));
@@ -215,45 +240,13 @@ impl SequenceRenderer {
         let apart = wants_guides
             && self.spp > 1
             && self.denoiser.as_ref().is_some_and(|d| d.guide_samples());
-        let first = if apart { 1 } else { self.spp };
         let mut film = Film::new(
             camera.width,
             camera.height,
             FilmBuffers::for_outputs(self.aovs),
         );
-        let pass = SamplePass {
-            indices: 0..first,
-            stream: SampleStream::Render,
-            pixels: None,
-            centre_first: wants_guides,
-        };
-        let seed = frame_seed(self.seed, f);
-        let mut stats = self
-            .technique
-            .render_pass(&ctx, &mut film, seed, &pass, &|_| {});
-        let extra_aovs = AovSet::for_channels(&EXTRA_SAMPLE_CHANNELS);
-        let mut extra = Vec::new();
-        for k in first..self.spp {
-            let mut one = Film::new(
-                camera.width,
-                camera.height,
-                FilmBuffers::for_outputs(extra_aovs),
-            );
-            let pass = SamplePass {
-                indices: k..k + 1,
-                stream: SampleStream::Render,
-                pixels: None,
-                centre_first: false,
-            };
-            let s = self
-                .technique
-                .render_pass(&ctx, &mut one, seed, &pass, &|_| {});
-            stats.elapsed += s.elapsed;
-            stats.samples += s.samples;
-            stats.rays += s.rays;
-            stats.discarded += s.discarded;
-            extra.push(NoisyFrame::from_film(&one, extra_aovs));
-        }
+        let (stats, extra, spp) =
+            self.render_samples(&ctx, &mut film, f, wants_guides, apart, frame_start);
         times.render = t.elapsed();
         let t = Instant::now();
         let guides = wants_guides.then(|| {
@@ -283,6 +276,7 @@ impl SequenceRenderer {
             None => noisy.colour.clone(),
         };
         times.denoise = t.elapsed();
+        self.reserve = times.guides + times.denoise;
         self.previous = Some((camera, time));
         Ok(SequenceFrame {
             frame: f,
@@ -291,6 +285,162 @@ impl SequenceRenderer {
             guides,
             stats,
             times,
+            spp,
         })
+    }
+
+    /// The frame's samples: sample 0 (or all of them) into `film`; with `apart`, every
+    /// further sample into a one-sample frame of its own (returned, for the denoiser). Without
+    /// a budget the film's samples go in one pass; with one, 1-spp passes while the next fits
+    /// (the rule in the module documentation). The stats of all passes together and how many
+    /// samples per pixel ran.
+    fn render_samples(
+        &self,
+        ctx: &Ctx<'_>,
+        film: &mut Film,
+        f: u32,
+        centre_first: bool,
+        apart: bool,
+        frame_start: Instant,
+    ) -> (RenderStats, Vec<NoisyFrame>, u32) {
+        let seed = frame_seed(self.seed, f);
+        let pass = |film: &mut Film, indices: Range<u32>, centre_first| {
+            let pass = SamplePass {
+                indices,
+                stream: SampleStream::Render,
+                pixels: None,
+                centre_first,
+            };
+            self.technique.render_pass(ctx, film, seed, &pass, &|_| {})
+        };
+        let step = if apart || self.budget.is_some() {
+            1
+        } else {
+            self.spp
+        };
+        let extra_aovs = AovSet::for_channels(&EXTRA_SAMPLE_CHANNELS);
+        let mut total = RenderStats::default();
+        let mut extra = Vec::new();
+        let mut done = 0;
+        while done < self.spp {
+            let t = Instant::now();
+            let indices = done..done + step;
+            total += if apart && done > 0 {
+                let mut one = Film::new(
+                    ctx.camera.width,
+                    ctx.camera.height,
+                    FilmBuffers::for_outputs(extra_aovs),
+                );
+                let stats = pass(&mut one, indices, false);
+                extra.push(NoisyFrame::from_film(&one, extra_aovs));
+                stats
+            } else {
+                pass(film, indices, centre_first)
+            };
+            done += step;
+            let last = t.elapsed();
+            if self
+                .budget
+                .is_some_and(|budget| frame_start.elapsed() + last + self.reserve > budget)
+            {
+                break;
+            }
+        }
+        (total, extra, done)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rt_core::Rgb;
+    use rt_integrators::IntegratorSpec;
+    use rt_temporal::TemporalSpec;
+    use std::path::Path;
+
+    /// A small moving scene at a small resolution.
+    fn scene() -> Scene {
+        let toml = r#"
+            [[camera]]
+            name = "c"
+            position = [0, 1, 4]
+            look_at = [0, 0.5, 0]
+            resolution = [24, 16]
+            [[material]]
+            name = "white"
+            color = [0.7, 0.7, 0.7]
+            [[material]]
+            name = "lamp"
+            color = [0, 0, 0]
+            emission = [8, 8, 8]
+            [[geometry]]
+            name = "floor"
+            shape = "quad"
+            vertices = [[-3, 0, 3], [3, 0, 3], [3, 0, -3], [-3, 0, -3]]
+            material = "white"
+            [[geometry]]
+            name = "lamp"
+            shape = "quad"
+            vertices = [[-0.5, 2, -0.5], [0.5, 2, -0.5], [0.5, 2, 0.5], [-0.5, 2, 0.5]]
+            material = "lamp"
+            [[geometry]]
+            name = "ball"
+            shape = "sphere"
+            center = [0, 0.3, 0]
+            radius = 0.3
+            material = "white"
+            [[animation]]
+            target = "ball"
+            keys = [ { time = 0.0 }, { time = 1.0, translate = [0.5, 0, 0] } ]
+        "#;
+        rt_scene::load_str(toml, Path::new("."), Path::new("test.toml"))
+            .unwrap()
+            .scene
+    }
+
+    fn renderer(spp: u32, budget: Option<Duration>) -> SequenceRenderer {
+        let technique = "path".parse::<IntegratorSpec>().unwrap().build();
+        let svgf = "svgf".parse::<TemporalSpec>().unwrap().build().unwrap();
+        let mut r = SequenceRenderer::new(
+            technique,
+            AccelSpec::default(),
+            Some(svgf),
+            None,
+            spp,
+            7,
+            24.0,
+        )
+        .unwrap();
+        r.set_budget(budget);
+        r
+    }
+
+    /// Three frames' (spp, noisy colour, denoised image).
+    fn frames(spp: u32, budget: Option<Duration>) -> Vec<(u32, Vec<Rgb>, Vec<Rgb>)> {
+        let mut scene = scene();
+        let mut r = renderer(spp, budget);
+        (0..3)
+            .map(|f| {
+                let out = r.render(&mut scene, f).unwrap();
+                let noisy = out.noisy.colour.pixels().to_vec();
+                (out.spp, noisy, out.image.pixels().to_vec())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_budget_that_never_runs_out_gives_the_bits_of_one_multi_spp_pass() {
+        let plain = frames(3, None);
+        let budgeted = frames(3, Some(Duration::from_secs(3600)));
+        assert!(plain.iter().all(|f| f.0 == 3));
+        assert_eq!(plain, budgeted);
+    }
+
+    #[test]
+    fn an_exhausted_budget_still_renders_one_pass() {
+        let one = frames(1, None);
+        let budgeted = frames(16, Some(Duration::ZERO));
+        assert!(budgeted.iter().all(|f| f.0 == 1), "spp per frame must be 1");
+        assert_eq!(one, budgeted);
     }
 }
