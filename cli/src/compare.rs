@@ -1,7 +1,9 @@
 //! `render compare A B`: how far image A is from the reference B (MSE, relMSE, RMSE, PSNR,
 //! SSIM from `rt-metrics`), printed as `name value` lines or one JSON object, plus an optional
-//! false-colour error image. Definitions: docs/experiments.md.
+//! false-colour error image. With `--frames`, A and B are numbered sequences and
+//! `compare_frames.rs` adds the temporal metrics. Definitions: docs/experiments.md.
 
+use crate::frame_pattern::names_frame;
 use anyhow::{anyhow, Result};
 use rt_film::read_rgb as load_rgb;
 use rt_metrics::{
@@ -44,10 +46,32 @@ pub struct CompareArgs {
     /// e.g. a dark, indirectly lit corner.
     #[arg(long, value_name = "X0,Y0,X1,Y1", value_delimiter = ',')]
     pub region: Option<Vec<usize>>,
+
+    /// Compare sequences: frames S..E (half-open) of A and B, whose names hold `{frame}` or
+    /// `{frame:0N}` (e.g. 'out/f_{frame:04}.exr'); a B without one is the reference of every
+    /// frame. Prints each frame's metrics, then the temporal error of A and of B and the
+    /// temporal relMSE.
+    #[arg(long, value_name = "S..E", value_parser = crate::args::parse_frames)]
+    pub frames: Option<std::ops::Range<u32>>,
+
+    /// With --frames: the first frame after a sudden change (e.g. a light toggles); also
+    /// prints the lag, the frames until A's relMSE is back within --lag-factor times its
+    /// steady state.
+    #[arg(long, value_name = "F", requires = "frames")]
+    pub event: Option<u32>,
+
+    /// The lag's steady state: the median per-frame relMSE over this many frames before
+    /// --event.
+    #[arg(long, value_name = "N", default_value_t = 10, requires = "event", value_parser = clap::value_parser!(u32).range(1..))]
+    pub lag_window: u32,
+
+    /// The lag's threshold: recovered when relMSE <= factor x the steady state.
+    #[arg(long, value_name = "FACTOR", default_value_t = 2.0, requires = "event", value_parser = positive)]
+    pub lag_factor: f64,
 }
 
 /// `image` cut to `region` (x0, y0, x1, y1), or a line saying why it cannot be.
-fn crop(image: RgbImage, region: &[usize], path: &Path) -> Result<RgbImage> {
+pub(crate) fn crop(image: RgbImage, region: &[usize], path: &Path) -> Result<RgbImage> {
     let &[x0, y0, x1, y1] = region else {
         return Err(anyhow!("--region takes four numbers: x0,y0,x1,y1"));
     };
@@ -64,7 +88,7 @@ fn crop(image: RgbImage, region: &[usize], path: &Path) -> Result<RgbImage> {
     }))
 }
 
-fn positive(s: &str) -> Result<f64, String> {
+pub(crate) fn positive(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
         _ => Err("must be a positive number".into()),
@@ -73,6 +97,17 @@ fn positive(s: &str) -> Result<f64, String> {
 
 /// Runs `render compare`.
 pub fn run(args: &CompareArgs) -> Result<()> {
+    if let Some(frames) = &args.frames {
+        return crate::compare_frames::run(args, frames.clone());
+    }
+    for path in [&args.test, &args.reference] {
+        if names_frame(path) && !path.exists() {
+            return Err(anyhow!(
+                "{}: names a frame; add --frames S..E to compare sequences",
+                path.display()
+            ));
+        }
+    }
     let mut test = load_rgb(&args.test)?;
     let mut reference = load_rgb(&args.reference)?;
     if let Some(region) = &args.region {
@@ -100,7 +135,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
 }
 
 /// Restates a metrics error with the file names the user typed.
-fn explain(e: MetricsError, test: &Path, reference: &Path) -> anyhow::Error {
+pub(crate) fn explain(e: MetricsError, test: &Path, reference: &Path) -> anyhow::Error {
     let file = |role| match role {
         Role::Test => test.display(),
         Role::Reference => reference.display(),

@@ -1,6 +1,7 @@
 //! Turning arguments and the scene's `[render]` table into a render, and running it.
 
 use crate::args::Args;
+use crate::frame_pattern::frame_path;
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rt_accel::AccelSpec;
@@ -154,7 +155,7 @@ pub fn run(args: &Args) -> Result<()> {
     for frame in frames {
         if let Some(f) = frame {
             scene.set_time((f64::from(f) / args.fps) as f32);
-            job.output = frame_output(&pattern, f);
+            job.output = frame_path(&pattern, f);
             job.settings.seed = frame_seed(seed, f);
         }
         if let Some(e) = scene.motion_blur_error() {
@@ -240,35 +241,6 @@ fn frame_list(args: &Args, output: &Path) -> Result<Vec<Option<u32>>> {
         }
         (None, f) => Ok(vec![f]),
     }
-}
-
-/// `pattern` with `{frame}` replaced by the frame number and `{frame:0N}` by it padded to N
-/// digits.
-pub fn frame_output(pattern: &Path, frame: u32) -> PathBuf {
-    let text = pattern.to_string_lossy();
-    let mut out = String::new();
-    let mut rest = text.as_ref();
-    while let Some(i) = rest.find("{frame") {
-        out.push_str(&rest[..i]);
-        let tail = &rest[i + "{frame".len()..];
-        let Some(end) = tail.find('}') else {
-            out.push_str(&rest[i..]);
-            rest = "";
-            break;
-        };
-        let spec = &tail[..end];
-        match spec
-            .strip_prefix(":0")
-            .and_then(|w| w.parse::<usize>().ok())
-        {
-            Some(width) => out.push_str(&format!("{frame:0width$}")),
-            None if spec.is_empty() => out.push_str(&frame.to_string()),
-            None => out.push_str(&rest[i..i + "{frame".len() + end + 1]),
-        }
-        rest = &tail[end + 1..];
-    }
-    out.push_str(rest);
-    PathBuf::from(out)
 }
 
 /// Renders one image of `scene` as it is now and writes it; prints the summary line.

@@ -5,7 +5,8 @@
 //! non-zero exit code (2 for usage errors, 1 for everything else). `render bench-accel` (in
 //! `bench_accel/`) measures the acceleration structures instead of rendering, `render
 //! bench-anim` (`bench_anim.rs`) their seconds per frame on an animated scene; `render compare`
-//! (`compare.rs`) measures the error of one image against another; `render reference` and
+//! (`compare.rs`, `compare_frames.rs`) measures the error of one image against another, or
+//! the per-frame and temporal errors of a sequence; `render reference` and
 //! `render experiment` (`reference/`, `experiment/`) render references and measured grids,
 //! sharing `session.rs` (one configuration, rendered progressively) with plain rendering;
 //! `render stress` (`stress.rs`) runs the numerical stress suite.
@@ -14,8 +15,10 @@ mod args;
 mod bench_accel;
 mod bench_anim;
 mod compare;
+mod compare_frames;
 mod denoise;
 mod experiment;
+mod frame_pattern;
 mod gree;
 mod job;
 mod progress;

@@ -5,7 +5,7 @@ use crate::error::{MetricsError, Result, Role};
 pub use rt_core::RgbImage;
 
 /// The first non-finite channel value in row-major order, as an error about `role`.
-fn check_finite(img: &RgbImage, role: Role) -> Result<()> {
+pub(crate) fn check_finite(img: &RgbImage, role: Role) -> Result<()> {
     // A fast scan first: images are almost always clean, and only a failure needs the
     // position.
     if img.pixels().iter().all(|p| p.is_finite()) {

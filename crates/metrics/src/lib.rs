@@ -14,6 +14,10 @@
 //! | PSNR | `10·log10(peak² / MSE)` dB, peak = 1 by default; `+inf` when MSE = 0 |
 //! | SSIM | Wang et al. 2004 on clamped linear luminance, 11×11 Gaussian window ([`ssim`]) |
 //!
+//! Sequences have their own metrics in [`temporal`]: temporal error (flicker under a fixed
+//! camera), temporal relMSE (frame differences against the reference's) and lag (frames to
+//! recover after a sudden change), and a frame-by-frame [`temporal::SequenceComparison`].
+//!
 //! Sums are taken in `f64` in a fixed order (per row or band of rows, then in order), so every
 //! result is the same bits for any number of threads. Inputs are checked first
 //! ([`validate_pair`]): empty images, different sizes and NaN or infinite values are typed errors
@@ -41,6 +45,7 @@ mod false_colour;
 mod image;
 mod reduce;
 mod ssim;
+pub mod temporal;
 
 pub use error::{MetricsError, Result, Role};
 pub use error_metrics::{mse, psnr, relmse, DEFAULT_EPSILON, DEFAULT_PEAK};
