@@ -1199,6 +1199,136 @@ seconds = [0.5, 0.1]
         );
     }
 
+    const SEQUENCE: &str = r#"
+[[scene]]
+path = "scenes/s.toml"
+resolution = [16, 12]
+frames = [0, 60]
+event = 30
+reference = { spp = 16 }
+
+[[method]]
+name = "a"
+spp = 1
+denoiser = "svgf:reflections=drop"
+
+[[method]]
+name = "b"
+spp = [2]
+denoiser = "atrous"
+
+[[method]]
+name = "c"
+spp = 1
+"#;
+
+    #[test]
+    fn sequence_configs_resolve() {
+        let p = plan(SEQUENCE).unwrap();
+        assert!(p.is_sequence());
+        let seq = p.scenes[0].sequence.as_ref().unwrap();
+        assert_eq!(
+            (seq.frames.clone(), seq.fps, seq.event),
+            (0..60, 24.0, Some(30))
+        );
+        assert_eq!(p.methods[0].runs, Runs::Sequence { spp: 1 });
+        assert_eq!(p.methods[1].runs, Runs::Sequence { spp: 2 });
+        let temporal: Vec<Option<bool>> = p
+            .methods
+            .iter()
+            .map(|m| m.temporal.as_ref().map(TemporalSpec::is_temporal))
+            .collect();
+        assert_eq!(temporal, [Some(true), Some(false), None]);
+        assert!(p.methods.iter().all(|m| m.denoiser.is_none()));
+        let camera = seq.camera_of(&p.scenes[0].loaded.scene).unwrap();
+        assert_eq!((camera.width, camera.height), (16, 12));
+        assert!(!plan(GOOD).unwrap().is_sequence());
+    }
+
+    #[test]
+    fn bad_sequence_configs_are_one_clear_line() {
+        let mixed = format!(
+            "{SEQUENCE}\n[[scene]]\nname = \"plain\"\npath = \"scenes/s.toml\"\nreference = {{ spp = 4 }}\n"
+        );
+        let cases = [
+            (
+                mixed,
+                "[[scene]] \"plain\" has no frames but [[scene]] \"s\" is a sequence",
+            ),
+            (
+                SEQUENCE.replace("spp = [2]", "spp = [2, 4]"),
+                "[[method]] \"b\": spp is the samples per pixel of every frame of a sequence: give one value, not a list of 2",
+            ),
+            (
+                SEQUENCE.replace("spp = [2]", "seconds = [1.0]"),
+                "[[method]] \"b\": seconds is not for sequences",
+            ),
+            (
+                SEQUENCE.replace("spp = [2]", "spp = 2\nerror = 0.01"),
+                "error is not for sequences",
+            ),
+            (
+                SEQUENCE.replace("spp = [2]", "spp = 2\ntime_limit = 1"),
+                "time_limit is not for sequences",
+            ),
+            (
+                SEQUENCE.replace("spp = [2]\ndenoiser = \"atrous\"", "spp = 2\ngree = \"sparsity=0.9\""),
+                "gree is not for sequences",
+            ),
+            (SEQUENCE.replace("spp = [2]", ""), "[[method]] \"b\": no spp"),
+            (SEQUENCE.replace("spp = [2]", "spp = 0"), "spp must be between 1 and"),
+            (
+                SEQUENCE.replace("frames = [0, 60]", "frames = [60, 0]"),
+                "[[scene]] \"s\": frames = [60, 0]: the first frame must come before the end",
+            ),
+            (
+                SEQUENCE.replace("frames = [0, 60]", "frames = [3, 4]"),
+                "at least two frames",
+            ),
+            (
+                SEQUENCE.replace("event = 30", "event = 0"),
+                "event = 0 must be a frame after the first",
+            ),
+            (
+                SEQUENCE.replace("event = 30", "event = 60"),
+                "event = 60 must be a frame after the first and before the end",
+            ),
+            (
+                SEQUENCE.replace("event = 30", "fps = 0"),
+                "fps must be in (0, 1000], got 0",
+            ),
+            (
+                GOOD.replace("scale = 0.5", "scale = 0.5\nevent = 3"),
+                "event belongs to a sequence: give frames = [A, B] too",
+            ),
+            (
+                SEQUENCE.replace("{ spp = 16 }", "\"r.exr\""),
+                "a sequence's reference is rendered frame by frame",
+            ),
+            (
+                SEQUENCE.replace("svgf:reflections=drop", "svgf:alpha=2"),
+                "[[method]] \"a\": denoiser = \"svgf:alpha=2\": ",
+            ),
+            (
+                SEQUENCE.replace("svgf:reflections=drop", "svgf:colour=1"),
+                "colour",
+            ),
+            (
+                SEQUENCE.replace("denoiser = \"svgf:reflections=drop\"", "denoiser = \"svgf\"\nintegrator = \"ao\""),
+                "reads the lighting split (direct, indirect, emission), which the",
+            ),
+        ];
+        for (config, needle) in cases {
+            let e = error(&config);
+            assert!(e.contains(needle), "{needle:?} not in {e:?}");
+        }
+        // OIDN per frame is refused in a build without it, as for images.
+        if "oidn".parse::<DenoiserSpec>().is_err() {
+            let e = error(&SEQUENCE.replace("\"atrous\"", "\"oidn\""));
+            assert!(e.contains("'oidn' is not in this build"), "{e}");
+        }
+    }
+
     #[test]
     fn a_reference_file_must_match_the_image_size() {
         let dir = tempfile::tempdir().unwrap();
