@@ -3,7 +3,8 @@
 //! sees the frames in order and carries its history; one line per frame.
 
 use crate::args::Args;
-use crate::job::{frame_output, Job};
+use crate::frame_pattern::frame_path;
+use crate::job::Job;
 use anyhow::{anyhow, bail, Context, Result};
 use rt_core::Scene;
 use rt_film::{AovSet, OutputOptions};
@@ -67,7 +68,7 @@ pub fn run(
             .install(|| renderer.render(scene, frame))
             .map_err(|e| anyhow!("{path}: frame {frame}: {e}"))?;
         let output = match f {
-            Some(f) => frame_output(&job.output, *f),
+            Some(f) => frame_path(&job.output, *f),
             None => job.output.clone(),
         };
         rt_film::write_rgb(

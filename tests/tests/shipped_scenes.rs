@@ -118,12 +118,17 @@ fn render_and_check(path: &Path, technique: &str) -> Result<(), String> {
 #[test]
 fn every_shipped_scene_renders_with_every_technique() {
     let scenes = shipped_scenes();
-    // The four scenes made for these techniques (issue 11) are among them.
+    // The four scenes made for these techniques (issue 11) are among them,
     for name in [
         "penumbra.toml",
         "caustic.toml",
         "sun-caustic.toml",
         "interior.toml",
+        // and issue 14's animated scenes.
+        "hall-glossy.toml",
+        "hall-mirror.toml",
+        "light-toggle.toml",
+        "dynamic-small.toml",
     ] {
         assert!(
             scenes.iter().any(|p| p.ends_with(name)),

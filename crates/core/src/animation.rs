@@ -1,16 +1,21 @@
-//! Rigid-body keyframe animation: transforms of instances and cameras as functions of time.
+//! Keyframe animation: transforms of instances and cameras, and the emission of materials, as
+//! functions of time.
 //!
 //! A [`Motion`] holds keys sorted by strictly increasing time. Translation and scale interpolate
 //! linearly and rotation by quaternion slerp (the shorter arc) between the two keys around `t`;
 //! before the first key and after the last the end keys hold. A [`CameraMotion`] does the same
 //! for a camera's position, look-at point, up vector and field of view (all linear: a camera
-//! is keyed by points, not by an orientation).
+//! is keyed by points, not by an orientation). A [`MaterialMotion`] keys a material's emitted
+//! radiance, linearly or as a step function ([`Interpolation::Step`]: each key holds until the
+//! next, so a light switch is two keys).
 //!
 //! Validation (keys in order, finite values, positive scale, a camera that can look) happens
 //! when a motion is built, with a typed [`AnimationError`]: a scene loader turns it into one
 //! line naming the file and the target.
 
+use crate::material::MAX_RADIANCE;
 use crate::transform::Transform;
+use crate::Rgb;
 use glam::{Mat4, Quat, Vec3};
 
 /// One keyframe of a rigid transform.
@@ -67,6 +72,14 @@ pub enum AnimationError {
     BadScale {
         /// Index of the offending key.
         index: usize,
+    },
+    /// An emission that is negative or too large.
+    #[error("key {index} has emission {value:?}: each component must be >= 0 and at most {MAX_RADIANCE:e}")]
+    BadEmission {
+        /// Index of the offending key.
+        index: usize,
+        /// The emission.
+        value: [f32; 3],
     },
     /// A camera key that cannot define a view.
     #[error("camera key {index}: {what}")]
@@ -280,6 +293,106 @@ impl CameraMotion {
     }
 }
 
+/// How a keyed value moves between two keys.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Interpolation {
+    /// Linearly from one key's value to the next.
+    #[default]
+    Linear,
+    /// Each key's value holds until the next key's time, where it jumps: a switch.
+    Step,
+}
+
+/// One keyframe of a material's emission.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EmissionKey {
+    /// Time in seconds.
+    pub time: f32,
+    /// Emitted radiance.
+    pub emission: Rgb,
+}
+
+/// A material whose emitted radiance is keyed over time (a lamp that dims or switches).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialMotion {
+    /// Index of the material in the scene.
+    pub material: usize,
+    keys: Vec<EmissionKey>,
+    times: Vec<f32>,
+    interpolation: Interpolation,
+}
+
+impl MaterialMotion {
+    /// A motion of material `material`'s emission through `keys`: times strictly increasing,
+    /// every emission finite, non-negative and at most [`MAX_RADIANCE`] (what
+    /// [`crate::Material::validate`] allows).
+    pub fn new(
+        material: usize,
+        keys: Vec<EmissionKey>,
+        interpolation: Interpolation,
+    ) -> Result<Self, AnimationError> {
+        check_times(keys.iter().map(|k| k.time))?;
+        for (index, k) in keys.iter().enumerate() {
+            if !k.emission.is_finite() {
+                return Err(AnimationError::NotFinite {
+                    index,
+                    what: "emission",
+                });
+            }
+            if k.emission.min_element() < 0.0 || k.emission.max_element() > MAX_RADIANCE {
+                return Err(AnimationError::BadEmission {
+                    index,
+                    value: k.emission.to_array(),
+                });
+            }
+        }
+        let times = keys.iter().map(|k| k.time).collect();
+        Ok(Self {
+            material,
+            keys,
+            times,
+            interpolation,
+        })
+    }
+
+    /// The keys.
+    pub fn keys(&self) -> &[EmissionKey] {
+        &self.keys
+    }
+
+    /// How values move between keys.
+    pub fn interpolation(&self) -> Interpolation {
+        self.interpolation
+    }
+
+    /// The emission at time `t`. With [`Interpolation::Step`] a key's value holds from its
+    /// time (inclusive) until the next key's.
+    pub fn at(&self, t: f32) -> Rgb {
+        let (i, j, w) = bracket(&self.times, t);
+        let (a, b) = (self.keys[i].emission, self.keys[j].emission);
+        match self.interpolation {
+            Interpolation::Step => a,
+            // The end keys exactly, not a blend that rounds away from them.
+            Interpolation::Linear if w == 0.0 => a,
+            Interpolation::Linear => a.lerp(b, w).max(Rgb::ZERO),
+        }
+    }
+
+    /// True if the emission changes within `(t0, t1)`: a linear blend between two different
+    /// values overlaps it, or a step to a different value falls inside it (a step at `t0`
+    /// itself has happened when the shutter opens).
+    pub fn spans(&self, t0: f32, t1: f32) -> bool {
+        self.keys.windows(2).any(|w| {
+            let (a, b) = (&w[0], &w[1]);
+            a.emission != b.emission
+                && match self.interpolation {
+                    Interpolation::Step => b.time > t0 && b.time < t1,
+                    Interpolation::Linear => a.time < t1 && b.time > t0,
+                }
+        })
+    }
+}
+
 impl crate::content_hash::ContentHash for Motion {
     fn content_hash(&self, out: &mut crate::content_hash::Sink<'_>) {
         for k in &self.keys {
@@ -303,6 +416,18 @@ impl crate::content_hash::ContentHash for CameraMotion {
             k.fov.content_hash(out);
         }
         self.keys.len().content_hash(out);
+    }
+}
+
+impl crate::content_hash::ContentHash for MaterialMotion {
+    fn content_hash(&self, out: &mut crate::content_hash::Sink<'_>) {
+        self.material.content_hash(out);
+        for k in &self.keys {
+            k.time.content_hash(out);
+            k.emission.content_hash(out);
+        }
+        self.keys.len().content_hash(out);
+        (self.interpolation == Interpolation::Step).content_hash(out);
     }
 }
 
@@ -360,5 +485,69 @@ mod tests {
             CameraMotion::new(0, vec![c]),
             Err(AnimationError::BadCamera { .. })
         ));
+    }
+
+    fn lamp(interpolation: Interpolation) -> MaterialMotion {
+        let key = |time, e| EmissionKey {
+            time,
+            emission: Rgb::splat(e),
+        };
+        MaterialMotion::new(
+            0,
+            vec![key(1.0, 8.0), key(2.0, 0.0), key(4.0, 4.0)],
+            interpolation,
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn step_holds_each_key_until_the_next_and_linear_blends() {
+        let (step, linear) = (lamp(Interpolation::Step), lamp(Interpolation::Linear));
+        for (t, s, l) in [
+            (0.0, 8.0, 8.0), // before the first key: it holds
+            (1.0, 8.0, 8.0),
+            (1.5, 8.0, 4.0),     // halfway between 8 and 0
+            (1.999, 8.0, 0.008), // a step holds until the next key
+            (2.0, 0.0, 0.0),     // and jumps at its time
+            (3.0, 0.0, 2.0),
+            (9.0, 4.0, 4.0), // after the last key: it holds
+        ] {
+            assert_eq!(step.at(t), Rgb::splat(s), "step at {t}");
+            assert!(
+                (linear.at(t) - Rgb::splat(l)).abs().max_element() < 1e-3,
+                "linear at {t}: {}",
+                linear.at(t)
+            );
+        }
+        assert!(step.spans(1.9, 2.1) && !step.spans(2.0, 2.1) && !step.spans(2.1, 3.9));
+        assert!(linear.spans(2.1, 2.2) && linear.spans(3.9, 5.0) && !linear.spans(4.0, 5.0));
+    }
+
+    #[test]
+    fn bad_emission_keys_are_refused() {
+        let key = |time, e: Rgb| EmissionKey { time, emission: e };
+        let new = |keys| MaterialMotion::new(0, keys, Interpolation::Step);
+        assert_eq!(
+            new(vec![key(0.0, Rgb::new(1.0, -0.5, 1.0))]),
+            Err(AnimationError::BadEmission {
+                index: 0,
+                value: [1.0, -0.5, 1.0]
+            })
+        );
+        assert_eq!(
+            new(vec![
+                key(0.0, Rgb::ONE),
+                key(1.0, Rgb::new(f32::INFINITY, 0.0, 0.0))
+            ]),
+            Err(AnimationError::NotFinite {
+                index: 1,
+                what: "emission"
+            })
+        );
+        assert!(matches!(
+            new(vec![key(1.0, Rgb::ONE), key(0.5, Rgb::ONE)]),
+            Err(AnimationError::OutOfOrder { index: 1, .. })
+        ));
+        assert_eq!(new(vec![]), Err(AnimationError::NoKeys));
     }
 }

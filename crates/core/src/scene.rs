@@ -9,7 +9,7 @@
 //! arrays, one range per instance, so a triangle index still means one thing everywhere.
 
 use crate::{
-    animation::{CameraMotion, Motion},
+    animation::{CameraMotion, MaterialMotion, Motion},
     environment::Environment,
     instance::{place_attributes, place_triangle, placement_error, Instance, Prototype},
     lights::LightSampler,
@@ -61,6 +61,8 @@ pub struct Scene {
     pub instances: Vec<Instance>,
     /// Keyframed cameras.
     pub camera_motions: Vec<CameraMotion>,
+    /// Materials whose emission is keyed ([`Scene::set_time`] writes it into `materials`).
+    pub material_motions: Vec<MaterialMotion>,
     /// The time (seconds) the world copies and cameras are at ([`Scene::set_time`]).
     pub time: f32,
     /// How long (seconds) the shutter stays open after `time`: 0 renders the instant `time`;
@@ -130,6 +132,7 @@ impl Scene {
             prototypes: Vec::new(),
             instances: Vec::new(),
             camera_motions: Vec::new(),
+            material_motions: Vec::new(),
             time: 0.0,
             shutter: 0.0,
             lights: OnceLock::new(),
@@ -189,11 +192,16 @@ impl Scene {
         self.lights.get()
     }
 
-    /// True if something emits: a triangle the light sampler would sample, or a non-black
+    /// True if something emits at some time: a triangle the light sampler would sample, a
+    /// triangle whose material's keyed emission is lit at some key, or a non-black
     /// environment. Cheap (no light sampler is built), for warnings about black images.
     pub fn has_light_sources(&self) -> bool {
         !self.environment.is_black()
             || (0..self.triangles.len() as u32).any(|i| crate::lights::is_emitter(self, i))
+            || self.material_motions.iter().any(|m| {
+                m.keys().iter().any(|k| k.emission.max_element() > 0.0)
+                    && self.material_ids.contains(&(m.material as u32))
+            })
     }
 
     /// Number of triangles.
@@ -320,7 +328,8 @@ impl Scene {
 
     /// Why the scene cannot be motion blurred as it is, if it cannot: lights are sampled
     /// from the world copies at the shutter's opening, so an emitter that moves while the
-    /// shutter is open would light the scene from the wrong place.
+    /// shutter is open would light the scene from the wrong place, and one whose emission
+    /// changes would light it with the wrong power.
     pub fn motion_blur_error(&self) -> Option<MotionBlurError> {
         self.instances
             .iter()
@@ -330,6 +339,15 @@ impl Scene {
                         .any(|p| crate::lights::is_emitter(self, p))
             })
             .map(|inst| MotionBlurError::MovingEmitter(inst.name.clone()))
+            .or_else(|| {
+                self.material_motions
+                    .iter()
+                    .find(|m| self.shutter > 0.0 && m.spans(self.time, self.time + self.shutter))
+                    .map(|m| {
+                        let name = self.materials.get(m.material).map(|x| x.name.clone());
+                        MotionBlurError::AnimatedEmission(name.unwrap_or_default())
+                    })
+            })
     }
 
     /// The instance triangle `prim` belongs to, if any.
@@ -473,8 +491,10 @@ impl Scene {
         }
     }
 
-    /// Moves the animated instances and cameras to time `t` (seconds): rewrites the world
-    /// copies of the instances whose transform changed and resets the light table if any did.
+    /// Moves the animated instances and cameras to time `t` (seconds) and sets the keyed
+    /// materials' emission: rewrites the world copies of the instances whose transform changed
+    /// and resets the light table if any did or any emission changed (a lamp switched off
+    /// leaves the table, so a frame without a lit emitter samples only the environment).
     /// Returns the indices of the instances that moved.
     pub fn set_time(&mut self, t: f32) -> Vec<u32> {
         self.time = t;
@@ -487,7 +507,16 @@ impl Scene {
                 moved.push(k as u32);
             }
         }
-        if !moved.is_empty() {
+        let mut relit = false;
+        for m in &self.material_motions {
+            let e = m.at(t);
+            let material = &mut self.materials[m.material];
+            if material.emission != e {
+                material.emission = e;
+                relit = true;
+            }
+        }
+        if !moved.is_empty() || relit {
             self.lights = OnceLock::new();
         }
         for m in &self.camera_motions {
@@ -530,6 +559,9 @@ pub enum MotionBlurError {
     /// An emitter moves while the shutter is open.
     #[error("`{0}` emits light and moves while the shutter is open: moving lights cannot be motion blurred (light sampling sees them where the shutter opens); render it with --shutter 0 or make it static")]
     MovingEmitter(String),
+    /// A material's keyed emission changes while the shutter is open.
+    #[error("material `{0}` has an animated emission that changes while the shutter is open: lights cannot be motion blurred (light sampling sees them as they are when the shutter opens); render it with --shutter 0 or move the shutter off the change")]
+    AnimatedEmission(String),
 }
 
 /// Why [`Scene::permute_triangles`] refused.
@@ -638,6 +670,7 @@ impl crate::content_hash::ContentHash for Scene {
             prototypes,
             instances,
             camera_motions,
+            material_motions,
             time,
             shutter,
             lights: _,
@@ -654,6 +687,7 @@ impl crate::content_hash::ContentHash for Scene {
         prototypes.content_hash(out);
         instances.content_hash(out);
         camera_motions.content_hash(out);
+        material_motions.content_hash(out);
         time.content_hash(out);
         shutter.content_hash(out);
     }

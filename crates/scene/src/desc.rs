@@ -284,15 +284,18 @@ pub(crate) struct InstanceDesc {
     pub transform: Option<Spanned<TransformDesc>>,
 }
 
-/// `[[animation]]`: keyframes of a geometry, an instance or a camera.
+/// `[[animation]]`: keyframes of a geometry, an instance, a camera or a material's emission.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct AnimationDesc {
     pub target: Spanned<String>,
     pub keys: Spanned<Vec<Spanned<KeyDesc>>>,
+    /// `"linear"` (default) or `"step"`; material animations only.
+    pub interpolate: Option<Spanned<String>>,
 }
 
-/// One key: `time` and either transform values (geometries, instances) or camera values.
+/// One key: `time` and either transform values (geometries, instances), camera values or a
+/// material's emission.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct KeyDesc {
@@ -305,6 +308,7 @@ pub(crate) struct KeyDesc {
     pub look_at: Option<V3>,
     pub up: Option<V3>,
     pub fov: Option<f32>,
+    pub emission: Option<V3>,
 }
 
 /// `[render]`: defaults for the renderer's command-line options.

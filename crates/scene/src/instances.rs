@@ -1,5 +1,6 @@
-//! `[[instance]]` and `[[animation]]`: geometries placed more than once and keyframed motion of
-//! geometries, instances and cameras (`docs/scene-format.md`, "Instances and animation").
+//! `[[instance]]` and `[[animation]]`: geometries placed more than once, keyframed motion of
+//! geometries, instances and cameras, and keyframed emission of materials
+//! (`docs/scene-format.md`, "Instances and animation").
 //!
 //! Runs after the geometry and the material assignments are loaded. A geometry that an
 //! instance places, or that an animation moves, becomes a prototype: its triangles (after its
@@ -11,8 +12,11 @@ use crate::desc::{AnimationDesc, CameraDesc, InstanceDesc, KeyDesc};
 use crate::error::Result;
 use crate::geometry;
 use crate::load::Ctx;
+use crate::material::MaterialTable;
 use glam::Vec3;
-use rt_core::animation::{CameraKey, CameraMotion, Key, Motion};
+use rt_core::animation::{
+    CameraKey, CameraMotion, EmissionKey, Interpolation, Key, MaterialMotion, Motion,
+};
 use rt_core::instance::Prototype;
 use rt_core::scene::Object;
 use rt_core::transform::Transform;
@@ -25,18 +29,21 @@ enum Target {
     Geometry,
     Instance,
     Camera(usize),
+    Material(u32),
 }
 
-/// Applies the file's instances and animations to `scene`.
+/// Applies the file's instances and animations to `scene`; returns the material animations,
+/// which the caller sets on the scene once its materials are in place.
 pub(crate) fn apply(
     ctx: &Ctx,
     instances: &[Spanned<InstanceDesc>],
     animations: &[Spanned<AnimationDesc>],
     cameras: &[Spanned<CameraDesc>],
+    materials: &MaterialTable,
     scene: &mut Scene,
-) -> Result<()> {
+) -> Result<Vec<MaterialMotion>> {
     if instances.is_empty() && animations.is_empty() {
-        return Ok(());
+        return Ok(Vec::new());
     }
     let geometries: HashSet<&str> = scene.objects.iter().map(|o| o.name.as_str()).collect();
     let camera_index: HashMap<&str, usize> = cameras
@@ -82,11 +89,37 @@ pub(crate) fn apply(
     // Animations by target.
     let mut motions: HashMap<String, Motion> = HashMap::new();
     let mut camera_motions = Vec::new();
+    let mut material_motions: Vec<MaterialMotion> = Vec::new();
     let mut animated_geometries = Vec::new();
     for a in animations {
         let d = a.get_ref();
         let t = d.target.get_ref();
-        let target = if let Some(&c) = camera_index.get(t.as_str()) {
+        // Emission keys make a material animation; so does a target that only a material has.
+        let emission_keys = d
+            .keys
+            .get_ref()
+            .iter()
+            .any(|k| k.get_ref().emission.is_some());
+        let other_target = camera_index.contains_key(t.as_str())
+            || instance_names.contains(t.as_str())
+            || geometries.contains(t.as_str());
+        let target = if emission_keys || !other_target {
+            match materials.find(t) {
+                Some(m) => Target::Material(m),
+                None if emission_keys => {
+                    return Err(ctx.src.error_at(
+                        d.target.span(),
+                        format!("animation target \"{t}\" has emission keys but is not a [[material]] (emission animates a material; geometries, instances and cameras take transform or camera keys)"),
+                    ))
+                }
+                None => {
+                    return Err(ctx.src.error_at(
+                        d.target.span(),
+                        format!("animation target \"{t}\" is not a geometry, instance, camera or material"),
+                    ))
+                }
+            }
+        } else if let Some(&c) = camera_index.get(t.as_str()) {
             Target::Camera(c)
         } else if instance_names.contains(t.as_str()) {
             Target::Instance
@@ -99,16 +132,18 @@ pub(crate) fn apply(
             }
             Target::Geometry
         } else {
-            return Err(ctx.src.error_at(
-                d.target.span(),
-                format!("animation target \"{t}\" is not a geometry, instance or camera"),
-            ));
+            unreachable!("other_target holds for one of the three");
         };
-        if motions.contains_key(t)
-            || camera_motions
-                .iter()
-                .any(|m: &CameraMotion| Some(&m.camera) == camera_index.get(t.as_str()))
-        {
+        let twice = match target {
+            Target::Material(m) => material_motions.iter().any(|x| x.material == m as usize),
+            _ => {
+                motions.contains_key(t)
+                    || camera_motions
+                        .iter()
+                        .any(|m: &CameraMotion| Some(&m.camera) == camera_index.get(t.as_str()))
+            }
+        };
+        if twice {
             return Err(ctx
                 .src
                 .error_at(d.target.span(), format!("\"{t}\" is animated twice")));
@@ -117,7 +152,15 @@ pub(crate) fn apply(
             ctx.src
                 .error_at(d.keys.span(), format!("animation of \"{t}\": {msg}"))
         };
+        let interpolation = interpolation(ctx, t, d, matches!(target, Target::Material(_)))?;
         match target {
+            Target::Material(m) => {
+                let keys = emission_keys_of(ctx, t, &d.keys)?;
+                material_motions.push(
+                    MaterialMotion::new(m as usize, keys, interpolation)
+                        .map_err(|e| at(e.to_string()))?,
+                );
+            }
             Target::Camera(c) => {
                 let keys = camera_keys(ctx, t, &d.keys, cameras[c].get_ref())?;
                 camera_motions.push(CameraMotion::new(c, keys).map_err(|e| at(e.to_string()))?);
@@ -171,7 +214,75 @@ pub(crate) fn apply(
     }
     scene.camera_motions = camera_motions;
     scene.set_time(0.0);
-    Ok(())
+    Ok(material_motions)
+}
+
+/// The animation's `interpolate` option: linear by default; step only for materials.
+fn interpolation(
+    ctx: &Ctx,
+    target: &str,
+    d: &AnimationDesc,
+    material: bool,
+) -> Result<Interpolation> {
+    let Some(i) = &d.interpolate else {
+        return Ok(Interpolation::Linear);
+    };
+    let value = match i.get_ref().as_str() {
+        "linear" => Interpolation::Linear,
+        "step" => Interpolation::Step,
+        other => {
+            return Err(ctx.src.error_at(
+                i.span(),
+                format!("animation of \"{target}\": interpolate = \"{other}\" is not \"linear\" or \"step\""),
+            ))
+        }
+    };
+    if !material && value != Interpolation::Linear {
+        return Err(ctx.src.error_at(
+            i.span(),
+            format!("animation of \"{target}\": interpolate = \"step\" applies to material (emission) animations only; transforms and cameras interpolate linearly"),
+        ));
+    }
+    Ok(value)
+}
+
+/// The keys of a material's animation: `time` and `emission`, nothing else.
+fn emission_keys_of(
+    ctx: &Ctx,
+    target: &str,
+    keys: &Spanned<Vec<Spanned<KeyDesc>>>,
+) -> Result<Vec<EmissionKey>> {
+    keys.get_ref()
+        .iter()
+        .map(|k| {
+            let d = k.get_ref();
+            let other = [
+                ("translate", d.translate.is_some()),
+                ("rotate", d.rotate.is_some()),
+                ("scale", d.scale.is_some()),
+                ("position", d.position.is_some()),
+                ("look_at", d.look_at.is_some()),
+                ("up", d.up.is_some()),
+                ("fov", d.fov.is_some()),
+            ];
+            if let Some((name, _)) = other.iter().find(|(_, set)| *set) {
+                return Err(ctx.src.error_at(
+                    k.span(),
+                    format!("animation of material \"{target}\": `{name}` is not a material key; a material takes time and emission (animate a geometry's motion in an [[animation]] of its own)"),
+                ));
+            }
+            let Some(e) = d.emission else {
+                return Err(ctx.src.error_at(
+                    k.span(),
+                    format!("animation of material \"{target}\": a key at time {} has no emission", d.time),
+                ));
+            };
+            Ok(EmissionKey {
+                time: d.time,
+                emission: Vec3::from(e),
+            })
+        })
+        .collect()
 }
 
 /// Refuses a placement whose world copy overflows at some key.

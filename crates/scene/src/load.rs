@@ -76,7 +76,14 @@ pub(crate) fn load(text: &str, base: &Path, name: &Path) -> Result<LoadedScene> 
     for a in &d.assign {
         assign(&ctx, a.get_ref(), &mut mats, &mut scene)?;
     }
-    instances::apply(&ctx, &d.instance, &d.animation, &d.camera, &mut scene)?;
+    let material_motions = instances::apply(
+        &ctx,
+        &d.instance,
+        &d.animation,
+        &d.camera,
+        &mats,
+        &mut scene,
+    )?;
     let render = render(&ctx, d.render)?;
 
     for name in mats.unused() {
@@ -84,6 +91,10 @@ pub(crate) fn load(text: &str, base: &Path, name: &Path) -> Result<LoadedScene> 
             .push(format!("material \"{name}\" is defined but never used"));
     }
     scene.materials = mats.into_vec();
+    if !material_motions.is_empty() {
+        scene.material_motions = material_motions;
+        scene.set_time(scene.time);
+    }
     scene.textures = std::mem::take(&mut ctx.textures).into_vec();
     scene.compact_attributes();
     if !scene.has_light_sources() {

@@ -60,6 +60,12 @@ impl MaterialTable {
         Some(id)
     }
 
+    /// Index of the material called `name`, without marking it used (an animation of a
+    /// material does not make it appear in the image).
+    pub fn find(&self, name: &str) -> Option<u32> {
+        self.by_name.get(name).copied()
+    }
+
     /// Names of the materials nothing refers to.
     pub fn unused(&self) -> impl Iterator<Item = &str> {
         self.list

@@ -163,7 +163,7 @@ fn bad_instances_and_animations_are_one_clear_line() {
         ),
         (
             "[[animation]]\ntarget = \"ghost\"\nkeys = [ { time = 0.0 } ]\n",
-            "animation target \"ghost\" is not a geometry, instance or camera",
+            "animation target \"ghost\" is not a geometry, instance, camera or material",
         ),
         (
             "[[animation]]\ntarget = \"tri\"\nkeys = [ { time = 1.0 }, { time = 0.5 } ]\n",
@@ -216,6 +216,130 @@ fn bad_instances_and_animations_are_one_clear_line() {
     ];
     for (extra, want) in cases {
         let e = error(extra);
+        assert!(e.contains(want), "{extra}\n  gave: {e}\n  want: {want}");
+    }
+}
+
+/// A lamp material for the material-animation tests, on a quad of its own.
+const LAMP: &str = r#"
+[[material]]
+name = "lamp"
+emission = [4, 4, 4]
+
+[[geometry]]
+name = "panel"
+shape = "quad"
+vertices = [[-1, 2, -1], [1, 2, -1], [1, 2, 1], [-1, 2, 1]]
+material = "lamp"
+"#;
+
+#[test]
+fn a_material_animation_keys_the_emission_and_resets_the_lights() {
+    let mut s = load(&format!(
+        r#"{LAMP}
+[[animation]]
+target = "lamp"
+interpolate = "step"
+keys = [ {{ time = 0.0, emission = [4, 4, 4] }}, {{ time = 1.0, emission = [0, 0, 0] }}, {{ time = 2.0, emission = [1, 2, 3] }} ]
+"#
+    ));
+    let lamp = s.materials.iter().position(|m| m.name == "lamp").unwrap();
+    assert_eq!(s.material_motions.len(), 1);
+    assert_eq!(s.material_motions[0].material, lamp);
+    assert_eq!(s.lights().emitter_count(), 2);
+    s.set_time(0.999);
+    assert_eq!(s.materials[lamp].emission, Vec3::splat(4.0), "a step holds");
+    s.set_time(1.0);
+    assert_eq!(s.materials[lamp].emission, Vec3::ZERO);
+    // Switched off: the table is rebuilt without the lamp, and is empty (black environment).
+    assert_eq!(s.lights().emitter_count(), 0);
+    assert!(s.lights().is_empty());
+    s.set_time(5.0);
+    assert_eq!(s.materials[lamp].emission, Vec3::new(1.0, 2.0, 3.0));
+    assert_eq!(s.lights().emitter_count(), 2);
+}
+
+#[test]
+fn a_lamp_off_at_time_zero_is_still_a_light_source() {
+    let loaded = load_str(
+        &format!(
+            r#"{BASE}{LAMP}
+[[animation]]
+target = "lamp"
+interpolate = "step"
+keys = [ {{ time = 0.0, emission = [0, 0, 0] }}, {{ time = 1.0, emission = [3, 3, 3] }} ]
+"#
+        ),
+        Path::new("."),
+        Path::new("t.toml"),
+    )
+    .unwrap();
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    assert_eq!(
+        loaded
+            .scene
+            .materials
+            .iter()
+            .find(|m| m.name == "lamp")
+            .unwrap()
+            .emission,
+        Vec3::ZERO
+    );
+}
+
+#[test]
+fn bad_material_animations_are_one_clear_line() {
+    let anim = |keys: &str, extra: &str| {
+        format!("{LAMP}\n[[animation]]\ntarget = \"lamp\"\n{extra}keys = [ {keys} ]\n")
+    };
+    let cases = [
+        (
+            anim("{ time = 0.0, emission = [1, -1, 1] }", ""),
+            "animation of \"lamp\": key 0 has emission [1.0, -1.0, 1.0]",
+        ),
+        (
+            anim("{ time = 0.0, emission = [1, 1, 1] }, { time = 1.0, emission = [inf, 0, 0] }", ""),
+            "animation of \"lamp\": key 1 has a value that is not finite (emission)",
+        ),
+        (
+            anim("{ time = 0.0, emission = [nan, 0, 0] }", ""),
+            "not finite (emission)",
+        ),
+        (
+            anim("{ time = 0.0, emission = [1, 1, 1], translate = [0, 1, 0] }", ""),
+            "animation of material \"lamp\": `translate` is not a material key",
+        ),
+        (
+            anim("{ time = 0.0, emission = [1, 1, 1] }, { time = 1.0, fov = 30 }", ""),
+            "`fov` is not a material key",
+        ),
+        (
+            anim("{ time = 0.0, emission = [1, 1, 1] }, { time = 1.0 }", ""),
+            "a key at time 1 has no emission",
+        ),
+        (
+            anim("{ time = 0.0, emission = [1, 1, 1] }", "interpolate = \"cubic\"\n"),
+            "interpolate = \"cubic\" is not \"linear\" or \"step\"",
+        ),
+        (
+            "[[animation]]\ntarget = \"tri\"\ninterpolate = \"step\"\nkeys = [ { time = 0.0 } ]\n".to_string(),
+            "applies to material (emission) animations only",
+        ),
+        (
+            "[[animation]]\ntarget = \"tri\"\nkeys = [ { time = 0.0, emission = [1, 1, 1] } ]\n".to_string(),
+            "animation target \"tri\" has emission keys but is not a [[material]]",
+        ),
+        (
+            "[[animation]]\ntarget = \"cam\"\nkeys = [ { time = 0.0, emission = [1, 1, 1] } ]\n".to_string(),
+            "is not a [[material]]",
+        ),
+        (
+            format!("{}[[animation]]\ntarget = \"lamp\"\nkeys = [ {{ time = 0.0, emission = [1, 1, 1] }} ]\n", anim("{ time = 0.0, emission = [1, 1, 1] }", "")),
+            "\"lamp\" is animated twice",
+        ),
+    ];
+    for (extra, want) in cases {
+        let e = error(&extra);
         assert!(e.contains(want), "{extra}\n  gave: {e}\n  want: {want}");
     }
 }

@@ -365,3 +365,115 @@ fn gree_scenes_load_from_the_shared_data() {
         assert!(s.scene.materials.iter().any(|m| m.is_emissive()), "{scene}");
     }
 }
+
+/// Index of the camera called `name`.
+fn camera_named(s: &rt_core::Scene, name: &str) -> usize {
+    s.cameras
+        .iter()
+        .position(|c| c.name == name)
+        .unwrap_or_else(|| panic!("no camera {name}"))
+}
+
+#[test]
+fn the_temporal_scenes_have_a_fixed_camera_and_move() {
+    // Issue 14's animated scenes: a fly-through (or orbit) camera that moves and a `fixed` one
+    // that does not (the fixed-camera temporal-error measurement).
+    for name in ["hall-glossy.toml", "hall-mirror.toml", "dynamic-small.toml"] {
+        let mut s = load_scene(name).scene;
+        let (main, fixed) = (camera_named(&s, "main"), camera_named(&s, "fixed"));
+        let before = (s.cameras[main].position, s.cameras[fixed].position);
+        s.set_time(2.0);
+        assert_ne!(
+            s.cameras[main].position, before.0,
+            "{name}: main does not move"
+        );
+        assert_eq!(s.cameras[fixed].position, before.1, "{name}: fixed moves");
+    }
+    let s = load_scene("light-toggle.toml").scene;
+    assert_eq!(s.cameras[0].name, "fixed");
+    assert!(s.camera_motions.is_empty());
+}
+
+#[test]
+fn the_mirror_hall_has_a_mirror_floor_and_orb_and_the_glossy_hall_a_glossy_floor() {
+    let floor = |name: &str| {
+        let s = load_scene(name).scene;
+        let o = s.objects.iter().find(|o| o.name == "floor").unwrap();
+        s.material_of(o.first).clone()
+    };
+    let (glossy, mirror) = (floor("hall-glossy.toml"), floor("hall-mirror.toml"));
+    let max_hardness = |m: &Material| m.layers.iter().map(|l| l.hardness).fold(0.0, f32::max);
+    assert!(
+        (0.1..1.0).contains(&max_hardness(&glossy)),
+        "{:?}",
+        glossy.layers
+    );
+    assert_eq!(mirror.layers.len(), 1);
+    assert_eq!(mirror.layers[0].hardness, 1.0);
+    let s = load_scene("hall-mirror.toml").scene;
+    let orb = s.objects.iter().find(|o| o.name == "orb").unwrap();
+    assert_eq!(s.material_of(orb.first).layers[0].hardness, 1.0);
+}
+
+#[test]
+fn the_light_toggle_lamp_is_off_from_frame_30_to_59_at_24_fps() {
+    let mut s = load_scene("light-toggle.toml").scene;
+    let lamp = s
+        .materials
+        .iter()
+        .position(|m| m.name == "main-lamp")
+        .unwrap();
+    for frame in [0, 29, 30, 45, 59, 60, 90] {
+        s.set_time((f64::from(frame) / 24.0) as f32);
+        let off = s.materials[lamp].emission == Rgb::ZERO;
+        assert_eq!(off, (30..60).contains(&frame), "frame {frame}");
+        // The dim lamp keeps the room lit.
+        assert!(!s.lights().is_empty(), "frame {frame}");
+    }
+}
+
+#[test]
+fn the_sponza_scenes_load_from_the_shared_data_with_their_floor_overridden() {
+    let Some(mesh) = rt_testkit::data::file("scenes/sponza-dabrovic/sponza.obj") else {
+        return;
+    };
+    for (scene, hardness) in [("sponza-glossy.toml", 0.3), ("sponza-mirror.toml", 1.0)] {
+        let path = rt_testkit::workspace_root()
+            .join("scenes/shared-data")
+            .join(scene);
+        let loaded = rt_scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let s = &loaded.scene;
+        let sponza = s.objects.iter().find(|o| o.name == "sponza").unwrap();
+        assert_eq!(sponza.count, fan_triangles(&mesh), "{scene}");
+        // The assigned range is the ground floor: eight triangles at y = 0.09 facing up,
+        // together 32.4 m x 14.4 m.
+        let floor = sponza.first + 10686..sponza.first + 10694;
+        let mut area = 0.0;
+        for t in floor.clone() {
+            let v = s.triangles[t as usize];
+            assert!(
+                v.iter().all(|p| (p.y - 0.09).abs() < 0.01),
+                "{scene}: {v:?}"
+            );
+            assert!(normal(&v).y > 0.99, "{scene}: triangle {t} faces down");
+            area += 0.5 * (v[1] - v[0]).cross(v[2] - v[0]).length();
+            let m = s.material_of(t);
+            assert_eq!(m.name, "floor", "{scene}");
+            let h = m.layers.iter().map(|l| l.hardness).fold(0.0, f32::max);
+            assert_eq!(h, hardness, "{scene}");
+        }
+        // The bounds above are rounded to 0.1 m: 1 % slack.
+        assert!(
+            (area / (32.4 * 14.4) - 1.0).abs() < 0.01,
+            "{scene}: floor area {area}"
+        );
+        assert_eq!(
+            s.material_of(floor.end).name,
+            "stone",
+            "{scene}: the range spills over"
+        );
+        assert!(!s.lights().is_empty(), "{scene}");
+        camera_named(s, "fixed");
+        assert_eq!(s.camera_motions.len(), 1, "{scene}: the fly-through");
+    }
+}
