@@ -141,6 +141,41 @@ fn a_tiny_sequence_experiment_writes_per_frame_and_temporal_metrics() {
         assert_eq!(value(row, "relmse"), m.relmse, "{}", still.exr);
         assert!(out.join(&still.file).exists());
     }
+    // The stills are the frames one SequenceRenderer makes rendering the frames in order (so
+    // SVGF's history carried from frame to frame), at the pair's settings and size.
+    for (pi, pair) in plan.pairs.iter().enumerate() {
+        let scene = &plan.scenes[pair.scene];
+        let method = &plan.methods[pair.method];
+        let seq = scene.sequence.as_ref().unwrap();
+        let rt_experiment::config::Runs::Sequence { spp } = method.runs else {
+            panic!("{pi}")
+        };
+        let mut renderer = rt_session::SequenceRenderer::new(
+            pair.estimator.build(),
+            pair.accel,
+            method.temporal.as_ref().map(|t| t.build().unwrap()),
+            None,
+            spp,
+            pair.seed,
+            seq.fps,
+        )
+        .unwrap();
+        let mut moving = scene.loaded.scene.clone();
+        for f in seq.frames.clone() {
+            moving.set_time((f64::from(f) / seq.fps) as f32);
+            let camera =
+                rt_session::ImageSize::Pixels(16, 12).apply(moving.cameras.first().unwrap());
+            let frame = renderer.render_with(&mut moving, f, Some(&camera)).unwrap();
+            if let Some(still) = results
+                .stills
+                .iter()
+                .find(|s| s.scene == pair.scene && s.method == method.name && s.frame == f)
+            {
+                let written = rt_film::read_rgb(&out.join(&still.exr)).unwrap();
+                assert!(written == frame.image, "{} differs", still.exr);
+            }
+        }
+    }
     // First, middle and last frames of every method and of the reference.
     let frames_of = |scene: usize, method: &str| -> Vec<u32> {
         results
