@@ -95,9 +95,16 @@ pub fn run(args: &ExperimentArgs) -> Result<()> {
             ));
         }
     }
+    let runs = match &outcome.sequences {
+        Some(s) => format!(
+            "{} frames of {} sequences",
+            s.frames.len(),
+            s.sequences.len()
+        ),
+        None => format!("{} runs", outcome.results.rows.len()),
+    };
     progress.message(&format!(
-        "{} runs in {:.1} s; to look at them, open {}",
-        outcome.results.rows.len(),
+        "{runs} in {:.1} s; to look at them, open {}",
         wall.elapsed().as_secs_f64(),
         outcome.html.display()
     ));

@@ -330,6 +330,7 @@ fn shipped_configs_are_valid() {
         "configs/accel.toml",
         "configs/light-transport.toml",
         "configs/stopping.toml",
+        "configs/temporal.toml",
     ];
     // Its last two scenes read meshes from ../shared/data (CI has it; elsewhere the file is
     // skipped with a line saying so, and RT_REQUIRE_DATA=1 makes a missing folder a failure).
@@ -354,14 +355,17 @@ fn shipped_configs_are_valid() {
     }
     // The OIDN comparison needs a build with the `oidn` feature; without it the file is
     // refused with a line saying so, not half run.
-    let out = Command::new(env!("CARGO_BIN_EXE_render"))
-        .current_dir(&root)
-        .args(["experiment", "configs/denoise-oidn.toml", "--check"])
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(err.contains("'oidn' is not in this build"), "{err}");
+    for name in ["configs/denoise-oidn.toml", "configs/temporal-oidn.toml"] {
+        let out = Command::new(env!("CARGO_BIN_EXE_render"))
+            .current_dir(&root)
+            .args(["experiment", name, "--check"])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{name}: {err}");
+        assert!(err.contains("'oidn' is not in this build"), "{name}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{name}: {err}");
+    }
     // A bad file still fails under --check.
     let dir = tempfile::tempdir().unwrap();
     let bad = dir.path().join("bad.toml");

@@ -6,12 +6,13 @@ use crate::{ExperimentError, Result as CrateResult};
 use rt_accel::AccelSpec;
 use rt_core::Camera;
 use rt_denoise::DenoiserSpec;
-use rt_film::read_rgb;
+use rt_film::{read_rgb, AovSet};
 use rt_integrators::spec::{check_ao_distance, check_max_depth};
 use rt_integrators::IntegratorSpec;
 use rt_metrics::RgbImage;
 use rt_scene::LoadedScene;
 use rt_session::{pick_camera, Budgets, ImageSize, Overrides, StopRule, MAX_SPP};
+use rt_temporal::TemporalSpec;
 use serde::de::{self, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 use std::collections::HashSet;
@@ -54,6 +55,9 @@ struct SceneDesc {
     resolution: Option<[u32; 2]>,
     scale: Option<f64>,
     reference: Option<ReferenceDesc>,
+    frames: Option<[u32; 2]>,
+    fps: Option<f64>,
+    event: Option<u32>,
 }
 
 /// `reference = "file.exr"` or `reference = { spp = 4096, ... }`.
@@ -174,6 +178,13 @@ pub struct Plan {
     pub warnings: Vec<String>,
 }
 
+impl Plan {
+    /// True for a sequence experiment (every scene has `frames`; methods render frames).
+    pub fn is_sequence(&self) -> bool {
+        self.scenes.iter().any(|s| s.sequence.is_some())
+    }
+}
+
 /// One scene of the grid.
 pub struct ScenePlan {
     /// Short name (file names, report).
@@ -186,6 +197,47 @@ pub struct ScenePlan {
     pub camera: Camera,
     /// Where the reference comes from.
     pub reference: ReferencePlan,
+    /// For a sequence scene (`frames = [A, B]`): which frames, at what rate, and how the
+    /// camera is found again after the scene moves.
+    pub sequence: Option<SequencePlan>,
+}
+
+/// The frames of a sequence scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SequencePlan {
+    /// Frames `A..B` (half-open, at least two).
+    pub frames: std::ops::Range<u32>,
+    /// Frames per second: frame `f` is at time `f / fps`.
+    pub fps: f64,
+    /// A frame where something changes (a light toggles); the lag is measured from it. Inside
+    /// `frames`, after the first.
+    pub event: Option<u32>,
+    /// The camera's name (`None`: the scene's first), looked up again at every frame's time
+    /// because cameras may move.
+    pub camera: Option<String>,
+    /// The image size applied to the camera at every frame.
+    pub size: ImageSize,
+}
+
+impl SequencePlan {
+    /// How many frames.
+    pub fn len(&self) -> usize {
+        self.frames.len()
+    }
+
+    /// True when there are none (never, for a validated plan).
+    pub fn is_empty(&self) -> bool {
+        self.frames.is_empty()
+    }
+
+    /// The camera of frame `f` (the scene already moved to the frame's time), resized.
+    pub fn camera_of(&self, scene: &rt_core::Scene) -> Option<Camera> {
+        let c = match &self.camera {
+            Some(name) => scene.cameras.iter().find(|c| &c.name == name)?,
+            None => scene.cameras.first()?,
+        };
+        Some(self.size.apply(c))
+    }
 }
 
 /// A scene's reference.
@@ -222,6 +274,9 @@ pub struct MethodPlan {
     /// GREE (`gree = "OPTIONS"`, `bank = [...]`): each `spp` budget is GREE's budget b, spent
     /// on its noisy image and its filter caches ([`rt_session::render_gree`]).
     pub gree: Option<GreePlan>,
+    /// A sequence method's denoiser (`denoiser = "svgf[:options]"` or any single-frame spec,
+    /// run per frame), already checked to build. Image experiments use [`MethodPlan::denoiser`].
+    pub temporal: Option<TemporalSpec>,
 }
 
 /// A GREE method's settings, checked at load.
@@ -244,6 +299,12 @@ pub enum Runs {
     /// `time_limit`, with `spp` as the cap (default [`MAX_SPP`]). In the order written
     /// (sorted: the largest error first, then the shortest time).
     Adaptive(Vec<StopRule>),
+    /// A sequence experiment's method: every frame rendered at `spp` samples per pixel
+    /// ([`rt_session::SequenceRenderer`]).
+    Sequence {
+        /// Samples per pixel per frame.
+        spp: u32,
+    },
 }
 
 impl Runs {
@@ -252,6 +313,7 @@ impl Runs {
         match self {
             Runs::Progressive(b) => b.len(),
             Runs::Adaptive(v) => v.len(),
+            Runs::Sequence { .. } => 1,
         }
     }
 
@@ -264,7 +326,7 @@ impl Runs {
     pub fn budgets(&self) -> Option<&Budgets> {
         match self {
             Runs::Progressive(b) => Some(b),
-            Runs::Adaptive(_) => None,
+            Runs::Adaptive(_) | Runs::Sequence { .. } => None,
         }
     }
 }
@@ -417,7 +479,11 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
             pick_camera(&loaded.scene, &scene_path, s.camera.as_deref())
                 .map_err(|e| format!("{here}: {e}"))?,
         );
+        let sequence = sequence_plan(&s, size, &here)?;
         let reference = match s.reference {
+            Some(ReferenceDesc::File(_)) if sequence.is_some() => bail!(
+                "{here}: a sequence's reference is rendered frame by frame: give reference = {{ spp = N }}, not an image file"
+            ),
             None => bail!(
                 "{here}: no reference (reference = {{ spp = N }} or reference = \"image.exr\")"
             ),
@@ -480,8 +546,20 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
             loaded,
             camera,
             reference,
+            sequence,
         });
     }
+    if let (Some(seq), Some(still)) = (
+        scenes.iter().find(|s| s.sequence.is_some()),
+        scenes.iter().find(|s| s.sequence.is_none()),
+    ) {
+        bail!(
+            "[[scene]] \"{}\" has no frames but [[scene]] \"{}\" is a sequence: an experiment's scenes are all sequences (frames = [A, B]) or all single images",
+            still.name,
+            seq.name
+        );
+    }
+    let sequences = scenes.iter().any(|s| s.sequence.is_some());
 
     let mut methods = Vec::new();
     let mut method_overrides = Vec::new();
@@ -497,7 +575,9 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
             bail!("{here}: two methods are named \"{}\"", m.name);
         }
         let at = |e: String| format!("{here}: {e}");
-        let runs = if m.error.is_some() || m.time_limit.is_some() {
+        let runs = if sequences {
+            sequence_runs(&m).map_err(at)?
+        } else if m.error.is_some() || m.time_limit.is_some() {
             Runs::Adaptive(
                 stop_rules(m.error, m.time_limit, m.spp, m.seconds.is_some()).map_err(at)?,
             )
@@ -536,12 +616,13 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
                 }
             }
         }
-        let denoiser = m
-            .denoiser
-            .as_deref()
-            .map(parse_denoiser)
-            .transpose()
-            .map_err(at)?;
+        let (denoiser, temporal) = if sequences {
+            let t = m.denoiser.as_deref().map(parse_temporal).transpose();
+            (None, t.map_err(at)?)
+        } else {
+            let d = m.denoiser.as_deref().map(parse_denoiser).transpose();
+            (d.map_err(at)?, None)
+        };
         let gree = match (m.gree, m.bank) {
             (None, None) => None,
             (None, Some(_)) => bail!("{here}: bank is GREE's filter bank: it needs gree = \"...\""),
@@ -570,6 +651,7 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
             runs,
             denoiser,
             gree,
+            temporal,
         });
         method_overrides.push(overrides);
         method_scenes.push(m.scenes);
@@ -589,6 +671,19 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
             let here =
                 |e: rt_session::SettingsError| format!("[[method]] \"{}\": {e}", method.name);
             let estimator = o.integrator_spec(desc, &scene.path).map_err(here)?;
+            if let Some(t) = &method.temporal {
+                let reads_split = t
+                    .build()
+                    .is_ok_and(|d| AovSet::for_channels(d.needs()).any_split());
+                let technique = estimator.build();
+                if reads_split && !technique.writes_split() {
+                    bail!(
+                        "[[method]] \"{}\": denoiser = \"{t}\" reads the lighting split (direct, indirect, emission), which the {} technique does not write",
+                        method.name,
+                        technique.name()
+                    );
+                }
+            }
             if let ReferencePlan::Render { estimator: r, .. } = &scene.reference {
                 if r.target() != estimator.target() {
                     warnings.push(format!(
@@ -623,6 +718,85 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
         pairs,
         warnings,
     })
+}
+
+/// Longest sequence accepted, in frames: a typo beyond it.
+const MAX_FRAMES: u32 = 100_000;
+
+/// The frames of a scene with `frames = [A, B]` (`fps` and `event` only with them).
+fn sequence_plan(s: &SceneDesc, size: ImageSize, here: &str) -> Result<Option<SequencePlan>> {
+    let Some([a, b]) = s.frames else {
+        for (key, given) in [("fps", s.fps.is_some()), ("event", s.event.is_some())] {
+            if given {
+                bail!("{here}: {key} belongs to a sequence: give frames = [A, B] too");
+            }
+        }
+        return Ok(None);
+    };
+    if a >= b {
+        bail!("{here}: frames = [{a}, {b}]: the first frame must come before the end (frames = [A, B] renders A, A + 1, ..., B - 1)");
+    }
+    if b - a < 2 {
+        bail!("{here}: frames = [{a}, {b}]: a sequence needs at least two frames for its temporal metrics");
+    }
+    if b - a > MAX_FRAMES {
+        bail!("{here}: frames = [{a}, {b}]: at most {MAX_FRAMES} frames");
+    }
+    let fps = s.fps.unwrap_or(24.0);
+    if !(fps.is_finite() && fps > 0.0 && fps <= 1000.0) {
+        bail!("{here}: fps must be in (0, 1000], got {fps}");
+    }
+    if let Some(e) = s.event {
+        if !(a < e && e < b) {
+            bail!("{here}: event = {e} must be a frame after the first and before the end of frames = [{a}, {b}] (the lag's steady state is measured before it)");
+        }
+    }
+    Ok(Some(SequencePlan {
+        frames: a..b,
+        fps,
+        event: s.event,
+        camera: s.camera.clone(),
+        size,
+    }))
+}
+
+/// A sequence method's samples per frame; the budget keys of image experiments are refused.
+fn sequence_runs(m: &MethodDesc) -> Result<Runs> {
+    for (key, given) in [
+        ("seconds", m.seconds.is_some()),
+        ("error", m.error.is_some()),
+        ("time_limit", m.time_limit.is_some()),
+        ("gree", m.gree.is_some()),
+        ("bank", m.bank.is_some()),
+    ] {
+        if given {
+            bail!("{key} is not for sequences: a sequence method renders spp = N samples per pixel in every frame");
+        }
+    }
+    let spp = match m.spp.as_ref().map(|s| match s {
+        OneOrMany::One(n) => vec![*n],
+        OneOrMany::Many(v) => v.clone(),
+    }) {
+        None => bail!("no spp: a sequence method needs spp = N (samples per pixel per frame)"),
+        Some(v) => match v.as_slice() {
+            &[n] if (1..=MAX_SPP).contains(&n) => n,
+            &[n] => bail!("spp must be between 1 and {MAX_SPP}, got {n}"),
+            v => bail!(
+                "spp is the samples per pixel of every frame of a sequence: give one value, not a list of {}",
+                v.len()
+            ),
+        },
+    };
+    Ok(Runs::Sequence { spp })
+}
+
+/// Parses a sequence denoiser (`svgf[:options]` or a single-frame spec run per frame) and
+/// builds it once, so bad options are found at load.
+fn parse_temporal(s: &str) -> Result<TemporalSpec, String> {
+    let at = |e: &dyn fmt::Display| format!("denoiser = \"{s}\": {e}");
+    let spec = s.parse::<TemporalSpec>().map_err(|e| at(&e))?;
+    spec.build().map_err(|e| at(&e))?;
+    Ok(spec)
 }
 
 /// The budgets of a progressive method: `spp = [...]` or `seconds = [...]`.
@@ -1023,6 +1197,136 @@ seconds = [0.5, 0.1]
             e.contains("[[method]] \"b\": seconds are the budgets"),
             "{e}"
         );
+    }
+
+    const SEQUENCE: &str = r#"
+[[scene]]
+path = "scenes/s.toml"
+resolution = [16, 12]
+frames = [0, 60]
+event = 30
+reference = { spp = 16 }
+
+[[method]]
+name = "a"
+spp = 1
+denoiser = "svgf:reflections=drop"
+
+[[method]]
+name = "b"
+spp = [2]
+denoiser = "atrous"
+
+[[method]]
+name = "c"
+spp = 1
+"#;
+
+    #[test]
+    fn sequence_configs_resolve() {
+        let p = plan(SEQUENCE).unwrap();
+        assert!(p.is_sequence());
+        let seq = p.scenes[0].sequence.as_ref().unwrap();
+        assert_eq!(
+            (seq.frames.clone(), seq.fps, seq.event),
+            (0..60, 24.0, Some(30))
+        );
+        assert_eq!(p.methods[0].runs, Runs::Sequence { spp: 1 });
+        assert_eq!(p.methods[1].runs, Runs::Sequence { spp: 2 });
+        let temporal: Vec<Option<bool>> = p
+            .methods
+            .iter()
+            .map(|m| m.temporal.as_ref().map(TemporalSpec::is_temporal))
+            .collect();
+        assert_eq!(temporal, [Some(true), Some(false), None]);
+        assert!(p.methods.iter().all(|m| m.denoiser.is_none()));
+        let camera = seq.camera_of(&p.scenes[0].loaded.scene).unwrap();
+        assert_eq!((camera.width, camera.height), (16, 12));
+        assert!(!plan(GOOD).unwrap().is_sequence());
+    }
+
+    #[test]
+    fn bad_sequence_configs_are_one_clear_line() {
+        let mixed = format!(
+            "{SEQUENCE}\n[[scene]]\nname = \"plain\"\npath = \"scenes/s.toml\"\nreference = {{ spp = 4 }}\n"
+        );
+        let cases = [
+            (
+                mixed,
+                "[[scene]] \"plain\" has no frames but [[scene]] \"s\" is a sequence",
+            ),
+            (
+                SEQUENCE.replace("spp = [2]", "spp = [2, 4]"),
+                "[[method]] \"b\": spp is the samples per pixel of every frame of a sequence: give one value, not a list of 2",
+            ),
+            (
+                SEQUENCE.replace("spp = [2]", "seconds = [1.0]"),
+                "[[method]] \"b\": seconds is not for sequences",
+            ),
+            (
+                SEQUENCE.replace("spp = [2]", "spp = 2\nerror = 0.01"),
+                "error is not for sequences",
+            ),
+            (
+                SEQUENCE.replace("spp = [2]", "spp = 2\ntime_limit = 1"),
+                "time_limit is not for sequences",
+            ),
+            (
+                SEQUENCE.replace("spp = [2]\ndenoiser = \"atrous\"", "spp = 2\ngree = \"sparsity=0.9\""),
+                "gree is not for sequences",
+            ),
+            (SEQUENCE.replace("spp = [2]", ""), "[[method]] \"b\": no spp"),
+            (SEQUENCE.replace("spp = [2]", "spp = 0"), "spp must be between 1 and"),
+            (
+                SEQUENCE.replace("frames = [0, 60]", "frames = [60, 0]"),
+                "[[scene]] \"s\": frames = [60, 0]: the first frame must come before the end",
+            ),
+            (
+                SEQUENCE.replace("frames = [0, 60]", "frames = [3, 4]"),
+                "at least two frames",
+            ),
+            (
+                SEQUENCE.replace("event = 30", "event = 0"),
+                "event = 0 must be a frame after the first",
+            ),
+            (
+                SEQUENCE.replace("event = 30", "event = 60"),
+                "event = 60 must be a frame after the first and before the end",
+            ),
+            (
+                SEQUENCE.replace("event = 30", "fps = 0"),
+                "fps must be in (0, 1000], got 0",
+            ),
+            (
+                GOOD.replace("scale = 0.5", "scale = 0.5\nevent = 3"),
+                "event belongs to a sequence: give frames = [A, B] too",
+            ),
+            (
+                SEQUENCE.replace("{ spp = 16 }", "\"r.exr\""),
+                "a sequence's reference is rendered frame by frame",
+            ),
+            (
+                SEQUENCE.replace("svgf:reflections=drop", "svgf:alpha=2"),
+                "[[method]] \"a\": denoiser = \"svgf:alpha=2\": ",
+            ),
+            (
+                SEQUENCE.replace("svgf:reflections=drop", "svgf:colour=1"),
+                "colour",
+            ),
+            (
+                SEQUENCE.replace("denoiser = \"svgf:reflections=drop\"", "denoiser = \"svgf\"\nintegrator = \"ao\""),
+                "reads the lighting split (direct, indirect, emission), which the",
+            ),
+        ];
+        for (config, needle) in cases {
+            let e = error(&config);
+            assert!(e.contains(needle), "{needle:?} not in {e:?}");
+        }
+        // OIDN per frame is refused in a build without it, as for images.
+        if "oidn".parse::<DenoiserSpec>().is_err() {
+            let e = error(&SEQUENCE.replace("\"atrous\"", "\"oidn\""));
+            assert!(e.contains("'oidn' is not in this build"), "{e}");
+        }
     }
 
     #[test]

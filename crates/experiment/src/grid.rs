@@ -363,6 +363,12 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
                     },
                 )?;
             }
+            Runs::Sequence { .. } => {
+                return Err(ExperimentError::Run(format!(
+                    "{}: a sequence method runs in a sequence experiment (crate::sequence)",
+                    method.name
+                )))
+            }
             Runs::Adaptive(rules) => {
                 let pixels = (scene.camera.width as f64 * scene.camera.height as f64).max(1.0);
                 for (i, rule) in rules.iter().enumerate() {

@@ -17,6 +17,11 @@
 //!   images).
 //! - A method may name a denoiser (`rt-denoise`); its images are denoised after each budget
 //!   and measured as denoised, with the noisy error and the denoising time kept beside.
+//! - [`sequence`] and [`seqreport`]: sequence experiments (scenes with `frames = [A, B]`):
+//!   every method renders the frames in order (`rt_session::SequenceRenderer`, denoised by
+//!   SVGF or a per-frame denoiser), each frame measured against its own reference frame, with
+//!   the temporal metrics of `rt_metrics::temporal`; frames.csv, sequences.csv, plots over
+//!   frames, stills.
 //!
 //! [`run`] does all of it into one output folder.
 //!
@@ -45,6 +50,8 @@ pub mod html;
 pub mod plot;
 pub mod reference;
 pub mod report;
+pub mod seqreport;
+pub mod sequence;
 pub mod views;
 
 pub use cache::{Cache, ReferenceRequest, CACHE_VERSION, DEFAULT_CACHE_DIR};
@@ -139,6 +146,8 @@ pub struct Outcome {
     pub report: PathBuf,
     /// The HTML report (inside the output folder).
     pub html: PathBuf,
+    /// A sequence experiment's measurements (then `results` holds no rows).
+    pub sequences: Option<sequence::SequenceResults>,
 }
 
 /// Runs `plan` (its file is copied beside the results) into the folder `out`
@@ -148,6 +157,44 @@ pub struct Outcome {
 pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> Result<Outcome> {
     let wall = Instant::now();
     let (y, mo, d, h, mi, _) = utc(now_secs());
+    if plan.is_sequence() {
+        let results = sequence::run(plan, out, cache, progress)?;
+        seqreport::plots(plan, &results, out)?;
+        rt_film::write_bytes_atomic(
+            &out.join("frames.csv"),
+            seqreport::frames_csv(plan, &results).as_bytes(),
+        )?;
+        rt_film::write_bytes_atomic(
+            &out.join("sequences.csv"),
+            seqreport::sequences_csv(plan, &results).as_bytes(),
+        )?;
+        rt_film::copy_atomic(&plan.path, &out.join("config.toml"))?;
+        let info = report::RunInfo {
+            started: format!("{y:04}-{mo:02}-{d:02} {h:02}:{mi:02}"),
+            threads: rayon::current_num_threads(),
+            wall_seconds: wall.elapsed().as_secs_f64(),
+        };
+        let report = out.join("report.md");
+        rt_film::write_bytes_atomic(
+            &report,
+            seqreport::markdown(plan, &results, &info).as_bytes(),
+        )?;
+        let html = out.join("report.html");
+        rt_film::write_bytes_atomic(&html, seqreport::html(plan, &results, &info).as_bytes())?;
+        return Ok(Outcome {
+            results: grid::Results {
+                references: Vec::new(),
+                rows: Vec::new(),
+                finals: Vec::new(),
+                noisy_finals: Vec::new(),
+            },
+            equal_time: Vec::new(),
+            equal_samples: Vec::new(),
+            report,
+            html,
+            sequences: Some(results),
+        });
+    }
     let results = grid::run(plan, out, cache, progress)?;
     let slopes = report::slopes(plan, &results);
     let equal_time = report::equal_time(plan, &results);
@@ -197,6 +244,7 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
         equal_samples,
         report,
         html,
+        sequences: None,
     })
 }
 

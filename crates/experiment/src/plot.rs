@@ -64,12 +64,26 @@ fn register_font() {
 
 /// Writes the chart as a PNG and an SVG, each atomically.
 pub fn write(chart: &Chart<'_>, png: &Path, svg: &Path) -> Result<()> {
+    write_scaled(chart, png, svg, false)
+}
+
+/// Writes the chart with a linear x axis (frame numbers; `x_base` unused) and a log y axis,
+/// as a PNG and an SVG, each atomically.
+pub fn write_linear_x(chart: &Chart<'_>, png: &Path, svg: &Path) -> Result<()> {
+    write_scaled(chart, png, svg, true)
+}
+
+fn write_scaled(chart: &Chart<'_>, png: &Path, svg: &Path, linear_x: bool) -> Result<()> {
     register_font();
     let (w, h) = SIZE;
     let mut rgb = vec![0u8; w as usize * h as usize * 3];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, SIZE).into_drawing_area();
-        draw(&root, chart).map_err(plot_error(png))?;
+        if linear_x {
+            draw_linear_x(&root, chart).map_err(plot_error(png))?;
+        } else {
+            draw(&root, chart).map_err(plot_error(png))?;
+        }
         root.present().map_err(plot_error(png))?;
     }
     let mut bytes = Vec::new();
@@ -86,7 +100,11 @@ pub fn write(chart: &Chart<'_>, png: &Path, svg: &Path) -> Result<()> {
     let mut text = String::new();
     {
         let root = SVGBackend::with_string(&mut text, SIZE).into_drawing_area();
-        draw(&root, chart).map_err(plot_error(svg))?;
+        if linear_x {
+            draw_linear_x(&root, chart).map_err(plot_error(svg))?;
+        } else {
+            draw(&root, chart).map_err(plot_error(svg))?;
+        }
         root.present().map_err(plot_error(svg))?;
     }
     Ok(rt_film::write_bytes_atomic(svg, text.as_bytes())?)
@@ -183,6 +201,70 @@ fn draw<DB: DrawingBackend>(
                 PathElement::new(vec![(x, y), (x + 22, y)], colour.stroke_width(2))
             });
         c.draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))?;
+    }
+    c.configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .label_font(("sans-serif", 14))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK.mix(0.4))
+        .draw()?;
+    Ok(())
+}
+
+/// [`draw`] with a linear x axis: error over frames. Points with a non-positive y are left out
+/// (log y axis); lines have no markers (sequences have many points).
+fn draw_linear_x<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    chart: &Chart<'_>,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    root.fill(&WHITE)?;
+    let pts = || {
+        chart
+            .series
+            .iter()
+            .flat_map(|s| s.points.iter())
+            .filter(|p| p.0.is_finite() && p.1 > 0.0 && p.1.is_finite())
+    };
+    let (x0, x1) = pts().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+        (lo.min(p.0), hi.max(p.0))
+    });
+    let (x0, x1) = if x0 < x1 {
+        (x0, x1)
+    } else if x0.is_finite() {
+        (x0 - 1.0, x0 + 1.0)
+    } else {
+        (0.0, 1.0)
+    };
+    let (y0, y1) = span(pts().map(|p| p.1));
+    let mut c = ChartBuilder::on(root)
+        .caption(chart.title, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(44)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x0..x1, (y0..y1).log_scale())?;
+    c.configure_mesh()
+        .x_desc(chart.x_label)
+        .y_desc(chart.y_label)
+        .x_label_formatter(&|v| tick(*v))
+        .y_label_formatter(&|v| tick(*v))
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 16))
+        .light_line_style(RGBColor(235, 235, 235))
+        .bold_line_style(RGBColor(200, 200, 200))
+        .draw()?;
+    for (i, s) in chart.series.iter().enumerate() {
+        let colour = COLOURS[i % COLOURS.len()];
+        let points: Vec<(f64, f64)> = s
+            .points
+            .iter()
+            .copied()
+            .filter(|p| p.0.is_finite() && p.1 > 0.0 && p.1.is_finite())
+            .collect();
+        c.draw_series(LineSeries::new(points, colour.stroke_width(2)))?
+            .label(s.name.as_str())
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 22, y)], colour.stroke_width(2))
+            });
     }
     c.configure_series_labels()
         .position(SeriesLabelPosition::UpperRight)
