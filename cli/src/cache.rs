@@ -2,9 +2,9 @@
 //! `rt-worldcache` behind the integrators' [`RadianceCache`] seam. One cache lives for the
 //! whole job, so it carries over from pass to pass and from frame to frame of a sequence.
 
-use anyhow::{anyhow, Result};
+use anyhow::{anyhow, bail, Result};
 use rt_core::{Rgb, Scene};
-use rt_integrators::RadianceCache;
+use rt_integrators::{IntegratorSpec, RadianceCache, Technique};
 use rt_worldcache::{AnyPoints, CacheSpec, WorldCache};
 use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 use std::sync::{Arc, RwLock};
@@ -45,6 +45,36 @@ pub fn build(text: &str, scene: &Scene) -> Result<Arc<SharedCache>> {
         table_full: AtomicU64::new(0),
         spec: spec.to_string(),
     }))
+}
+
+/// The job's cache for `--cache TEXT` (`None` without the flag), refused with one line when
+/// `integrator` cannot use one.
+pub fn for_job(
+    text: Option<&str>,
+    integrator: &IntegratorSpec,
+    scene: &Scene,
+) -> Result<Option<Arc<dyn RadianceCache>>> {
+    let Some(text) = text else {
+        return Ok(None);
+    };
+    let c: Arc<dyn RadianceCache> = build(text, scene)?;
+    if integrator.build_cached(c.clone()).is_none() {
+        bail!("--cache {text}: the {integrator} technique cannot use a cache (path, path-bsdf or ao can)");
+    }
+    Ok(Some(c))
+}
+
+/// `integrator` built over `cache` when there is one (which [`for_job`] checked it takes).
+pub fn technique(
+    integrator: &IntegratorSpec,
+    cache: Option<Arc<dyn RadianceCache>>,
+) -> Result<Box<dyn Technique>> {
+    match cache {
+        Some(c) => integrator
+            .build_cached(c)
+            .ok_or_else(|| anyhow!("--cache: the {integrator} technique cannot use a cache")),
+        None => Ok(integrator.build()),
+    }
 }
 
 impl RadianceCache for SharedCache {

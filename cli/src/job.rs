@@ -152,19 +152,7 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let pool = pool.build().context("cannot start worker threads")?;
     // One cache for the whole job: it persists across passes and frames.
-    let cache: Option<Arc<dyn RadianceCache>> = match &args.cache {
-        None => None,
-        Some(text) => {
-            let c = crate::cache::build(text, &scene)?;
-            if job.settings.integrator.build_cached(c.clone()).is_none() {
-                bail!(
-                    "--cache {text}: the {} technique cannot use a cache (path, path-bsdf or ao can)",
-                    job.settings.integrator
-                );
-            }
-            Some(c)
-        }
-    };
+    let cache = crate::cache::for_job(args.cache.as_deref(), &job.settings.integrator, &scene)?;
     let (pattern, seed) = (job.output.clone(), job.settings.seed);
     let mut accel: Option<Box<dyn Accel>> = None;
     for frame in frames {
@@ -273,15 +261,7 @@ fn render_one(
     let load_secs = load_time.as_secs_f64();
     let camera = pick_camera(scene, &job.scene_path, job.camera.as_deref())?;
     let build_secs = build_time.as_secs_f64();
-    let integrator = match cache {
-        // Checked in `run`: the technique takes a cache.
-        Some(c) => job
-            .settings
-            .integrator
-            .build_cached(c)
-            .ok_or_else(|| anyhow::anyhow!("--cache: the technique cannot use a cache"))?,
-        None => job.settings.integrator.build(),
-    };
+    let integrator = crate::cache::technique(&job.settings.integrator, cache)?;
     let ctx = Ctx {
         scene,
         accel,

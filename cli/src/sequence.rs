@@ -51,8 +51,10 @@ pub fn run(
         pool = pool.num_threads(t);
     }
     let pool = pool.build().context("cannot start worker threads")?;
+    // One cache for the sequence, as for a plain job: it carries over from frame to frame.
+    let cache = crate::cache::for_job(args.cache.as_deref(), &job.settings.integrator, scene)?;
     let mut renderer = SequenceRenderer::new(
-        job.settings.integrator.build(),
+        crate::cache::technique(&job.settings.integrator, cache)?,
         job.settings.accel,
         Some(denoiser),
         job.camera.clone(),

@@ -1,5 +1,5 @@
 //! `render --cache`: a cached render is the same image for any thread count, a cache carries
-//! over a sequence's frames, and bad options give one error line naming the option.
+//! over a sequence's frames (SVGF's too), and bad options give one error line naming the option.
 
 mod common;
 
@@ -141,6 +141,59 @@ fn cached_renders_do_not_depend_on_the_thread_count() {
         .filter_map(|l| l.split(": ").nth(1)?.split(" passes").next())
         .collect();
     assert_eq!(passes, ["2", "4"], "{stats}");
+}
+
+#[test]
+fn a_temporally_denoised_sequence_uses_the_cache() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    scene(dir);
+    let run = |extra: &[&str], out: &str| {
+        let mut args = vec![
+            "s.toml",
+            "--spp",
+            "4",
+            "--frames",
+            "0..3",
+            "--denoiser",
+            "svgf",
+            "-q",
+            "-o",
+            out,
+        ];
+        args.extend_from_slice(extra);
+        let o = render(dir, &args);
+        assert!(o.status.success(), "{args:?}: {o:?}");
+    };
+    run(&["--cache", "worldspace:lod=4"], "c_{frame}.exr");
+    run(&[], "p_{frame}.exr");
+    let (c, p) = (pixels(&dir.join("c_2.exr")), pixels(&dir.join("p_2.exr")));
+    assert!(c.iter().all(|v| v.is_finite()));
+    assert_ne!(
+        c, p,
+        "--cache must not be ignored by a temporal denoiser's sequence"
+    );
+    // A technique without a cache is refused there as in a plain render.
+    let o = render(
+        dir,
+        &[
+            "s.toml",
+            "--spp",
+            "1",
+            "--frames",
+            "0..2",
+            "--denoiser",
+            "svgf",
+            "--integrator",
+            "direct",
+            "--cache",
+            "worldspace",
+            "-o",
+            "x_{frame}.exr",
+        ],
+    );
+    let e = one_error_line(&o);
+    assert!(e.contains("--cache worldspace"), "{e}");
 }
 
 #[test]
