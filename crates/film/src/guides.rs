@@ -65,6 +65,11 @@ pub struct ReflectedGuides {
     pub albedo: Image<Rgb>,
     /// Unit direction of the representative ray from the primary hit (zero where not specular).
     pub direction: Image<Vec3>,
+    /// For a pure mirror: the light the end of its chain sends back along it (an emitter's
+    /// emission, or the environment where the chain escapes) times the mirror albedos on the
+    /// way; zero elsewhere. It has no albedo to be demodulated by, so SVGF adds it back as it
+    /// does the primary hit's emission instead of filtering it.
+    pub emission: Image<Rgb>,
 }
 
 impl GuideBuffers {

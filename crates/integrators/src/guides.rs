@@ -112,6 +112,7 @@ struct Texel {
     r_distance: f32,
     r_albedo: Rgb,
     r_direction: Vec3,
+    r_emission: Rgb,
 }
 
 /// A surface hit along a guide ray: where, facing which way, what it reflects.
@@ -177,6 +178,7 @@ pub fn render_guides(
         distance: plane(&texels, w, h, |t| t.r_distance),
         albedo: plane(&texels, w, h, |t| t.r_albedo),
         direction: plane(&texels, w, h, |t| t.r_direction),
+        emission: plane(&texels, w, h, |t| t.r_emission),
     });
     GuideBuffers {
         depth: plane(&texels, w, h, |t| t.depth),
@@ -286,6 +288,9 @@ fn reflected(
         let Some(hit) = trace(ctx, &ray) else {
             // The reflection escapes: nothing to reproject by.
             t.r_albedo = albedo;
+            if mirror {
+                t.r_emission = albedo * ctx.scene.environment.radiance(ray.dir.normalize());
+            }
             return;
         };
         distance += hit.t;
@@ -299,6 +304,9 @@ fn reflected(
         t.r_normal = hit.normal;
         t.r_distance = distance;
         t.r_albedo = albedo * hit.albedo;
+        if mirror {
+            t.r_emission = albedo * m.emitted(hit.si.ng, -ray.dir.normalize());
+        }
         return;
     }
     t.r_albedo = albedo;

@@ -5,9 +5,9 @@
 //! floor with parallax.
 
 use rt_core::glam::{Vec2, Vec3};
-use rt_core::{Camera, Image, Material, Rgb, RgbImage, Scene};
-use rt_film::GuideBuffers;
-use rt_integrators::{render_guides, Ctx, GuideOptions, PreviousView};
+use rt_core::{Camera, Image, Material, Rgb, RgbImage, SampleStream, Scene};
+use rt_film::{AovSet, Channel, Film, FilmBuffers, GuideBuffers, NoisyFrame};
+use rt_integrators::{render_guides, Ctx, GuideOptions, PreviousView, SamplePass};
 use rt_temporal::{Reflections, Svgf, SvgfInput, SvgfParams};
 
 fn quad(s: &mut Scene, a: Vec3, b: Vec3, c: Vec3, d: Vec3, m: u32) {
@@ -181,4 +181,133 @@ fn guide_motion_of_a_static_point_matches_its_projection() {
         let centre = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
         assert!((centre - g.motion.pixels()[i] - before).length() < 1e-3);
     }
+}
+
+/// A lamp seen only in mirrors: in the floor (one bounce) and in the back wall by way of the
+/// floor (two), next to a diffuse ceiling the mirrors also show, under a dim sky that the
+/// mirror chains leaving the scene see. Frame 0 through the path tracer at 1 spp, filtered,
+/// and a 256-spp reference.
+fn mirrored_lamp() -> (RgbImage, RgbImage, usize, usize) {
+    let toml = r#"
+        [environment]
+        color = [0.2, 0.2, 0.2]
+        [[camera]]
+        name = "c"
+        position = [0, 1.5, 6]
+        look_at = [0, 0.8, 0]
+        fov = 60
+        resolution = [64, 48]
+        [[material]]
+        name = "mirror"
+        type = "mirror"
+        color = [0.9, 0.9, 0.9]
+        [[material]]
+        name = "lamp"
+        color = [0, 0, 0]
+        emission = [10, 10, 10]
+        [[geometry]]
+        name = "floor"
+        shape = "quad"
+        vertices = [[-8, 0, 8], [8, 0, 8], [8, 0, -4], [-8, 0, -4]]
+        material = "mirror"
+        [[geometry]]
+        name = "back"
+        shape = "quad"
+        vertices = [[-8, 0, -4], [8, 0, -4], [8, 6, -4], [-8, 6, -4]]
+        material = "mirror"
+        [[material]]
+        name = "white"
+        color = [0.8, 0.8, 0.8]
+        [[geometry]]
+        name = "ceiling"
+        shape = "quad"
+        vertices = [[-8, 5.05, 6], [-8, 5.05, -4], [8, 5.05, -4], [8, 5.05, 6]]
+        material = "white"
+        [[geometry]]
+        name = "lamp"
+        shape = "quad"
+        vertices = [[-2.5, 5, 0], [2.5, 5, 0], [2.5, 5, 3], [-2.5, 5, 3]]
+        material = "lamp"
+    "#;
+    let scene = rt_scene::load_str(
+        toml,
+        std::path::Path::new("."),
+        std::path::Path::new("t.toml"),
+    )
+    .unwrap()
+    .scene;
+    let camera = scene.cameras[0].clone();
+    let accel = rt_accel::AccelSpec::default().build_scene(&scene);
+    let ctx = Ctx {
+        scene: &scene,
+        accel: accel.as_ref(),
+        camera: &camera,
+    };
+    let technique = "path"
+        .parse::<rt_integrators::IntegratorSpec>()
+        .unwrap()
+        .build();
+    let aovs = AovSet::for_channels(&[Channel::Direct, Channel::Indirect, Channel::Emission]);
+    let render = |spp: u32, centre_first: bool| {
+        let mut film = Film::new(camera.width, camera.height, FilmBuffers::for_outputs(aovs));
+        let pass = SamplePass {
+            indices: 0..spp,
+            stream: SampleStream::Render,
+            pixels: None,
+            centre_first,
+        };
+        technique.render_pass(&ctx, &mut film, 3, &pass, &|_| {});
+        NoisyFrame::from_film(&film, aovs)
+    };
+    let frame = render(1, true);
+    let g = render_guides(&ctx, None, &GuideOptions::default());
+    let r = g.reflected.as_ref().unwrap();
+    let direct = frame.image(Channel::Direct).unwrap();
+    let indirect = frame.image(Channel::Indirect).unwrap();
+    let lamp_in = |pick: &dyn Fn(usize) -> bool| {
+        (0..direct.pixels().len())
+            .filter(|&i| r.emission.pixels()[i].x > 0.0 && pick(i))
+            .count()
+    };
+    let one_bounce = lamp_in(&|i| direct.pixels()[i].x > 0.0);
+    let two_bounces = lamp_in(&|i| direct.pixels()[i].x == 0.0 && indirect.pixels()[i].x > 0.0);
+    let out = Svgf::new(SvgfParams::default()).push(&SvgfInput {
+        guides: &g,
+        direct,
+        indirect,
+        emission: frame.image(Channel::Emission).unwrap(),
+    });
+    (out, render(256, false).colour, one_bounce, two_bounces)
+}
+
+#[test]
+fn a_lamp_seen_in_mirrors_is_not_divided_by_its_black_albedo() {
+    // The lamp has no albedo to demodulate by: filtered as light over albedo 10⁻³, its
+    // reflections became a thousand times too bright and bled into every mirror pixel near
+    // them. Its light is carried past the filter like primary emission instead.
+    let (out, reference, one, two) = mirrored_lamp();
+    assert!(
+        one > 20 && two > 20,
+        "lamp pixels: {one} by one mirror, {two} by two"
+    );
+    let max = |img: &RgbImage| {
+        img.pixels()
+            .iter()
+            .map(|c| c.max_element())
+            .fold(0.0, f32::max)
+    };
+    let mean = |img: &RgbImage| {
+        img.pixels().iter().map(|c| f64::from(c.x)).sum::<f64>() / img.pixels().len() as f64
+    };
+    assert!(
+        max(&out) <= 1.01 * max(&reference),
+        "max {} vs reference {}",
+        max(&out),
+        max(&reference)
+    );
+    let (m, m_ref) = (mean(&out), mean(&reference));
+    assert!(
+        (m - m_ref).abs() < 0.1 * m_ref,
+        "mean {m} vs reference {m_ref}"
+    );
 }

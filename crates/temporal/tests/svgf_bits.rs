@@ -68,6 +68,7 @@ fn guides(w: usize, h: usize, k: usize) -> GuideBuffers {
                 }
             }),
             albedo: Image::from_fn(w, h, |x, y| Rgb::splat(0.3 + 0.5 * hash(x, y, 7))),
+            emission: Image::from_fn(w, h, |x, y| Rgb::splat((hash(x, y, 9) - 0.8).max(0.0))),
             direction: Image::from_fn(w, h, |x, y| {
                 Vec3::new(hash(x, y, 8) - 0.5, 1.0, 0.2 * k as f32).normalize()
             }),

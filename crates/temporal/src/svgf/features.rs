@@ -43,6 +43,9 @@ pub struct Features {
     pub class: Vec<Class>,
     /// Albedo the light is divided by (mirrors: primary × reflected).
     pub albedo: Vec<Rgb>,
+    /// Light a mirror's chain ends in (`ReflectedGuides::emission`): taken out of the direct
+    /// light before demodulation and added back after filtering, like primary emission.
+    pub reflected_emission: Vec<Rgb>,
     /// Depth edge-stopping compares: view depth, or for a mirror the unfolded depth of what
     /// it reflects.
     pub depth: Vec<f32>,
@@ -57,6 +60,17 @@ pub struct Features {
     pub object: Vec<u32>,
     /// Extra spatial bandwidth of sharp glossy pixels (Voorhuis Eq. 6), 0 where none.
     pub sigma_spatial: Vec<f32>,
+}
+
+/// `direct` and `indirect` light without `emitted`, the light a mirror chain ends in, taken
+/// from the direct light first and the rest from the indirect (a chain of one mirror reaches
+/// its end in one bounce, a longer one in more; per colour channel, never below zero).
+pub fn without_emitted(direct: Rgb, indirect: Rgb, emitted: Rgb) -> [Rgb; 2] {
+    let rest = (emitted - direct).max(Rgb::ZERO);
+    [
+        (direct - emitted).max(Rgb::ZERO),
+        (indirect - rest).max(Rgb::ZERO),
+    ]
 }
 
 fn class_of(g: &GuideBuffers, i: usize, p: &SvgfParams) -> Class {
@@ -119,6 +133,13 @@ impl Features {
                 _ => g.albedo.pixels()[i],
             })
             .collect();
+        let reflected_emission = (0..n)
+            .into_par_iter()
+            .map(|i| match (class[i], refl) {
+                (Class::Mirror, Some(r)) if reflect => r.emission.pixels()[i],
+                _ => Rgb::ZERO,
+            })
+            .collect();
         let depth: Vec<f32> = (0..n)
             .into_par_iter()
             .map(|i| match refl {
@@ -164,6 +185,7 @@ impl Features {
             h,
             class,
             albedo,
+            reflected_emission,
             depth,
             depth_step,
             normal,

@@ -157,7 +157,12 @@ impl Svgf {
                     return [Rgb::ZERO; 2];
                 }
                 let a = f.albedo[i].max(Rgb::splat(MIN_ALBEDO));
-                [input.direct.pixels()[i] / a, input.indirect.pixels()[i] / a]
+                let [direct, indirect] = features::without_emitted(
+                    input.direct.pixels()[i],
+                    input.indirect.pixels()[i],
+                    f.reflected_emission[i],
+                );
+                [direct / a, indirect / a]
             })
             .collect();
         let gathered = (!extra.is_empty()).then(|| supersample::gather(&f, g, extra, &mut current));
@@ -258,7 +263,7 @@ impl Svgf {
                 let c = if f.class[i] == features::Class::Sky {
                     e + input.direct.pixels()[i] + input.indirect.pixels()[i]
                 } else {
-                    e + f.albedo[i].max(Rgb::splat(MIN_ALBEDO)) * shown[i]
+                    e + f.reflected_emission[i] + f.albedo[i].max(Rgb::splat(MIN_ALBEDO)) * shown[i]
                 };
                 if c.is_finite() {
                     c.max(Rgb::ZERO)
@@ -268,7 +273,7 @@ impl Svgf {
             })
             .collect();
         if let Some(gathered) = &gathered {
-            supersample::resolve(extra, gathered, &shown, &mut pixels);
+            supersample::resolve(&f, extra, gathered, &shown, &mut pixels);
         }
         let out = Image::new(w, h, pixels).expect("one output pixel per pixel");
         // Keep the history.

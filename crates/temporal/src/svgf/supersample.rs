@@ -11,9 +11,10 @@
 //! scores above [`MAX_SCORE`] (it saw a surface no neighbouring guide saw) is not assigned and
 //! keeps its own, unfiltered light; a sample is demodulated by its own albedo times the ratio of
 //! its guide's demodulation albedo to the guide's albedo (a mirror guide's reflected albedo
-//! carries over); samples that see the sky are never assigned.
+//! carries over), after taking out the light its mirror guide's chain ends in, which the
+//! sample takes back from the guide; samples that see the sky are never assigned.
 
-use super::features::{Class, Features, MIN_ALBEDO};
+use super::features::{without_emitted, Class, Features, MIN_ALBEDO};
 use rayon::prelude::*;
 use rt_core::glam::Vec3;
 use rt_core::{Image, Rgb, RgbImage};
@@ -115,8 +116,13 @@ pub fn gather(
                 continue;
             }
             let q = guide[p] as usize;
-            sums[q][0] += layer.direct.pixels()[p] / albedo[p];
-            sums[q][1] += layer.indirect.pixels()[p] / albedo[p];
+            let [direct, indirect] = without_emitted(
+                layer.direct.pixels()[p],
+                layer.indirect.pixels()[p],
+                f.reflected_emission[q],
+            );
+            sums[q][0] += direct / albedo[p];
+            sums[q][1] += indirect / albedo[p];
             counts[q] += 1;
         }
         gathered.guide.push(guide);
@@ -135,6 +141,7 @@ pub fn gather(
 /// remodulated from its guide's filtered illumination `shown`, or its own light where it was
 /// not assigned.
 pub fn resolve(
+    f: &Features,
     extra: &[ExtraSample<'_>],
     gathered: &Gathered,
     shown: &[Rgb],
@@ -149,7 +156,8 @@ pub fn resolve(
             sum += if q == NONE {
                 e + layer.direct.pixels()[p] + layer.indirect.pixels()[p]
             } else {
-                e + gathered.albedo[k][p] * shown[q as usize]
+                let q = q as usize;
+                e + f.reflected_emission[q] + gathered.albedo[k][p] * shown[q]
             };
         }
         let c = sum / samples;
