@@ -17,7 +17,8 @@ pub const FRAMES_HEADER: &str = "scene,method,frame,relmse,mse,ssim,render_s,gui
 
 /// The columns of sequences.csv.
 pub const SEQUENCES_HEADER: &str = "scene,method,frames,temporal_error,\
-reference_temporal_error,temporal_relmse,lag,mean_relmse,last_relmse,ms_per_frame";
+reference_temporal_error,temporal_relmse,lag,mean_relmse,last_relmse,ms_per_frame,\
+temporal_error_specular";
 
 fn names(plan: &Plan, pair: usize) -> (&str, &str) {
     let p = &plan.pairs[pair];
@@ -51,7 +52,7 @@ pub fn sequences_csv(plan: &Plan, results: &SequenceResults) -> String {
         let (scene, method) = names(plan, r.pair);
         let _ = writeln!(
             s,
-            "{scene},{method},{},{},{},{},{},{},{},{}",
+            "{scene},{method},{},{},{},{},{},{},{},{},{}",
             r.frames,
             r.temporal_error,
             r.reference_temporal_error,
@@ -59,7 +60,10 @@ pub fn sequences_csv(plan: &Plan, results: &SequenceResults) -> String {
             r.lag.map(|l| l.to_string()).unwrap_or_default(),
             r.mean_relmse,
             r.last_relmse,
-            r.ms_per_frame
+            r.ms_per_frame,
+            r.temporal_error_specular
+                .map(|v| v.to_string())
+                .unwrap_or_default()
         );
     }
     s
@@ -134,6 +138,7 @@ fn table(
         "method",
         "settings",
         "temporal error",
+        "over specular pixels",
         "reference's",
         "temporal relMSE",
         "lag (frames)",
@@ -150,6 +155,7 @@ fn table(
                 plan.methods[plan.pairs[r.pair].method].name.clone(),
                 method_text(plan, r.pair),
                 sci(r.temporal_error),
+                r.temporal_error_specular.map_or("–".into(), sci),
                 sci(r.reference_temporal_error),
                 sci(r.temporal_relmse),
                 lag_text(r, has_event),

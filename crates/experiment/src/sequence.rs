@@ -16,9 +16,12 @@ use crate::config::{Plan, ReferencePlan, Runs, SequencePlan};
 use crate::error::{io, ExperimentError, Result};
 use crate::Progress;
 use rt_core::{Accel, RgbImage, Scene};
-use rt_metrics::temporal::{lag, LagOptions, SequenceComparison};
+use rt_integrators::GuideOptions;
+use rt_metrics::temporal::{
+    lag, luminance_change_in, LagOptions, SequenceComparison, TemporalError,
+};
 use rt_metrics::{CompareOptions, Metrics};
-use rt_session::{FrameTimes, SequenceRenderer};
+use rt_session::{FrameTimes, SequenceFrame, SequenceRenderer};
 use std::path::{Path, PathBuf};
 
 /// The lag's steady state is the median of at most this many frames before the event.
@@ -51,6 +54,10 @@ pub struct SequenceRow {
     pub temporal_error: f64,
     /// The same of the reference frames (what the scene itself changes).
     pub reference_temporal_error: f64,
+    /// The temporal error over the specular pixels only (primary roughness below SVGF's
+    /// specular limit in the frame's guide buffers, the same for every method): where
+    /// reflection reprojection acts. `None` when no frame shows a specular surface.
+    pub temporal_error_specular: Option<f64>,
     /// Mean relMSE of the method's frame differences against the reference's.
     pub temporal_relmse: f64,
     /// Frames after the scene's event until the per-frame relMSE is back within
@@ -236,7 +243,9 @@ pub fn run(
                 seq.fps,
             )
             .map_err(|e| at(&e))?;
+            renderer.set_guides(true);
             let mut moving = scene.loaded.scene.clone();
+            let mut specular = SpecularFlicker::default();
             let mut comparison = SequenceComparison::new(opts).map_err(|e| at(&e))?;
             let mut total_ms = 0.0;
             for f in seq.frames.clone() {
@@ -250,6 +259,9 @@ pub fn run(
                         .stills
                         .push(write_still(out, &dir, si, &method.name, f, &frame.image)?);
                 }
+                specular
+                    .push(&frame)
+                    .map_err(|e| at(&format!("frame {f}: {e}")))?;
                 let reference = references[(f - seq.frames.start) as usize].clone();
                 let measured = comparison
                     .push(frame.image, reference)
@@ -287,6 +299,7 @@ pub fn run(
                 frames: relmse.len(),
                 temporal_error: m.temporal_error_test.mean,
                 reference_temporal_error: m.temporal_error_reference.mean,
+                temporal_error_specular: specular.mean(),
                 temporal_relmse: m.temporal_relmse.mean,
                 lag: lag_frames,
                 steady_relmse: steady,
@@ -297,6 +310,35 @@ pub fn run(
         }
     }
     Ok(results)
+}
+
+/// The temporal error over each step's specular pixels, accumulated frame by frame.
+#[derive(Default)]
+struct SpecularFlicker {
+    previous: Option<RgbImage>,
+    sum: f64,
+    steps: usize,
+}
+
+impl SpecularFlicker {
+    fn push(&mut self, frame: &SequenceFrame) -> std::result::Result<(), TemporalError> {
+        if let (Some(previous), Some(g)) = (&self.previous, &frame.guides) {
+            let limit = GuideOptions::default().specular_limit;
+            let mask: Vec<bool> = (0..g.roughness.pixels().len())
+                .map(|i| g.has_surface(i) && g.roughness.pixels()[i] < limit)
+                .collect();
+            if let Some(v) = luminance_change_in(previous, &frame.image, &mask)? {
+                self.sum += v;
+                self.steps += 1;
+            }
+        }
+        self.previous = Some(frame.image.clone());
+        Ok(())
+    }
+
+    fn mean(&self) -> Option<f64> {
+        (self.steps > 0).then(|| self.sum / self.steps as f64)
+    }
 }
 
 /// Every frame's reference of scene `si`, from the cache or rendered into it, and a line on

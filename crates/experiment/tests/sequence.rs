@@ -193,7 +193,7 @@ fn a_tiny_sequence_experiment_writes_per_frame_and_temporal_metrics() {
     assert_eq!(
         shead.join(","),
         "scene,method,frames,temporal_error,reference_temporal_error,temporal_relmse,lag,\
-         mean_relmse,last_relmse,ms_per_frame"
+         mean_relmse,last_relmse,ms_per_frame,temporal_error_specular"
     );
     assert_eq!(srows.len(), 5);
     let seq = |scene: &str, method: &str| {
@@ -216,6 +216,8 @@ fn a_tiny_sequence_experiment_writes_per_frame_and_temporal_metrics() {
         assert_eq!(sv(r, "last_relmse"), relmse[3]);
         assert!(sv(r, "temporal_error") > 0.0 && sv(r, "temporal_relmse") > 0.0);
         assert!(sv(r, "ms_per_frame") > 0.0);
+        // Both scenes are all diffuse: no pixel to measure the specular flicker over.
+        assert_eq!(r[col(&shead, "temporal_error_specular")], "", "{r:?}");
         // The lag: only where there is an event, and as rt-metrics computes it from the
         // per-frame errors (steady state over the two frames before frame 12).
         let lag = &r[col(&shead, "lag")];

@@ -85,7 +85,8 @@ pub struct SequenceFrame {
     pub image: RgbImage,
     /// The noisy frame the denoiser read (its colour is the film's mean).
     pub noisy: NoisyFrame,
-    /// The guide buffers, if the denoiser reads them.
+    /// The guide buffers, if the denoiser reads them or [`SequenceRenderer::set_guides`] asked
+    /// for them.
     pub guides: Option<GuideBuffers>,
     /// Samples and rays of the render.
     pub stats: RenderStats,
@@ -111,6 +112,8 @@ pub struct SequenceRenderer {
     fps: f64,
     previous: Option<(Camera, f32)>,
     budget: Option<Duration>,
+    /// Render the guide pass even when the denoiser does not read it.
+    always_guides: bool,
     /// The last frame's guide and denoise time: what a budgeted frame keeps free for them.
     reserve: Duration,
 }
@@ -153,6 +156,7 @@ impl SequenceRenderer {
             fps,
             previous: None,
             budget: None,
+            always_guides: false,
             reserve: Duration::ZERO,
         })
     }
@@ -161,6 +165,13 @@ impl SequenceRenderer {
     /// the module documentation describes; `spp` is then the most passes a frame takes.
     pub fn set_budget(&mut self, budget: Option<Duration>) {
         self.budget = budget;
+    }
+
+    /// Renders the guide pass for every frame (`SequenceFrame::guides`) whether or not the
+    /// denoiser reads it: an experiment measures every method over the same regions (the
+    /// specular pixels) with it. It does not change the images.
+    pub fn set_guides(&mut self, always: bool) {
+        self.always_guides = always;
     }
 
     /// The denoiser's name, if any.
@@ -249,7 +260,7 @@ impl SequenceRenderer {
             self.render_samples(&ctx, &mut film, f, wants_guides, apart, frame_start);
         times.render = t.elapsed();
         let t = Instant::now();
-        let guides = wants_guides.then(|| {
+        let guides = (wants_guides || self.always_guides).then(|| {
             let previous = self.previous.as_ref().map(|(c, time)| PreviousView {
                 camera: c,
                 time: *time,

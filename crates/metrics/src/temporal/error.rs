@@ -63,6 +63,14 @@ pub enum TemporalError {
         /// What is wrong with it.
         cause: MetricsError,
     },
+    /// A region mask whose length is not the frames' pixel count.
+    #[error("the mask has {mask} entries but the frames have {pixels} pixels")]
+    MaskSize {
+        /// Entries in the mask.
+        mask: usize,
+        /// Pixels per frame.
+        pixels: usize,
+    },
     /// [`lag`](super::lag)'s event frame is not one of the per-frame errors.
     #[error("the event frame {event} is outside the {frames} per-frame errors")]
     EventOutOfRange {

@@ -41,7 +41,7 @@ mod temporal_relmse;
 pub use error::{Result, TemporalError};
 pub use lag::{lag, Lag, LagOptions};
 pub use sequence::{FrameMetrics, SequenceComparison, SequenceMetrics, StepMetrics};
-pub use temporal_error::temporal_error;
+pub use temporal_error::{luminance_change_in, temporal_error};
 pub use temporal_relmse::temporal_relmse;
 
 /// A temporal metric per pair of consecutive frames and its mean.

@@ -168,6 +168,9 @@ impl Features {
             .into_par_iter()
             .map(|i| step_of(w, h, &primary_depth, i, |j| class[j] != Class::Sky))
             .collect();
+        // A pixel's footprint grows as the image shrinks; measured in pixels of the thesis'
+        // 1280-wide frames, ω means the same at any resolution.
+        let per_thesis_pixel = w as f32 / THESIS_WIDTH;
         let sigma_spatial = match refl {
             Some(r) if reflect => (0..n)
                 .into_par_iter()
@@ -175,7 +178,8 @@ impl Features {
                     if class[i] != Class::SharpGlossy || r.distance.pixels()[i] <= 0.0 {
                         return 0.0;
                     }
-                    footprint(g, r, w, h, i, &class).map_or(0.0, |f| (-f / p.omega).exp())
+                    footprint(g, r, w, h, i, &class)
+                        .map_or(0.0, |f| (-f * per_thesis_pixel / p.omega).exp())
                 })
                 .collect(),
             _ => vec![0.0; n],
@@ -196,6 +200,9 @@ impl Features {
         }
     }
 }
+
+/// Width of the frames ω = 0.5 was chosen for (Voorhuis renders at 1280×720).
+const THESIS_WIDTH: f32 = 1280.0;
 
 /// The world-space footprint of a sharp glossy pixel's reflection, as if it were a mirror:
 /// the mean distance from its approximate hit (Voorhuis Eq. 4) to its right and lower
