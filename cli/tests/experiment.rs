@@ -331,6 +331,7 @@ fn shipped_configs_are_valid() {
         "configs/light-transport.toml",
         "configs/stopping.toml",
         "configs/temporal.toml",
+        "configs/temporal-reflections.toml",
     ];
     // Its last two scenes read meshes from ../shared/data (CI has it; elsewhere the file is
     // skipped with a line saying so, and RT_REQUIRE_DATA=1 makes a missing folder a failure).
