@@ -3,15 +3,7 @@
 
 mod common;
 
-use std::process::{Command, Output};
-
-fn render(dir: &std::path::Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_render"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap()
-}
+use common::{one_error_line, render};
 
 fn scene(dir: &std::path::Path) {
     let camera = "[[camera]]\nname = \"c\"\nposition = [0.0, 1.0, 2.5]\nlook_at = [0.0, 0.0, 0.0]\nfov = 50.0\nresolution = [24, 16]\n";
@@ -20,14 +12,6 @@ fn scene(dir: &std::path::Path) {
         format!("{camera}{}", common::FLOOR_AND_LAMP),
     )
     .unwrap();
-}
-
-fn one_error_line(out: &Output) -> String {
-    assert_eq!(out.status.code(), Some(1), "{out:?}");
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(err.lines().count(), 1, "{err}");
-    assert!(!err.contains("panicked"), "{err}");
-    err
 }
 
 fn pixels(path: &std::path::Path) -> Vec<f32> {

@@ -4,17 +4,10 @@
 
 mod common;
 
+use common::{one_error_line, render};
+
 use rt_denoise::{DenoiserSpec, NoisyFrame};
 use rt_film::Channel;
-use std::process::{Command, Output};
-
-fn render(dir: &std::path::Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_render"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap()
-}
 
 fn scene(dir: &std::path::Path) {
     let camera = "[[camera]]\nname = \"c\"\nposition = [0.0, 1.0, 2.5]\nlook_at = [0.0, 0.0, 0.0]\nfov = 50.0\nresolution = [20, 14]\n";
@@ -23,14 +16,6 @@ fn scene(dir: &std::path::Path) {
         format!("{camera}{}", common::FLOOR_AND_LAMP),
     )
     .unwrap();
-}
-
-fn one_error_line(out: &Output) -> String {
-    assert_eq!(out.status.code(), Some(1), "{out:?}");
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(err.lines().count(), 1, "{err}");
-    assert!(!err.contains("panicked"), "{err}");
-    err
 }
 
 #[test]

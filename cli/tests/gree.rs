@@ -3,22 +3,7 @@
 
 mod common;
 
-use std::process::{Command, Output};
-
-fn render(dir: &std::path::Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_render"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn one_error_line(out: &Output) -> String {
-    assert_eq!(out.status.code(), Some(1), "{out:?}");
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(err.lines().count(), 1, "{err}");
-    err
-}
+use common::{one_error_line, render};
 
 #[test]
 fn gree_writes_its_outputs_and_refuses_what_it_cannot_do() {

@@ -7,6 +7,8 @@ use std::process::{Command, Output};
 
 mod common;
 
+use common::one_error_line;
+
 fn render(dir: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_render"))
         .current_dir(dir)
@@ -21,14 +23,6 @@ fn ok(out: &Output) {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-}
-
-fn one_error_line(out: &Output) -> String {
-    assert_eq!(out.status.code(), Some(1), "{out:?}");
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(err.lines().count(), 1, "{err}");
-    assert!(!err.contains("panicked"), "{err}");
-    err
 }
 
 /// A lit floor seen from above, 32 × 24 pixels, nothing moving.

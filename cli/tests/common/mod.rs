@@ -1,4 +1,4 @@
-//! Scene text shared by the CLI's integration tests.
+//! Scene text and helpers shared by the CLI's integration tests.
 
 // Each test binary compiles this module and uses part of it.
 #![allow(dead_code)]
@@ -67,3 +67,21 @@ material = "white"
 target = "box"
 keys = [ { time = 0.0, translate = [-1, 0, 0] }, { time = 2.0, translate = [1, 0, 0], rotate = [0, 90, 0] } ]
 "#;
+
+/// Runs `render ARGS` in `dir`.
+pub fn render(dir: &std::path::Path, args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_render"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// Checks that `out` failed with status 1 and one error line, no panic; returns the line.
+pub fn one_error_line(out: &std::process::Output) -> String {
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    err
+}

@@ -7,6 +7,7 @@
 //! the viewer draw the text.
 
 use crate::error::{ExperimentError, Result};
+use plotters::coord::ranged1d::ValueFormatter;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -159,56 +160,21 @@ fn draw<DB: DrawingBackend>(
     chart: &Chart<'_>,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     root.fill(&WHITE)?;
+    let keep = |p: &(f64, f64)| p.0 > 0.0 && p.1 > 0.0;
     let pts = || {
         chart
             .series
             .iter()
             .flat_map(|s| s.points.iter())
-            .filter(|p| p.0 > 0.0 && p.1 > 0.0)
+            .filter(|p| keep(p))
     };
     let (x0, x1) = span(pts().map(|p| p.0));
     let (y0, y1) = span(pts().map(|p| p.1));
-    let mut c = ChartBuilder::on(root)
-        .caption(chart.title, ("sans-serif", 20))
-        .margin(12)
-        .x_label_area_size(44)
-        .y_label_area_size(70)
-        .build_cartesian_2d(
-            (x0..x1).log_scale().base(chart.x_base),
-            (y0..y1).log_scale(),
-        )?;
-    c.configure_mesh()
-        .x_desc(chart.x_label)
-        .y_desc(chart.y_label)
-        .x_label_formatter(&|v| tick(*v))
-        .y_label_formatter(&|v| tick(*v))
-        .label_style(("sans-serif", 14))
-        .axis_desc_style(("sans-serif", 16))
-        .light_line_style(RGBColor(235, 235, 235))
-        .bold_line_style(RGBColor(200, 200, 200))
-        .draw()?;
-    for (i, s) in chart.series.iter().enumerate() {
-        let colour = COLOURS[i % COLOURS.len()];
-        let points: Vec<(f64, f64)> = s
-            .points
-            .iter()
-            .copied()
-            .filter(|p| p.0 > 0.0 && p.1 > 0.0)
-            .collect();
-        c.draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))?
-            .label(s.name.as_str())
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 22, y)], colour.stroke_width(2))
-            });
-        c.draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))?;
-    }
-    c.configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .label_font(("sans-serif", 14))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK.mix(0.4))
-        .draw()?;
-    Ok(())
+    let c = builder(root, chart).build_cartesian_2d(
+        (x0..x1).log_scale().base(chart.x_base),
+        (y0..y1).log_scale(),
+    )?;
+    finish(c, chart, keep, true)
 }
 
 /// [`draw`] with a linear x axis: error over frames. Points with a non-positive y are left out
@@ -218,12 +184,13 @@ fn draw_linear_x<DB: DrawingBackend>(
     chart: &Chart<'_>,
 ) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
     root.fill(&WHITE)?;
+    let keep = |p: &(f64, f64)| p.0.is_finite() && p.1 > 0.0 && p.1.is_finite();
     let pts = || {
         chart
             .series
             .iter()
             .flat_map(|s| s.points.iter())
-            .filter(|p| p.0.is_finite() && p.1 > 0.0 && p.1.is_finite())
+            .filter(|p| keep(p))
     };
     let (x0, x1) = pts().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
         (lo.min(p.0), hi.max(p.0))
@@ -236,12 +203,36 @@ fn draw_linear_x<DB: DrawingBackend>(
         (0.0, 1.0)
     };
     let (y0, y1) = span(pts().map(|p| p.1));
-    let mut c = ChartBuilder::on(root)
-        .caption(chart.title, ("sans-serif", 20))
+    let c = builder(root, chart).build_cartesian_2d(x0..x1, (y0..y1).log_scale())?;
+    finish(c, chart, keep, false)
+}
+
+/// The chart's frame: caption, margins and label areas.
+fn builder<'a, 'b, DB: DrawingBackend>(
+    root: &'a DrawingArea<DB, Shift>,
+    chart: &Chart<'_>,
+) -> ChartBuilder<'a, 'b, DB> {
+    let mut b = ChartBuilder::on(root);
+    b.caption(chart.title, ("sans-serif", 20))
         .margin(12)
         .x_label_area_size(44)
-        .y_label_area_size(70)
-        .build_cartesian_2d(x0..x1, (y0..y1).log_scale())?;
+        .y_label_area_size(70);
+    b
+}
+
+/// Grid, axis labels, one line per series (points where `keep`, with markers if asked) and
+/// the legend, on either kind of x axis.
+fn finish<'a, DB, X, Y>(
+    mut c: ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    chart: &Chart<'_>,
+    keep: impl Fn(&(f64, f64)) -> bool,
+    markers: bool,
+) -> Result<(), DrawingAreaErrorKind<DB::ErrorType>>
+where
+    DB: DrawingBackend + 'a,
+    X: Ranged<ValueType = f64> + ValueFormatter<f64>,
+    Y: Ranged<ValueType = f64> + ValueFormatter<f64>,
+{
     c.configure_mesh()
         .x_desc(chart.x_label)
         .y_desc(chart.y_label)
@@ -254,17 +245,15 @@ fn draw_linear_x<DB: DrawingBackend>(
         .draw()?;
     for (i, s) in chart.series.iter().enumerate() {
         let colour = COLOURS[i % COLOURS.len()];
-        let points: Vec<(f64, f64)> = s
-            .points
-            .iter()
-            .copied()
-            .filter(|p| p.0.is_finite() && p.1 > 0.0 && p.1.is_finite())
-            .collect();
-        c.draw_series(LineSeries::new(points, colour.stroke_width(2)))?
+        let points: Vec<(f64, f64)> = s.points.iter().copied().filter(|p| keep(p)).collect();
+        c.draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))?
             .label(s.name.as_str())
             .legend(move |(x, y)| {
                 PathElement::new(vec![(x, y), (x + 22, y)], colour.stroke_width(2))
             });
+        if markers {
+            c.draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))?;
+        }
     }
     c.configure_series_labels()
         .position(SeriesLabelPosition::UpperRight)

@@ -1,7 +1,7 @@
 //! World-space reconstruction: modified Shepard interpolation (Bikker & Reijerse 2009, as the
 //! thesis uses it, §3.2 Eq. 3) over the cached points near a position. Each stored point `i`
 //! at distance `d_i < sd` weighs `sd − d_i` (a linear tent; the exact form was lost from the
-//! text, seed digest §1.7 [recon]); `F = Σ w_i v_i / Σ w_i`. Points are culled by distance
+//! text, seed digest §1.7 \[recon\]); `F = Σ w_i v_i / Σ w_i`. Points are culled by distance
 //! before the table is probed (digest §6), and the search distance is a multiple of the point
 //! spacing, so it follows the level of detail. No normals, depths or edge-stopping weights,
 //! as in the thesis.

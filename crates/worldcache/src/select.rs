@@ -6,7 +6,7 @@
 //! of barycentric areas, `a_i = d_j² · d_k²` normalised, i.e. `w_i ∝ 1/d_i²` (inverse squared
 //! distance), and Eq. 1.4 as the branchless inverse CDF
 //! `i = sat(⌊ξ / w0⌋) + sat(⌊ξ / (w0 + w1)⌋)`. The nearest point always has the largest
-//! probability. This is a reconstruction (seed digest §1.4, [recon]).
+//! probability. This is a reconstruction (seed digest §1.4, \[recon\]).
 
 use crate::discretisation::{Connectivity, Discretisation};
 use crate::hash::{pcg, unit};

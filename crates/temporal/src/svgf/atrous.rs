@@ -13,7 +13,7 @@
 //! and [`super::atrous_avx2`], eight pixels at a time on structure-of-arrays planes
 //! ([`super::planes`]) where the CPU has AVX2; they give the same bits (tests/svgf_bits.rs).
 //!
-//! Deviations ([ours]): |∇z| is the largest depth step to a 4-neighbour of the same kind, not a
+//! Deviations (\[ours\]): |∇z| is the largest depth step to a 4-neighbour of the same kind, not a
 //! screen-space derivative; the depth term's ε is relative to depth; taps across the edge of a
 //! mirror (mirror vs non-mirror) get no weight, since their features describe different
 //! surfaces; Eq. 6's σ is read in units of two taps, so σ = 1 is a mild falloff over the 5×5

@@ -3,7 +3,7 @@
 //! blurred by a separable 7×7 Gaussian, and a specular pixel's reprojected history is clamped
 //! into it. A history from a wrong motion vector is thereby pulled to what the pixel sees now.
 //!
-//! Reading ([ours]; the thesis gives no σ): the 7 taps are the binomial weights
+//! Reading (\[ours\]; the thesis gives no σ): the 7 taps are the binomial weights
 //! (1, 6, 15, 20, 15, 6, 1)/64, a Gaussian of σ ≈ 1.2 pixels; clamping is per channel.
 
 use rayon::prelude::*;

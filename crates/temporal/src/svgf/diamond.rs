@@ -4,7 +4,7 @@
 //! whenever the centre stays best, then a small-pattern step, then sub-pixel refinement
 //! (Eq. 2–3) so reflections do not shake by whole pixels.
 //!
-//! Deviations and readings ([ours], the thesis' Fig. 3 did not survive extraction): the large
+//! Deviations and readings (\[ours\], the thesis' Fig. 3 did not survive extraction): the large
 //! pattern is {(±2, 0), (0, ±2)}·step and the small one {(±1, 0), (0, ±1)}; taps are clamped
 //! to the image; the search stops after [`MAX_STEPS`] moves; a candidate the caller scores as
 //! infinitely far (not specular in the previous frame) is never chosen; when two distances are

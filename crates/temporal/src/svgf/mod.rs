@@ -5,7 +5,7 @@
 //!
 //! 1. **Demodulate** by the primary albedo (a mirror: by the product of the albedos along its
 //!    reflection, Voorhuis §4.2), so texture never has to survive the filter.
-//! 2. **Reproject** ([`reproject`]): the history where the surface was (primary motion
+//! 2. **Reproject** (`reproject.rs`): the history where the surface was (primary motion
 //!    vectors), or for specular pixels with `reflections=reproject` where its reflection was
 //!    (diamond search on reflected hits for mirrors, on representative rays for sharp glossy
 //!    surfaces), fetched bilinearly from taps passing the consistency tests.
@@ -17,7 +17,7 @@
 //! 5. **Variance** from the moments, or while the history is shorter than 4 frames from the
 //!    neighbours' accumulated moments over a 7×7 depth- and normal-weighted window, scaled by
 //!    4/h as Falcor does.
-//! 6. **À-Trous** ([`atrous`]), 5 iterations; the output of the `feedback`-th is the next
+//! 6. **À-Trous** (`atrous.rs`), 5 iterations; the output of the `feedback`-th is the next
 //!    frame's colour history.
 //! 7. **Remodulate**, add emission; a 3×3 median on diffuse pixels for display only.
 //!

@@ -6,7 +6,7 @@
 //! its guide's filtered illumination times its own albedo, and a pixel is the mean of its
 //! samples: sharp anti-aliased edges and textures without TAA, and less input noise.
 //!
-//! Readings ([ours]; the thesis leaves them open, seed 001 §2.6): similarity is the distance of
+//! Readings (\[ours\]; the thesis leaves them open, seed 001 §2.6): similarity is the distance of
 //! the first hits relative to the guide's depth plus `1 − n·n'`, and a sample whose best guide
 //! scores above [`MAX_SCORE`] (it saw a surface no neighbouring guide saw) is not assigned and
 //! keeps its own, unfiltered light; a sample is demodulated by its own albedo times the ratio of
