@@ -5,6 +5,8 @@ from here; edit this script, not the TOML files, and rerun:
     python3 tools/scenes/make_hall.py scenes
 """
 import sys
+
+from floor_materials import floor_materials
 def hall(kind):
     glossy = kind == "glossy"
     out = []
@@ -73,30 +75,9 @@ keys = [ { time = 0.0, position = [0.0, 1.7, 10.5], look_at = [0.0, 1.4, 0.0] },
          { time = 2.5, position = [1.0, 1.6, 3.0], look_at = [0.0, 1.3, -6.0] },
          { time = 5.0, position = [0.8, 1.7, -5.5], look_at = [-3.0, 1.2, -9.0] } ]
 ''')
-    if glossy:
-        w('''
-# --- Materials --------------------------------------------------------------------------------
-# The glossy floor: 40 % a glossy lobe (hardness 0.3), 60 % a warm diffuse stone.
-[[material]]
-name = "floor"
-layers = [
-    { weight = 0.4, color = [0.9, 0.9, 0.9], hardness = 0.3 },
-    { weight = 0.6, color = [0.45, 0.4, 0.34] },
-]
-''')
-    else:
-        w('''
-# --- Materials --------------------------------------------------------------------------------
-[[material]]
-name = "floor"
-type = "mirror"
-color = [0.85, 0.85, 0.85]
-
-[[material]]
-name = "orb"
-type = "mirror"
-color = [0.95, 0.95, 0.95]
-''')
+    w('''
+# --- Materials --------------------------------------------------------------------------------''')
+    w(floor_materials(kind))
     w('''
 [[material]]
 name = "stone"

@@ -4,6 +4,8 @@
     python3 tools/scenes/make_sponza.py scenes/shared-data
 """
 import sys
+
+from floor_materials import floor_materials
 def sponza(kind):
     glossy = kind=="glossy"
     o=[]; w=o.append
@@ -76,29 +78,7 @@ keys = [ { time = 0.0, position = [10.0, 1.8, 0.8], look_at = [0.0, 2.5, 0.0] },
 name = "stone"
 color = [0.7, 0.66, 0.6]
 ''')
-    if glossy:
-        w('''
-# The glossy floor: 40 % a glossy lobe (hardness 0.3, about a Beckmann roughness of 0.08), 60 %
-# a warm diffuse stone.
-[[material]]
-name = "floor"
-layers = [
-    { weight = 0.4, color = [0.9, 0.9, 0.9], hardness = 0.3 },
-    { weight = 0.6, color = [0.45, 0.4, 0.34] },
-]
-''')
-    else:
-        w('''
-[[material]]
-name = "floor"
-type = "mirror"
-color = [0.85, 0.85, 0.85]
-
-[[material]]
-name = "orb"
-type = "mirror"
-color = [0.95, 0.95, 0.95]
-''')
+    w(floor_materials(kind))
     w('''
 [[material]]
 name = "sky"
