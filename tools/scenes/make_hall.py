@@ -7,6 +7,8 @@ from here; edit this script, not the TOML files, and rerun:
 import sys
 
 from floor_materials import floor_materials
+
+
 def hall(kind):
     glossy = kind == "glossy"
     out = []

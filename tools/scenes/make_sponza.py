@@ -6,6 +6,8 @@
 import sys
 
 from floor_materials import floor_materials
+
+
 def sponza(kind):
     glossy = kind=="glossy"
     o=[]; w=o.append
