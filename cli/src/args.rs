@@ -158,6 +158,12 @@ pub struct Args {
     #[arg(long, value_name = "NAME[:options]", conflicts_with = "gree")]
     pub cache: Option<String>,
 
+    /// Refuse any file the scene refers to (meshes, material libraries, textures, glTF buffers
+    /// and images, environment maps, and the scene file itself) whose real path, symbolic
+    /// links resolved, lies outside DIR: for farms that render scenes they did not write.
+    #[arg(long, value_name = "DIR")]
+    pub confine: Option<PathBuf>,
+
     /// Denoise by GREE (Bauszat, thesis ch. 5): --spp is the budget b; render the noisy image
     /// at n = fraction x b spp, run the filter bank (--bank), render filter caches at a share
     /// 1 - sparsity of the pixels with independent samples, pick a filter per pixel by the

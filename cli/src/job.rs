@@ -8,7 +8,7 @@ use rt_accel::AccelSpec;
 use rt_core::{Accel, Scene};
 use rt_film::{AovSet, Film, FilmBuffers, OutputOptions};
 use rt_integrators::{Ctx, RadianceCache, RenderStats, SamplePass, Technique};
-use rt_scene::{LoadedScene, RenderDesc};
+use rt_scene::{FileAccess, LoadedScene, RenderDesc};
 use rt_session::{
     frame_seed, pick_camera, render_adaptive, Adaptive, Overrides, RenderReport, ReportInputs,
     Settings, StopRule, MAX_SPP,
@@ -41,7 +41,12 @@ fn scene_arg(args: &Args) -> &Path {
 
 /// Loads a scene file or `gen:NAME`.
 pub fn load_scene(path: &Path) -> Result<LoadedScene> {
-    rt_scene::load_any(path).map_err(|e| anyhow::anyhow!("{e}"))
+    load_scene_with(path, &FileAccess::open())
+}
+
+/// [`load_scene`] reading only what `access` allows (`--confine`).
+pub fn load_scene_with(path: &Path, access: &FileAccess) -> Result<LoadedScene> {
+    rt_scene::load_any_with(path, access).map_err(|e| anyhow::anyhow!("{e}"))
 }
 
 impl Job {
@@ -128,7 +133,11 @@ impl Job {
 /// Loads, renders and writes; prints the summary line.
 pub fn run(args: &Args) -> Result<()> {
     let t_load = Instant::now();
-    let loaded = load_scene(scene_arg(args))?;
+    let access = match &args.confine {
+        Some(dir) => FileAccess::confined_to(dir).map_err(|e| anyhow::anyhow!("{e}"))?,
+        None => FileAccess::open(),
+    };
+    let loaded = load_scene_with(scene_arg(args), &access)?;
     let load_time = t_load.elapsed();
     for w in &loaded.warnings {
         if !args.quiet {

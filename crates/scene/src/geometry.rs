@@ -356,7 +356,7 @@ fn load_file(
     match ext.as_str() {
         "obj" => obj::load(path, want_materials, &mut ctx.textures, &mut ctx.warnings),
         "gltf" | "glb" => gltf::load(path, want_materials, &mut ctx.textures, &mut ctx.warnings),
-        "ra2" => raw::load(path),
+        "ra2" => raw::load(ctx.textures.access(), path),
         _ => Err(ctx.src.error_at(
             f.span(),
             format!(

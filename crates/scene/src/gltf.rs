@@ -56,11 +56,18 @@ pub(crate) fn load(
     textures: &mut Textures,
     warnings: &mut Vec<String>,
 ) -> Result<Mesh> {
-    let bytes =
-        std::fs::read(path).map_err(|e| SceneError::file(path, format!("cannot open: {e}")))?;
+    let bytes = textures.access().read(path, "")?;
     let ::gltf::Gltf { document, blob } = ::gltf::Gltf::from_slice(&bytes)
         .map_err(|e| SceneError::file(path, format!("malformed glTF: {e}")))?;
     let dir = path.parent().unwrap_or(Path::new(""));
+    // The gltf crate opens external buffers itself: check them first.
+    for b in document.buffers() {
+        if let ::gltf::buffer::Source::Uri(uri) = b.source() {
+            if !uri.starts_with("data:") {
+                textures.access().check(&dir.join(percent_decode(uri)))?;
+            }
+        }
+    }
     let buffers = ::gltf::import_buffers(&document, Some(dir), blob)
         .map_err(|e| SceneError::file(path, format!("cannot load buffer data: {e}")))?;
     let mut l = Loader {
@@ -304,6 +311,7 @@ impl Loader<'_> {
                         .ok_or_else(|| self.error(format!("image {index}: invalid base64 data")))?
                 } else {
                     let p = self.dir.join(percent_decode(uri));
+                    self.textures.access().check(&p)?;
                     std::fs::read(&p).map_err(|e| {
                         SceneError::file(
                             &p,

@@ -1,25 +1,41 @@
 //! Image files: textures (PNG, JPEG; sRGB decoded to linear) and EXR environment maps.
 
 use crate::error::{Result, SceneError};
+use crate::files::FileAccess;
 use rt_core::{texture::Texture, Rgb};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-/// The scene's textures, loaded once per file.
+/// The scene's textures, loaded once per file, and the file policy every loader of the scene
+/// reads through (it travels with the textures because every mesh loader takes them).
 #[derive(Default)]
 pub(crate) struct Textures {
     list: Vec<Texture>,
     by_path: HashMap<PathBuf, u32>,
+    access: FileAccess,
 }
 
 impl Textures {
+    /// No textures yet; files are read under `access`.
+    pub fn new(access: FileAccess) -> Self {
+        Self {
+            access,
+            ..Self::default()
+        }
+    }
+
+    /// The file policy.
+    pub fn access(&self) -> &FileAccess {
+        &self.access
+    }
+
     /// Index of the texture in `path`, loading it on first use.
     pub fn load_file(&mut self, path: &Path) -> Result<u32> {
         let key = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
         if let Some(&i) = self.by_path.get(&key) {
             return Ok(i);
         }
-        let t = read_texture(path)?;
+        let t = read_texture(&self.access, path)?;
         let i = self.add(t);
         self.by_path.insert(key, i);
         Ok(i)
@@ -39,9 +55,8 @@ impl Textures {
 
 /// Reads a PNG or JPEG texture (`rt_film::decode_srgb`: sRGB decoded to linear, alpha
 /// ignored).
-pub(crate) fn read_texture(path: &Path) -> Result<Texture> {
-    let bytes =
-        std::fs::read(path).map_err(|e| SceneError::file(path, format!("cannot open: {e}")))?;
+pub(crate) fn read_texture(access: &FileAccess, path: &Path) -> Result<Texture> {
+    let bytes = access.read(path, "")?;
     texture_from_bytes(&bytes).map_err(|e| SceneError::file(path, e))
 }
 
@@ -57,7 +72,8 @@ pub(crate) fn texture_from_bytes(bytes: &[u8]) -> std::result::Result<Texture, S
 
 /// Reads the first RGB(A) layer of an EXR file as row-major linear radiance (row 0 at the
 /// top). Rejects empty images and NaN, infinite or negative texels, naming the first bad one.
-pub(crate) fn read_env_map(path: &Path) -> Result<(u32, u32, Vec<Rgb>)> {
+pub(crate) fn read_env_map(access: &FileAccess, path: &Path) -> Result<(u32, u32, Vec<Rgb>)> {
+    access.check(path)?;
     if !path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
@@ -111,7 +127,7 @@ mod tests {
         img.put_pixel(0, 0, image::Rgb([255, 0, 0]));
         img.put_pixel(1, 0, image::Rgb([188, 188, 188]));
         img.save(&p).unwrap();
-        let t = read_texture(&p).unwrap();
+        let t = read_texture(&FileAccess::open(), &p).unwrap();
         assert_eq!((t.width, t.height), (2, 2));
         assert_eq!(t.texels[0], Rgb::new(1.0, 0.0, 0.0));
         // sRGB 188 is about 0.5 linear.
@@ -129,11 +145,15 @@ mod tests {
     fn bad_texture_files_name_the_file() {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("missing.png");
-        let e = read_texture(&p).unwrap_err().to_string();
+        let e = read_texture(&FileAccess::open(), &p)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("missing.png: cannot open"), "{e}");
         let p = dir.path().join("junk.png");
         std::fs::write(&p, b"not a png").unwrap();
-        let e = read_texture(&p).unwrap_err().to_string();
+        let e = read_texture(&FileAccess::open(), &p)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("junk.png: cannot decode image"), "{e}");
     }
 
@@ -142,7 +162,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("env.exr");
         exr::prelude::write_rgb_file(&p, 4, 2, |x, y| (x as f32, y as f32, 0.5f32)).unwrap();
-        let (w, h, t) = read_env_map(&p).unwrap();
+        let (w, h, t) = read_env_map(&FileAccess::open(), &p).unwrap();
         assert_eq!((w, h), (4, 2));
         assert_eq!(t[4 + 3], Rgb::new(3.0, 1.0, 0.5));
 
@@ -151,16 +171,20 @@ mod tests {
                 (if (x, y) == (2, 1) { bad } else { 1.0f32 }, 1.0f32, 1.0f32)
             })
             .unwrap();
-            let e = read_env_map(&p).unwrap_err().to_string();
+            let e = read_env_map(&FileAccess::open(), &p)
+                .unwrap_err()
+                .to_string();
             assert!(e.contains("env.exr: texel (2, 1)"), "{e}");
             assert!(e.contains(what), "{e}");
         }
-        let e = read_env_map(&dir.path().join("none.exr"))
+        let e = read_env_map(&FileAccess::open(), &dir.path().join("none.exr"))
             .unwrap_err()
             .to_string();
         assert!(e.contains("none.exr: cannot open"), "{e}");
         std::fs::write(&p, b"garbage").unwrap();
-        let e = read_env_map(&p).unwrap_err().to_string();
+        let e = read_env_map(&FileAccess::open(), &p)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("env.exr: cannot read"), "{e}");
     }
 }

@@ -54,6 +54,7 @@
 
 mod desc;
 mod error;
+mod files;
 mod geometry;
 mod gltf;
 mod image_io;
@@ -67,6 +68,7 @@ mod shapes;
 pub mod views;
 
 pub use error::{LineCol, SceneError};
+pub use files::FileAccess;
 
 use std::path::Path;
 
@@ -109,6 +111,11 @@ pub struct RenderDesc {
 /// ([`procedural::generate`], with an empty `[render]` table): what every command that takes
 /// a scene argument accepts.
 pub fn load_any(path: &Path) -> Result<LoadedScene, SceneError> {
+    load_any_with(path, &FileAccess::open())
+}
+
+/// [`load_any`] reading files only as `access` allows (`render --confine DIR`).
+pub fn load_any_with(path: &Path, access: &FileAccess) -> Result<LoadedScene, SceneError> {
     if let Some(name) = path.to_str().and_then(|p| p.strip_prefix("gen:")) {
         let scene = procedural::generate(name).map_err(|e| SceneError::File {
             file: path.to_path_buf(),
@@ -120,7 +127,7 @@ pub fn load_any(path: &Path) -> Result<LoadedScene, SceneError> {
             warnings: Vec::new(),
         });
     }
-    load(path)
+    load_with(path, access)
 }
 
 /// Loads a bare mesh file (OBJ, glTF, .ra2) as a scene through the scene format: one grey
@@ -151,6 +158,12 @@ pub fn load_mesh(path: &Path) -> Result<LoadedScene, SceneError> {
 /// Loads the scene file at `path`. Relative paths inside it (meshes, textures, environment
 /// maps) are resolved against the file's directory, and errors name `path` as given.
 pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
+    load_with(path, &FileAccess::open())
+}
+
+/// [`load`] reading files (the scene file too) only as `access` allows.
+pub fn load_with(path: &Path, access: &FileAccess) -> Result<LoadedScene, SceneError> {
+    access.check(path)?;
     let text = std::fs::read_to_string(path).map_err(|e| {
         let why = if e.kind() == std::io::ErrorKind::InvalidData {
             "cannot read: the file is not UTF-8 text".to_string()
@@ -160,7 +173,7 @@ pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
         SceneError::file(path, why)
     })?;
     let base = path.parent().unwrap_or(Path::new(""));
-    load_str(&text, base, path)
+    load::load(&text, base, path, access)
 }
 
 /// Loads a scene from TOML text. Relative paths inside it are resolved against `base_dir`;
@@ -170,5 +183,5 @@ pub fn load_str(
     base_dir: &Path,
     name_for_errors: &Path,
 ) -> Result<LoadedScene, SceneError> {
-    load::load(toml, base_dir, name_for_errors)
+    load::load(toml, base_dir, name_for_errors, &FileAccess::open())
 }

@@ -6,6 +6,7 @@ use crate::desc::{
     self, AssignDesc, CameraDesc, EnvironmentDesc, RenderTableDesc, SceneDesc, SkyDesc, V3,
 };
 use crate::error::{Result, Source};
+use crate::files::FileAccess;
 use crate::geometry;
 use crate::image_io::{self, Textures};
 use crate::instances;
@@ -45,13 +46,18 @@ impl Ctx<'_> {
 }
 
 /// Loads a scene from TOML text (see [`crate::load_str`]).
-pub(crate) fn load(text: &str, base: &Path, name: &Path) -> Result<LoadedScene> {
+pub(crate) fn load(
+    text: &str,
+    base: &Path,
+    name: &Path,
+    access: &FileAccess,
+) -> Result<LoadedScene> {
     let src = Source { name, text };
     let d: SceneDesc = desc::parse(text).map_err(|e| src.toml_error(&e))?;
     let mut ctx = Ctx {
         src,
         base,
-        textures: Textures::default(),
+        textures: Textures::new(access.clone()),
         warnings: Vec::new(),
     };
     let mut scene = Scene::empty();
@@ -216,7 +222,7 @@ fn environment(ctx: &Ctx, env: &Spanned<EnvironmentDesc>) -> Result<Environment>
         ));
     }
     let path = ctx.resolve(map.get_ref());
-    let (w, h, mut texels) = image_io::read_env_map(&path)?;
+    let (w, h, mut texels) = image_io::read_env_map(ctx.textures.access(), &path)?;
     for t in &mut texels {
         *t *= strength;
         if t.max_element() > MAX_RADIANCE {

@@ -37,8 +37,7 @@ pub(crate) fn load(
     textures: &mut Textures,
     warnings: &mut Vec<String>,
 ) -> Result<Mesh> {
-    let bytes =
-        std::fs::read(path).map_err(|e| SceneError::file(path, format!("cannot open: {e}")))?;
+    let bytes = textures.access().read(path, "")?;
     let text = String::from_utf8_lossy(&bytes);
     let dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
     // The material loader cannot return our errors through tobj: collect them here.
@@ -55,7 +54,7 @@ pub(crate) fn load(
             return Ok(Default::default());
         }
         let p = dir.join(lib);
-        match read_mtl(&p) {
+        match read_mtl(textures.access(), &p) {
             Ok(r) => {
                 mtl_files.borrow_mut().push(p);
                 r
@@ -129,9 +128,8 @@ pub(crate) fn load(
 }
 
 /// Reads one material library, with errors that name it.
-fn read_mtl(p: &Path) -> Result<tobj::MTLLoadResult> {
-    let bytes = std::fs::read(p)
-        .map_err(|e| SceneError::file(p, format!("cannot open material library: {e}")))?;
+fn read_mtl(access: &crate::FileAccess, p: &Path) -> Result<tobj::MTLLoadResult> {
+    let bytes = access.read(p, "material library")?;
     let r = tobj::load_mtl_buf(&mut Cursor::new(bytes));
     if let Err(e) = &r {
         return Err(SceneError::file(

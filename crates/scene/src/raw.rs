@@ -164,7 +164,14 @@ pub fn write(path: &Path, mesh: &RawMesh) -> std::io::Result<()> {
 }
 
 /// Loads a `.ra2` file (with companions) as a mesh without materials.
-pub(crate) fn load(path: &Path) -> Result<Mesh, SceneError> {
+pub(crate) fn load(access: &crate::FileAccess, path: &Path) -> Result<Mesh, SceneError> {
+    for p in [
+        path.to_path_buf(),
+        companion(path, "ran"),
+        companion(path, "ruv"),
+    ] {
+        access.check(&p)?;
+    }
     let r = read(path)?;
     let mut m = Mesh::default();
     for (i, t) in r.triangles.iter().enumerate() {
@@ -217,7 +224,7 @@ mod tests {
         };
         write(&q, &plain).unwrap();
         assert_eq!(read(&q).unwrap(), plain);
-        let mesh = load(&p).unwrap();
+        let mesh = load(&crate::FileAccess::open(), &p).unwrap();
         assert_eq!(mesh.tris, m.triangles);
         assert_eq!(mesh.normals[2], Some([Vec3::Z, Vec3::Y, Vec3::X]));
     }
