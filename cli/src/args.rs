@@ -164,6 +164,12 @@ pub struct Args {
     #[arg(long, value_name = "DIR")]
     pub confine: Option<PathBuf>,
 
+    /// Refuse, before allocating, a render whose estimated memory (film buffers and per-sample
+    /// records exactly, the acceleration structure by an upper bound) exceeds SIZE, e.g. 512M
+    /// or 8G. [default: the memory the system reports available]
+    #[arg(long, value_name = "SIZE")]
+    pub max_memory: Option<String>,
+
     /// Denoise by GREE (Bauszat, thesis ch. 5): --spp is the budget b; render the noisy image
     /// at n = fraction x b spp, run the filter bank (--bank), render filter caches at a share
     /// 1 - sparsity of the pixels with independent samples, pick a filter per pixel by the

@@ -151,6 +151,7 @@ pub fn run(args: &Args) -> Result<()> {
         job.settings.accel = AccelSpec::default_for_scene(&scene);
     }
     set_shutter(args, &job, &mut scene)?;
+    check_memory(args, &job, &scene)?;
     if let Some(spec) = crate::sequence::temporal_spec(args)? {
         return crate::sequence::run(args, &job, &spec, &mut scene, &frames);
     }
@@ -201,6 +202,66 @@ pub fn run(args: &Args) -> Result<()> {
         )?;
     }
     Ok(())
+}
+
+/// The single-frame denoiser `--denoiser` names, built (`None` without one).
+fn single_frame_denoiser(args: &Args, job: &Job) -> Result<Option<Box<dyn rt_denoise::Denoiser>>> {
+    let Some(text) = &args.denoiser else {
+        return Ok(None);
+    };
+    if job.settings.aovs != AovSet::default() {
+        bail!("--denoiser writes the denoised image only; save a noisy frame's AOVs with a render without it");
+    }
+    let d = text
+        .parse::<rt_denoise::DenoiserSpec>()
+        .and_then(|s| s.build())
+        .map_err(|e| anyhow::anyhow!("--denoiser {text}: {e}"))?;
+    Ok(Some(d))
+}
+
+/// The film buffers a render keeps: only what its outputs and its denoiser read, no variance
+/// or half-buffers unless asked for; the stopping criterion reads the even samples' half.
+fn film_buffers(job: &Job, denoiser: Option<&dyn rt_denoise::Denoiser>) -> FilmBuffers {
+    let denoise_aovs = denoiser.map_or(AovSet::default(), |d| AovSet::for_channels(d.needs()));
+    let buffers = FilmBuffers::for_outputs(job.settings.aovs.union(denoise_aovs));
+    if job.stop.is_some_and(|s| s.error.is_some()) {
+        buffers.with_halves()
+    } else {
+        buffers
+    }
+}
+
+/// `--max-memory`: refuses, before the structure and the film are allocated, a render whose
+/// estimate exceeds the limit (`crate::memory`).
+fn check_memory(args: &Args, job: &Job, scene: &Scene) -> Result<()> {
+    let limit = args
+        .max_memory
+        .as_deref()
+        .map(crate::memory::parse_size)
+        .transpose()?;
+    let camera = pick_camera(scene, &job.scene_path, job.camera.as_deref())?;
+    // A temporal denoiser's needs are its own; the plain film is still the floor.
+    let denoiser = if crate::sequence::temporal_spec(args)?.is_some() {
+        None
+    } else {
+        single_frame_denoiser(args, job)?
+    };
+    let splats = job
+        .settings
+        .integrator
+        .build()
+        .camera_integrator()
+        .is_none();
+    crate::memory::Estimate::new(
+        camera.width,
+        camera.height,
+        film_buffers(job, denoiser.as_deref()),
+        job.settings.spp,
+        splats,
+        &job.settings.accel,
+        scene.triangle_count(),
+    )
+    .check(&job.scene_path.display().to_string(), limit)
 }
 
 /// Opens the scene's shutter for `--shutter` of a frame and checks that the render can blur
@@ -279,19 +340,7 @@ fn render_one(
     if args.gree.is_some() {
         return pool.install(|| crate::gree::render(args, job, &ctx, integrator.as_ref()));
     }
-    let denoiser = match &args.denoiser {
-        None => None,
-        Some(text) => {
-            if job.settings.aovs != AovSet::default() {
-                bail!("--denoiser writes the denoised image only; save a noisy frame's AOVs with a render without it");
-            }
-            let d = text
-                .parse::<rt_denoise::DenoiserSpec>()
-                .and_then(|s| s.build())
-                .map_err(|e| anyhow::anyhow!("--denoiser {text}: {e}"))?;
-            Some(d)
-        }
-    };
+    let denoiser = single_frame_denoiser(args, job)?;
     let denoise_aovs = denoiser
         .as_ref()
         .map_or(AovSet::default(), |d| AovSet::for_channels(d.needs()));
@@ -302,13 +351,11 @@ fn render_one(
             job.settings.integrator
         );
     }
-    // Only the buffers the outputs (and the denoiser) read: no variance or half-buffers unless
-    // asked for. The stopping criterion reads the even samples' half-buffer.
-    let mut buffers = FilmBuffers::for_outputs(job.settings.aovs.union(denoise_aovs));
-    if job.stop.is_some_and(|s| s.error.is_some()) {
-        buffers = buffers.with_halves();
-    }
-    let mut film = Film::new(camera.width, camera.height, buffers);
+    let mut film = Film::new(
+        camera.width,
+        camera.height,
+        film_buffers(job, denoiser.as_deref()),
+    );
     let pass = SamplePass {
         indices: 0..job.settings.spp,
         stream: rt_core::SampleStream::Render,

@@ -23,6 +23,7 @@ mod experiment;
 mod frame_pattern;
 mod gree;
 mod job;
+mod memory;
 mod progress;
 mod reference;
 mod sequence;

@@ -107,6 +107,32 @@ impl AccelKind {
         matches!(self, AccelKind::Qbvh | AccelKind::Bvh8)
     }
 
+    /// An upper bound on the bytes a structure of this kind over `triangles` triangles needs
+    /// while it is built and after: its triangle copies, nodes and the builder's temporary
+    /// arrays. The per-triangle figures are about twice the largest held size measured
+    /// (`render --stats` on the shipped scenes and Sponza, 66k triangles: BVH 69 B/triangle,
+    /// QBVH 56, BVH8 55, two-level 55, clusters 57, uniform grid 65, irregular grid 320,
+    /// IOSP-0/4/2 36/37/74), which covers the builders' reference arrays; 64 KiB covers the
+    /// fixed parts of small scenes. `crates/accel/tests/memory_bound.rs` checks the held size
+    /// against it. For refusing renders that cannot fit (`render --max-memory`), not for
+    /// accounting.
+    pub fn memory_bound(self, triangles: usize) -> u64 {
+        let per_triangle: u64 = match self {
+            AccelKind::BruteForce | AccelKind::Iosp0 => 80,
+            AccelKind::Iosp4 => 96,
+            AccelKind::Bvh
+            | AccelKind::Qbvh
+            | AccelKind::Bvh8
+            | AccelKind::Grid
+            | AccelKind::Iosp2 => 160,
+            AccelKind::TwoLevel | AccelKind::Clusters => 192,
+            AccelKind::IrregularGrid => 1024,
+        };
+        (triangles as u64)
+            .saturating_mul(per_triangle)
+            .saturating_add(64 << 10)
+    }
+
     /// The name used in specs and reports.
     pub fn name(self) -> &'static str {
         match self {

@@ -248,6 +248,52 @@ pub struct FilmMemory {
 }
 
 impl FilmMemory {
+    /// What `Film::new(width, height, buffers)` holds once every pixel has
+    /// `samples_per_pixel` samples (per-sample records grow with them) and, with `splats`,
+    /// after the first light-path splat: the sizes [`Film::memory`] reports, computed without
+    /// allocating, so that a render that cannot fit is refused before it starts.
+    pub fn estimate(
+        width: u32,
+        height: u32,
+        buffers: impl Into<FilmBuffers>,
+        samples_per_pixel: u64,
+        splats: bool,
+    ) -> FilmMemory {
+        let mut buffers = buffers.into();
+        buffers.variance |= buffers.aovs.variance;
+        let n = width as usize * height as usize;
+        let a = buffers.aovs;
+        let of = |keep: bool, element: usize| keep.then_some(n.saturating_mul(element));
+        use std::mem::size_of;
+        FilmMemory {
+            mean: n * size_of::<MeanCount>(),
+            variance: of(buffers.variance, size_of::<Rgb>()),
+            halves: of(buffers.halves, size_of::<HalfSums>()),
+            first_hits: of(a.any_first_hit(), size_of::<u32>()),
+            albedo: of(a.albedo, size_of::<Rgb>()),
+            normal: of(a.normal, size_of::<Vec3>()),
+            depth: of(a.depth, size_of::<f32>()),
+            position: of(a.position, size_of::<Vec3>()),
+            feature_variance: of(
+                a.feature_variance && a.any_first_hit(),
+                size_of::<FeatureM2>(),
+            ),
+            split: of(a.any_split(), size_of::<LightSplit>()),
+            // The even samples' splats only with half-buffers (`SplatSums::add`).
+            splats: of(
+                splats,
+                (1 + usize::from(buffers.halves)) * size_of::<[f64; 3]>(),
+            ),
+            samples: buffers.samples.then(|| {
+                (n as u64)
+                    .saturating_mul(samples_per_pixel)
+                    .saturating_mul(crate::samples::SAMPLE_RECORD_BYTES as u64)
+                    .min(usize::MAX as u64) as usize
+                    + (n + 1) * size_of::<usize>()
+            }),
+        }
+    }
+
     /// Bytes of all buffers together.
     pub fn total(&self) -> usize {
         self.mean
@@ -797,6 +843,63 @@ impl Film {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_estimate_is_what_a_film_allocates() {
+        // Every output combination `render --aov` can ask for, one at a time and all together.
+        let mut sets: Vec<AovSet> = AOV_NAMES
+            .iter()
+            .map(|n| AovSet::parse_list([*n]).unwrap())
+            .collect();
+        sets.push(AovSet::parse_list(AOV_NAMES).unwrap());
+        sets.push(AovSet::default());
+        for aovs in sets {
+            for buffers in [
+                FilmBuffers::for_outputs(aovs),
+                FilmBuffers::for_outputs(aovs).with_halves().with_variance(),
+            ] {
+                let film = Film::new(7, 5, buffers);
+                assert_eq!(
+                    FilmMemory::estimate(7, 5, buffers, 0, false),
+                    film.memory(),
+                    "{buffers:?}"
+                );
+            }
+        }
+        // Splats appear with the first light path; records grow with the samples.
+        let mut film = Film::new(7, 5, FilmBuffers::default());
+        film.add_splats(
+            0,
+            1,
+            &[Splat {
+                pixel: 3,
+                value: Rgb::ONE,
+            }],
+        );
+        let e = FilmMemory::estimate(7, 5, FilmBuffers::default(), 0, true);
+        assert_eq!(e.splats, film.memory().splats);
+        let halves = FilmBuffers::default().with_halves();
+        let mut film = Film::new(7, 5, halves);
+        film.add_splats(
+            0,
+            1,
+            &[Splat {
+                pixel: 3,
+                value: Rgb::ONE,
+            }],
+        );
+        let e = FilmMemory::estimate(7, 5, halves, 0, true);
+        assert_eq!(e.splats, film.memory().splats);
+        let records = FilmBuffers {
+            samples: true,
+            ..FilmBuffers::default()
+        };
+        let e = FilmMemory::estimate(7, 5, records, 16, false);
+        assert_eq!(e.samples, Some(35 * 16 * 56 + 36 * 8));
+        // A 16384² film with every sample kept at 1024 spp: about 15 TB, without overflow.
+        let huge = FilmMemory::estimate(16384, 16384, records, 1024, false);
+        assert!(huge.total() > 15_000_000_000_000, "{huge:?}");
+    }
 
     fn all_buffers() -> FilmBuffers {
         FilmBuffers::for_outputs(AovSet {
