@@ -1,0 +1,107 @@
+//! `rt-fuzzing`: every file format the renderer reads, behind one function that takes the
+//! file's bytes, loads them with the shipped loader and drops the result. The cargo-fuzz
+//! targets in `fuzz/` call these (a campaign, outside CI: docs/testing.md, "Fuzzing"), and
+//! `tests/replay.rs` runs them over the committed corpus `fuzz/corpus/<target>/` in CI, so
+//! every input a campaign kept, and every crash it found, stays a test.
+//!
+//! An input passes when its loader returns, `Ok` or `Err`; a panic, a hang or an allocation
+//! the fuzzer's memory limit refuses is a failure. Depends on rt-scene, rt-film and
+//! rt-experiment (the loaders) and tempfile. Dev-only, like rt-testkit: no shipped crate
+//! depends on it.
+//!
+//! ```
+//! // A scene file with a stray byte is an error, not a panic.
+//! rt_fuzzing::scene_toml(b"[[camera]]\nname = \"c\"\x00");
+//! ```
+
+use std::cell::RefCell;
+use std::path::{Path, PathBuf};
+
+/// A fuzz target: the bytes of one input file.
+pub type Target = fn(&[u8]);
+
+/// The fuzz targets by name, as in `fuzz/fuzz_targets/` and `fuzz/corpus/`.
+pub const TARGETS: [(&str, Target); 8] = [
+    ("scene_toml", scene_toml),
+    ("experiment_toml", experiment_toml),
+    ("obj", obj),
+    ("gltf", gltf),
+    ("glb", glb),
+    ("ra2", ra2),
+    ("exr", exr),
+    ("image", image),
+];
+
+thread_local! {
+    /// One scratch directory per thread for the loaders that read a path.
+    static SCRATCH: RefCell<Option<tempfile::TempDir>> = const { RefCell::new(None) };
+}
+
+/// Writes `data` to `name` in this thread's scratch directory and calls `load` on the path.
+fn with_file(name: &str, data: &[u8], load: impl FnOnce(&Path)) {
+    let path: PathBuf = SCRATCH.with(|s| {
+        let mut s = s.borrow_mut();
+        let dir = s.get_or_insert_with(|| tempfile::tempdir().expect("a scratch directory"));
+        dir.path().join(name)
+    });
+    std::fs::write(&path, data).expect("the scratch directory is writable");
+    load(&path);
+}
+
+/// A scene file (`rt_scene::load`), read from a directory holding nothing else, so that the
+/// files it names are missing (their loaders have targets of their own).
+pub fn scene_toml(data: &[u8]) {
+    with_file("scene.toml", data, |p| {
+        let _ = rt_scene::load(p);
+    });
+}
+
+/// An experiment file (`rt_experiment::config::load`, which also loads the scenes it names).
+pub fn experiment_toml(data: &[u8]) {
+    with_file("experiment.toml", data, |p| {
+        let _ = rt_experiment::config::load(p);
+    });
+}
+
+/// An OBJ mesh with its materials (`rt_scene::load_mesh`).
+pub fn obj(data: &[u8]) {
+    with_file("mesh.obj", data, |p| {
+        let _ = rt_scene::load_mesh(p);
+    });
+}
+
+/// A glTF file (JSON).
+pub fn gltf(data: &[u8]) {
+    with_file("mesh.gltf", data, |p| {
+        let _ = rt_scene::load_mesh(p);
+    });
+}
+
+/// A binary glTF file.
+pub fn glb(data: &[u8]) {
+    with_file("mesh.glb", data, |p| {
+        let _ = rt_scene::load_mesh(p);
+    });
+}
+
+/// A `.ra2` triangle file.
+pub fn ra2(data: &[u8]) {
+    with_file("mesh.ra2", data, |p| {
+        let _ = rt_scene::load_mesh(p);
+    });
+}
+
+/// An EXR image, as `render compare` reads it (`rt_film::read_rgb`) and as `render denoise`
+/// reads a saved frame (`NoisyFrame::from_exr`).
+pub fn exr(data: &[u8]) {
+    with_file("image.exr", data, |p| {
+        let _ = rt_film::read_rgb(p);
+        let _ = rt_film::NoisyFrame::from_exr(p);
+    });
+}
+
+/// A PNG or JPEG image (`rt_film::decode_srgb`, the decoder of image files and of images
+/// inside glTF files).
+pub fn image(data: &[u8]) {
+    let _ = rt_film::decode_srgb(data);
+}
