@@ -1,8 +1,9 @@
 //! `rt-fuzzing`: every file format the renderer reads, behind one function that takes the
 //! file's bytes, loads them with the shipped loader and drops the result. The cargo-fuzz
 //! targets in `fuzz/` call these (a campaign, outside CI: docs/testing.md, "Fuzzing"), and
-//! `tests/replay.rs` runs them over the committed corpus `fuzz/corpus/<target>/` in CI, so
-//! every input a campaign kept, and every crash it found, stays a test.
+//! `tests/replay.rs` runs them over the committed seeds (`fuzz/seeds/<target>/`, with every
+//! crash found as `crash-*`) and corpus (`fuzz/corpus/<target>/`) in CI, so every input a
+//! campaign kept, and every crash it found, stays a test.
 //!
 //! An input passes when its loader returns, `Ok` or `Err`; a panic, a hang or an allocation
 //! the fuzzer's memory limit refuses is a failure. Depends on rt-scene, rt-film and
@@ -20,7 +21,7 @@ use std::path::{Path, PathBuf};
 /// A fuzz target: the bytes of one input file.
 pub type Target = fn(&[u8]);
 
-/// The fuzz targets by name, as in `fuzz/fuzz_targets/` and `fuzz/corpus/`.
+/// The fuzz targets by name, as in `fuzz/fuzz_targets/`, `fuzz/seeds/` and `fuzz/corpus/`.
 pub const TARGETS: [(&str, Target); 8] = [
     ("scene_toml", scene_toml),
     ("experiment_toml", experiment_toml),

@@ -1,37 +1,49 @@
-//! Every input of the committed corpus (`fuzz/corpus/<target>/`: the seeds, what campaigns
-//! kept, and the crashes they found, named `crash-*`) through its target: a panic fails the
-//! test, naming the file. This is how CI runs the fuzz targets (the campaigns themselves run
-//! outside CI: docs/testing.md, "Fuzzing").
+//! Every input of the committed seeds and corpus (`fuzz/seeds/<target>/`: valid files of each
+//! format and the crashes campaigns found, named `crash-*`; `fuzz/corpus/<target>/`: what
+//! campaigns kept, minimized) through its target: a panic fails the test, naming the file.
+//! This is how CI runs the fuzz targets (the campaigns themselves run outside CI:
+//! docs/testing.md, "Fuzzing").
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+fn fuzz_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz")
+}
+
+/// The files of `dir`, sorted; none if it does not exist.
+fn files(dir: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = match std::fs::read_dir(dir) {
+        Ok(entries) => entries.filter_map(|e| Some(e.ok()?.path())).collect(),
+        Err(_) => Vec::new(),
+    };
+    v.sort();
+    v
+}
 
 #[test]
-fn the_corpus_loads_without_a_panic() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/corpus");
+fn the_seeds_and_the_corpus_load_without_a_panic() {
     let mut inputs = 0;
     for (name, target) in rt_fuzzing::TARGETS {
-        let dir = root.join(name);
-        let mut files: Vec<_> = std::fs::read_dir(&dir)
-            .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
-            .map(|e| e.unwrap().path())
-            .collect();
-        files.sort();
-        assert!(!files.is_empty(), "{} has no seeds", dir.display());
-        for file in files {
+        let seeds = files(&fuzz_dir().join("seeds").join(name));
+        assert!(!seeds.is_empty(), "fuzz/seeds/{name} is empty");
+        for file in seeds
+            .into_iter()
+            .chain(files(&fuzz_dir().join("corpus").join(name)))
+        {
             let data = std::fs::read(&file).unwrap();
             let outcome = std::panic::catch_unwind(|| target(&data));
             assert!(outcome.is_ok(), "{name}: {} panics", file.display());
             inputs += 1;
         }
     }
-    println!("{inputs} corpus inputs replayed");
+    println!("{inputs} inputs replayed");
 }
 
 #[test]
 fn the_seeds_are_valid_inputs_of_their_loaders() {
     // The seeds must reach deep into their formats: each loads without error where it is
     // self-contained (an invalid seed would leave the fuzzer at the parser's door).
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../fuzz/corpus");
+    let seeds = fuzz_dir().join("seeds");
     for (dir, ext) in [
         ("obj", "obj"),
         ("gltf", "gltf"),
@@ -39,8 +51,7 @@ fn the_seeds_are_valid_inputs_of_their_loaders() {
         ("ra2", "ra2"),
     ] {
         let d = tempfile::tempdir().unwrap();
-        for f in std::fs::read_dir(root.join(dir)).unwrap() {
-            let f = f.unwrap().path();
+        for f in files(&seeds.join(dir)) {
             if f.file_name()
                 .unwrap()
                 .to_string_lossy()
@@ -53,6 +64,6 @@ fn the_seeds_are_valid_inputs_of_their_loaders() {
             rt_scene::load_mesh(&p).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
         }
     }
-    rt_film::read_rgb(&root.join("exr/tiny.exr")).unwrap();
-    rt_film::decode_srgb(&std::fs::read(root.join("image/checker.png")).unwrap()).unwrap();
+    rt_film::read_rgb(&seeds.join("exr/tiny.exr")).unwrap();
+    rt_film::decode_srgb(&std::fs::read(seeds.join("image/checker.png")).unwrap()).unwrap();
 }

@@ -188,9 +188,11 @@ fn key_before(text: &str, offset: usize) -> Option<&str> {
             continue;
         }
         let lhs = before[..eq].trim_end();
+        // The character before the key may be several bytes long (found by fuzzing).
         let start = lhs
-            .rfind(|c: char| !(c.is_ascii_alphanumeric() || c == '_' || c == '-'))
-            .map_or(0, |i| i + 1);
+            .char_indices()
+            .rfind(|&(_, c)| !(c.is_ascii_alphanumeric() || c == '_' || c == '-'))
+            .map_or(0, |(i, c)| i + c.len_utf8());
         let key = &lhs[start..];
         return (!key.is_empty()).then_some(key);
     }
@@ -202,6 +204,26 @@ pub type Result<T, E = SceneError> = std::result::Result<T, E>;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_key_after_a_multibyte_character_is_found() {
+        // fuzz/seeds/scene_toml/crash-key-after-multibyte: a key right after a four-byte
+        // character sliced the text inside it.
+        let text = "name =\"\u{10968b}rceis =";
+        assert_eq!(key_before(text, text.len()), Some("rceis"));
+        let bytes = std::fs::read(
+            Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../fuzz/seeds/scene_toml/crash-key-after-multibyte"),
+        )
+        .unwrap();
+        let e = crate::load_str(
+            &String::from_utf8_lossy(&bytes),
+            Path::new("."),
+            Path::new("f.toml"),
+        )
+        .unwrap_err();
+        assert!(e.to_string().starts_with("f.toml:"), "{e}");
+    }
 
     #[test]
     fn line_col_counts_lines_and_characters_from_one() {
