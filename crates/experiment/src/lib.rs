@@ -157,6 +157,7 @@ pub struct Outcome {
 pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> Result<Outcome> {
     let wall = Instant::now();
     let (y, mo, d, h, mi, _) = utc(now_secs());
+    let started = (y, mo, d, h, mi);
     if plan.is_sequence() {
         let results = sequence::run(plan, out, cache, progress)?;
         seqreport::plots(plan, &results, out)?;
@@ -169,11 +170,7 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
             seqreport::sequences_csv(plan, &results).as_bytes(),
         )?;
         rt_film::copy_atomic(&plan.path, &out.join("config.toml"))?;
-        let info = report::RunInfo {
-            started: format!("{y:04}-{mo:02}-{d:02} {h:02}:{mi:02}"),
-            threads: rayon::current_num_threads(),
-            wall_seconds: wall.elapsed().as_secs_f64(),
-        };
+        let info = report::RunInfo::now(started, wall.elapsed());
         let report = out.join("report.md");
         rt_film::write_bytes_atomic(
             &report,
@@ -210,11 +207,7 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
         report::slopes_csv(plan, &slopes).as_bytes(),
     )?;
     rt_film::copy_atomic(&plan.path, &out.join("config.toml"))?;
-    let info = report::RunInfo {
-        started: format!("{y:04}-{mo:02}-{d:02} {h:02}:{mi:02}"),
-        threads: rayon::current_num_threads(),
-        wall_seconds: wall.elapsed().as_secs_f64(),
-    };
+    let info = report::RunInfo::now(started, wall.elapsed());
     let md = report::markdown(
         plan,
         &results,

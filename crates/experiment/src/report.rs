@@ -575,6 +575,43 @@ pub struct RunInfo {
     pub wall_seconds: f64,
 }
 
+impl RunInfo {
+    /// Facts of a run that started at `started` (UTC, `now_secs` seconds) and took `wall`, on
+    /// the current thread pool.
+    pub fn now(started: (i64, u32, u32, u32, u32), wall: std::time::Duration) -> Self {
+        let (y, mo, d, h, mi) = started;
+        Self {
+            started: format!("{y:04}-{mo:02}-{d:02} {h:02}:{mi:02}"),
+            threads: rayon::current_num_threads(),
+            wall_seconds: wall.as_secs_f64(),
+        }
+    }
+
+    /// report.md's title, run line, `data` (what the output folder holds) and the plan's
+    /// warnings.
+    pub fn header(&self, plan: &Plan, title: &str, data: &str) -> String {
+        let mut s = String::new();
+        let _ = writeln!(s, "# Experiment `{}`{title}\n", plan.name);
+        let _ = writeln!(
+            s,
+            "Config `{}`, started {} UTC, {} worker threads, {:.1} s in all. relMSE uses ε = {}.\n{data}",
+            plan.path.display(),
+            self.started,
+            self.threads,
+            self.wall_seconds,
+            plan.epsilon
+        );
+        if !plan.warnings.is_empty() {
+            let _ = writeln!(s, "Warnings:\n");
+            for w in &plan.warnings {
+                let _ = writeln!(s, "- {w}");
+            }
+            s.push('\n');
+        }
+        s
+    }
+}
+
 /// report.md.
 pub fn markdown(
     plan: &Plan,
@@ -585,26 +622,12 @@ pub fn markdown(
     blocks: &[(usize, usize, usize)],
     info: &RunInfo,
 ) -> String {
-    let mut s = String::new();
-    let _ = writeln!(s, "# Experiment `{}`\n", plan.name);
-    let _ = writeln!(
-        s,
-        "Config `{}`, started {} UTC, {} worker threads, {:.1} s in all. relMSE uses ε = {}.\n\
-         Data: [results.csv](results.csv) (one row per run), [slopes.csv](slopes.csv); images in \
+    let mut s = info.header(
+        plan,
+        "",
+        "Data: [results.csv](results.csv) (one row per run), [slopes.csv](slopes.csv); images in \
          `images/<scene>/`.\n",
-        plan.path.display(),
-        info.started,
-        info.threads,
-        info.wall_seconds,
-        plan.epsilon
     );
-    if !plan.warnings.is_empty() {
-        let _ = writeln!(s, "Warnings:\n");
-        for w in &plan.warnings {
-            let _ = writeln!(s, "- {w}");
-        }
-        s.push('\n');
-    }
 
     let _ = writeln!(s, "## Summary\n");
     // Equal samples matters where sample counts differ from the budgets (adaptive runs) or

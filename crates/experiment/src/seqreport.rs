@@ -196,29 +196,15 @@ fn scene_line(plan: &Plan, results: &SequenceResults, si: usize) -> String {
 
 /// report.md of a sequence experiment.
 pub fn markdown(plan: &Plan, results: &SequenceResults, info: &RunInfo) -> String {
-    let mut s = String::new();
-    let _ = writeln!(s, "# Experiment `{}` (sequences)\n", plan.name);
-    let _ = writeln!(
-        s,
-        "Config `{}`, started {} UTC, {} worker threads, {:.1} s in all. relMSE uses ε = {}.\n\
-         Data: [frames.csv](frames.csv) (one row per frame), [sequences.csv](sequences.csv) \
+    let mut s = info.header(
+        plan,
+        " (sequences)",
+        "Data: [frames.csv](frames.csv) (one row per frame), [sequences.csv](sequences.csv) \
          (one row per method and scene); stills in `images/<scene>/`.\n\n\
          Temporal error: mean absolute luminance change between consecutive frames (the \
          reference's column is what the scene itself changes). Temporal relMSE: relMSE of each \
          frame difference against the reference's difference, averaged over the steps.\n",
-        plan.path.display(),
-        info.started,
-        info.threads,
-        info.wall_seconds,
-        plan.epsilon
     );
-    if !plan.warnings.is_empty() {
-        let _ = writeln!(s, "Warnings:\n");
-        for w in &plan.warnings {
-            let _ = writeln!(s, "- {w}");
-        }
-        s.push('\n');
-    }
     for (si, scene) in plan.scenes.iter().enumerate() {
         let _ = writeln!(s, "## {}\n", scene.name);
         let _ = writeln!(s, "{}\n", scene_line(plan, results, si));
