@@ -369,31 +369,12 @@ mod tests {
     use rt_temporal::TemporalSpec;
     use std::path::Path;
 
-    /// A small moving scene at a small resolution.
+    /// A small moving scene at a small resolution: the shared lit floor with a moving ball.
     fn scene() -> Scene {
-        let toml = r#"
-            [[camera]]
-            name = "c"
-            position = [0, 1, 4]
-            look_at = [0, 0.5, 0]
-            resolution = [24, 16]
-            [[material]]
-            name = "white"
-            color = [0.7, 0.7, 0.7]
-            [[material]]
-            name = "lamp"
-            color = [0, 0, 0]
-            emission = [8, 8, 8]
-            [[geometry]]
-            name = "floor"
-            shape = "quad"
-            vertices = [[-3, 0, 3], [3, 0, 3], [3, 0, -3], [-3, 0, -3]]
-            material = "white"
-            [[geometry]]
-            name = "lamp"
-            shape = "quad"
-            vertices = [[-0.5, 2, -0.5], [0.5, 2, -0.5], [0.5, 2, 0.5], [-0.5, 2, 0.5]]
-            material = "lamp"
+        let toml = format!(
+            "{}{}",
+            rt_testkit::scenes::LIT_FLOOR,
+            r#"
             [[geometry]]
             name = "ball"
             shape = "sphere"
@@ -403,8 +384,9 @@ mod tests {
             [[animation]]
             target = "ball"
             keys = [ { time = 0.0 }, { time = 1.0, translate = [0.5, 0, 0] } ]
-        "#;
-        rt_scene::load_str(toml, Path::new("."), Path::new("test.toml"))
+        "#
+        );
+        rt_scene::load_str(&toml, Path::new("."), Path::new("test.toml"))
             .unwrap()
             .scene
     }
