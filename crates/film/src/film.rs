@@ -1,8 +1,7 @@
 //! The film: a grid of pixel statistics plus optional first-hit AOVs.
 
-use crate::pixel::{
-    add_m2, welford_on_sums, FeatureM2, FirstHit, HalfSums, LightSplit, MeanCount, PixelStats,
-};
+use crate::fixed::{sample_variance, sample_variance3, Sum1, Sum3};
+use crate::pixel::{FeatureSquares, FirstHit, HalfSums, LightSplit, PixelStats, SplitSums};
 use crate::samples::SampleRecords;
 use crate::splat::{Splat, SplatSums};
 use rt_core::glam::Vec3;
@@ -170,9 +169,10 @@ pub struct FilmBuffers {
     /// First-hit AOVs to accumulate, and which outputs will be written. Its `variance` flag
     /// implies [`FilmBuffers::variance`].
     pub aovs: AovSet,
-    /// Welford `M2` per pixel, for the variance of the mean (12 bytes per pixel).
+    /// Sums of squares per pixel, for the variance of the mean (48 bytes per pixel).
     pub variance: bool,
-    /// Sums and counts of the even- and odd-numbered samples (32 bytes per pixel).
+    /// Sums and counts of the even-numbered samples, from which the odd ones follow (64 bytes
+    /// per pixel).
     pub halves: bool,
     /// Every camera sample kept apart ([`SampleRecords`], 56 bytes per sample): radiance,
     /// first-hit guides and circle of confusion, for sample-space filters (SBMF). The render
@@ -225,7 +225,7 @@ pub struct FilmMemory {
     pub mean: usize,
     /// Welford `M2`.
     pub variance: Option<usize>,
-    /// Even/odd half sums and counts.
+    /// Even samples' sums and counts.
     pub halves: Option<usize>,
     /// Per-pixel count of samples with a first hit, shared by the first-hit AOVs.
     pub first_hits: Option<usize>,
@@ -237,7 +237,7 @@ pub struct FilmMemory {
     pub depth: Option<usize>,
     /// Position sums.
     pub position: Option<usize>,
-    /// Welford `M2` of the first-hit features.
+    /// Sums of squares of the first-hit features.
     pub feature_variance: Option<usize>,
     /// Sums of the lighting split (one buffer for all its parts).
     pub split: Option<usize>,
@@ -266,23 +266,23 @@ impl FilmMemory {
         let of = |keep: bool, element: usize| keep.then_some(n.saturating_mul(element));
         use std::mem::size_of;
         FilmMemory {
-            mean: n * size_of::<MeanCount>(),
-            variance: of(buffers.variance, size_of::<Rgb>()),
-            halves: of(buffers.halves, size_of::<HalfSums>()),
+            mean: n * (size_of::<u32>() + size_of::<Sum3>()),
+            variance: of(buffers.variance, size_of::<Sum3>()),
+            halves: of(buffers.halves, size_of::<EvenSums>()),
             first_hits: of(a.any_first_hit(), size_of::<u32>()),
-            albedo: of(a.albedo, size_of::<Rgb>()),
-            normal: of(a.normal, size_of::<Vec3>()),
-            depth: of(a.depth, size_of::<f32>()),
-            position: of(a.position, size_of::<Vec3>()),
+            albedo: of(a.albedo, size_of::<Sum3>()),
+            normal: of(a.normal, size_of::<Sum3>()),
+            depth: of(a.depth, size_of::<Sum1>()),
+            position: of(a.position, size_of::<Sum3>()),
             feature_variance: of(
                 a.feature_variance && a.any_first_hit(),
-                size_of::<FeatureM2>(),
+                size_of::<FeatureSquares>(),
             ),
-            split: of(a.any_split(), size_of::<LightSplit>()),
+            split: of(a.any_split(), size_of::<SplitSums>()),
             // The even samples' splats only with half-buffers (`SplatSums::add`).
             splats: of(
                 splats,
-                (1 + usize::from(buffers.halves)) * size_of::<[f64; 3]>(),
+                (1 + usize::from(buffers.halves)) * size_of::<Sum3>(),
             ),
             samples: buffers.samples.then(|| {
                 (n as u64)
@@ -333,44 +333,53 @@ pub struct FeatureVariances {
 
 /// Sums of the first-hit AOVs, one buffer per quantity; each is empty unless asked for.
 #[derive(Debug, Default)]
-struct AovBuffers {
+pub(crate) struct AovBuffers {
     /// Samples whose first hit was recorded (the divisor of every AOV average).
-    hits: Vec<u32>,
-    albedo: Vec<Rgb>,
-    normal: Vec<Vec3>,
-    depth: Vec<f32>,
-    position: Vec<Vec3>,
-    /// Welford `M2` of the features (all four in one buffer).
-    m2: Vec<FeatureM2>,
+    pub(crate) hits: Vec<u32>,
+    pub(crate) albedo: Vec<Sum3>,
+    pub(crate) normal: Vec<Sum3>,
+    pub(crate) depth: Vec<Sum1>,
+    pub(crate) position: Vec<Sum3>,
+    /// Sums of squares of the features (all four in one buffer).
+    pub(crate) squares: Vec<FeatureSquares>,
     /// Sums of the lighting split, divided by the pixel's sample count (every kept sample
-    /// carries a split when one is kept). One buffer for all parts: 72 bytes per pixel, the
+    /// carries a split when one is kept). One buffer for all parts: 288 bytes per pixel, the
     /// price of a simple accumulation loop; only written parts reach the output.
-    split: Vec<LightSplit>,
+    pub(crate) split: Vec<SplitSums>,
 }
 
 /// A band of [`AovBuffers`].
 struct AovSlices<'a> {
     hits: &'a mut [u32],
-    albedo: &'a mut [Rgb],
-    normal: &'a mut [Vec3],
-    depth: &'a mut [f32],
-    position: &'a mut [Vec3],
-    m2: &'a mut [FeatureM2],
-    split: &'a mut [LightSplit],
+    albedo: &'a mut [Sum3],
+    normal: &'a mut [Sum3],
+    depth: &'a mut [Sum1],
+    position: &'a mut [Sum3],
+    squares: &'a mut [FeatureSquares],
+    split: &'a mut [SplitSums],
+}
+
+/// The even-numbered samples' sum and count of one pixel (the odd ones are the rest).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct EvenSums {
+    pub sum: Sum3,
+    pub n: u32,
 }
 
 /// Per-pixel accumulation for a `width × height` image, row 0 at the top. Only the buffers
-/// named by its [`FilmBuffers`] exist; the others have length zero.
+/// named by its [`FilmBuffers`] exist; the others have length zero. Every statistic is an
+/// exact integer sum (see the crate doc), so the order samples arrive in never changes a bit.
 #[derive(Debug)]
 pub struct Film {
     width: u32,
     height: u32,
     buffers: FilmBuffers,
-    mean: Vec<MeanCount>,
-    m2: Vec<Rgb>,
-    halves: Vec<HalfSums>,
-    aov: AovBuffers,
-    splats: SplatSums,
+    pub(crate) counts: Vec<u32>,
+    pub(crate) sums: Vec<Sum3>,
+    pub(crate) squares: Vec<Sum3>,
+    pub(crate) even: Vec<EvenSums>,
+    pub(crate) aov: AovBuffers,
+    pub(crate) splats: SplatSums,
     samples: Option<SampleRecords>,
     discarded: AtomicU64,
 }
@@ -382,9 +391,10 @@ pub struct FilmStripe<'a> {
     pub y0: u32,
     /// Image width.
     pub width: u32,
-    mean: &'a mut [MeanCount],
-    m2: &'a mut [Rgb],
-    halves: &'a mut [HalfSums],
+    counts: &'a mut [u32],
+    sums: &'a mut [Sum3],
+    squares: &'a mut [Sum3],
+    even: &'a mut [EvenSums],
     aov: AovSlices<'a>,
     discarded: &'a AtomicU64,
 }
@@ -392,7 +402,7 @@ pub struct FilmStripe<'a> {
 impl FilmStripe<'_> {
     /// Number of rows in this band.
     pub fn rows(&self) -> u32 {
-        (self.mean.len() / self.width as usize) as u32
+        (self.counts.len() / self.width as usize) as u32
     }
 
     /// Adds a radiance sample (sample number `index`) to pixel `(x, y)` (image coordinates).
@@ -428,13 +438,14 @@ impl FilmStripe<'_> {
         }
         // Optional buffers are empty slices when not kept, so `get_mut` is the "is it kept"
         // test: one predictable branch per buffer, no per-sample flags to consult.
-        let px = &mut self.mean[i];
-        let delta = px.add(radiance);
-        if let Some(m2) = self.m2.get_mut(i) {
-            add_m2(m2, radiance, delta, px.mean);
+        self.counts[i] += 1;
+        self.sums[i].add(radiance);
+        if let Some(q) = self.squares.get_mut(i) {
+            q.add_squares(radiance);
         }
-        if let Some(h) = self.halves.get_mut(i) {
-            h.add(radiance, index);
+        if let (Some(e), true) = (self.even.get_mut(i), index.is_multiple_of(2)) {
+            e.sum.add(radiance);
+            e.n += 1;
         }
         if let (Some(sum), Some(sp)) = (self.aov.split.get_mut(i), split) {
             if sp.is_finite() {
@@ -444,33 +455,24 @@ impl FilmStripe<'_> {
         let a = &mut self.aov;
         if let (Some(n), Some(h)) = (a.hits.get_mut(i), hit) {
             if h.is_finite() {
-                if let Some(m2) = a.m2.get_mut(i) {
-                    // Before the sums move: Welford needs the old means.
-                    if let Some(&s) = a.albedo.get(i) {
-                        welford_on_sums(&mut m2.albedo, s, *n, h.albedo);
-                    }
-                    if let Some(&s) = a.normal.get(i) {
-                        welford_on_sums(&mut m2.normal, s, *n, h.normal);
-                    }
-                    if let Some(&s) = a.depth.get(i) {
-                        welford_on_sums(&mut m2.depth, s, *n, h.depth);
-                    }
-                    if let Some(&s) = a.position.get(i) {
-                        welford_on_sums(&mut m2.position, s, *n, h.position);
-                    }
-                }
                 *n += 1;
                 if let Some(v) = a.albedo.get_mut(i) {
-                    *v += h.albedo;
+                    v.add(h.albedo);
                 }
                 if let Some(v) = a.normal.get_mut(i) {
-                    *v += h.normal;
+                    v.add(h.normal);
                 }
                 if let Some(v) = a.depth.get_mut(i) {
-                    *v += h.depth;
+                    v.add(h.depth);
                 }
                 if let Some(v) = a.position.get_mut(i) {
-                    *v += h.position;
+                    v.add(h.position);
+                }
+                if let Some(q) = a.squares.get_mut(i) {
+                    q.albedo.add_squares(h.albedo);
+                    q.normal.add_squares(h.normal);
+                    q.depth.add_square(h.depth);
+                    q.position.add_squares(h.position);
                 }
             }
         }
@@ -501,25 +503,13 @@ fn chunks<T>(v: &mut [T], chunk: usize) -> impl Iterator<Item = &mut [T]> {
 
 /// Per-pixel averages of one AOV's sums (zero where no sample hit a surface), or `None` if the
 /// film does not keep it.
-fn averages<T>(sums: &[T], hits: &[u32]) -> Option<Vec<T>>
-where
-    T: Copy + Default + std::ops::Mul<f32, Output = T>,
-{
-    if sums.is_empty() {
-        return None;
-    }
-    Some(
+fn averages(sums: &[Sum3], hits: &[u32]) -> Option<Vec<Vec3>> {
+    (!sums.is_empty()).then(|| {
         sums.iter()
             .zip(hits)
-            .map(|(&s, &n)| {
-                if n == 0 {
-                    T::default()
-                } else {
-                    s * (1.0 / n as f32)
-                }
-            })
-            .collect(),
-    )
+            .map(|(s, &n)| s.mean(n.into()))
+            .collect()
+    })
 }
 
 impl Film {
@@ -534,16 +524,17 @@ impl Film {
             width,
             height,
             buffers,
-            mean: vec![MeanCount::default(); n],
-            m2: buffer(buffers.variance, n),
-            halves: buffer(buffers.halves, n),
+            counts: vec![0; n],
+            sums: vec![Sum3::default(); n],
+            squares: buffer(buffers.variance, n),
+            even: buffer(buffers.halves, n),
             aov: AovBuffers {
                 hits: buffer(a.any_first_hit(), n),
                 albedo: buffer(a.albedo, n),
                 normal: buffer(a.normal, n),
                 depth: buffer(a.depth, n),
                 position: buffer(a.position, n),
-                m2: buffer(a.feature_variance && a.any_first_hit(), n),
+                squares: buffer(a.feature_variance && a.any_first_hit(), n),
                 split: buffer(a.any_split(), n),
             },
             splats: SplatSums::default(),
@@ -575,15 +566,16 @@ impl Film {
     /// Bytes held by each buffer.
     pub fn memory(&self) -> FilmMemory {
         FilmMemory {
-            mean: std::mem::size_of_val(self.mean.as_slice()),
-            variance: bytes(&self.m2),
-            halves: bytes(&self.halves),
+            mean: std::mem::size_of_val(self.counts.as_slice())
+                + std::mem::size_of_val(self.sums.as_slice()),
+            variance: bytes(&self.squares),
+            halves: bytes(&self.even),
             first_hits: bytes(&self.aov.hits),
             albedo: bytes(&self.aov.albedo),
             normal: bytes(&self.aov.normal),
             depth: bytes(&self.aov.depth),
             position: bytes(&self.aov.position),
-            feature_variance: bytes(&self.aov.m2),
+            feature_variance: bytes(&self.aov.squares),
             split: bytes(&self.aov.split),
             splats: self.splats.bytes(),
             samples: self.samples.as_ref().map(SampleRecords::memory_bytes),
@@ -595,17 +587,23 @@ impl Film {
         self.memory().total()
     }
 
+    /// Counts samples another film dropped (when its sums are added to this one).
+    pub(crate) fn add_discarded(&self, n: u64) {
+        self.discarded.fetch_add(n, Ordering::Relaxed);
+    }
+
     /// Samples dropped because they were NaN, infinite or negative.
     pub fn discarded(&self) -> u64 {
         self.discarded.load(Ordering::Relaxed)
     }
 
     fn stats_at(&self, i: usize) -> PixelStats {
-        PixelStats::new(
-            self.mean[i],
-            self.m2.get(i).copied(),
-            self.halves.get(i).copied(),
-        )
+        let (sum, n) = (&self.sums[i], self.counts[i]);
+        let halves = self
+            .even
+            .get(i)
+            .map(|e| HalfSums::from_sums(&e.sum, &sum.minus(&e.sum), [e.n, n - e.n]));
+        PixelStats::new(sum, n, self.squares.get(i), halves)
     }
 
     /// Statistics of pixel `(x, y)`.
@@ -615,7 +613,7 @@ impl Film {
 
     /// Statistics of all pixels, row-major.
     pub fn pixels(&self) -> impl ExactSizeIterator<Item = PixelStats> + '_ {
-        (0..self.mean.len()).map(|i| self.stats_at(i))
+        (0..self.counts.len()).map(|i| self.stats_at(i))
     }
 
     /// Adds a sample to pixel `(x, y)`, as [`FilmStripe::add_sample`] does, for callers that
@@ -641,31 +639,33 @@ impl Film {
         let rows = rows.max(1);
         let chunk = (rows as usize * w as usize).max(1);
         let discarded = &self.discarded;
-        let mut m2 = chunks(&mut self.m2, chunk);
-        let mut halves = chunks(&mut self.halves, chunk);
+        let mut sums = chunks(&mut self.sums, chunk);
+        let mut squares = chunks(&mut self.squares, chunk);
+        let mut even = chunks(&mut self.even, chunk);
         let mut hits = chunks(&mut self.aov.hits, chunk);
         let mut albedo = chunks(&mut self.aov.albedo, chunk);
         let mut normal = chunks(&mut self.aov.normal, chunk);
         let mut depth = chunks(&mut self.aov.depth, chunk);
         let mut position = chunks(&mut self.aov.position, chunk);
-        let mut feature_m2 = chunks(&mut self.aov.m2, chunk);
+        let mut feature_squares = chunks(&mut self.aov.squares, chunk);
         let mut split = chunks(&mut self.aov.split, chunk);
-        self.mean
+        self.counts
             .chunks_mut(chunk)
             .enumerate()
-            .map(move |(i, mean)| FilmStripe {
+            .map(move |(i, counts)| FilmStripe {
                 y0: i as u32 * rows,
                 width: w,
-                mean,
-                m2: m2.next().unwrap_or_default(),
-                halves: halves.next().unwrap_or_default(),
+                counts,
+                sums: sums.next().unwrap_or_default(),
+                squares: squares.next().unwrap_or_default(),
+                even: even.next().unwrap_or_default(),
                 aov: AovSlices {
                     hits: hits.next().unwrap_or_default(),
                     albedo: albedo.next().unwrap_or_default(),
                     normal: normal.next().unwrap_or_default(),
                     depth: depth.next().unwrap_or_default(),
                     position: position.next().unwrap_or_default(),
-                    m2: feature_m2.next().unwrap_or_default(),
+                    squares: feature_squares.next().unwrap_or_default(),
                     split: split.next().unwrap_or_default(),
                 },
                 discarded,
@@ -682,7 +682,7 @@ impl Film {
     /// render in parallel hand them over in a fixed order, so the sums do not depend on the
     /// thread count. Non-finite, negative or out-of-image splats are dropped and counted.
     pub fn add_splats(&mut self, index: u32, paths: u64, splats: &[Splat]) {
-        let n = self.mean.len();
+        let n = self.counts.len();
         let dropped = self
             .splats
             .add(n, self.buffers.halves, index, paths, splats);
@@ -726,16 +726,17 @@ impl Film {
     /// The pixel estimates, row-major: the mean of the camera samples plus the light paths'
     /// splats over the number of light paths.
     pub fn mean_image(&self) -> Vec<Rgb> {
-        self.mean
+        self.sums
             .iter()
+            .zip(&self.counts)
             .enumerate()
-            .map(|(i, p)| p.mean + self.splats.mean(i))
+            .map(|(i, (s, &n))| s.mean(n.into()) + self.splats.mean(i))
             .collect()
     }
 
     /// Variance of each pixel estimate, row-major; `None` without a variance buffer.
     pub fn variance_image(&self) -> Option<Vec<Rgb>> {
-        if self.m2.is_empty() {
+        if self.squares.is_empty() {
             return None;
         }
         Some(
@@ -747,14 +748,15 @@ impl Film {
 
     /// Mean of the even (`0`) or odd (`1`) samples, row-major; `None` without half-buffers.
     pub fn half_image(&self, half: usize) -> Option<Vec<Rgb>> {
-        if self.halves.is_empty() {
+        if self.even.is_empty() {
             return None;
         }
         Some(
-            self.halves
-                .iter()
-                .enumerate()
-                .map(|(i, h)| h.mean(half) + self.splats.half_mean(i, half))
+            (0..self.counts.len())
+                .map(|i| {
+                    let h = self.stats_at(i).halves().copied().unwrap_or_default();
+                    h.mean(half) + self.splats.half_mean(i, half)
+                })
                 .collect(),
         )
     }
@@ -771,7 +773,13 @@ impl Film {
 
     /// Average first-hit distance from the camera; `None` unless kept.
     pub fn depth_image(&self) -> Option<Vec<f32>> {
-        averages(&self.aov.depth, &self.aov.hits)
+        let d = &self.aov.depth;
+        (!d.is_empty()).then(|| {
+            d.iter()
+                .zip(&self.aov.hits)
+                .map(|(s, &n)| s.mean(n.into()))
+                .collect()
+        })
     }
 
     /// Average first-hit world position; `None` unless kept.
@@ -782,33 +790,34 @@ impl Film {
     /// Variance of each pixel's mean first-hit feature, for the features kept, when the film
     /// keeps feature variances; `None` otherwise.
     pub fn feature_variance_images(&self) -> Option<FeatureVariances> {
-        if self.aov.m2.is_empty() {
+        let (q, a, n) = (&self.aov.squares, &self.aov, &self.aov.hits);
+        if q.is_empty() {
             return None;
         }
-        let of_mean = |m2: f32, n: u32| {
-            if n < 2 {
-                0.0
-            } else {
-                m2 / (n - 1) as f32 / n as f32
-            }
-        };
-        let n = &self.aov.hits;
-        let pick = |keep: bool, f: &dyn Fn(&FeatureM2, u32) -> Vec3| {
-            keep.then(|| self.aov.m2.iter().zip(n).map(|(m, &n)| f(m, n)).collect())
-        };
-        let v3 = |v: Vec3, n: u32| v.map(|c| of_mean(c, n));
-        Some(FeatureVariances {
-            albedo: pick(!self.aov.albedo.is_empty(), &|m, n| v3(m.albedo, n)),
-            normal: pick(!self.aov.normal.is_empty(), &|m, n| v3(m.normal, n)),
-            depth: (!self.aov.depth.is_empty()).then(|| {
-                self.aov
-                    .m2
-                    .iter()
+        let of_mean = |v: f32, n: u32| if n < 2 { 0.0 } else { v / n as f32 };
+        let pick = |sums: &[Sum3], sq: fn(&FeatureSquares) -> &Sum3| {
+            (!sums.is_empty()).then(|| {
+                sums.iter()
+                    .zip(q)
                     .zip(n)
-                    .map(|(m, &n)| of_mean(m.depth, n))
+                    .map(|((s, f), &n)| {
+                        sample_variance3(n.into(), s, sq(f)).map(|v| of_mean(v, n))
+                    })
+                    .collect()
+            })
+        };
+        Some(FeatureVariances {
+            albedo: pick(&a.albedo, |f| &f.albedo),
+            normal: pick(&a.normal, |f| &f.normal),
+            depth: (!a.depth.is_empty()).then(|| {
+                a.depth
+                    .iter()
+                    .zip(q)
+                    .zip(n)
+                    .map(|((s, f), &n)| of_mean(sample_variance(n.into(), s.0, f.depth.0), n))
                     .collect()
             }),
-            position: pick(!self.aov.position.is_empty(), &|m, n| v3(m.position, n)),
+            position: pick(&a.position, |f| &f.position),
         })
     }
 
@@ -822,21 +831,15 @@ impl Film {
             self.aov
                 .split
                 .iter()
-                .zip(&self.mean)
-                .map(|(s, p)| {
-                    if p.n == 0 {
-                        LightSplit::default()
-                    } else {
-                        s.scaled(1.0 / p.n as f32)
-                    }
-                })
+                .zip(&self.counts)
+                .map(|(s, &n)| s.mean(n))
                 .collect(),
         )
     }
 
     /// Total samples accumulated.
     pub fn total_samples(&self) -> u64 {
-        self.mean.iter().map(|p| p.n as u64).sum()
+        self.counts.iter().map(|&n| u64::from(n)).sum()
     }
 }
 
@@ -953,7 +956,7 @@ mod tests {
     fn only_requested_buffers_are_allocated() {
         let film = Film::new(4, 4, AovSet::default());
         let m = film.memory();
-        assert_eq!(m.mean, 16 * 16, "mean (12 B) and count (4 B) per pixel");
+        assert_eq!(m.mean, 16 * 52, "sums (48 B) and count (4 B) per pixel");
         assert_eq!(
             (m.variance, m.halves, m.first_hits),
             (None, None, None),
@@ -963,7 +966,7 @@ mod tests {
             (m.albedo, m.normal, m.depth, m.position),
             (None, None, None, None)
         );
-        assert_eq!(film.memory_bytes(), 256);
+        assert_eq!(film.memory_bytes(), 16 * 52);
         assert!(film.variance_image().is_none() && film.half_image(0).is_none());
         assert!(film.pixel(1, 1).variance_of_mean().is_none());
 
@@ -977,7 +980,7 @@ mod tests {
             },
         );
         let m = film.memory();
-        assert_eq!(m.variance, Some(16 * 12));
+        assert_eq!(m.variance, Some(16 * 48));
         assert_eq!((m.halves, m.first_hits, m.albedo), (None, None, None));
         assert!(film.buffers().variance && !film.buffers().halves);
         assert_eq!(film.variance_image().unwrap().len(), 16);
@@ -992,7 +995,7 @@ mod tests {
             },
         );
         let m = film.memory();
-        assert_eq!((m.first_hits, m.albedo), (Some(16 * 4), Some(16 * 12)));
+        assert_eq!((m.first_hits, m.albedo), (Some(16 * 4), Some(16 * 48)));
         assert_eq!(
             (m.normal, m.depth, m.position, m.variance),
             (None, None, None, None)
@@ -1000,34 +1003,19 @@ mod tests {
 
         let film = Film::new(4, 4, all_buffers());
         let per_pixel = film.memory_bytes() / 16;
-        assert_eq!(per_pixel, 16 + 12 + 32 + 4 + 12 + 12 + 4 + 12);
+        assert_eq!(per_pixel, 52 + 48 + 64 + 4 + 48 + 48 + 16 + 48);
         assert!(film.half_image(1).is_some());
         assert!(AovSet::parse_list(["albedo", "bogus"]).is_err());
     }
 
     /// The accumulation before the buffers became optional: one struct per pixel, Welford mean
     /// and M2 updated together. Kept here to prove the mean's bits did not change.
-    #[derive(Default)]
-    struct Legacy {
-        mean: Rgb,
-        m2: Rgb,
-        n: u32,
-    }
-
-    impl Legacy {
-        fn add(&mut self, x: Rgb) {
-            self.n += 1;
-            let delta = x - self.mean;
-            self.mean += delta / self.n as f32;
-            self.m2 += delta * (x - self.mean);
-        }
-    }
-
     #[test]
-    fn statistics_are_bit_identical_with_and_without_optional_buffers() {
+    fn statistics_are_exact_and_the_same_with_and_without_optional_buffers() {
         let mut lean = Film::new(2, 2, AovSet::default());
         let mut full = Film::new(2, 2, all_buffers());
-        let mut legacy: Vec<Legacy> = (0..4).map(|_| Legacy::default()).collect();
+        // Each pixel's samples in f64, for the reference statistics.
+        let mut kept: Vec<Vec<[f64; 3]>> = vec![Vec::new(); 4];
         // A spread of magnitudes, so that rounding differences would show.
         let mut state = 0x1234_5678u32;
         for i in 0..1000u32 {
@@ -1038,17 +1026,24 @@ mod tests {
             let (px, py) = (p as u32 % 2, p as u32 / 2);
             assert!(lean.add_sample(px, py, i, x, None));
             assert!(full.add_sample(px, py, i, x, Some(&FirstHit::default())));
-            legacy[p].add(x);
+            kept[p].push(x.to_array().map(f64::from));
         }
         let bits = |img: &[Rgb]| -> Vec<[u32; 3]> {
             img.iter().map(|p| p.to_array().map(f32::to_bits)).collect()
         };
-        let legacy_mean: Vec<Rgb> = legacy.iter().map(|l| l.mean).collect();
-        assert_eq!(bits(&lean.mean_image()), bits(&legacy_mean));
-        assert_eq!(bits(&full.mean_image()), bits(&legacy_mean));
-        for (p, l) in full.pixels().zip(&legacy) {
-            let want = l.m2 / (l.n - 1) as f32 / l.n as f32;
-            assert_eq!(bits(&[p.variance_of_mean().unwrap()]), bits(&[want]));
+        assert_eq!(bits(&lean.mean_image()), bits(&full.mean_image()));
+        for (p, xs) in full.pixels().zip(&kept) {
+            let n = xs.len() as f64;
+            for c in 0..3 {
+                let mean = xs.iter().map(|x| x[c]).sum::<f64>() / n;
+                let var = xs.iter().map(|x| (x[c] - mean).powi(2)).sum::<f64>() / (n - 1.0);
+                // The mean within an f32 rounding; the variance within the f64 subtraction's
+                // cancellation (relative to the squares' size) and an f32 rounding.
+                assert!((f64::from(p.mean()[c]) - mean).abs() <= 1e-7 * mean, "{c}");
+                let squares = xs.iter().map(|x| x[c] * x[c]).sum::<f64>() / n;
+                let got = f64::from(p.variance_of_mean().unwrap()[c]);
+                assert!((got - var / n).abs() <= 1e-7 * var / n + 1e-15 * squares);
+            }
         }
         assert_eq!(lean.pixels().len(), 4);
         assert_eq!(full.total_samples(), 1000);

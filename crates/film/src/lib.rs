@@ -30,16 +30,18 @@
 //! assert_eq!(film.pixel(0, 0).mean(), Vec3::splat(2.0));
 //! assert_eq!(film.pixel(0, 0).variance_of_mean(), Some(Vec3::splat(1.0)));
 //! assert!(film.half_image(0).is_none());
-//! assert_eq!(film.memory_bytes(), 2 * (16 + 12));
+//! assert_eq!(film.memory_bytes(), 2 * (52 + 48));
 //! ```
 #![forbid(unsafe_code)]
 
 mod film;
+mod fixed;
 mod guides;
 pub mod input;
 mod noisy_frame;
 pub mod output;
 mod pixel;
+mod raw;
 pub mod samples;
 mod splat;
 pub mod stopping;
@@ -54,6 +56,7 @@ pub use output::{
     copy_atomic, read_exr, write_bytes_atomic, write_image, write_image_with, write_rgb, FilmError,
     OutputOptions,
 };
+pub use raw::{RawError, Rect};
 pub use pixel::{accepts_sample, FirstHit, HalfSums, LightSplit, PixelStats};
 pub use samples::{Sample, SampleBand, SampleRecords, SampleRecordsError};
 pub use splat::Splat;

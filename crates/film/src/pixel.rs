@@ -1,65 +1,37 @@
-//! Per-pixel accumulators. The film keeps each kind in its own buffer so that a render pays
-//! only for the statistics some consumer reads: the mean and count always, the Welford `M2`
-//! and the even/odd half sums only when asked for (see [`crate::FilmBuffers`]).
+//! Per-pixel statistics. The film keeps each kind of exact sum ([`crate::fixed`]) in its own
+//! buffer so that a render pays only for the statistics some consumer reads: the sum and count
+//! always, the sums of squares and the even samples' sums only when asked for (see
+//! [`crate::FilmBuffers`]). This module holds what is read back from those sums.
 
 use rt_core::glam::Vec3;
 use rt_core::Rgb;
 
-/// Running mean and sample count of one pixel: the only per-pixel state every film keeps.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct MeanCount {
-    pub mean: Rgb,
-    pub n: u32,
-}
+use crate::fixed::{sample_variance3, Sum1, Sum3};
 
-impl MeanCount {
-    /// Welford's mean update (numerically stable where a running sum would lose the small
-    /// samples of a bright pixel). Returns `delta = x - old mean`, which the optional `M2`
-    /// update needs: computing it once here keeps the mean's bits the same whether or not the
-    /// variance is kept.
-    #[inline]
-    pub fn add(&mut self, x: Rgb) -> Rgb {
-        self.n += 1;
-        let delta = x - self.mean;
-        self.mean += delta / self.n as f32;
-        delta
-    }
-}
-
-/// Welford's `M2` update, after [`MeanCount::add`] returned `delta` and moved the mean to
-/// `mean`.
-#[inline]
-pub(crate) fn add_m2(m2: &mut Rgb, x: Rgb, delta: Rgb, mean: Rgb) {
-    *m2 += delta * (x - mean);
-}
-
-/// Sums and counts of the even- and odd-numbered samples of one pixel: two independent
+/// The means and counts of the even- and odd-numbered samples of one pixel: two independent
 /// half-estimates whose difference the stopping criterion (Dammertz §6.2) and the GREE error
 /// estimates read. Counts are kept rather than derived from the sample index because dropped
 /// (non-finite) samples leave gaps.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct HalfSums {
-    sum: [Rgb; 2],
+    mean: [Rgb; 2],
     n: [u32; 2],
 }
 
 impl HalfSums {
-    /// Adds sample number `index`; its parity picks the half.
-    #[inline]
-    pub fn add(&mut self, x: Rgb, index: u32) {
-        let h = (index & 1) as usize;
-        self.sum[h] += x;
-        self.n[h] += 1;
+    /// From the even and odd samples' exact sums and counts.
+    pub(crate) fn from_sums(even: &Sum3, odd: &Sum3, n: [u32; 2]) -> Self {
+        Self {
+            mean: [even.mean(n[0].into()), odd.mean(n[1].into())],
+            n,
+        }
     }
 
     /// Mean of the even-numbered (`half = 0`) or odd-numbered (`half = 1`) samples; zero
     /// without samples.
     #[inline]
     pub fn mean(&self, half: usize) -> Rgb {
-        if self.n[half] == 0 {
-            return Rgb::ZERO;
-        }
-        self.sum[half] / self.n[half] as f32
+        self.mean[half]
     }
 
     /// Number of samples in half `half`.
@@ -75,16 +47,21 @@ impl HalfSums {
 pub struct PixelStats {
     mean: Rgb,
     n: u32,
-    m2: Option<Rgb>,
+    sample_variance: Option<Rgb>,
     halves: Option<HalfSums>,
 }
 
 impl PixelStats {
-    pub(crate) fn new(mc: MeanCount, m2: Option<Rgb>, halves: Option<HalfSums>) -> Self {
+    pub(crate) fn new(
+        sum: &Sum3,
+        n: u32,
+        squares: Option<&Sum3>,
+        halves: Option<HalfSums>,
+    ) -> Self {
         Self {
-            mean: mc.mean,
-            n: mc.n,
-            m2,
+            mean: sum.mean(n.into()),
+            n,
+            sample_variance: squares.map(|q| sample_variance3(n.into(), sum, q)),
             halves,
         }
     }
@@ -105,25 +82,21 @@ impl PixelStats {
     /// keeps no variance buffer.
     #[inline]
     pub fn sample_variance(&self) -> Option<Rgb> {
-        let m2 = self.m2?;
-        if self.n < 2 {
-            return Some(Rgb::ZERO);
-        }
-        Some(m2 / (self.n - 1) as f32)
+        self.sample_variance
     }
 
     /// Estimated variance of the mean (sample variance / n); `None` if the film keeps no
     /// variance buffer.
     #[inline]
     pub fn variance_of_mean(&self) -> Option<Rgb> {
-        let v = self.sample_variance()?;
+        let v = self.sample_variance?;
         if self.n < 2 {
             return Some(Rgb::ZERO);
         }
         Some(v / self.n as f32)
     }
 
-    /// The even/odd half sums; `None` if the film keeps no half-buffers.
+    /// The even/odd half means; `None` if the film keeps no half-buffers.
     #[inline]
     pub fn halves(&self) -> Option<&HalfSums> {
         self.halves.as_ref()
@@ -194,58 +167,66 @@ impl LightSplit {
             && self.glossy.is_finite()
             && self.irradiance.is_finite()
     }
+}
 
+/// Exact sums of the lighting split of one pixel's samples.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct SplitSums([Sum3; 6]);
+
+impl SplitSums {
     #[inline]
-    pub(crate) fn add(&mut self, o: &LightSplit) {
-        self.emission += o.emission;
-        self.direct += o.direct;
-        self.indirect += o.indirect;
-        self.diffuse += o.diffuse;
-        self.glossy += o.glossy;
-        self.irradiance += o.irradiance;
+    pub fn add(&mut self, o: &LightSplit) {
+        let parts = [o.emission, o.direct, o.indirect, o.diffuse, o.glossy, o.irradiance];
+        for (s, v) in self.0.iter_mut().zip(parts) {
+            s.add(v);
+        }
     }
 
-    #[inline]
-    pub(crate) fn scaled(&self, k: f32) -> LightSplit {
+    pub fn parts(&self) -> &[Sum3; 6] {
+        &self.0
+    }
+
+    pub fn from_parts(parts: [Sum3; 6]) -> Self {
+        Self(parts)
+    }
+
+    pub fn merge(&mut self, o: &SplitSums) {
+        for (s, v) in self.0.iter_mut().zip(&o.0) {
+            s.merge(v);
+        }
+    }
+
+    /// The parts' means over `n` samples.
+    pub fn mean(&self, n: u32) -> LightSplit {
+        let m = self.0.map(|s| s.mean(n.into()));
         LightSplit {
-            emission: self.emission * k,
-            direct: self.direct * k,
-            indirect: self.indirect * k,
-            diffuse: self.diffuse * k,
-            glossy: self.glossy * k,
-            irradiance: self.irradiance * k,
+            emission: m[0],
+            direct: m[1],
+            indirect: m[2],
+            diffuse: m[3],
+            glossy: m[4],
+            irradiance: m[5],
         }
     }
 }
 
-/// Welford `M2` of every first-hit feature of one pixel, for the variance of the features'
-/// means (the NFOR/Tungsten buffer convention: each feature with its variance).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(crate) struct FeatureM2 {
-    pub albedo: Rgb,
-    pub normal: Vec3,
-    pub depth: f32,
-    pub position: Vec3,
+/// Exact sums of squares of every first-hit feature of one pixel, for the variance of the
+/// features' means (the NFOR/Tungsten buffer convention: each feature with its variance).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct FeatureSquares {
+    pub albedo: Sum3,
+    pub normal: Sum3,
+    pub depth: Sum1,
+    pub position: Sum3,
 }
 
-/// Welford's update of `m2` for a feature kept as a running sum: `sum` and `n` are the sum and
-/// count before `x` is added.
-#[inline]
-pub(crate) fn welford_on_sums<T>(m2: &mut T, sum: T, n: u32, x: T)
-where
-    T: Copy
-        + std::ops::Add<Output = T>
-        + std::ops::Sub<Output = T>
-        + std::ops::Mul<Output = T>
-        + std::ops::Mul<f32, Output = T>
-        + std::ops::AddAssign,
-{
-    if n == 0 {
-        return;
+impl FeatureSquares {
+    pub fn merge(&mut self, o: &FeatureSquares) {
+        self.albedo.merge(&o.albedo);
+        self.normal.merge(&o.normal);
+        self.depth.merge(&o.depth);
+        self.position.merge(&o.position);
     }
-    let old_mean = sum * (1.0 / n as f32);
-    let new_mean = (sum + x) * (1.0 / (n + 1) as f32);
-    *m2 += (x - old_mean) * (x - new_mean);
 }
 
 #[cfg(test)]
@@ -253,18 +234,23 @@ mod tests {
     use super::*;
 
     fn stats(xs: &[f32]) -> PixelStats {
-        let (mut mc, mut m2, mut h) = (MeanCount::default(), Rgb::ZERO, HalfSums::default());
+        let (mut sum, mut sq, mut even) = (Sum3::default(), Sum3::default(), Sum3::default());
+        let mut n = [0u32; 2];
         for (i, &x) in xs.iter().enumerate() {
             let x = Rgb::splat(x);
-            let delta = mc.add(x);
-            add_m2(&mut m2, x, delta, mc.mean);
-            h.add(x, i as u32);
+            sum.add(x);
+            sq.add_squares(x);
+            if i % 2 == 0 {
+                even.add(x);
+            }
+            n[i % 2] += 1;
         }
-        PixelStats::new(mc, Some(m2), Some(h))
+        let halves = HalfSums::from_sums(&even, &sum.minus(&even), n);
+        PixelStats::new(&sum, xs.len() as u32, Some(&sq), Some(halves))
     }
 
     #[test]
-    fn welford_matches_two_pass_statistics() {
+    fn exact_sums_match_two_pass_statistics() {
         let xs = [0.5f32, 2.0, 7.25, 1.0, 1e-3, 4.0, 3.5];
         let p = stats(&xs);
         let n = xs.len() as f32;
@@ -282,9 +268,9 @@ mod tests {
 
     #[test]
     fn missing_buffers_read_as_none_and_one_sample_has_zero_variance() {
-        let mut mc = MeanCount::default();
-        mc.add(Rgb::splat(2.0));
-        let p = PixelStats::new(mc, None, None);
+        let mut sum = Sum3::default();
+        sum.add(Rgb::splat(2.0));
+        let p = PixelStats::new(&sum, 1, None, None);
         assert_eq!(p.mean(), Rgb::splat(2.0));
         assert!(p.sample_variance().is_none() && p.variance_of_mean().is_none());
         assert!(p.halves().is_none());

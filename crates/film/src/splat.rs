@@ -2,12 +2,14 @@
 //! the number of light paths taken, not by a pixel's camera samples (Dammertz 2011, §6.1.2;
 //! Veach 1997, §10.3.3).
 //!
-//! Sums are `f64`: a light tracer adds many small splats to the same pixels over thousands of
-//! passes, and an `f32` sum would stop growing long before (the accumulation problem of
-//! instant radiosity, thesis §6.1.4). The sums of the even-numbered sample indices are kept
+//! Sums are exact ([`crate::fixed`]): a light tracer adds many small splats to the same pixels
+//! over thousands of passes, where an `f32` sum would stop growing long before (the
+//! accumulation problem of instant radiosity, thesis §6.1.4), and splats from many threads or
+//! machines land in no fixed order. The sums of the even-numbered sample indices are kept
 //! apart when the film keeps half-buffers, so the two half-images of a splatting technique are
 //! as independent as a camera technique's.
 
+use crate::fixed::Sum3;
 use rt_core::Rgb;
 
 /// One light path's contribution to one pixel (row-major index).
@@ -22,9 +24,9 @@ pub struct Splat {
 /// Splat sums of a film; nothing is allocated until the first splat arrives.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct SplatSums {
-    all: Vec<[f64; 3]>,
+    all: Vec<Sum3>,
     /// Sums of the even sample indices (only with half-buffers).
-    even: Vec<[f64; 3]>,
+    even: Vec<Sum3>,
     paths: u64,
     even_paths: u64,
 }
@@ -41,10 +43,7 @@ impl SplatSums {
         splats: &[Splat],
     ) -> u64 {
         if self.all.is_empty() {
-            self.all = vec![[0.0; 3]; pixels];
-            if halves {
-                self.even = vec![[0.0; 3]; pixels];
-            }
+            self.allocate(pixels, halves);
         }
         let even = index.is_multiple_of(2) && !self.even.is_empty();
         self.paths += paths;
@@ -59,9 +58,9 @@ impl SplatSums {
                 dropped += 1;
                 continue;
             }
-            add3(&mut self.all[i], v);
+            self.all[i].add(v);
             if even {
-                add3(&mut self.even[i], v);
+                self.even[i].add(v);
             }
         }
         dropped
@@ -76,8 +75,8 @@ impl SplatSums {
     #[inline]
     pub(crate) fn mean(&self, i: usize) -> Rgb {
         match self.all.get(i) {
-            Some(s) if self.paths > 0 => scaled(*s, self.paths),
-            _ => Rgb::ZERO,
+            Some(s) => s.mean(self.paths),
+            None => Rgb::ZERO,
         }
     }
 
@@ -87,10 +86,9 @@ impl SplatSums {
             return Rgb::ZERO;
         };
         if half == 0 {
-            scaled(*even, self.even_paths)
+            even.mean(self.even_paths)
         } else {
-            let odd = [all[0] - even[0], all[1] - even[1], all[2] - even[2]];
-            scaled(odd, self.paths - self.even_paths)
+            all.minus(even).mean(self.paths - self.even_paths)
         }
     }
 
@@ -102,18 +100,31 @@ impl SplatSums {
     }
 }
 
-#[inline]
-fn add3(s: &mut [f64; 3], v: Rgb) {
-    s[0] += f64::from(v.x);
-    s[1] += f64::from(v.y);
-    s[2] += f64::from(v.z);
-}
-
-#[inline]
-fn scaled(s: [f64; 3], n: u64) -> Rgb {
-    if n == 0 {
-        return Rgb::ZERO;
+impl SplatSums {
+    fn allocate(&mut self, pixels: usize, halves: bool) {
+        self.all = vec![Sum3::default(); pixels];
+        if halves {
+            self.even = vec![Sum3::default(); pixels];
+        }
     }
-    let k = 1.0 / n as f64;
-    Rgb::new((s[0] * k) as f32, (s[1] * k) as f32, (s[2] * k) as f32)
+
+    /// The sums of all and of the even sample indices, the light paths and the even ones;
+    /// `None` before the first light path.
+    pub(crate) fn parts(&self) -> Option<(&[Sum3], &[Sum3], u64, u64)> {
+        (!self.all.is_empty()).then_some((&self.all, &self.even, self.paths, self.even_paths))
+    }
+
+    /// The sums to add into, allocated if there were none.
+    pub(crate) fn parts_mut(&mut self, pixels: usize, halves: bool) -> (&mut [Sum3], &mut [Sum3]) {
+        if self.all.is_empty() {
+            self.allocate(pixels, halves);
+        }
+        (&mut self.all, &mut self.even)
+    }
+
+    /// Counts light paths whose splats were added with [`SplatSums::parts_mut`].
+    pub(crate) fn add_paths(&mut self, paths: u64, even_paths: u64) {
+        self.paths += paths;
+        self.even_paths += even_paths;
+    }
 }
