@@ -170,6 +170,17 @@ pub struct Args {
     #[arg(long, value_name = "SIZE")]
     pub max_memory: Option<String>,
 
+    /// Render only sample indices A..B (half-open) of every pixel, and light paths A..B of a
+    /// light-path technique, into a part file (-o NAME.rpart) for `render merge`. Parts of
+    /// any split merge to the very bits of the whole render (docs/distributed.md).
+    #[arg(long, value_name = "A..B", value_parser = parse_sample_range)]
+    pub sample_range: Option<std::ops::Range<u32>>,
+
+    /// Render only the pixels x0..x1 × y0..y1 into a part file (-o NAME.rpart). Light-path
+    /// techniques trace all their light paths and keep the splats that land inside.
+    #[arg(long, value_name = "x0,y0,x1,y1", value_parser = parse_region)]
+    pub region: Option<rt_film::Rect>,
+
     /// Denoise by GREE (Bauszat, thesis ch. 5): --spp is the budget b; render the noisy image
     /// at n = fraction x b spp, run the filter bank (--bank), render filter caches at a share
     /// 1 - sparsity of the pixels with independent samples, pick a filter per pixel by the
@@ -217,6 +228,29 @@ pub fn parse_frames(s: &str) -> Result<std::ops::Range<u32>, String> {
         return Err(bad());
     }
     Ok(a..b)
+}
+
+/// `--sample-range A..B`: sample indices, half-open, A < B.
+pub fn parse_sample_range(s: &str) -> Result<std::ops::Range<u32>, String> {
+    parse_frames(s).map_err(|_| {
+        format!("--sample-range must be A..B with integers 0 <= A < B (half-open), got `{s}`")
+    })
+}
+
+/// `--region x0,y0,x1,y1`: a non-empty pixel rectangle (checked against the image later).
+pub fn parse_region(s: &str) -> Result<rt_film::Rect, String> {
+    let bad = || format!("--region must be x0,y0,x1,y1 with x0 < x1 and y0 < y1, got `{s}`");
+    let v: Vec<u32> = s
+        .split(',')
+        .map(|t| t.trim().parse().map_err(|_| bad()))
+        .collect::<Result<_, _>>()?;
+    let [x0, y0, x1, y1] = v[..] else {
+        return Err(bad());
+    };
+    if x0 >= x1 || y0 >= y1 {
+        return Err(bad());
+    }
+    Ok(rt_film::Rect { x0, y0, x1, y1 })
 }
 
 /// `--accel`'s help, naming the default from the accel crate.
@@ -272,6 +306,15 @@ pub enum Command {
     /// wheel); or --headless, a sequence within a per-frame --frame-budget that reports frames
     /// per second (docs/real-time.md).
     View(crate::view::ViewArgs),
+    /// Merge part files (`render SCENE --sample-range/--region -o P.rpart`, or `render part`)
+    /// into the image the whole render would have written, bit for bit; refuses parts that do
+    /// not belong together, overlap or leave a gap (docs/distributed.md).
+    Merge(crate::parts::MergeArgs),
+    /// Cut a render into parts for a scheduler: tiles x sample ranges x frames, written as a
+    /// JSON plan that `render part` and `render merge --plan` read (docs/distributed.md).
+    Plan(crate::parts::PlanArgs),
+    /// Render part I of a plan into a directory: what a scheduler's task runs.
+    Part(crate::parts::PartArgs),
     /// Write a procedural scene's triangles to a Wavefront OBJ file (one `o` per part), e.g.
     /// to benchmark other ray tracers on the same geometry.
     GenScene {

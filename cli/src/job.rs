@@ -30,6 +30,8 @@ pub struct Job {
     pub quiet: bool,
     /// Adaptive stopping (`--error`, `--time-limit`), if asked for.
     pub stop: Option<StopRule>,
+    /// The frame of a sequence being rendered (`--frame`, or the current one of `--frames`).
+    pub frame: Option<u32>,
 }
 
 /// The scene path; clap requires it whenever there is no subcommand.
@@ -82,8 +84,11 @@ impl Job {
             .map(str::to_ascii_lowercase)
             .as_deref()
         {
-            Some("exr") | Some("png") => {}
-            _ => bail!("{}: output must end in .exr or .png", output.display()),
+            Some("exr") | Some("png") | Some("rpart") => {}
+            _ => bail!(
+                "{}: output must end in .exr or .png (or .rpart for a part file)",
+                output.display()
+            ),
         }
         if settings.aovs != AovSet::default()
             && output
@@ -126,6 +131,7 @@ impl Job {
             exposure: args.exposure,
             quiet: args.quiet,
             stop,
+            frame: args.frame,
         })
     }
 }
@@ -138,6 +144,9 @@ pub fn run(args: &Args) -> Result<()> {
         None => FileAccess::open(),
     };
     let loaded = load_scene_with(scene_arg(args), &access)?;
+    // A part file names the scene's content; nothing else needs the files read twice.
+    let scene_hash = crate::parts::writes_part(args)
+        .then(|| rt_parts::content_hash(&access.files_used(), &scene_arg(args).to_string_lossy()));
     let load_time = t_load.elapsed();
     for w in &loaded.warnings {
         if !args.quiet {
@@ -166,6 +175,7 @@ pub fn run(args: &Args) -> Result<()> {
     let (pattern, seed) = (job.output.clone(), job.settings.seed);
     let mut accel: Option<Box<dyn Accel>> = None;
     for frame in frames {
+        job.frame = frame;
         if let Some(f) = frame {
             scene.set_time((f64::from(f) / args.fps) as f32);
             job.output = frame_path(&pattern, f);
@@ -199,13 +209,17 @@ pub fn run(args: &Args) -> Result<()> {
             built,
             cache.clone(),
             (load_time, t_build.elapsed()),
+            scene_hash.as_deref(),
         )?;
     }
     Ok(())
 }
 
 /// The single-frame denoiser `--denoiser` names, built (`None` without one).
-fn single_frame_denoiser(args: &Args, job: &Job) -> Result<Option<Box<dyn rt_denoise::Denoiser>>> {
+pub(crate) fn single_frame_denoiser(
+    args: &Args,
+    job: &Job,
+) -> Result<Option<Box<dyn rt_denoise::Denoiser>>> {
     let Some(text) = &args.denoiser else {
         return Ok(None);
     };
@@ -221,7 +235,7 @@ fn single_frame_denoiser(args: &Args, job: &Job) -> Result<Option<Box<dyn rt_den
 
 /// The film buffers a render keeps: only what its outputs and its denoiser read, no variance
 /// or half-buffers unless asked for; the stopping criterion reads the even samples' half.
-fn film_buffers(job: &Job, denoiser: Option<&dyn rt_denoise::Denoiser>) -> FilmBuffers {
+pub(crate) fn film_buffers(job: &Job, denoiser: Option<&dyn rt_denoise::Denoiser>) -> FilmBuffers {
     let denoise_aovs = denoiser.map_or(AovSet::default(), |d| AovSet::for_channels(d.needs()));
     let buffers = FilmBuffers::for_outputs(job.settings.aovs.union(denoise_aovs));
     if job.stop.is_some_and(|s| s.error.is_some()) {
@@ -327,6 +341,7 @@ fn render_one(
     accel: &dyn Accel,
     cache: Option<Arc<dyn RadianceCache>>,
     (load_time, build_time): (std::time::Duration, std::time::Duration),
+    scene_hash: Option<&str>,
 ) -> Result<()> {
     let load_secs = load_time.as_secs_f64();
     let camera = pick_camera(scene, &job.scene_path, job.camera.as_deref())?;
@@ -356,10 +371,15 @@ fn render_one(
         camera.height,
         film_buffers(job, denoiser.as_deref()),
     );
+    let slice = crate::parts::slice_of(args, job, camera, &film)?;
     let pass = SamplePass {
-        indices: 0..job.settings.spp,
+        indices: slice
+            .as_ref()
+            .map_or(0..job.settings.spp, |s| s.samples.clone()),
         stream: rt_core::SampleStream::Render,
-        pixels: None,
+        pixels: slice
+            .as_ref()
+            .and_then(|s| s.mask(camera.width, camera.height)),
         centre_first: false,
     };
 
@@ -402,20 +422,34 @@ fn render_one(
     };
     bar.finish_and_clear();
 
+    if let (Some(slice), Some(hash)) = (&slice, scene_hash) {
+        crate::parts::write(args, job, camera, &film, slice, hash)?;
+        if !job.quiet {
+            println!(
+                "{}: samples {}..{} of pixels {} ({} {}, {:.2} s render, {} invalid samples discarded) -> {}",
+                job.scene_path.display(),
+                slice.samples.start,
+                slice.samples.end,
+                slice.region,
+                integrator.name(),
+                job.settings.accel,
+                stats.elapsed.as_secs_f64(),
+                stats.discarded,
+                job.output.display()
+            );
+        }
+        return Ok(());
+    }
     if let Some(d) = &denoiser {
         let t = Instant::now();
-        let frame = rt_film::NoisyFrame::from_film_taking_samples(&mut film, denoise_aovs);
-        let image = d
-            .denoise(&frame)
-            .map_err(|e| anyhow::anyhow!("{}: {e}", job.scene_path.display()))?;
-        let denoise_time = t.elapsed();
-        rt_film::write_rgb(
+        write_denoised(
+            &mut film,
+            d.as_ref(),
             &job.output,
-            &image,
-            &OutputOptions {
-                exposure: job.exposure,
-            },
+            job.exposure,
+            &job.scene_path,
         )?;
+        let denoise_time = t.elapsed();
         if !job.quiet {
             println!(
                 "{}: {}x{} {} spp {} ({:.2} s render), denoised by {} in {:.3} s -> {}",
@@ -490,6 +524,24 @@ fn render_one(
             })
         );
     }
+    Ok(())
+}
+
+/// Denoises the film with `d` and writes the image: the end of a render with `--denoiser`, and
+/// of `render merge` for one.
+pub(crate) fn write_denoised(
+    film: &mut Film,
+    d: &dyn rt_denoise::Denoiser,
+    output: &Path,
+    exposure: f32,
+    scene: &Path,
+) -> Result<()> {
+    let frame =
+        rt_film::NoisyFrame::from_film_taking_samples(film, AovSet::for_channels(d.needs()));
+    let image = d
+        .denoise(&frame)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", scene.display()))?;
+    rt_film::write_rgb(output, &image, &OutputOptions { exposure })?;
     Ok(())
 }
 

@@ -24,6 +24,7 @@ mod frame_pattern;
 mod gree;
 mod job;
 mod memory;
+mod parts;
 mod progress;
 mod reference;
 mod sequence;
@@ -52,6 +53,9 @@ fn main() -> ExitCode {
         Some(args::Command::Experiment(x)) => experiment::run(x),
         Some(args::Command::Stress(stress)) => stress::run(stress),
         Some(args::Command::View(v)) => view::run(v),
+        Some(args::Command::Merge(m)) => parts::merge(m),
+        Some(args::Command::Plan(p)) => parts::plan(p),
+        Some(args::Command::Part(p)) => parts::part(p),
         Some(args::Command::GenScene { name, output }) => {
             bench_accel::input::write_obj(name, output)
         }

@@ -126,6 +126,33 @@ impl AovSet {
         }
     }
 
+    /// The names of the outputs in the set, in [`AOV_NAMES`] order, for [`AovSet::parse_list`]
+    /// to read back (`samples`, which has no name, is left out).
+    pub fn names(&self) -> Vec<&'static str> {
+        let flags = [
+            self.albedo,
+            self.normal,
+            self.depth,
+            self.position,
+            self.variance,
+            self.halves,
+            self.feature_variance,
+            self.emission,
+            self.direct,
+            self.indirect,
+            self.diffuse,
+            self.glossy,
+            self.irradiance,
+            self.blocks,
+        ];
+        AOV_NAMES
+            .iter()
+            .zip(flags)
+            .filter(|(_, f)| *f)
+            .map(|(n, _)| *n)
+            .collect()
+    }
+
     /// Parses a comma-separated list such as `albedo,normal,variance`; `denoise` stands for
     /// [`AovSet::DENOISE`].
     pub fn parse_list<'a>(names: impl IntoIterator<Item = &'a str>) -> Result<Self, UnknownAov> {
@@ -800,9 +827,7 @@ impl Film {
                 sums.iter()
                     .zip(q)
                     .zip(n)
-                    .map(|((s, f), &n)| {
-                        sample_variance3(n.into(), s, sq(f)).map(|v| of_mean(v, n))
-                    })
+                    .map(|((s, f), &n)| sample_variance3(n.into(), s, sq(f)).map(|v| of_mean(v, n)))
                     .collect()
             })
         };
@@ -1006,6 +1031,9 @@ mod tests {
         assert_eq!(per_pixel, 52 + 48 + 64 + 4 + 48 + 48 + 16 + 48);
         assert!(film.half_image(1).is_some());
         assert!(AovSet::parse_list(["albedo", "bogus"]).is_err());
+        let all = AovSet::parse_list(AOV_NAMES).unwrap();
+        assert_eq!(AovSet::parse_list(all.names()), Ok(all));
+        assert_eq!(all.names().len(), AOV_NAMES.len() - 1, "all but `denoise`");
     }
 
     /// The accumulation before the buffers became optional: one struct per pixel, Welford mean

@@ -179,7 +179,11 @@ mod tests {
         }
         let n = xs.len() as f64;
         let mean = xs.iter().map(|&x| f64::from(x)).sum::<f64>() / n;
-        let var = xs.iter().map(|&x| (f64::from(x) - mean).powi(2)).sum::<f64>() / (n - 1.0);
+        let var = xs
+            .iter()
+            .map(|&x| (f64::from(x) - mean).powi(2))
+            .sum::<f64>()
+            / (n - 1.0);
         let got = f64::from(sample_variance(xs.len() as u64, s.0, q.0));
         assert!((got - var).abs() < 1e-6 * var, "{got} vs {var}");
         // Large counts of the largest values stay in range.

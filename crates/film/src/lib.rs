@@ -56,7 +56,7 @@ pub use output::{
     copy_atomic, read_exr, write_bytes_atomic, write_image, write_image_with, write_rgb, FilmError,
     OutputOptions,
 };
-pub use raw::{RawError, Rect};
 pub use pixel::{accepts_sample, FirstHit, HalfSums, LightSplit, PixelStats};
+pub use raw::{RawError, Rect};
 pub use samples::{Sample, SampleBand, SampleRecords, SampleRecordsError};
 pub use splat::Splat;

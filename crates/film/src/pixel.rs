@@ -176,7 +176,14 @@ pub(crate) struct SplitSums([Sum3; 6]);
 impl SplitSums {
     #[inline]
     pub fn add(&mut self, o: &LightSplit) {
-        let parts = [o.emission, o.direct, o.indirect, o.diffuse, o.glossy, o.irradiance];
+        let parts = [
+            o.emission,
+            o.direct,
+            o.indirect,
+            o.diffuse,
+            o.glossy,
+            o.irradiance,
+        ];
         for (s, v) in self.0.iter_mut().zip(parts) {
             s.add(v);
         }

@@ -208,7 +208,12 @@ impl Sums for FeatureSquares {
     const N: usize = 10;
     fn values(&self) -> impl Iterator<Item = i128> {
         let d = [self.depth.0];
-        self.albedo.0.into_iter().chain(self.normal.0).chain(d).chain(self.position.0)
+        self.albedo
+            .0
+            .into_iter()
+            .chain(self.normal.0)
+            .chain(d)
+            .chain(self.position.0)
     }
     fn from_values(mut v: impl FnMut(usize) -> i128) -> Self {
         FeatureSquares {
@@ -297,7 +302,11 @@ impl Adder<'_> {
         }
         let (mine, rest) = self.bytes.split_at(self.rect.area() as usize * T::BYTES);
         self.bytes = rest;
-        for (i, b) in self.rect.indices(self.width).zip(mine.chunks_exact(T::BYTES)) {
+        for (i, b) in self
+            .rect
+            .indices(self.width)
+            .zip(mine.chunks_exact(T::BYTES))
+        {
             self.overflow |= !buf[i].merge(&T::get(b));
         }
     }
@@ -484,24 +493,46 @@ mod tests {
         let mut merged = Film::new(5, 4, buffers());
         for range in [0..2, 2..7, 7..9] {
             let part = render(full, range);
-            merged.add_encoded(full, &part.encode_sums(full), true).unwrap();
+            merged
+                .add_encoded(full, &part.encode_sums(full), true)
+                .unwrap();
         }
         assert_eq!(bits(&merged), bits(&whole));
         assert_eq!(merged.mean_image(), whole.mean_image());
         assert_eq!(merged.half_image(1), whole.half_image(1));
         assert_eq!(merged.variance_image(), whole.variance_image());
         assert_eq!(merged.split_images(), whole.split_images());
-        assert_eq!(merged.feature_variance_images(), whole.feature_variance_images());
+        assert_eq!(
+            merged.feature_variance_images(),
+            whole.feature_variance_images()
+        );
         // Regions, each of all sample indices (light paths counted once).
         let tiles = [
-            Rect { x0: 0, y0: 0, x1: 3, y1: 4 },
-            Rect { x0: 3, y0: 0, x1: 5, y1: 1 },
-            Rect { x0: 3, y0: 1, x1: 5, y1: 4 },
+            Rect {
+                x0: 0,
+                y0: 0,
+                x1: 3,
+                y1: 4,
+            },
+            Rect {
+                x0: 3,
+                y0: 0,
+                x1: 5,
+                y1: 1,
+            },
+            Rect {
+                x0: 3,
+                y0: 1,
+                x1: 5,
+                y1: 4,
+            },
         ];
         let mut merged = Film::new(5, 4, buffers());
         for (k, t) in tiles.iter().enumerate() {
             let part = render(*t, 0..9);
-            merged.add_encoded(*t, &part.encode_sums(*t), k == 0).unwrap();
+            merged
+                .add_encoded(*t, &part.encode_sums(*t), k == 0)
+                .unwrap();
         }
         assert_eq!(merged.mean_image(), whole.mean_image());
         assert_eq!(bits(&merged), bits(&whole));
@@ -520,7 +551,12 @@ mod tests {
         let mut flags = bytes.clone();
         flags[0] = 7;
         assert!(film.add_encoded(full, &flags, true).is_err());
-        let outside = Rect { x0: 4, y0: 0, x1: 6, y1: 1 };
+        let outside = Rect {
+            x0: 4,
+            y0: 0,
+            x1: 6,
+            y1: 1,
+        };
         assert!(matches!(
             film.add_encoded(outside, &bytes, true),
             Err(RawError::Rect { .. })

@@ -6,12 +6,16 @@
 
 use crate::error::SceneError;
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 
-/// The loaders' file policy.
+/// The loaders' file policy, and the record of every file they opened (for a part file's
+/// scene hash: [`FileAccess::files_used`]). Clones share the record.
 #[derive(Clone, Debug, Default)]
 pub struct FileAccess {
     /// Canonical directory every file must lie in; `None`: any file.
     confine: Option<PathBuf>,
+    /// Files checked so far, in order, each once.
+    used: Arc<Mutex<Vec<PathBuf>>>,
 }
 
 impl FileAccess {
@@ -30,6 +34,7 @@ impl FileAccess {
         }
         Ok(Self {
             confine: Some(root),
+            used: Arc::default(),
         })
     }
 
@@ -41,6 +46,7 @@ impl FileAccess {
     /// Refuses `path` if it lies outside the confinement directory. A file that does not
     /// exist is let through: opening it gives the loader's own error.
     pub fn check(&self, path: &Path) -> Result<(), SceneError> {
+        self.record(path);
         let Some(root) = &self.confine else {
             return Ok(());
         };
@@ -63,6 +69,19 @@ impl FileAccess {
                 ),
             ))
         }
+    }
+
+    fn record(&self, path: &Path) {
+        let mut used = self.used.lock().unwrap_or_else(|e| e.into_inner());
+        if !used.iter().any(|p| p == path) {
+            used.push(path.to_path_buf());
+        }
+    }
+
+    /// Every file the loaders have checked (and so opened or tried to), in the order of first
+    /// use: what a scene's content consists of.
+    pub fn files_used(&self) -> Vec<PathBuf> {
+        self.used.lock().unwrap_or_else(|e| e.into_inner()).clone()
     }
 
     /// The bytes of `path` after [`FileAccess::check`]; `what` names the file in the error
@@ -118,5 +137,10 @@ mod tests {
             .to_string();
         assert!(e.contains("cannot open texture"), "{e}");
         assert!(FileAccess::confined_to(&inside.join("nope")).is_err());
+        // Every file checked is recorded once, in order, refused ones included.
+        let used = access.files_used();
+        assert_eq!(used.first(), Some(&inside.join("a.obj")));
+        assert_eq!(used.iter().filter(|p| p.ends_with("a.obj")).count(), 1);
+        assert!(used.iter().any(|p| p.ends_with("none.png")));
     }
 }
