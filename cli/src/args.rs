@@ -27,7 +27,7 @@ pub struct Args {
 
     /// Scene file (TOML), or gen:NAME for a procedural scene (worst-case, rotated, mixed,
     /// million).
-    #[arg(required = true)]
+    #[arg(required_unless_present = "resume")]
     pub scene: Option<PathBuf>,
 
     /// Output image; the extension picks the format: .exr (linear float, AOVs as extra
@@ -169,6 +169,28 @@ pub struct Args {
     /// or 8G. [default: the memory the system reports available]
     #[arg(long, value_name = "SIZE")]
     pub max_memory: Option<String>,
+
+    /// Render in passes of one sample per pixel and write the render's state to FILE
+    /// (atomically) every --checkpoint-every seconds, and when SIGINT or SIGTERM stops the
+    /// render at the next pass (the image so far is written too; a second signal ends it at
+    /// once). `render --resume FILE` continues it to the same bytes as a render never stopped.
+    /// Removed when the render completes.
+    #[arg(long, value_name = "FILE.rpart")]
+    pub checkpoint: Option<PathBuf>,
+
+    /// Seconds between checkpoints (0: after every pass).
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 60.0,
+        requires = "checkpoint"
+    )]
+    pub checkpoint_every: f64,
+
+    /// Continue the render a checkpoint was written for, with the settings it was started
+    /// with (only --threads and -q may be given again).
+    #[arg(long, value_name = "FILE.rpart", conflicts_with = "scene")]
+    pub resume: Option<PathBuf>,
 
     /// Render only sample indices A..B (half-open) of every pixel, and light paths A..B of a
     /// light-path technique, into a part file (-o NAME.rpart) for `render merge`. Parts of

@@ -32,6 +32,11 @@ pub struct Job {
     pub stop: Option<StopRule>,
     /// The frame of a sequence being rendered (`--frame`, or the current one of `--frames`).
     pub frame: Option<u32>,
+    /// The command line after the program name (a resumed render keeps its first one), for
+    /// part and checkpoint headers.
+    pub command: Vec<String>,
+    /// The checkpoint a resumed render starts from (`--resume`), and its file.
+    pub resume: Option<(PathBuf, rt_parts::Part)>,
 }
 
 /// The scene path; clap requires it whenever there is no subcommand.
@@ -132,12 +137,25 @@ impl Job {
             quiet: args.quiet,
             stop,
             frame: args.frame,
+            command: std::env::args().skip(1).collect(),
+            resume: None,
         })
     }
 }
 
 /// Loads, renders and writes; prints the summary line.
 pub fn run(args: &Args) -> Result<()> {
+    match crate::checkpoint::resume_args(args)? {
+        Some((old, part)) => {
+            let path = args.resume.clone().expect("resuming");
+            run_job(&old, Some((path, part)))
+        }
+        None => run_job(args, None),
+    }
+}
+
+/// [`run`], continuing from the checkpoint `resume` if given.
+fn run_job(args: &Args, resume: Option<(PathBuf, rt_parts::Part)>) -> Result<()> {
     let t_load = Instant::now();
     let access = match &args.confine {
         Some(dir) => FileAccess::confined_to(dir).map_err(|e| anyhow::anyhow!("{e}"))?,
@@ -145,7 +163,7 @@ pub fn run(args: &Args) -> Result<()> {
     };
     let loaded = load_scene_with(scene_arg(args), &access)?;
     // A part file names the scene's content; nothing else needs the files read twice.
-    let scene_hash = crate::parts::writes_part(args)
+    let scene_hash = (crate::parts::writes_part(args) || args.checkpoint.is_some())
         .then(|| rt_parts::content_hash(&access.files_used(), &scene_arg(args).to_string_lossy()));
     let load_time = t_load.elapsed();
     for w in &loaded.warnings {
@@ -154,6 +172,11 @@ pub fn run(args: &Args) -> Result<()> {
         }
     }
     let mut job = Job::resolve(args, &loaded.render)?;
+    crate::checkpoint::check(args, &job)?;
+    if let Some((path, part)) = resume {
+        job.command = part.header.args.clone();
+        job.resume = Some((path, part));
+    }
     let mut scene = loaded.scene;
     let frames = frame_list(args, &job.output)?;
     if args.accel.is_none() && loaded.render.accel.is_none() {
@@ -397,13 +420,43 @@ fn render_one(
         b
     };
     let mut adaptive = None;
-    let stats: RenderStats = match &job.stop {
-        None => pool.install(|| {
+    let mut interrupted = None;
+    let checkpointer = scene_hash.map(|scene_hash| crate::checkpoint::Checkpointer {
+        args,
+        job,
+        camera,
+        scene_hash,
+    });
+    let stats: RenderStats = match (&job.stop, &checkpointer) {
+        (None, Some(ck)) if args.checkpoint.is_some() => {
+            let start = match &job.resume {
+                Some((path, part)) => {
+                    let fresh = ck.part(&film, 1);
+                    let name = path.display().to_string();
+                    crate::checkpoint::restore(part, &fresh, &mut film, &name)?
+                }
+                None => 0,
+            };
+            bar.set_length(u64::from(job.settings.spp));
+            bar.set_position(u64::from(start));
+            let (stats, stop) = pool.install(|| {
+                ck.render(
+                    &ctx,
+                    integrator.as_ref(),
+                    &mut film,
+                    start..job.settings.spp,
+                    &|k| bar.set_position(u64::from(k)),
+                )
+            })?;
+            interrupted = stop;
+            stats
+        }
+        (None, _) => pool.install(|| {
             integrator.render_pass(&ctx, &mut film, job.settings.seed, &pass, &|rows| {
                 bar.set_position(rows as u64)
             })
         }),
-        Some(rule) => {
+        (Some(rule), _) => {
             let rows = camera.height as f64;
             let a = pool.install(|| {
                 render_adaptive(
@@ -464,7 +517,7 @@ fn render_one(
                 job.output.display()
             );
         }
-        return Ok(());
+        return end_checkpoint(args, job, interrupted);
     }
     let t_write = Instant::now();
     let extra = match adaptive.as_ref() {
@@ -524,7 +577,36 @@ fn render_one(
             })
         );
     }
-    Ok(())
+    end_checkpoint(args, job, interrupted)
+}
+
+/// After the image is written: an interrupted render says so and fails; a finished one
+/// removes its checkpoint (everything in it is in the image).
+fn end_checkpoint(
+    args: &Args,
+    job: &Job,
+    interrupted: Option<crate::checkpoint::Interrupted>,
+) -> Result<()> {
+    let Some(path) = &args.checkpoint else {
+        return Ok(());
+    };
+    if let Some(i) = interrupted {
+        bail!(
+            "interrupted by {} after {} of {} samples per pixel: wrote {} and the checkpoint {} (render --resume {} continues)",
+            i.signal,
+            i.samples,
+            job.settings.spp,
+            job.output.display(),
+            path.display(),
+            path.display()
+        );
+    }
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            bail!("--checkpoint {}: cannot remove it: {e}", path.display())
+        }
+        _ => Ok(()),
+    }
 }
 
 /// Denoises the film with `d` and writes the image: the end of a render with `--denoiser`, and

@@ -16,6 +16,7 @@ mod args;
 mod bench_accel;
 mod bench_anim;
 mod cache;
+mod checkpoint;
 mod compare;
 mod compare_frames;
 mod denoise;

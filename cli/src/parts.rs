@@ -132,11 +132,6 @@ fn settings(args: &Args, job: &Job, camera: &rt_core::Camera) -> BTreeMap<String
     .collect()
 }
 
-/// The command line after the program name, for the header.
-fn command_line() -> Vec<String> {
-    std::env::args().skip(1).collect()
-}
-
 /// The header of a part or checkpoint of this render.
 pub fn header(
     args: &Args,
@@ -169,7 +164,7 @@ pub fn header(
         aovs: b.aovs.names().into_iter().map(str::to_string).collect(),
         variance: b.variance,
         halves: b.halves,
-        args: command_line(),
+        args: job.command.clone(),
     }
 }
 

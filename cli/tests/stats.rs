@@ -100,7 +100,7 @@ fn stats_show_skipped_stages_for_a_scene_without_environment_map_or_aovs() {
     assert!(table.starts_with("stage "), "{table}");
 
     assert_skipped(&table, "environment importance map", "no environment");
-    assert_skipped(&table, "film variance (M2)", "no consumer");
+    assert_skipped(&table, "film squares (variance)", "no consumer");
     assert_skipped(&table, "film half-buffers", "no consumer");
     assert_skipped(&table, "film AOV hit count", "no first-hit AOV requested");
     for aov in ["albedo", "normal", "depth", "position"] {
@@ -138,7 +138,7 @@ fn stats_show_skipped_stages_for_a_scene_without_environment_map_or_aovs() {
     );
     assert_eq!(
         assert_holds(&table, "film mean + count", "allocated"),
-        PIXELS * 16
+        PIXELS * 52
     );
     let written = assert_holds(&table, "output write", "done");
     assert_eq!(
@@ -186,14 +186,14 @@ fn requested_aovs_are_allocated_and_leave_the_beauty_image_unchanged() {
         dir.path(),
         &[&common[..], &["-o", "aov.exr", "--aov", "variance,albedo"]].concat(),
     );
-    assert_skipped(&plain, "film variance (M2)", "no consumer");
+    assert_skipped(&plain, "film squares (variance)", "no consumer");
     assert_eq!(
-        assert_holds(&table, "film variance (M2)", "allocated"),
-        PIXELS * 12
+        assert_holds(&table, "film squares (variance)", "allocated"),
+        PIXELS * 48
     );
     assert_eq!(
         assert_holds(&table, "film AOV albedo", "allocated"),
-        PIXELS * 12
+        PIXELS * 48
     );
     assert_eq!(
         assert_holds(&table, "film AOV hit count", "allocated"),

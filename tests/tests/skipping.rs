@@ -48,7 +48,7 @@ fn no_environment_map_and_no_aovs_allocate_none_of_their_buffers() {
     assert!(scene.environment.is_black());
     let film = render(&scene, &PathIntegrator::new(4), AovSet::default().into());
     let m = film.memory();
-    assert_eq!(m.mean, 16 * 12 * 16);
+    assert_eq!(m.mean, 16 * 12 * 52);
     assert_eq!((m.variance, m.halves, m.first_hits), (None, None, None));
     assert_eq!(
         (m.albedo, m.normal, m.depth, m.position),
@@ -135,7 +135,7 @@ fn requested_buffers_are_allocated_and_filled() {
     let n = 16 * 12;
     assert_eq!(
         (m.variance, m.first_hits, m.albedo),
-        (Some(n * 12), Some(n * 4), Some(n * 12))
+        (Some(n * 48), Some(n * 4), Some(n * 48))
     );
     assert_eq!(
         (m.normal, m.depth, m.position, m.halves),

@@ -250,7 +250,7 @@ impl From<AovSet> for FilmBuffers {
 pub struct FilmMemory {
     /// Mean and sample count (always kept).
     pub mean: usize,
-    /// Welford `M2`.
+    /// Sums of squares.
     pub variance: Option<usize>,
     /// Even samples' sums and counts.
     pub halves: Option<usize>,
@@ -1036,8 +1036,8 @@ mod tests {
         assert_eq!(all.names().len(), AOV_NAMES.len() - 1, "all but `denoise`");
     }
 
-    /// The accumulation before the buffers became optional: one struct per pixel, Welford mean
-    /// and M2 updated together. Kept here to prove the mean's bits did not change.
+    /// The mean's bits do not depend on which optional buffers are kept, and the statistics
+    /// agree with a two-pass computation in `f64`.
     #[test]
     fn statistics_are_exact_and_the_same_with_and_without_optional_buffers() {
         let mut lean = Film::new(2, 2, AovSet::default());

@@ -1,15 +1,23 @@
 //! `rt-film`: where samples land, and how images leave the renderer.
 //!
-//! [`Film`] keeps per-pixel running statistics in separate buffers, and only those a consumer
-//! asked for in its [`FilmBuffers`]: the Welford mean and sample count always (16 bytes per
-//! pixel); the Welford `M2` for the variance of the mean (12 bytes); the two half-buffers of
-//! even- and odd-numbered samples that the thesis' stopping criterion (Dammertz §6.2) and the
-//! error estimators of the denoisers compare (32 bytes); each first-hit AOV (albedo, shading
-//! normal, depth, world position) and their shared hit count; and, for sample-space filters,
-//! every sample kept apart ([`SampleRecords`], 56 bytes per sample). [`Film::memory`] reports
-//! what is held. Nothing non-finite ever enters a buffer: such samples are counted and dropped.
+//! [`Film`] keeps per-pixel statistics in separate buffers, and only those a consumer asked
+//! for in its [`FilmBuffers`]: the sum and sample count always (52 bytes per pixel); the sums
+//! of squares for the variance of the mean (48 bytes); the even-numbered samples' sums, from
+//! which the two half-images that the thesis' stopping criterion (Dammertz §6.2) and the
+//! error estimators of the denoisers compare follow (64 bytes); each first-hit AOV (albedo,
+//! shading normal, depth, world position), their sums of squares and their shared hit count;
+//! and, for sample-space filters, every sample kept apart ([`SampleRecords`], 56 bytes per
+//! sample). [`Film::memory`] reports what is held. Nothing non-finite ever enters a buffer:
+//! such samples are counted and dropped.
 //!
-//! Light paths land on any pixel: their [`Splat`]s are summed apart (in `f64`, allocated at the
+//! Every sum is exact: each sample's value is rounded once to a grid of 2⁻³² and added as a
+//! 128-bit integer (the `fixed` module says why, and what it costs). So the order samples
+//! arrive in never changes a bit: [`Film::encode_sums`] and [`Film::add_encoded`] carry the
+//! sums of a rectangle ([`Rect`]) between machines, and the film that adds up the parts of a
+//! render (sample ranges, regions, a checkpoint and what came after it) is the film of the
+//! whole render, bit for bit (`rt-parts` builds part files and plans on this).
+//!
+//! Light paths land on any pixel: their [`Splat`]s are summed apart (exactly, allocated at the
 //! first splat) and divided by the number of light paths taken; the image is the camera
 //! samples' mean plus that ([`Film::mean_image`]).
 //!

@@ -42,5 +42,5 @@ mod plan;
 
 pub use file::{Part, PartError, PartHeader, PartKind, FORMAT, MAGIC, MAX_SIDE};
 pub use hash::{binary_id, content_hash};
-pub use merge::{merge, MergeError, Merged};
+pub use merge::{check_belongs, merge, MergeError, Merged};
 pub use plan::{Plan, PlanError, PlanRequest, PlannedOutput, PlannedPart, MAX_PARTS, PLAN_FORMAT};

@@ -97,6 +97,25 @@ fn identity(h: &PartHeader) -> Vec<(String, String)> {
     v
 }
 
+/// Checks that `other` comes from the same render as `first` (everything but the slice and
+/// the command line agrees), naming the first field that differs.
+pub fn check_belongs(
+    (first_name, first): (&str, &PartHeader),
+    (name, other): (&str, &PartHeader),
+) -> Result<(), MergeError> {
+    let (want, got) = (identity(first), identity(other));
+    match want.iter().zip(&got).find(|(a, b)| a != b) {
+        Some(((field, ours), (_, theirs))) => Err(MergeError::Mismatch {
+            file: name.to_string(),
+            first: first_name.to_string(),
+            field: field.clone(),
+            theirs: theirs.clone(),
+            ours: ours.clone(),
+        }),
+        None => Ok(()),
+    }
+}
+
 fn range_text(r: &Range<u32>) -> String {
     format!("samples {}..{}", r.start, r.end)
 }
@@ -105,18 +124,8 @@ fn range_text(r: &Range<u32>) -> String {
 /// `memory_limit`: the most bytes the merged film may hold (checked before allocating it).
 pub fn merge(parts: &[(String, Part)], memory_limit: Option<u64>) -> Result<Merged, MergeError> {
     let (first_name, first) = parts.first().ok_or(MergeError::Empty)?;
-    let want = identity(&first.header);
     for (name, p) in &parts[1..] {
-        let got = identity(&p.header);
-        if let Some(((field, ours), (_, theirs))) = want.iter().zip(&got).find(|(a, b)| a != b) {
-            return Err(MergeError::Mismatch {
-                file: name.clone(),
-                first: first_name.clone(),
-                field: field.clone(),
-                theirs: theirs.clone(),
-                ours: ours.clone(),
-            });
-        }
+        check_belongs((first_name, &first.header), (name, &p.header))?;
     }
     let h = &first.header;
     let (w, hgt, spp) = (h.width, h.height, h.spp);

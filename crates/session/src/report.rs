@@ -201,7 +201,11 @@ impl RenderReport {
             Some(b) => Stage::ran(name, "allocated", None, Some(b)).details(per_pixel(b)),
             None => Stage::skipped(name, why_not),
         };
-        stages.push(buffer("film variance (M2)", fm.variance, "no consumer"));
+        stages.push(buffer(
+            "film squares (variance)",
+            fm.variance,
+            "no consumer",
+        ));
         stages.push(buffer("film half-buffers", fm.halves, "no consumer"));
         stages.push(buffer(
             "film AOV hit count",
@@ -347,11 +351,14 @@ mod tests {
         let s = stats_for(&scene, &film, 0.0);
         assert_eq!(skipped(&s, "light sampling structure"), "no emitters");
         assert_eq!(skipped(&s, "environment importance map"), "no environment");
-        assert_eq!(skipped(&s, "film variance (M2)"), "no consumer");
+        assert_eq!(
+            skipped(&s, "film squares (variance)"),
+            "no consumer"
+        );
         assert_eq!(skipped(&s, "film half-buffers"), "no consumer");
         assert_eq!(skipped(&s, "film AOV albedo"), "not requested");
         assert_eq!(skipped(&s, "lens sampling"), "pinhole camera");
-        assert_eq!(s.stage("film mean + count").unwrap().bytes, Some(8 * 16));
+        assert_eq!(s.stage("film mean + count").unwrap().bytes, Some(8 * 52));
         assert_eq!(s.stage("output write").unwrap().bytes, None);
         let sum: u64 = ["scene load", "acceleration structure", "film mean + count"]
             .iter()
@@ -382,10 +389,10 @@ mod tests {
             "constant environment"
         );
         for (name, per_pixel) in [
-            ("film variance (M2)", 12),
-            ("film half-buffers", 32),
+            ("film squares (variance)", 48),
+            ("film half-buffers", 64),
             ("film AOV hit count", 4),
-            ("film AOV albedo", 12),
+            ("film AOV albedo", 48),
         ] {
             assert_eq!(s.stage(name).unwrap().bytes, Some(8 * per_pixel), "{name}");
         }

@@ -1,6 +1,6 @@
 //! "The same image within noise": a z-test of two renders on blocks of pixels.
 //!
-//! Each pixel of a film carries its mean and the estimated variance of that mean (Welford, in
+//! Each pixel of a film carries its mean and the estimated variance of that mean (exact sums, in
 //! `rt-film`). For independent renders `a` and `b` of the same image, the difference of the
 //! sums over a block of pixels has variance `Σ (var_a + var_b)`, so
 //! `z = Σ (mean_a − mean_b) / sqrt(Σ (var_a + var_b))` is close to standard normal per block

@@ -1,0 +1,143 @@
+//! Checkpoints: a render stopped by SIGINT or SIGTERM writes its image so far and a checkpoint
+//! and fails with one line; one killed by SIGKILL keeps its last checkpoint; `render --resume`
+//! finishes either to the very bytes of a render never stopped.
+
+mod common;
+use common::{one_error_line, render, FLOOR_AND_LAMP};
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// Enough samples that the render is still running when the signal arrives.
+const SPP: &str = "6000";
+
+fn scene(dir: &Path) {
+    let text = format!(
+        "{FLOOR_AND_LAMP}\n[[camera]]\nname = \"cam\"\nposition = [0, 1, 3]\nlook_at = [0, 0.5, 0]\nresolution = [16, 12]\n"
+    );
+    std::fs::write(dir.join("s.toml"), text).unwrap();
+}
+
+fn start(dir: &Path, out: &str) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_render"))
+        .current_dir(dir)
+        .args(["s.toml", "--spp", SPP, "-q", "-o", out])
+        .args(["--checkpoint", "ck.rpart", "--checkpoint-every", "0"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// Waits until the render has written a checkpoint.
+fn wait_for_checkpoint(dir: &Path) {
+    let t = Instant::now();
+    while !dir.join("ck.rpart").exists() {
+        assert!(
+            t.elapsed() < Duration::from_secs(60),
+            "no checkpoint after a minute"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(100));
+}
+
+fn signal(child: &Child, sig: &str) {
+    let ok = Command::new("kill")
+        .args([sig, &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(ok.success());
+}
+
+fn resume_and_compare(dir: &Path, out: &str) {
+    let r = render(dir, &["--resume", "ck.rpart", "--threads", "1"]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    assert!(
+        std::fs::read(dir.join(out)).unwrap() == std::fs::read(dir.join("whole.exr")).unwrap(),
+        "the resumed render differs from the uninterrupted one"
+    );
+    assert!(
+        !dir.join("ck.rpart").exists(),
+        "a finished render removes its checkpoint"
+    );
+}
+
+#[test]
+fn interrupted_and_killed_renders_resume_to_the_same_bytes() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    scene(dir);
+    let whole = render(dir, &["s.toml", "--spp", SPP, "-q", "-o", "whole.exr"]);
+    assert!(whole.status.success());
+
+    for sig in ["-INT", "-TERM"] {
+        let child = start(dir, "int.exr");
+        wait_for_checkpoint(dir);
+        signal(&child, sig);
+        let out = child.wait_with_output().unwrap();
+        let line = one_error_line(&out);
+        let name = if sig == "-INT" { "SIGINT" } else { "SIGTERM" };
+        assert!(
+            line.contains(&format!("interrupted by {name} after ")),
+            "{line}"
+        );
+        assert!(
+            line.contains(&format!(" of {SPP} samples per pixel: wrote int.exr")),
+            "{line}"
+        );
+        assert!(
+            line.contains("render --resume ck.rpart continues"),
+            "{line}"
+        );
+        // The image so far was written (a readable EXR).
+        assert!(rt_film::read_exr(&dir.join("int.exr")).is_ok());
+        resume_and_compare(dir, "int.exr");
+        std::fs::remove_file(dir.join("int.exr")).unwrap();
+    }
+
+    // SIGKILL: no image, but the last checkpoint is whole (written atomically).
+    let mut child = start(dir, "killed.exr");
+    wait_for_checkpoint(dir);
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(!dir.join("killed.exr").exists());
+    resume_and_compare(dir, "killed.exr");
+}
+
+#[test]
+fn resuming_refuses_a_changed_scene_and_checkpoints_refuse_what_they_cannot_keep() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    scene(dir);
+    let child = start(dir, "int.exr");
+    wait_for_checkpoint(dir);
+    signal(&child, "-INT");
+    child.wait_with_output().unwrap();
+    let text = std::fs::read_to_string(dir.join("s.toml")).unwrap();
+    std::fs::write(
+        dir.join("s.toml"),
+        text.replace("0.7, 0.7, 0.7", "0.6, 0.7, 0.7"),
+    )
+    .unwrap();
+    let e = one_error_line(&render(dir, &["--resume", "ck.rpart"]));
+    assert!(
+        e.contains("--resume: this render does not belong with ck.rpart: its scene content"),
+        "{e}"
+    );
+    let e = one_error_line(&render(dir, &["--resume", "s.toml"]));
+    assert!(e.contains("s.toml: not a part file"), "{e}");
+    for (extra, want) in [
+        (
+            &["--error", "0.01"][..],
+            "cannot checkpoint an adaptive render",
+        ),
+        (&["--gree"][..], "cannot checkpoint GREE"),
+        (&["-o", "p.rpart"][..], "cannot checkpoint a part"),
+    ] {
+        let mut a = vec!["s.toml", "--spp", "4", "--checkpoint", "c.rpart"];
+        a.extend(extra);
+        let e = one_error_line(&render(dir, &a));
+        assert!(e.contains(want), "{extra:?}: {e}");
+    }
+}
