@@ -351,10 +351,7 @@ mod tests {
         let s = stats_for(&scene, &film, 0.0);
         assert_eq!(skipped(&s, "light sampling structure"), "no emitters");
         assert_eq!(skipped(&s, "environment importance map"), "no environment");
-        assert_eq!(
-            skipped(&s, "film squares (variance)"),
-            "no consumer"
-        );
+        assert_eq!(skipped(&s, "film squares (variance)"), "no consumer");
         assert_eq!(skipped(&s, "film half-buffers"), "no consumer");
         assert_eq!(skipped(&s, "film AOV albedo"), "not requested");
         assert_eq!(skipped(&s, "lens sampling"), "pinhole camera");
