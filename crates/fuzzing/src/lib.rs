@@ -6,8 +6,8 @@
 //! campaign kept, and every crash it found, stays a test.
 //!
 //! An input passes when its loader returns, `Ok` or `Err`; a panic, a hang or an allocation
-//! the fuzzer's memory limit refuses is a failure. Depends on rt-scene, rt-film and
-//! rt-experiment (the loaders) and tempfile. Dev-only, like rt-testkit: no shipped crate
+//! the fuzzer's memory limit refuses is a failure. Depends on rt-scene, rt-film,
+//! rt-experiment and rt-parts (the loaders) and tempfile. Dev-only, like rt-testkit: no shipped crate
 //! depends on it.
 //!
 //! ```
@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 pub type Target = fn(&[u8]);
 
 /// The fuzz targets by name, as in `fuzz/fuzz_targets/`, `fuzz/seeds/` and `fuzz/corpus/`.
-pub const TARGETS: [(&str, Target); 8] = [
+pub const TARGETS: [(&str, Target); 10] = [
     ("scene_toml", scene_toml),
     ("experiment_toml", experiment_toml),
     ("obj", obj),
@@ -31,6 +31,8 @@ pub const TARGETS: [(&str, Target); 8] = [
     ("ra2", ra2),
     ("exr", exr),
     ("image", image),
+    ("part", part),
+    ("plan", plan),
 ];
 
 thread_local! {
@@ -105,4 +107,21 @@ pub fn exr(data: &[u8]) {
 /// inside glTF files).
 pub fn image(data: &[u8]) {
     let _ = rt_film::decode_srgb(data);
+}
+
+/// A part file or checkpoint (`rt_parts::Part::from_bytes`), merged alone into a film of its
+/// header's size (refused above 64 MiB, as `render merge --max-memory 64M` would) and read.
+pub fn part(data: &[u8]) {
+    if let Ok(p) = rt_parts::Part::from_bytes(data) {
+        if let Ok(m) = rt_parts::merge(&[("fuzz".to_string(), p)], Some(64 << 20)) {
+            let _ = m.film.mean_image();
+        }
+    }
+}
+
+/// A plan (`rt_parts::Plan::from_json`), as `render part` and `render merge --plan` read it.
+pub fn plan(data: &[u8]) {
+    if let Ok(text) = std::str::from_utf8(data) {
+        let _ = rt_parts::Plan::from_json(text);
+    }
 }

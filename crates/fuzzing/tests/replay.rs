@@ -66,4 +66,22 @@ fn the_seeds_are_valid_inputs_of_their_loaders() {
     }
     rt_film::read_rgb(&seeds.join("exr/tiny.exr")).unwrap();
     rt_film::decode_srgb(&std::fs::read(seeds.join("image/checker.png")).unwrap()).unwrap();
+    // Part files and checkpoints as `render` writes them (by this build: the format is
+    // versioned), each merging alone into its film.
+    for f in files(&seeds.join("part")) {
+        let part = rt_parts::Part::from_bytes(&std::fs::read(&f).unwrap())
+            .unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+        let mut whole = part.clone();
+        whole.header.samples[0] = 0;
+        whole.header.samples[1] = whole.header.spp;
+        let r = part.header.rect();
+        if (r.width(), r.height()) == (whole.header.width, whole.header.height) {
+            rt_parts::merge(&[("seed".into(), whole)], None)
+                .unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+        }
+    }
+    for f in files(&seeds.join("plan")) {
+        rt_parts::Plan::from_json(&std::fs::read_to_string(&f).unwrap())
+            .unwrap_or_else(|e| panic!("{}: {e}", f.display()));
+    }
 }
