@@ -35,6 +35,8 @@ pub struct Job {
     /// The command line after the program name (a resumed render keeps its first one), for
     /// part and checkpoint headers.
     pub command: Vec<String>,
+    /// The scene's content hash, when a part or a checkpoint will name it.
+    pub scene_hash: Option<String>,
     /// The checkpoint a resumed render starts from (`--resume`), and its file.
     pub resume: Option<(PathBuf, rt_parts::Part)>,
 }
@@ -138,6 +140,7 @@ impl Job {
             stop,
             frame: args.frame,
             command: std::env::args().skip(1).collect(),
+            scene_hash: None,
             resume: None,
         })
     }
@@ -173,6 +176,7 @@ fn run_job(args: &Args, resume: Option<(PathBuf, rt_parts::Part)>) -> Result<()>
     }
     let mut job = Job::resolve(args, &loaded.render)?;
     crate::checkpoint::check(args, &job)?;
+    job.scene_hash = scene_hash;
     if let Some((path, part)) = resume {
         job.command = part.header.args.clone();
         job.resume = Some((path, part));
@@ -232,7 +236,6 @@ fn run_job(args: &Args, resume: Option<(PathBuf, rt_parts::Part)>) -> Result<()>
             built,
             cache.clone(),
             (load_time, t_build.elapsed()),
-            scene_hash.as_deref(),
         )?;
     }
     Ok(())
@@ -364,8 +367,8 @@ fn render_one(
     accel: &dyn Accel,
     cache: Option<Arc<dyn RadianceCache>>,
     (load_time, build_time): (std::time::Duration, std::time::Duration),
-    scene_hash: Option<&str>,
 ) -> Result<()> {
+    let scene_hash = job.scene_hash.as_deref();
     let load_secs = load_time.as_secs_f64();
     let camera = pick_camera(scene, &job.scene_path, job.camera.as_deref())?;
     let build_secs = build_time.as_secs_f64();

@@ -15,7 +15,11 @@
 //! arrive in never changes a bit: [`Film::encode_sums`] and [`Film::add_encoded`] carry the
 //! sums of a rectangle ([`Rect`]) between machines, and the film that adds up the parts of a
 //! render (sample ranges, regions, a checkpoint and what came after it) is the film of the
-//! whole render, bit for bit (`rt-parts` builds part files and plans on this).
+//! whole render, bit for bit (`rt-parts` builds part files and plans on this). The encoding
+//! is a flags byte (bit 0: splats present), the discarded-sample count (`u64`), with splats
+//! the light paths and even-index light paths taken (two `u64`), then each kept buffer in a
+//! fixed order, one element per pixel of the rectangle, row-major, little-endian; the reader
+//! derives every length from its own buffers and the rectangle and checks the total first.
 //!
 //! Light paths land on any pixel: their [`Splat`]s are summed apart (exactly, allocated at the
 //! first splat) and divided by the number of light paths taken; the image is the camera

@@ -314,7 +314,7 @@ impl Adder<'_> {
 
 impl Film {
     /// The exact sums of the pixels in `rect` (which must lie inside the film), with the
-    /// light-path counts and the discarded-sample count, as bytes ([module doc](self)).
+    /// light-path counts and the discarded-sample count, as bytes (layout: the crate doc).
     pub fn encode_sums(&self, rect: Rect) -> Vec<u8> {
         let w = self.width();
         let splats = self.splats.parts();
