@@ -479,7 +479,8 @@ fn render_one(
     bar.finish_and_clear();
 
     if let (Some(slice), Some(hash)) = (&slice, scene_hash) {
-        crate::parts::write(args, job, camera, &film, slice, hash)?;
+        let seconds = stats.elapsed.as_secs_f64();
+        crate::parts::write(args, job, camera, &film, slice, (hash, seconds))?;
         if !job.quiet {
             println!(
                 "{}: samples {}..{} of pixels {} ({} {}, {:.2} s render, {} invalid samples discarded) -> {}",

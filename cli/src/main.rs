@@ -45,7 +45,19 @@ fn main() -> ExitCode {
             return ExitCode::from(code);
         }
     };
-    let result = match &args.command {
+    let result = run(&args);
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {}", one_line(&e));
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// Runs what the arguments ask for (also for `render part`, which runs a render of a plan).
+pub(crate) fn run(args: &args::Args) -> anyhow::Result<()> {
+    match &args.command {
         Some(args::Command::BenchAccel(bench)) => bench_accel::run(bench),
         Some(args::Command::BenchAnim(bench)) => bench_anim::run(bench),
         Some(args::Command::Compare(c)) => compare::run(c),
@@ -60,14 +72,7 @@ fn main() -> ExitCode {
         Some(args::Command::GenScene { name, output }) => {
             bench_accel::input::write_obj(name, output)
         }
-        None => job::run(&args),
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {}", one_line(&e));
-            ExitCode::from(1)
-        }
+        None => job::run(args),
     }
 }
 

@@ -8,7 +8,7 @@ use crate::job::Job;
 use anyhow::{bail, Context, Result};
 use clap::Parser;
 use rt_film::{Film, Rect};
-use rt_parts::{Part, PartHeader, PartKind, Plan, PlanRequest};
+use rt_parts::{Part, PartHeader, PartKind, Plan, PlanRequest, PlannedRender};
 use std::collections::BTreeMap;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
@@ -142,18 +142,32 @@ pub fn header(
     scene_hash: &str,
     kind: PartKind,
 ) -> PartHeader {
+    PartHeader {
+        scene: job.scene_path.display().to_string(),
+        scene_hash: scene_hash.to_string(),
+        settings: settings(args, job, camera),
+        frame: job.frame,
+        spp: job.settings.spp,
+        args: job.command.clone(),
+        ..film_header(film, slice, kind)
+    }
+}
+
+/// A header with what the film and the slice say (format, build, size, region, samples,
+/// buffers); the caller fills in the scene, settings, spp, frame and command line.
+pub fn film_header(film: &Film, slice: &Slice, kind: PartKind) -> PartHeader {
     let b = film.buffers();
     PartHeader {
         format: rt_parts::FORMAT,
         kind,
         binary: rt_parts::binary_id(env!("CARGO_PKG_VERSION")),
-        scene: job.scene_path.display().to_string(),
-        scene_hash: scene_hash.to_string(),
-        settings: settings(args, job, camera),
-        frame: job.frame,
-        width: camera.width,
-        height: camera.height,
-        spp: job.settings.spp,
+        scene: String::new(),
+        scene_hash: String::new(),
+        settings: BTreeMap::new(),
+        frame: None,
+        width: film.width(),
+        height: film.height(),
+        spp: slice.samples.end,
         region: [
             slice.region.x0,
             slice.region.y0,
@@ -164,7 +178,8 @@ pub fn header(
         aovs: b.aovs.names().into_iter().map(str::to_string).collect(),
         variance: b.variance,
         halves: b.halves,
-        args: job.command.clone(),
+        args: Vec::new(),
+        seconds: 0.0,
     }
 }
 
@@ -175,10 +190,13 @@ pub fn write(
     camera: &rt_core::Camera,
     film: &Film,
     slice: &Slice,
-    scene_hash: &str,
+    (scene_hash, seconds): (&str, f64),
 ) -> Result<()> {
     let part = Part {
-        header: header(args, job, camera, film, slice, scene_hash, PartKind::Part),
+        header: PartHeader {
+            seconds,
+            ..header(args, job, camera, film, slice, scene_hash, PartKind::Part)
+        },
         sums: film.encode_sums(slice.region),
     };
     part.write(&job.output)
@@ -213,7 +231,7 @@ pub fn merge(m: &MergeArgs) -> Result<()> {
     };
     let Some(plan_path) = &m.plan else {
         let output = m.output.as_ref().expect("clap requires -o without --plan");
-        return merge_files(&m.parts, output, limit, m.quiet);
+        return merge_files(&m.parts, output, false, limit, m.quiet);
     };
     let plan = read_plan(plan_path)?;
     let [dir] = &m.parts[..] else {
@@ -228,12 +246,29 @@ pub fn merge(m: &MergeArgs) -> Result<()> {
             .iter()
             .map(|&i| dir.join(&plan.parts[i].file))
             .collect();
-        merge_files(&files, Path::new(&out.output), limit, m.quiet)?;
+        merge_files(
+            &files,
+            Path::new(&out.output),
+            out.into_cache,
+            limit,
+            m.quiet,
+        )?;
     }
     Ok(())
 }
 
-fn merge_files(files: &[PathBuf], output: &Path, limit: Option<u64>, quiet: bool) -> Result<()> {
+/// Merges `files` into `output` (or, `into_cache`, into the reference cache directory
+/// `output`).
+fn merge_files(
+    files: &[PathBuf],
+    output: &Path,
+    into_cache: bool,
+    limit: Option<u64>,
+    quiet: bool,
+) -> Result<()> {
+    if into_cache {
+        return merge_reference(files, output, limit, quiet);
+    }
     match output
         .extension()
         .and_then(|e| e.to_str())
@@ -246,17 +281,7 @@ fn merge_files(files: &[PathBuf], output: &Path, limit: Option<u64>, quiet: bool
             output.display()
         ),
     }
-    let mut parts = Vec::with_capacity(files.len());
-    for f in files {
-        let p = Part::read(f).map_err(|e| anyhow::anyhow!("{}: {e}", f.display()))?;
-        if p.header.kind != PartKind::Part {
-            bail!(
-                "{}: a checkpoint, not a part: continue it with render --resume",
-                f.display()
-            );
-        }
-        parts.push((f.display().to_string(), p));
-    }
+    let parts = read_parts(files)?;
     let t = std::time::Instant::now();
     let mut merged = rt_parts::merge(&parts, limit).map_err(|e| anyhow::anyhow!("{e}"))?;
     let h = &merged.header;
@@ -310,10 +335,74 @@ fn merge_files(files: &[PathBuf], output: &Path, limit: Option<u64>, quiet: bool
     Ok(())
 }
 
+/// Reads part files (checkpoints are refused: they are resumed, not merged).
+fn read_parts(files: &[PathBuf]) -> Result<Vec<(String, Part)>> {
+    let mut parts = Vec::with_capacity(files.len());
+    for f in files {
+        let p = Part::read(f).map_err(|e| anyhow::anyhow!("{}: {e}", f.display()))?;
+        if p.header.kind != PartKind::Part {
+            bail!(
+                "{}: a checkpoint, not a part: continue it with render --resume",
+                f.display()
+            );
+        }
+        parts.push((f.display().to_string(), p));
+    }
+    Ok(parts)
+}
+
+/// Merges the parts of a reference (`render reference --sample-range/--region`) and stores
+/// it in the reference cache `dir`, where `render reference` and experiments find it.
+fn merge_reference(files: &[PathBuf], dir: &Path, limit: Option<u64>, quiet: bool) -> Result<()> {
+    let parts = read_parts(files)?;
+    let merged = rt_parts::merge(&parts, limit).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let h = &merged.header;
+    let setting = |k: &str| {
+        h.settings
+            .get(k)
+            .cloned()
+            .ok_or_else(|| anyhow::anyhow!("{}: not a reference's part (no {k})", parts[0].0))
+    };
+    if setting("stream")? != "reference" {
+        bail!("{}: not a reference's part", parts[0].0);
+    }
+    let key = rt_experiment::cache::Key {
+        hex: setting("cache key")?,
+        description: setting("cache description")?,
+    };
+    let seconds: f64 = parts.iter().map(|(_, p)| p.header.seconds).sum();
+    let samples = u64::from(h.width) * u64::from(h.height) * u64::from(h.spp);
+    let sidecar = rt_experiment::cache::Sidecar {
+        key: key.hex.clone(),
+        description: key.description.clone(),
+        scene: h.scene.clone(),
+        width: h.width,
+        height: h.height,
+        spp: h.spp,
+        seconds,
+        samples_per_second: samples as f64 / seconds.max(1e-9),
+    };
+    let path =
+        rt_experiment::Cache::new(dir).store(Path::new(&h.scene), &key, &merged.film, &sidecar)?;
+    if !quiet {
+        println!(
+            "merged {} parts of the reference of {} ({}x{}, {} spp, {:.1} s of rendering) -> {}",
+            parts.len(),
+            h.scene,
+            h.width,
+            h.height,
+            h.spp,
+            seconds,
+            path.display()
+        );
+    }
+    Ok(())
+}
+
 /// `render plan`.
 #[derive(clap::Args, Debug)]
 pub struct PlanArgs {
-    /// Scene file (TOML), or gen:NAME.
+    /// Scene file (TOML), or gen:NAME; with --experiment, an experiment file.
     pub scene: PathBuf,
     /// Tiles of W×H pixels (the last column and row take what is left). [default: the whole
     /// image]
@@ -325,6 +414,13 @@ pub struct PlanArgs {
     /// Frames A..B of a sequence (the render's output must name the frame).
     #[arg(long, value_name = "A..B", value_parser = crate::args::parse_frames)]
     pub frames: Option<Range<u32>>,
+    /// SCENE is an experiment file: plan the references it renders (into the reference cache,
+    /// where `render experiment` then finds them); its timed runs stay on one machine.
+    #[arg(long, conflicts_with = "frames")]
+    pub experiment: bool,
+    /// With --experiment: the reference cache the merge stores into.
+    #[arg(long, value_name = "DIR", default_value = rt_experiment::DEFAULT_CACHE_DIR)]
+    pub cache: PathBuf,
     /// The plan to write (JSON).
     #[arg(short, long)]
     pub output: PathBuf,
@@ -344,17 +440,37 @@ fn parse_tile(s: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-/// The render's arguments as `render` parses them: `SCENE ARGS...`.
-fn render_args(scene: &Path, rest: &[String]) -> Result<Args> {
-    let argv = std::iter::once("render".to_string())
-        .chain(std::iter::once(scene.display().to_string()))
-        .chain(rest.iter().cloned());
+/// `args` as `render` parses them (the program name added).
+fn parse_args(args: &[String]) -> Result<Args> {
+    let argv = std::iter::once("render".to_string()).chain(args.iter().cloned());
     Args::try_parse_from(argv)
         .map_err(|e| anyhow::anyhow!("{}", e.to_string().lines().next().unwrap_or_default()))
 }
 
 /// `render plan`.
 pub fn plan(p: &PlanArgs) -> Result<()> {
+    let requests = if p.experiment {
+        if !p.render_args.is_empty() {
+            bail!("render plan --experiment: the experiment file holds the settings; nothing goes after --");
+        }
+        experiment_requests(p)?
+    } else {
+        vec![render_request(p)?]
+    };
+    let plan = Plan::new(&requests).map_err(|e| anyhow::anyhow!("render plan: {e}"))?;
+    rt_film::write_bytes_atomic(&p.output, plan.to_json().as_bytes())
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    println!(
+        "{} parts, {} outputs -> {}",
+        plan.parts.len(),
+        plan.outputs.len(),
+        p.output.display()
+    );
+    Ok(())
+}
+
+/// One render, its frames and outputs, cut as `p` asks.
+fn render_request(p: &PlanArgs) -> Result<PlanRequest> {
     let rest = p.render_args.clone();
     for flag in ["--frames", "--frame", "--sample-range", "--region"] {
         if rest
@@ -366,7 +482,9 @@ pub fn plan(p: &PlanArgs) -> Result<()> {
             );
         }
     }
-    let args = render_args(&p.scene, &rest)?;
+    let mut all = vec![p.scene.display().to_string()];
+    all.extend(rest.iter().cloned());
+    let args = parse_args(&all)?;
     let loaded = crate::job::load_scene(&p.scene)?;
     let job = Job::resolve(&args, &loaded.render)?;
     let camera = rt_session::pick_camera(&loaded.scene, &job.scene_path, job.camera.as_deref())?;
@@ -379,12 +497,8 @@ pub fn plan(p: &PlanArgs) -> Result<()> {
             }
             r.clone()
                 .map(|f| {
-                    (
-                        Some(f),
-                        crate::frame_pattern::frame_path(&job.output, f)
-                            .display()
-                            .to_string(),
-                    )
+                    let path = crate::frame_pattern::frame_path(&job.output, f);
+                    (Some(f), path.display().to_string())
                 })
                 .collect()
         }
@@ -399,25 +513,70 @@ pub fn plan(p: &PlanArgs) -> Result<()> {
             part_args.push(a);
         }
     }
-    let plan = Plan::new(&PlanRequest {
-        args: part_args,
-        width: camera.width,
-        height: camera.height,
-        spp: job.settings.spp,
+    Ok(PlanRequest {
+        render: PlannedRender {
+            args: part_args,
+            width: camera.width,
+            height: camera.height,
+            spp: job.settings.spp,
+        },
+        into_cache: false,
         frames,
         tile: p.tiles,
         sample_splits: p.sample_splits,
     })
-    .map_err(|e| anyhow::anyhow!("render plan: {e}"))?;
-    rt_film::write_bytes_atomic(&p.output, plan.to_json().as_bytes())
-        .map_err(|e| anyhow::anyhow!("{e}"))?;
-    println!(
-        "{} parts, {} outputs -> {}",
-        plan.parts.len(),
-        plan.outputs.len(),
-        p.output.display()
-    );
-    Ok(())
+}
+
+/// The references an experiment renders, each a `render reference` cut as `p` asks and
+/// merged into the cache. Sequence scenes (one reference per frame) are refused for now.
+fn experiment_requests(p: &PlanArgs) -> Result<Vec<PlanRequest>> {
+    let exp = rt_experiment::config::load(&p.scene)?;
+    let mut requests = Vec::new();
+    for scene in &exp.scenes {
+        let rt_experiment::config::ReferencePlan::Render {
+            spp,
+            estimator,
+            seed,
+            accel,
+        } = &scene.reference
+        else {
+            continue;
+        };
+        if scene.sequence.is_some() {
+            bail!(
+                "{}: scene {}: the per-frame references of a sequence are not plannable yet",
+                p.scene.display(),
+                scene.name
+            );
+        }
+        let c = &scene.camera;
+        let args = [
+            "reference".to_string(),
+            scene.path.display().to_string(),
+            format!("--spp={spp}"),
+            format!("--seed={seed}"),
+            format!("--integrator={estimator}"),
+            format!("--camera={}", c.name),
+            format!("--resolution={}x{}", c.width, c.height),
+            format!("--accel={accel}"),
+        ];
+        requests.push(PlanRequest {
+            render: PlannedRender {
+                args: args.to_vec(),
+                width: c.width,
+                height: c.height,
+                spp: *spp,
+            },
+            into_cache: true,
+            frames: vec![(None, p.cache.display().to_string())],
+            tile: p.tiles,
+            sample_splits: p.sample_splits,
+        });
+    }
+    if requests.is_empty() {
+        bail!("{}: the experiment renders no reference", p.scene.display());
+    }
+    Ok(requests)
 }
 
 fn read_plan(path: &Path) -> Result<Plan> {
@@ -457,7 +616,7 @@ pub fn part(p: &PartArgs) -> Result<()> {
         .with_context(|| format!("{}: cannot create the parts directory", p.output.display()))?;
     let [x0, y0, x1, y1] = part.region;
     let [a, b] = part.samples;
-    let mut argv: Vec<String> = plan.args[1..].to_vec();
+    let mut argv: Vec<String> = plan.renders[part.render].args.clone();
     argv.extend([
         "--sample-range".into(),
         format!("{a}..{b}"),
@@ -472,6 +631,5 @@ pub fn part(p: &PartArgs) -> Result<()> {
     if p.quiet {
         argv.push("-q".into());
     }
-    let args = render_args(Path::new(&plan.args[0]), &argv)?;
-    crate::job::run(&args)
+    crate::run(&parse_args(&argv)?)
 }

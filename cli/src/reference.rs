@@ -73,6 +73,15 @@ pub struct ReferenceArgs {
     /// No progress bar and no messages.
     #[arg(short, long)]
     pub quiet: bool,
+
+    /// Render only sample indices A..B of the reference into a part file (-o NAME.rpart);
+    /// `render merge --plan` stores the merged parts in the cache (`render plan --experiment`).
+    #[arg(long, value_name = "A..B", value_parser = crate::args::parse_sample_range)]
+    pub sample_range: Option<std::ops::Range<u32>>,
+
+    /// Render only the pixels x0..x1 × y0..y1 of the reference into a part file.
+    #[arg(long, value_name = "x0,y0,x1,y1", value_parser = crate::args::parse_region)]
+    pub region: Option<rt_film::Rect>,
 }
 
 /// Parses `--resolution WxH`.
@@ -89,13 +98,24 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
             args.spp
         );
     }
+    let part = args.output.as_ref().is_some_and(|o| {
+        o.extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("rpart"))
+    });
     if let Some(out) = &args.output {
-        if !out
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+        if !part
+            && !out
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
         {
-            bail!("{}: a reference is written as .exr", out.display());
+            bail!(
+                "{}: a reference is written as .exr (or .rpart for a part)",
+                out.display()
+            );
         }
+    }
+    if !part && (args.sample_range.is_some() || args.region.is_some()) {
+        bail!("--sample-range and --region write a part file: -o must end in .rpart");
     }
     let size = match (args.resolution, args.scale) {
         (Some((w, h)), _) => ImageSize::Pixels(w, h),
@@ -107,7 +127,8 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         Some(a) => Some(a.parse().map_err(|e| anyhow!("--accel {a}: {e}"))?),
         None => None,
     };
-    let loaded = crate::job::load_scene(&args.scene)?;
+    let access = rt_scene::FileAccess::open();
+    let loaded = crate::job::load_scene_with(&args.scene, &access)?;
     let overrides = Overrides {
         integrator: args.integrator,
         max_depth: args.max_depth,
@@ -139,6 +160,10 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         seed: overrides.seed(&loaded.render),
     };
     let pool = crate::experiment::thread_pool(args.threads)?;
+    if part {
+        let hash = rt_parts::content_hash(&access.files_used(), &args.scene.to_string_lossy());
+        return pool.install(|| render_part(args, &req, &accel_spec, &hash));
+    }
     let progress = Progress::new(
         args.quiet,
         1000,
@@ -180,5 +205,88 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         _ => obtained.path,
     };
     println!("{}", printed.display());
+    Ok(())
+}
+
+/// A slice of the reference (`--sample-range`, `--region`) as a part file: the reference's
+/// stream, its variance, and the cache key in the header for the merge to store it under.
+fn render_part(
+    args: &ReferenceArgs,
+    req: &ReferenceRequest<'_>,
+    accel_spec: &rt_accel::AccelSpec,
+    scene_hash: &str,
+) -> Result<()> {
+    let (w, h) = (req.camera.width, req.camera.height);
+    let samples = args.sample_range.clone().unwrap_or(0..req.spp);
+    if samples.end > req.spp {
+        bail!(
+            "--sample-range {}..{}: the reference takes samples 0..{} (--spp)",
+            samples.start,
+            samples.end,
+            req.spp
+        );
+    }
+    let region = args.region.unwrap_or(rt_film::Rect::full(w, h));
+    if !region.is_inside(w, h) {
+        bail!("--region {region}: outside the {w}x{h} image");
+    }
+    let key = req.key()?;
+    let integrator = req.estimator.build();
+    let mut film = rt_film::Film::new(
+        w,
+        h,
+        rt_film::AovSet {
+            variance: true,
+            ..Default::default()
+        },
+    );
+    let slice = crate::parts::Slice { samples, region };
+    let pass = rt_integrators::SamplePass {
+        indices: slice.samples.clone(),
+        stream: rt_core::SampleStream::Reference,
+        pixels: slice.mask(w, h),
+        centre_first: false,
+    };
+    let accel = accel_spec.build_scene(req.scene);
+    let ctx = rt_integrators::Ctx {
+        scene: req.scene,
+        accel: accel.as_ref(),
+        camera: req.camera,
+    };
+    let stats = integrator.render_pass(&ctx, &mut film, req.seed, &pass, &|_| {});
+    let settings = [
+        ("stream", "reference".to_string()),
+        ("cache key", key.hex.clone()),
+        ("cache description", key.description.clone()),
+    ];
+    let header = rt_parts::PartHeader {
+        scene: req.scene_path.display().to_string(),
+        scene_hash: scene_hash.to_string(),
+        settings: settings
+            .into_iter()
+            .map(|(k, v)| (k.to_string(), v))
+            .collect(),
+        spp: req.spp,
+        args: std::env::args().skip(1).collect(),
+        seconds: stats.elapsed.as_secs_f64(),
+        ..crate::parts::film_header(&film, &slice, rt_parts::PartKind::Part)
+    };
+    let out = args.output.as_ref().expect("a part has an output");
+    rt_parts::Part {
+        header,
+        sums: film.encode_sums(region),
+    }
+    .write(out)
+    .map_err(|e| anyhow!("{}: {e}", out.display()))?;
+    if !args.quiet {
+        println!(
+            "{}: reference samples {}..{} of pixels {region} ({:.2} s) -> {}",
+            req.scene_path.display(),
+            slice.samples.start,
+            slice.samples.end,
+            stats.elapsed.as_secs_f64(),
+            out.display()
+        );
+    }
     Ok(())
 }

@@ -280,3 +280,83 @@ fn parts_that_do_not_belong_together_are_refused_with_one_line() {
         "{e}"
     );
 }
+
+#[test]
+fn an_experiments_references_are_planned_merged_into_the_cache_and_found_there() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    scene(dir);
+    std::fs::write(
+        dir.join("x.toml"),
+        "name = \"tiny\"\n\n[[scene]]\nname = \"room\"\npath = \"s.toml\"\nresolution = [12, 8]\nreference = { spp = 16 }\n\n[[method]]\nname = \"nee\"\nintegrator = \"path\"\nspp = [2]\n",
+    )
+    .unwrap();
+    let out = ok(render(
+        dir,
+        &[
+            "plan",
+            "x.toml",
+            "--experiment",
+            "--tiles",
+            "5x8",
+            "--sample-splits",
+            "2",
+            "-o",
+            "plan.json",
+            "--cache",
+            "cache",
+        ],
+    ));
+    // 3 tiles x 2 ranges of the one reference.
+    assert!(out.starts_with("6 parts, 1 outputs"), "{out}");
+    for i in 0..6 {
+        ok(render(
+            dir,
+            &[
+                "part",
+                "plan.json",
+                "--index",
+                &i.to_string(),
+                "-o",
+                "parts",
+                "-q",
+            ],
+        ));
+    }
+    ok(render(
+        dir,
+        &["merge", "--plan", "plan.json", "parts", "-q"],
+    ));
+    // The same bytes as the reference rendered in one go.
+    ok(render(
+        dir,
+        &[
+            "reference",
+            "s.toml",
+            "--spp",
+            "16",
+            "--resolution",
+            "12x8",
+            "--no-cache",
+            "-o",
+            "one.exr",
+            "-q",
+        ],
+    ));
+    let cached: Vec<_> = std::fs::read_dir(dir.join("cache"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "exr"))
+        .collect();
+    assert_eq!(cached.len(), 1);
+    assert!(std::fs::read(&cached[0]).unwrap() == bytes(dir, "one.exr"));
+    // The experiment takes it from the cache instead of rendering it.
+    let out = render(
+        dir,
+        &["experiment", "x.toml", "--out", "out", "--cache", "cache"],
+    );
+    let text =
+        String::from_utf8_lossy(&out.stderr).into_owned() + &String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    assert!(text.contains("room: reference from the cache"), "{text}");
+}

@@ -32,7 +32,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 /// Bump when the renderer's output for the same settings changes, to retire old entries.
-pub const CACHE_VERSION: u32 = 2;
+pub const CACHE_VERSION: u32 = 3;
 
 /// The default cache directory, relative to the working directory.
 pub const DEFAULT_CACHE_DIR: &str = ".render-cache/references";

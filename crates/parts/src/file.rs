@@ -35,8 +35,8 @@ pub enum PartKind {
 }
 
 /// Everything about a part except its sums. Parts merge only if every field but `kind`,
-/// `region`, `samples` and `args` is equal.
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+/// `region`, `samples`, `args` and `seconds` is equal.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PartHeader {
     /// [`FORMAT`].
@@ -71,6 +71,9 @@ pub struct PartHeader {
     pub halves: bool,
     /// The command line that wrote it, after the program name (to resume a checkpoint).
     pub args: Vec<String>,
+    /// Seconds its samples took to render (a checkpoint: all of them so far).
+    #[serde(default)]
+    pub seconds: f64,
 }
 
 impl PartHeader {
@@ -237,6 +240,7 @@ pub(crate) mod tests {
             variance: true,
             halves: false,
             args: vec!["s.toml".into()],
+            seconds: 1.5,
         }
     }
 

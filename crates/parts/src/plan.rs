@@ -10,12 +10,30 @@ use serde::{Deserialize, Serialize};
 /// Version of the plan format.
 pub const PLAN_FORMAT: u32 = 1;
 
+/// One render of a plan: what its parts run.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlannedRender {
+    /// The command line after the program name, without `-o`, `--frames`, `--frame`,
+    /// `--sample-range` and `--region` (each part adds its own): `SCENE ARGS...` for an image,
+    /// `reference SCENE ARGS...` for an experiment's reference.
+    pub args: Vec<String>,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+    /// Samples per pixel.
+    pub spp: u32,
+}
+
 /// One part of a plan.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PlannedPart {
     /// Its index (the scheduler's task index).
     pub index: usize,
+    /// Which render of the plan it belongs to.
+    pub render: usize,
     /// Frame of a sequence, if any.
     pub frame: Option<u32>,
     /// Pixels `[x0, y0, x1, y1]`.
@@ -30,12 +48,17 @@ pub struct PlannedPart {
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PlannedOutput {
+    /// Which render of the plan.
+    pub render: usize,
     /// Frame of a sequence, if any.
     pub frame: Option<u32>,
     /// Indices of its parts.
     pub parts: Vec<usize>,
-    /// The image to write.
+    /// The image to write; for a reference (`into_cache`), the reference cache directory.
     pub output: String,
+    /// True if the merge stores a reference in the cache that experiments read.
+    #[serde(default)]
+    pub into_cache: bool,
 }
 
 /// A render cut into parts.
@@ -44,15 +67,8 @@ pub struct PlannedOutput {
 pub struct Plan {
     /// [`PLAN_FORMAT`].
     pub format: u32,
-    /// The render's command line after the program name, without `-o`, `--frames` and
-    /// `--frame` (each part adds its own).
-    pub args: Vec<String>,
-    /// Image width.
-    pub width: u32,
-    /// Image height.
-    pub height: u32,
-    /// Samples per pixel of the whole render.
-    pub spp: u32,
+    /// The renders cut (one for an image or a sequence; one per reference of an experiment).
+    pub renders: Vec<PlannedRender>,
     /// Every part, in index order.
     pub parts: Vec<PlannedPart>,
     /// Every output and its parts.
@@ -62,14 +78,10 @@ pub struct Plan {
 /// How to cut a render.
 #[derive(Clone, Debug)]
 pub struct PlanRequest {
-    /// See [`Plan::args`].
-    pub args: Vec<String>,
-    /// Image width.
-    pub width: u32,
-    /// Image height.
-    pub height: u32,
-    /// Samples per pixel.
-    pub spp: u32,
+    /// The render.
+    pub render: PlannedRender,
+    /// True if its outputs go into the reference cache (`frames`' paths name the cache).
+    pub into_cache: bool,
     /// Frames, each with its output path; `None` for a still.
     pub frames: Vec<(Option<u32>, String)>,
     /// Tile size in pixels (`--tiles WxH`); `None`: the whole image.
@@ -94,46 +106,61 @@ pub enum PlanError {
 pub const MAX_PARTS: usize = 1 << 20;
 
 impl Plan {
-    /// Cuts a render: every frame into tiles (row-major; the last column and row take what
-    /// is left) times sample ranges (as equal as integers allow).
-    pub fn new(r: &PlanRequest) -> Result<Plan, PlanError> {
+    /// Cuts renders: every frame of each into tiles (row-major; the last column and row take
+    /// what is left) times sample ranges (as equal as integers allow).
+    pub fn new(requests: &[PlanRequest]) -> Result<Plan, PlanError> {
+        let mut plan = Plan {
+            format: PLAN_FORMAT,
+            renders: Vec::new(),
+            parts: Vec::new(),
+            outputs: Vec::new(),
+        };
+        for r in requests {
+            plan.add(r)?;
+        }
+        Ok(plan)
+    }
+
+    fn add(&mut self, r: &PlanRequest) -> Result<(), PlanError> {
         let bad = |m: String| Err(PlanError::Request(m));
-        if r.sample_splits == 0 || r.sample_splits > r.spp {
+        let render = self.renders.len();
+        let (width, height, spp) = (r.render.width, r.render.height, r.render.spp);
+        if r.sample_splits == 0 || r.sample_splits > spp {
             return bad(format!(
-                "--sample-splits {} must be between 1 and the {} spp",
-                r.sample_splits, r.spp
+                "--sample-splits {} must be between 1 and the {spp} spp",
+                r.sample_splits
             ));
         }
-        let (tw, th) = r.tile.unwrap_or((r.width, r.height));
+        let (tw, th) = r.tile.unwrap_or((width, height));
         if tw == 0 || th == 0 {
             return bad("--tiles: a tile must be at least 1x1 pixels".into());
         }
-        let cols = r.width.div_ceil(tw);
-        let rows = r.height.div_ceil(th);
-        let count = cols as u64 * rows as u64 * u64::from(r.sample_splits) * r.frames.len() as u64;
+        let cols = width.div_ceil(tw);
+        let rows = height.div_ceil(th);
+        let count = cols as u64 * rows as u64 * u64::from(r.sample_splits) * r.frames.len() as u64
+            + self.parts.len() as u64;
         if count > MAX_PARTS as u64 {
             return bad(format!(
                 "{count} parts is more than the {MAX_PARTS} a plan may hold"
             ));
         }
-        let mut parts = Vec::new();
-        let mut outputs = Vec::new();
         for (frame, output) in &r.frames {
             let mut mine = Vec::new();
             for k in 0..r.sample_splits {
                 let s =
-                    |k: u32| (u64::from(k) * u64::from(r.spp) / u64::from(r.sample_splits)) as u32;
+                    |k: u32| (u64::from(k) * u64::from(spp) / u64::from(r.sample_splits)) as u32;
                 for ty in 0..rows {
                     for tx in 0..cols {
-                        let index = parts.len();
+                        let index = self.parts.len();
                         let region = [
                             tx * tw,
                             ty * th,
-                            ((tx + 1) * tw).min(r.width),
-                            ((ty + 1) * th).min(r.height),
+                            ((tx + 1) * tw).min(width),
+                            ((ty + 1) * th).min(height),
                         ];
-                        parts.push(PlannedPart {
+                        self.parts.push(PlannedPart {
                             index,
+                            render,
                             frame: *frame,
                             region,
                             samples: [s(k), s(k + 1)],
@@ -143,21 +170,16 @@ impl Plan {
                     }
                 }
             }
-            outputs.push(PlannedOutput {
+            self.outputs.push(PlannedOutput {
+                render,
                 frame: *frame,
                 parts: mine,
                 output: output.clone(),
+                into_cache: r.into_cache,
             });
         }
-        Ok(Plan {
-            format: PLAN_FORMAT,
-            args: r.args.clone(),
-            width: r.width,
-            height: r.height,
-            spp: r.spp,
-            parts,
-            outputs,
-        })
+        self.renders.push(r.render.clone());
+        Ok(())
     }
 
     /// Parses and checks a plan file's text.
@@ -169,8 +191,8 @@ impl Plan {
                 p.format
             )));
         }
-        if p.args.is_empty() {
-            return Err(PlanError::Invalid("no scene in `args`".into()));
+        if p.renders.iter().any(|r| r.args.is_empty()) {
+            return Err(PlanError::Invalid("a render without arguments".into()));
         }
         if p.parts.len() > MAX_PARTS {
             return Err(PlanError::Invalid(format!("{} parts", p.parts.len())));
@@ -180,7 +202,7 @@ impl Plan {
                 && !part.file.contains(['/', '\\'])
                 && part.file != ".."
                 && part.file != ".";
-            if part.index != i || !ok_name {
+            if part.index != i || !ok_name || part.render >= p.renders.len() {
                 return Err(PlanError::Invalid(format!(
                     "part {i} is out of order or has a bad file name"
                 )));
@@ -210,10 +232,13 @@ mod tests {
 
     fn request(tile: Option<(u32, u32)>, splits: u32, frames: usize) -> PlanRequest {
         PlanRequest {
-            args: vec!["scene.toml".into()],
-            width: 10,
-            height: 7,
-            spp: 9,
+            render: PlannedRender {
+                args: vec!["scene.toml".into()],
+                width: 10,
+                height: 7,
+                spp: 9,
+            },
+            into_cache: false,
             frames: (0..frames)
                 .map(|f| (Some(f as u32), format!("f{f}.exr")))
                 .collect(),
@@ -224,7 +249,7 @@ mod tests {
 
     #[test]
     fn tiles_and_ranges_cover_each_frame_once() {
-        let p = Plan::new(&request(Some((4, 4)), 2, 3)).unwrap();
+        let p = Plan::new(&[request(Some((4, 4)), 2, 3)]).unwrap();
         // 3 columns x 2 rows x 2 ranges per frame.
         assert_eq!(p.parts.len(), 3 * 12);
         assert_eq!(p.outputs.len(), 3);
@@ -245,9 +270,15 @@ mod tests {
         }
         let back = Plan::from_json(&p.to_json()).unwrap();
         assert_eq!(back, p);
-        assert!(Plan::new(&request(None, 10, 1)).is_err());
-        assert!(Plan::new(&request(None, 0, 1)).is_err());
-        assert!(Plan::new(&request(Some((0, 2)), 1, 1)).is_err());
+        assert!(Plan::new(&[request(None, 10, 1)]).is_err());
+        assert!(Plan::new(&[request(None, 0, 1)]).is_err());
+        assert!(Plan::new(&[request(Some((0, 2)), 1, 1)]).is_err());
+        // Two renders: parts numbered on, each pointing at its render.
+        let two = Plan::new(&[request(None, 3, 1), request(Some((5, 7)), 1, 1)]).unwrap();
+        assert_eq!(two.parts.len(), 5);
+        assert_eq!(two.parts[4].render, 1);
+        assert_eq!(two.outputs[1].parts, vec![3, 4]);
+        assert_eq!(Plan::from_json(&two.to_json()).unwrap(), two);
         let mut evil = p.clone();
         evil.parts[3].file = "../x".into();
         assert!(Plan::from_json(&evil.to_json()).is_err());
