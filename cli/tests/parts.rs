@@ -360,3 +360,70 @@ fn an_experiments_references_are_planned_merged_into_the_cache_and_found_there()
     assert!(out.status.success(), "{text}");
     assert!(text.contains("room: reference from the cache"), "{text}");
 }
+
+#[test]
+fn a_planned_sequence_merges_to_each_frame_of_the_single_render() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    std::fs::write(dir.join("m.toml"), common::MOVING_BOX).unwrap();
+    let out = ok(render(
+        dir,
+        &[
+            "plan",
+            "m.toml",
+            "--frames",
+            "0..3",
+            "--sample-splits",
+            "2",
+            "--tiles",
+            "6x8",
+            "-o",
+            "plan.json",
+            "--",
+            "--spp",
+            "4",
+            "-o",
+            "p_{frame}.exr",
+        ],
+    ));
+    assert!(out.starts_with("12 parts, 3 outputs"), "{out}");
+    for i in 0..12 {
+        ok(render(
+            dir,
+            &[
+                "part",
+                "plan.json",
+                "--index",
+                &i.to_string(),
+                "-o",
+                "parts",
+                "-q",
+            ],
+        ));
+    }
+    ok(render(
+        dir,
+        &["merge", "--plan", "plan.json", "parts", "-q"],
+    ));
+    ok(render(
+        dir,
+        &[
+            "m.toml",
+            "--frames",
+            "0..3",
+            "--spp",
+            "4",
+            "-o",
+            "s_{frame}.exr",
+            "-q",
+        ],
+    ));
+    for f in 0..3 {
+        assert!(
+            bytes(dir, &format!("p_{f}.exr")) == bytes(dir, &format!("s_{f}.exr")),
+            "frame {f}"
+        );
+    }
+    // Frames differ from each other (the box moves), so a mix-up would show.
+    assert!(bytes(dir, "s_0.exr") != bytes(dir, "s_2.exr"));
+}
