@@ -179,7 +179,15 @@ mod tests {
         assert_eq!(to_fixed(1e-10), 0, "below half a unit");
         assert_eq!(to_fixed(2e-10), 1);
         // The fast conversion agrees with the general one across the 64-bit boundary.
-        for s in [0i128, 1, -7, (1 << 62) + 3, i64::MAX as i128, i64::MAX as i128 + 1, -(1 << 80) - 5] {
+        for s in [
+            0i128,
+            1,
+            -7,
+            (1 << 62) + 3,
+            i64::MAX as i128,
+            i64::MAX as i128 + 1,
+            -(1 << 80) - 5,
+        ] {
             assert_eq!(real(s).to_bits(), (s as f64 / ONE).to_bits(), "{s}");
         }
     }

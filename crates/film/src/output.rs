@@ -293,6 +293,44 @@ impl ExrImage {
     }
 }
 
+/// How many times its size in bytes an EXR file may claim to decode to. Real files compress
+/// by far less (ZIP and PIZ by a few times; a constant image by deflate's limit, about 1000);
+/// a header that claims more is refused before the decoder allocates what it claims.
+const EXR_MAX_EXPANSION: u64 = 1024;
+/// What any EXR file may claim to decode to, however small: 64 MiB.
+const EXR_MIN_BUDGET: u64 = 64 << 20;
+
+/// Refuses an EXR file whose headers claim far more samples than its bytes could hold (the
+/// decoder would allocate them all up front; fuzzing found a 500-byte file claiming 13 TB).
+fn check_exr_claims(path: &Path) -> Result<(), FilmError> {
+    let codec = |message: String| FilmError::Codec {
+        path: path.to_path_buf(),
+        message,
+    };
+    let file_len = std::fs::metadata(path)
+        .map_err(|source| FilmError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?
+        .len();
+    let meta =
+        exr::meta::MetaData::read_from_file(path, false).map_err(|e| codec(e.to_string()))?;
+    let claimed = meta.headers.iter().fold(0u64, |sum, h| {
+        let area = (h.layer_size.0 as u64).saturating_mul(h.layer_size.1 as u64);
+        let channels = h.channels.list.len() as u64;
+        sum.saturating_add(area.saturating_mul(channels).saturating_mul(4))
+    });
+    let budget = file_len
+        .saturating_mul(EXR_MAX_EXPANSION)
+        .max(EXR_MIN_BUDGET);
+    if claimed > budget {
+        return Err(codec(format!(
+            "the header claims {claimed} bytes of samples, more than a {file_len}-byte file can hold"
+        )));
+    }
+    Ok(())
+}
+
 /// Reads every channel of the first layer of an EXR file as f32.
 pub fn read_exr(path: &Path) -> Result<ExrImage, FilmError> {
     use exr::prelude::{read, ReadChannels, ReadLayers};
@@ -300,6 +338,7 @@ pub fn read_exr(path: &Path) -> Result<ExrImage, FilmError> {
         path: path.to_path_buf(),
         message: e.to_string(),
     };
+    check_exr_claims(path)?;
     let img = read()
         .no_deep_data()
         .largest_resolution_level()

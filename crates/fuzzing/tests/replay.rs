@@ -85,3 +85,33 @@ fn the_seeds_are_valid_inputs_of_their_loaders() {
             .unwrap_or_else(|e| panic!("{}: {e}", f.display()));
     }
 }
+
+#[test]
+fn the_crashes_campaigns_found_are_now_one_clear_error() {
+    let seeds = fuzz_dir().join("seeds");
+    let d = tempfile::tempdir().unwrap();
+    let copy = |from: &str, name: &str| {
+        let p = d.path().join(name);
+        std::fs::copy(seeds.join(from), &p).unwrap();
+        p
+    };
+    // gltf-json's validation indexed POSITION's accessor before checking it.
+    let e = rt_scene::load_mesh(&copy("gltf/crash-position-accessor-out-of-range", "a.gltf"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("names accessor 4, but there are 4"), "{e}");
+    // The gltf crate's index reader hit `unreachable!` on signed indices.
+    let e = rt_scene::load_mesh(&copy("glb/crash-float-indices", "b.glb"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("indices must be unsigned integer scalars"),
+        "{e}"
+    );
+    // The exr crate allocated the 13 TB a 580-byte header claimed.
+    let e = rt_film::read_exr(&copy("exr/crash-exr-claims-13tb", "c.exr"))
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("more than a 580-byte file can hold"), "{e}");
+}

@@ -57,8 +57,14 @@ pub(crate) fn load(
     warnings: &mut Vec<String>,
 ) -> Result<Mesh> {
     let bytes = textures.access().read(path, "")?;
-    let ::gltf::Gltf { document, blob } = ::gltf::Gltf::from_slice(&bytes)
-        .map_err(|e| SceneError::file(path, format!("malformed glTF: {e}")))?;
+    let malformed = |e: String| SceneError::file(path, format!("malformed glTF: {e}"));
+    // Parsed without the gltf crate's validation, whose POSITION check indexes the accessors
+    // before checking the index (a panic fuzzing found); validated once that is checked.
+    let ::gltf::Gltf { document, blob } = ::gltf::Gltf::from_slice_without_validation(&bytes)
+        .map_err(|e| malformed(e.to_string()))?;
+    let json = document.into_json();
+    check_attribute_accessors(&json).map_err(malformed)?;
+    let document = ::gltf::Document::from_json(json).map_err(|e| malformed(e.to_string()))?;
     let dir = path.parent().unwrap_or(Path::new(""));
     // The gltf crate opens external buffers itself: check them first.
     for b in document.buffers() {
@@ -189,6 +195,18 @@ impl Loader<'_> {
         if uvs.as_ref().is_some_and(|v| v.len() != n) {
             uvs = None;
             self.dropped_attributes += 1;
+        }
+        // The gltf crate's reader has no case for other index types (`unreachable!`).
+        if let Some(a) = prim.indices() {
+            use ::gltf::accessor::{DataType, Dimensions};
+            let integer = matches!(a.data_type(), DataType::U8 | DataType::U16 | DataType::U32);
+            if !integer || a.dimensions() != Dimensions::Scalar {
+                return Err(self.error(format!(
+                    "{what}: indices must be unsigned integer scalars, not {:?} {:?}",
+                    a.data_type(),
+                    a.dimensions()
+                )));
+            }
         }
         let indices: Vec<u32> = match reader.read_indices() {
             Some(ix) => ix.into_u32().collect(),
@@ -377,6 +395,23 @@ pub(crate) fn base64_decode(s: &str) -> Option<Vec<u8>> {
         }
     }
     Some(out)
+}
+
+/// Every primitive attribute names an accessor that exists (checked before the gltf crate's
+/// validation, which indexes POSITION's accessor without checking it).
+fn check_attribute_accessors(json: &::gltf::json::Root) -> std::result::Result<(), String> {
+    let n = json.accessors.len();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let refs = prim.attributes.values().chain(prim.indices.as_ref());
+            if let Some(bad) = refs.map(|i| i.value()).find(|&i| i >= n) {
+                return Err(format!(
+                    "mesh {m} primitive {p} names accessor {bad}, but there are {n}"
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]
