@@ -189,6 +189,12 @@ fn run_job(args: &Args, resume: Option<(PathBuf, rt_parts::Part)>) -> Result<()>
     set_shutter(args, &job, &mut scene)?;
     check_memory(args, &job, &scene)?;
     if let Some(spec) = crate::sequence::temporal_spec(args)? {
+        if crate::parts::writes_part(args) {
+            bail!(
+                "{}: a part file cannot hold a temporally denoised sequence: its history carries from frame to frame; render the frames' parts without it",
+                job.output.display()
+            );
+        }
         return crate::sequence::run(args, &job, &spec, &mut scene, &frames);
     }
 

@@ -254,6 +254,20 @@ fn parts_that_do_not_belong_together_are_refused_with_one_line() {
         "x.rpart",
     ]);
     assert!(e.contains("per-sample records"), "{e}");
+    std::fs::write(dir.join("m.toml"), common::MOVING_BOX).unwrap();
+    let e = refuse(&[
+        "m.toml",
+        "--frames",
+        "0..2",
+        "--denoiser",
+        "svgf",
+        "-o",
+        "p_{frame}.rpart",
+    ]);
+    assert!(
+        e.contains("cannot hold a temporally denoised sequence"),
+        "{e}"
+    );
     let e = refuse(&["s.toml", "--sample-range", "0..2", "-o", "x.exr"]);
     assert!(e.contains("-o must end in .rpart"), "{e}");
     let e = refuse(&[
