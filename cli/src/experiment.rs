@@ -34,6 +34,11 @@ pub struct ExperimentArgs {
     /// the size of the grid and exit: nothing is rendered or written.
     #[arg(long)]
     pub check: bool,
+
+    /// Refuse any file the experiment, its scenes or their references refer to outside DIR
+    /// (as `render --confine`).
+    #[arg(long, value_name = "DIR")]
+    pub confine: Option<PathBuf>,
 }
 
 /// A rayon pool of `threads` workers (all cores by default).
@@ -54,7 +59,8 @@ pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
 /// Runs `render experiment`.
 pub fn run(args: &ExperimentArgs) -> Result<()> {
     let wall = Instant::now();
-    let plan = rt_experiment::config::load(&args.config)?;
+    let access = crate::job::file_access(args.confine.as_deref())?;
+    let plan = rt_experiment::config::load_with(&args.config, &access)?;
     if args.check {
         for w in &plan.warnings {
             eprintln!("warning: {w}");

@@ -48,6 +48,14 @@ fn scene_arg(args: &Args) -> &Path {
         .expect("clap requires SCENE when no subcommand is given")
 }
 
+/// What the loaders may read: anything, or with `--confine DIR` only files inside DIR.
+pub fn file_access(confine: Option<&Path>) -> Result<FileAccess> {
+    match confine {
+        Some(dir) => FileAccess::confined_to(dir).map_err(|e| anyhow::anyhow!("{e}")),
+        None => Ok(FileAccess::open()),
+    }
+}
+
 /// Loads a scene file or `gen:NAME`.
 pub fn load_scene(path: &Path) -> Result<LoadedScene> {
     load_scene_with(path, &FileAccess::open())
@@ -160,10 +168,7 @@ pub fn run(args: &Args) -> Result<()> {
 /// [`run`], continuing from the checkpoint `resume` if given.
 fn run_job(args: &Args, resume: Option<(PathBuf, rt_parts::Part)>) -> Result<()> {
     let t_load = Instant::now();
-    let access = match &args.confine {
-        Some(dir) => FileAccess::confined_to(dir).map_err(|e| anyhow::anyhow!("{e}"))?,
-        None => FileAccess::open(),
-    };
+    let access = file_access(args.confine.as_deref())?;
     let loaded = load_scene_with(scene_arg(args), &access)?;
     // A part file names the scene's content; nothing else needs the files read twice.
     let scene_hash = (crate::parts::writes_part(args) || args.checkpoint.is_some())

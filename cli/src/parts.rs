@@ -421,6 +421,10 @@ pub struct PlanArgs {
     /// With --experiment: the reference cache the merge stores into.
     #[arg(long, value_name = "DIR", default_value = rt_experiment::DEFAULT_CACHE_DIR)]
     pub cache: PathBuf,
+    /// Refuse any file the scene (or experiment) refers to outside DIR; give it after `--`
+    /// too for the parts' renders.
+    #[arg(long, value_name = "DIR")]
+    pub confine: Option<PathBuf>,
     /// The plan to write (JSON).
     #[arg(short, long)]
     pub output: PathBuf,
@@ -485,7 +489,8 @@ fn render_request(p: &PlanArgs) -> Result<PlanRequest> {
     let mut all = vec![p.scene.display().to_string()];
     all.extend(rest.iter().cloned());
     let args = parse_args(&all)?;
-    let loaded = crate::job::load_scene(&p.scene)?;
+    let access = crate::job::file_access(p.confine.as_deref())?;
+    let loaded = crate::job::load_scene_with(&p.scene, &access)?;
     let job = Job::resolve(&args, &loaded.render)?;
     let camera = rt_session::pick_camera(&loaded.scene, &job.scene_path, job.camera.as_deref())?;
     let output = job.output.display().to_string();
@@ -530,7 +535,8 @@ fn render_request(p: &PlanArgs) -> Result<PlanRequest> {
 /// The references an experiment renders, each a `render reference` cut as `p` asks and
 /// merged into the cache. Sequence scenes (one reference per frame) are refused for now.
 fn experiment_requests(p: &PlanArgs) -> Result<Vec<PlanRequest>> {
-    let exp = rt_experiment::config::load(&p.scene)?;
+    let access = crate::job::file_access(p.confine.as_deref())?;
+    let exp = rt_experiment::config::load_with(&p.scene, &access)?;
     let mut requests = Vec::new();
     for scene in &exp.scenes {
         let rt_experiment::config::ReferencePlan::Render {

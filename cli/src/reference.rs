@@ -82,6 +82,10 @@ pub struct ReferenceArgs {
     /// Render only the pixels x0..x1 × y0..y1 of the reference into a part file.
     #[arg(long, value_name = "x0,y0,x1,y1", value_parser = crate::args::parse_region)]
     pub region: Option<rt_film::Rect>,
+
+    /// Refuse any file the scene refers to outside DIR (as `render --confine`).
+    #[arg(long, value_name = "DIR")]
+    pub confine: Option<PathBuf>,
 }
 
 /// Parses `--resolution WxH`.
@@ -127,7 +131,7 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         Some(a) => Some(a.parse().map_err(|e| anyhow!("--accel {a}: {e}"))?),
         None => None,
     };
-    let access = rt_scene::FileAccess::open();
+    let access = crate::job::file_access(args.confine.as_deref())?;
     let loaded = crate::job::load_scene_with(&args.scene, &access)?;
     let overrides = Overrides {
         integrator: args.integrator,

@@ -100,3 +100,47 @@ fn files_outside_the_confinement_are_refused_before_they_are_read() {
     let e = one_error_line(&o);
     assert!(e.contains("--confine"), "{e}");
 }
+
+#[test]
+fn reference_experiment_and_plan_are_confined_too() {
+    let d = tempfile::tempdir().unwrap();
+    let root = d.path();
+    let farm = root.join("farm");
+    std::fs::create_dir_all(&farm).unwrap();
+    std::fs::write(root.join("outside.obj"), TRIANGLE).unwrap();
+    std::fs::write(root.join("m.mtl"), MTL).unwrap();
+    scene(&farm, "../outside.obj");
+    std::fs::write(
+        farm.join("x.toml"),
+        "name = \"x\"\n[[scene]]\nname = \"s\"\npath = \"s.toml\"\nreference = { spp = 4 }\n[[method]]\nname = \"p\"\nintegrator = \"path\"\nspp = [1]\n",
+    )
+    .unwrap();
+    let farm_s = farm.display().to_string();
+    for args in [
+        vec!["reference", "s.toml", "--spp", "4", "--confine", &farm_s],
+        vec!["experiment", "x.toml", "--check", "--confine", &farm_s],
+        vec!["plan", "s.toml", "--confine", &farm_s, "-o", "p.json"],
+        vec![
+            "plan",
+            "x.toml",
+            "--experiment",
+            "--confine",
+            &farm_s,
+            "-o",
+            "p.json",
+        ],
+    ] {
+        let e = one_error_line(&render(&farm, &args));
+        assert!(
+            e.contains("outside.obj") && e.contains("refused"),
+            "{args:?}: {e}"
+        );
+    }
+    // Without the flag, the same files load.
+    let out = render(&farm, &["experiment", "x.toml", "--check"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

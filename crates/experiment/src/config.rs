@@ -398,10 +398,17 @@ fn check_ao(d: Option<f32>) -> Result<Option<f32>, String> {
 /// Reads and validates the experiment file at `path`. Every error is one line that starts with
 /// the file's name.
 pub fn load(path: &Path) -> CrateResult<Plan> {
+    load_with(path, &rt_scene::FileAccess::open())
+}
+
+/// [`load`], reading only the files `access` allows (`--confine`): the experiment file, its
+/// scenes and everything they refer to, and reference images.
+pub fn load_with(path: &Path, access: &rt_scene::FileAccess) -> CrateResult<Plan> {
     let config = |message: String| ExperimentError::Config {
         file: path.to_path_buf(),
         message,
     };
+    access.check(path).map_err(|e| config(e.to_string()))?;
     let text = std::fs::read_to_string(path).map_err(|e| config(format!("cannot open: {e}")))?;
     let desc: ConfigDesc = toml::from_str(&text).map_err(|e| {
         let at = e
@@ -414,10 +421,10 @@ pub fn load(path: &Path) -> CrateResult<Plan> {
             message: message.join("; "),
         }
     })?;
-    build(desc, path).map_err(config)
+    build(desc, path, access).map_err(config)
 }
 
-fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
+fn build(desc: ConfigDesc, path: &Path, access: &rt_scene::FileAccess) -> Result<Plan> {
     let base = path.parent().unwrap_or(Path::new(""));
     let name = match desc.name {
         Some(n) => n,
@@ -474,7 +481,8 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
             (None, None) => ImageSize::Native,
         };
         size.validate(&here).map_err(|e| e.to_string())?;
-        let loaded = rt_scene::load_any(&scene_path).map_err(|e| format!("{here}: {e}"))?;
+        let loaded =
+            rt_scene::load_any_with(&scene_path, access).map_err(|e| format!("{here}: {e}"))?;
         let camera = size.apply(
             pick_camera(&loaded.scene, &scene_path, s.camera.as_deref())
                 .map_err(|e| format!("{here}: {e}"))?,
@@ -489,6 +497,9 @@ fn build(desc: ConfigDesc, path: &Path) -> Result<Plan> {
             ),
             Some(ReferenceDesc::File(f)) => {
                 let file = base.join(&f);
+                access
+                    .check(&file)
+                    .map_err(|e| format!("{here}: reference: {e}"))?;
                 let image = read_rgb(&file).map_err(|e| format!("{here}: reference: {e}"))?;
                 let (w, h) = (image.width(), image.height());
                 if (w, h) != (camera.width as usize, camera.height as usize) {
