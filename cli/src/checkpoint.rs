@@ -117,10 +117,11 @@ impl Checkpointer<'_> {
         }
     }
 
-    fn write(&self, film: &Film, samples: u32) -> Result<()> {
+    fn write(&self, film: &Film, samples: u32, seconds: f64) -> Result<()> {
         let path = self.args.checkpoint.as_ref().expect("checkpointing");
-        self.part(film, samples)
-            .write(path)
+        let mut part = self.part(film, samples);
+        part.header.seconds = seconds;
+        part.write(path)
             .map_err(|e| anyhow::anyhow!("--checkpoint {}: {e}", path.display()))
     }
 
@@ -135,6 +136,12 @@ impl Checkpointer<'_> {
         progress: &(dyn Fn(u32) + Sync),
     ) -> Result<(RenderStats, Option<Interrupted>)> {
         let signals = watch_signals()?;
+        // Render time of the samples a resumed render started from.
+        let before = self
+            .job
+            .resume
+            .as_ref()
+            .map_or(0.0, |(_, p)| p.header.seconds);
         let every = Duration::from_secs_f64(self.args.checkpoint_every);
         let mut last = Instant::now();
         let mut stats = RenderStats::default();
@@ -149,7 +156,7 @@ impl Checkpointer<'_> {
             progress(i + 1);
             let sig = signals.load(Ordering::Relaxed);
             if sig != 0 {
-                self.write(film, i + 1)?;
+                self.write(film, i + 1, before + stats.elapsed.as_secs_f64())?;
                 let signal = signal_name(sig);
                 return Ok((
                     stats,
@@ -160,7 +167,7 @@ impl Checkpointer<'_> {
                 ));
             }
             if i + 1 < range.end && last.elapsed() >= every {
-                self.write(film, i + 1)?;
+                self.write(film, i + 1, before + stats.elapsed.as_secs_f64())?;
                 last = Instant::now();
             }
         }
