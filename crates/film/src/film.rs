@@ -779,10 +779,17 @@ impl Film {
             return None;
         }
         Some(
-            (0..self.counts.len())
-                .map(|i| {
-                    let h = self.stats_at(i).halves().copied().unwrap_or_default();
-                    h.mean(half) + self.splats.half_mean(i, half)
+            self.even
+                .iter()
+                .zip(self.sums.iter().zip(&self.counts))
+                .enumerate()
+                .map(|(i, (e, (sum, &n)))| {
+                    let camera = if half == 0 {
+                        e.sum.mean(e.n.into())
+                    } else {
+                        sum.minus(&e.sum).mean((n - e.n).into())
+                    };
+                    camera + self.splats.half_mean(i, half)
                 })
                 .collect(),
         )
