@@ -96,6 +96,29 @@ fn interrupted_and_killed_renders_resume_to_the_same_bytes() {
         std::fs::remove_file(dir.join("int.exr")).unwrap();
     }
 
+    // A second signal ends the process at once (status 130), in the middle of writing the
+    // image and the checkpoint at the latest: both signals are sent microseconds apart, while
+    // those writes take milliseconds. What is on disk is still whole.
+    let child = start(dir, "twice.exr");
+    wait_for_checkpoint(dir);
+    let pid = child.id();
+    let both = Command::new("sh")
+        .args(["-c", &format!("kill -INT {pid}; kill -TERM {pid}")])
+        .status()
+        .unwrap();
+    assert!(both.success());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(130),
+        "a second signal ends the render at once: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    if dir.join("twice.exr").exists() {
+        assert!(rt_film::read_exr(&dir.join("twice.exr")).is_ok());
+    }
+    resume_and_compare(dir, "twice.exr");
+
     // SIGKILL: no image, but the last checkpoint is whole (written atomically).
     let mut child = start(dir, "killed.exr");
     wait_for_checkpoint(dir);
