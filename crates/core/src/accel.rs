@@ -114,6 +114,31 @@ pub trait Accel: Send + Sync {
         false
     }
 
+    /// Closest hits of a stream of rays, uncounted: `hits[i]` is what
+    /// [`Accel::intersect`]`(&rays[i], t_max[i])` returns, whatever order or grouping the
+    /// structure traces them in. Wavefront integrators hand over a whole stage's rays at once,
+    /// so a structure may trace coherent ones as packets (as Embree's `rtcIntersect4/8/16` and
+    /// ray streams do); the default traces them one by one.
+    fn intersect_stream(&self, rays: &[Ray], t_max: &[f32], hits: &mut [Option<Hit>]) {
+        for ((ray, &t), hit) in rays.iter().zip(t_max).zip(hits.iter_mut()) {
+            *hit = self.intersect(ray, t);
+        }
+    }
+
+    /// Occlusion of a stream of shadow rays, uncounted: `occluded[i]` is what
+    /// [`Accel::occluded_toward`]`(&rays[i], t_max[i], target)` returns, with `target` the
+    /// light-side endpoint `toward[i]` when it is finite, else [`Accel::occluded`]. The default
+    /// traces them one by one.
+    fn occluded_stream(&self, rays: &[Ray], t_max: &[f32], toward: &[Vec3], occluded: &mut [bool]) {
+        for (((ray, &t), &p), o) in rays.iter().zip(t_max).zip(toward).zip(occluded.iter_mut()) {
+            *o = if p.is_finite() {
+                self.occluded_toward(ray, t, p)
+            } else {
+                self.occluded(ray, t)
+            };
+        }
+    }
+
     /// Closest hit with `t ∈ (0, t_max]`, uncounted.
     fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
         self.closest_hit(ray, t_max, None)
