@@ -55,7 +55,7 @@ pub use content_hash::ContentHash;
 pub use image::{Image, PixelCountError, RgbImage};
 pub use material::{Layer, Material};
 pub use ray::Ray;
-pub use sampler::{SampleStream, Sampler};
+pub use sampler::{SampleKey, SampleStream, Sampler};
 pub use scene::Scene;
 
 /// Re-export so downstream crates use the same glam version as the core.

@@ -93,28 +93,66 @@ impl Sampler {
     /// The next 1D value in [0, 1).
     #[inline]
     pub fn next_1d(&mut self) -> f32 {
-        let h = self.dim_hash();
-        let i = laine_karras_permutation(self.index_reversed, h).reverse_bits();
-        // nested_uniform_scramble(sobol_dim0(i)) with the two bit reversals that cancel removed.
-        to_unit_float(laine_karras_permutation(i, hash_u32(h ^ 0x68bc_21eb)).reverse_bits())
+        let v = draw_1d(self.key(), self.dim);
+        self.dim = self.dim.wrapping_add(1);
+        v
     }
 
     /// The next 2D value in [0, 1)².
     #[inline]
     pub fn next_2d(&mut self) -> Vec2 {
-        let h = self.dim_hash();
-        let i = laine_karras_permutation(self.index_reversed, h).reverse_bits();
-        let x = laine_karras_permutation(i, hash_u32(h ^ 0x68bc_21eb)).reverse_bits();
-        let y = nested_uniform_scramble(sobol_dim1(i), hash_u32(h ^ 0x02e5_be93));
-        Vec2::new(to_unit_float(x), to_unit_float(y))
+        let v = draw_2d(self.key(), self.dim);
+        self.dim = self.dim.wrapping_add(1);
+        v
     }
 
+    /// What every draw of the current sample depends on besides its dimension.
     #[inline]
-    fn dim_hash(&mut self) -> u32 {
-        let h = hash2(self.pixel_hash, self.dim);
-        self.dim = self.dim.wrapping_add(1);
-        h
+    pub fn key(&self) -> SampleKey {
+        SampleKey {
+            pixel_hash: self.pixel_hash,
+            index_reversed: self.index_reversed,
+        }
     }
+
+    /// The dimension the next draw takes. A wavefront integrator draws a whole bounce's numbers
+    /// for many samples at once with [`draw_1d`] and [`draw_2d`] from [`Sampler::key`] and
+    /// this, instead of keeping one sampler per sample in flight.
+    #[inline]
+    pub fn dimension(&self) -> u32 {
+        self.dim
+    }
+}
+
+/// The part of a sample's stream that does not change from draw to draw: the hash of
+/// `(seed, pixel)` and the bit-reversed sample index. With a dimension it fixes a draw.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SampleKey {
+    /// Hash of the pixel and the seed.
+    pub pixel_hash: u32,
+    /// The sample index, bits reversed.
+    pub index_reversed: u32,
+}
+
+/// The 1D value of dimension `dim` of the sample `key`: what [`Sampler::next_1d`] returns when
+/// its next dimension is `dim`. Pure integer arithmetic, so a loop over many keys vectorises
+/// and gives the same bits.
+#[inline(always)]
+pub fn draw_1d(key: SampleKey, dim: u32) -> f32 {
+    let h = hash2(key.pixel_hash, dim);
+    let i = laine_karras_permutation(key.index_reversed, h).reverse_bits();
+    // nested_uniform_scramble(sobol_dim0(i)) with the two bit reversals that cancel removed.
+    to_unit_float(laine_karras_permutation(i, hash_u32(h ^ 0x68bc_21eb)).reverse_bits())
+}
+
+/// The 2D value of dimension `dim` of the sample `key` ([`Sampler::next_2d`]).
+#[inline(always)]
+pub fn draw_2d(key: SampleKey, dim: u32) -> Vec2 {
+    let h = hash2(key.pixel_hash, dim);
+    let i = laine_karras_permutation(key.index_reversed, h).reverse_bits();
+    let x = laine_karras_permutation(i, hash_u32(h ^ 0x68bc_21eb)).reverse_bits();
+    let y = nested_uniform_scramble(sobol_dim1(i), hash_u32(h ^ 0x02e5_be93));
+    Vec2::new(to_unit_float(x), to_unit_float(y))
 }
 
 /// 32-bit integer hash with good avalanche (Chris Wellons' "lowbias32").

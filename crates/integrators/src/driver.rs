@@ -198,7 +198,7 @@ pub fn render_samples(
 
 /// How camera samples are taken: the film position, then the lens only for a thin lens, then
 /// the shutter time only when something moves while the shutter is open (see the module doc).
-struct CameraSampling<'a> {
+pub(crate) struct CameraSampling<'a> {
     camera: &'a rt_core::Camera,
     thin_lens: bool,
     blurred: bool,
@@ -209,7 +209,7 @@ struct CameraSampling<'a> {
 }
 
 impl<'a> CameraSampling<'a> {
-    fn new(ctx: &Ctx<'a>) -> Self {
+    pub(crate) fn new(ctx: &Ctx<'a>) -> Self {
         let camera = ctx.camera;
         Self {
             camera,
@@ -222,7 +222,7 @@ impl<'a> CameraSampling<'a> {
         }
     }
 
-    fn centre_first(mut self, on: bool) -> Self {
+    pub(crate) fn centre_first(mut self, on: bool) -> Self {
         self.centre_first = on;
         self
     }
@@ -234,10 +234,18 @@ impl<'a> CameraSampling<'a> {
         ctx: &Ctx<'_>,
         integrator: &dyn Integrator,
         sampler: &mut Sampler,
-        (x, y, i): (u32, u32, u32),
+        xyi: (u32, u32, u32),
         aux: &mut SampleAux,
         counters: &mut RayCounters,
     ) -> rt_core::Rgb {
+        let ray = self.ray(sampler, xyi);
+        integrator.li(ctx, ray, sampler, aux, counters)
+    }
+
+    /// The camera ray of sample `i` of pixel `(x, y)`, leaving `sampler` at the integrator's
+    /// first dimension.
+    #[inline]
+    pub(crate) fn ray(&self, sampler: &mut Sampler, (x, y, i): (u32, u32, u32)) -> rt_core::Ray {
         sampler.start(x, y, i);
         let jitter = sampler.next_2d();
         let jitter = if self.centre_first && i == 0 {
@@ -252,7 +260,7 @@ impl<'a> CameraSampling<'a> {
             Vec2::ZERO
         };
         let camera = self.camera;
-        let ray = if self.blurred {
+        if self.blurred {
             let time = sampler.next_1d();
             match self.camera_motion {
                 Some(m) => {
@@ -263,8 +271,7 @@ impl<'a> CameraSampling<'a> {
             }
         } else {
             camera.generate_ray(film_pos, lens)
-        };
-        integrator.li(ctx, ray, sampler, aux, counters)
+        }
     }
 }
 

@@ -17,7 +17,8 @@
 //! `render --integrator`.
 //!
 //! Depends on `rt-core` and `rt-film`.
-#![forbid(unsafe_code)]
+// Unsafe code only where a module allows it: the SIMD kernels of `wavefront`.
+#![deny(unsafe_code)]
 
 mod ao;
 mod bdpt;
@@ -30,6 +31,7 @@ pub mod radiance_cache;
 pub mod spec;
 pub mod technique;
 mod transport;
+mod wavefront;
 mod work;
 
 pub use ao::{AoIntegrator, CachedAo};
@@ -44,6 +46,7 @@ pub use spec::{
     IntegratorKind, IntegratorSpec, IntegratorSpecError, Target, DEFAULT_MAX_DEPTH, MAX_DEPTH,
 };
 pub use technique::{CameraRays, Technique, TechniqueStage};
+pub use wavefront::{Wavefront, DEFAULT_LANES};
 
 use rt_core::{Accel, Camera, Rgb, Sampler, Scene};
 use rt_film::{FirstHit, LightSplit};

@@ -10,7 +10,7 @@
 //!
 //! | option | kinds | meaning |
 //! |---|---|---|
-//! | `max-depth=N` | path, path-bsdf, light, bdpt, partitioned |
+//! | `max-depth=N` | path, wavefront, path-bsdf, light, bdpt, partitioned |
 //! | `vpls=N`, `photons=N`, `clamp=F`, `cull=off\|unbiased\|biased`, `maps=on\|off`, `indirect-caustics=N` | partitioned | VPL paths and caustic photons per pass (16, 100000), G-clamp distance as a fraction of the scene diagonal (0.001), VPL culling (unbiased), projection maps (on), caustic photons also from the VPLs of the first N diffuse bounces (0): [`PartitionOptions`] | bounce limit (default [`DEFAULT_MAX_DEPTH`], at most [`MAX_DEPTH`]) |
 //! | `distance=F` | ao | occluder distance (default unlimited) |
 
@@ -34,6 +34,9 @@ pub const MAX_DEPTH: u32 = 10_000;
 pub enum IntegratorKind {
     /// Path tracing with next-event estimation and MIS ([`PathIntegrator::new`]).
     Path,
+    /// The same estimator advanced in batches, stage by stage ([`crate::Wavefront`]): the
+    /// same image as `path`, bit for bit.
+    Wavefront,
     /// Path tracing with BSDF sampling only ([`PathIntegrator::bsdf_only`]).
     PathBsdf,
     /// Direct lighting: one bounce, NEE + MIS ([`PathIntegrator::direct`]).
@@ -52,8 +55,9 @@ pub enum IntegratorKind {
 
 impl IntegratorKind {
     /// Every kind, in the order help texts list them.
-    pub const ALL: [IntegratorKind; 7] = [
+    pub const ALL: [IntegratorKind; 8] = [
         IntegratorKind::Path,
+        IntegratorKind::Wavefront,
         IntegratorKind::PathBsdf,
         IntegratorKind::Direct,
         IntegratorKind::Ao,
@@ -66,6 +70,7 @@ impl IntegratorKind {
     pub fn name(self) -> &'static str {
         match self {
             IntegratorKind::Path => "path",
+            IntegratorKind::Wavefront => "wavefront",
             IntegratorKind::PathBsdf => "path-bsdf",
             IntegratorKind::Direct => "direct",
             IntegratorKind::Ao => "ao",
@@ -80,6 +85,7 @@ impl IntegratorKind {
         matches!(
             self,
             IntegratorKind::Path
+                | IntegratorKind::Wavefront
                 | IntegratorKind::PathBsdf
                 | IntegratorKind::Light
                 | IntegratorKind::Bdpt
@@ -165,7 +171,7 @@ pub enum IntegratorSpecError {
     #[error("\"{0}\" is not one of {names}", names = IntegratorKind::names())]
     UnknownKind(String),
     /// An option this crate does not know, or one that does not apply to the kind.
-    #[error("option `{option}` does not apply to `{kind}` (options: max-depth=N for path, path-bsdf, light, bdpt and partitioned, distance=F for ao, vpls=N, photons=N, clamp=F, cull=off|unbiased|biased, maps=on|off and indirect-caustics=N for partitioned)")]
+    #[error("option `{option}` does not apply to `{kind}` (options: max-depth=N for path, wavefront, path-bsdf, light, bdpt and partitioned, distance=F for ao, vpls=N, photons=N, clamp=F, cull=off|unbiased|biased, maps=on|off and indirect-caustics=N for partitioned)")]
     UnknownOption {
         /// The integrator.
         kind: IntegratorKind,
@@ -238,6 +244,10 @@ impl IntegratorSpec {
             |i: Box<dyn crate::Integrator>| -> Box<dyn Technique> { Box::new(CameraRays(i)) };
         match self.kind {
             IntegratorKind::Path => camera(Box::new(PathIntegrator::new(self.depth()))),
+            IntegratorKind::Wavefront => Box::new(crate::Wavefront::new(
+                PathIntegrator::new(self.depth()),
+                crate::DEFAULT_LANES,
+            )),
             IntegratorKind::PathBsdf => camera(Box::new(PathIntegrator::bsdf_only(self.depth()))),
             IntegratorKind::Direct => camera(Box::new(PathIntegrator::direct())),
             IntegratorKind::Ao => camera(Box::new(AoIntegrator {
@@ -258,7 +268,8 @@ impl IntegratorSpec {
         cache: std::sync::Arc<dyn crate::RadianceCache>,
     ) -> Option<Box<dyn Technique>> {
         let integrator: Box<dyn crate::Integrator> = match self.kind {
-            IntegratorKind::Path => {
+            // A cached render runs on the scalar tracer (the wavefront one leaves caches to it).
+            IntegratorKind::Path | IntegratorKind::Wavefront => {
                 Box::new(PathIntegrator::new(self.depth()).with_cache(cache.clone()))
             }
             IntegratorKind::PathBsdf => {
@@ -284,6 +295,7 @@ impl IntegratorSpec {
             // Light tracing misses paths ending in a delta bounce and the environment seen
             // directly; where a scene has neither, it converges to the path tracer's image.
             IntegratorKind::Path
+            | IntegratorKind::Wavefront
             | IntegratorKind::PathBsdf
             | IntegratorKind::Light
             | IntegratorKind::Bdpt

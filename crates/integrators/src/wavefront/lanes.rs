@@ -1,0 +1,200 @@
+//! The path state of one batch, the per-bounce random numbers of all its lanes, and the kernel
+//! that draws them eight lanes at a time.
+//!
+//! The draws are the scalar sampler's ([`rt_core::sampler::draw_1d`], [`draw_2d`]): integer
+//! hashing only, so the AVX2 build of the same loop gives the same bits as the portable one,
+//! and a wavefront sample sees exactly the numbers the scalar path tracer's sample sees.
+#![allow(unsafe_code)] // the AVX2 entry point of the draw kernel, behind runtime detection
+
+use rt_core::glam::{Vec2, Vec3};
+use rt_core::sampler::{draw_1d, draw_2d};
+use rt_core::{Hit, Ray, Rgb, SampleKey};
+use rt_film::FirstHit;
+
+/// Random numbers one path vertex draws, in the scalar path tracer's order: light choice,
+/// light point, layer choice, BSDF direction, roulette (five dimensions).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct VertexDraws {
+    pub light_sel: f32,
+    pub light: Vec2,
+    pub layer: f32,
+    pub bsdf: Vec2,
+    pub rr: f32,
+}
+
+/// Dimensions a vertex consumes.
+pub(crate) const DIMS_PER_VERTEX: u32 = 5;
+
+/// One path in flight.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PathState {
+    /// Pixel and sample index.
+    pub x: u32,
+    pub y: u32,
+    pub index: u32,
+    /// The sample's stream and the first dimension after the camera's draws.
+    pub key: SampleKey,
+    pub dim0: u32,
+    pub ray: Ray,
+    pub beta: Rgb,
+    pub l: Rgb,
+    /// MIS state of the previous vertex (as in the scalar path tracer).
+    pub prev_delta: bool,
+    pub prev_pdf: f32,
+    pub prev_p: Vec3,
+    pub depth: u32,
+    pub lambda: Option<f32>,
+    pub first_hit: Option<FirstHit>,
+    /// The path ends once its pending shadow ray (if any) is resolved.
+    pub done: bool,
+}
+
+/// A shadow ray waiting for the stream: the lane it belongs to and the radiance it adds if
+/// unoccluded.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PendingShadow {
+    pub lane: u32,
+    pub contribution: Rgb,
+}
+
+/// Every buffer of one thread's batch, allocated once.
+pub(crate) struct Batch {
+    pub capacity: usize,
+    pub paths: Vec<PathState>,
+    pub rays: Vec<Ray>,
+    pub t_max: Vec<f32>,
+    pub hits: Vec<Option<Hit>>,
+    pub keys: Vec<SampleKey>,
+    pub dims: Vec<u32>,
+    pub draws: Vec<VertexDraws>,
+    pub shadow_rays: Vec<Ray>,
+    pub shadow_t_max: Vec<f32>,
+    pub shadow_toward: Vec<Vec3>,
+    pub shadow_occluded: Vec<bool>,
+    pub shadow: Vec<PendingShadow>,
+}
+
+impl Batch {
+    pub fn new(capacity: usize) -> Self {
+        Self {
+            capacity,
+            paths: Vec::with_capacity(capacity),
+            rays: Vec::with_capacity(capacity),
+            t_max: vec![f32::INFINITY; capacity],
+            hits: vec![None; capacity],
+            keys: Vec::with_capacity(capacity),
+            dims: Vec::with_capacity(capacity),
+            draws: vec![VertexDraws::default(); capacity],
+            shadow_rays: Vec::with_capacity(capacity),
+            shadow_t_max: Vec::with_capacity(capacity),
+            shadow_toward: Vec::with_capacity(capacity),
+            shadow_occluded: vec![false; capacity],
+            shadow: Vec::with_capacity(capacity),
+        }
+    }
+}
+
+/// Fills `out[k]` with the draws of the vertex whose first dimension is `dims[k]` in the
+/// stream `keys[k]`, for every `k`.
+pub(crate) fn draw_vertices(keys: &[SampleKey], dims: &[u32], out: &mut [VertexDraws]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU supports AVX2 (checked just above), the only requirement of
+            // `draw_vertices_avx2`.
+            unsafe { draw_vertices_avx2(keys, dims, out) };
+            return;
+        }
+    }
+    draw_vertices_portable(keys, dims, out);
+}
+
+/// The portable kernel compiled for AVX2: eight lanes per instruction for the hashes (the
+/// compiler vectorises the lane loop), the same integer results.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn draw_vertices_avx2(keys: &[SampleKey], dims: &[u32], out: &mut [VertexDraws]) {
+    draw_vertices_portable(keys, dims, out);
+}
+
+/// Lanes at a time: the loop body works on arrays of this many values, which is what lets
+/// the compiler turn each hash step into one vector instruction.
+const CHUNK: usize = 8;
+
+#[inline(always)]
+fn draw_vertices_portable(keys: &[SampleKey], dims: &[u32], out: &mut [VertexDraws]) {
+    let n = keys.len().min(dims.len()).min(out.len());
+    let mut k = 0;
+    while k + CHUNK <= n {
+        let key: [SampleKey; CHUNK] = std::array::from_fn(|j| keys[k + j]);
+        let dim: [u32; CHUNK] = std::array::from_fn(|j| dims[k + j]);
+        let light_sel: [f32; CHUNK] = std::array::from_fn(|j| draw_1d(key[j], dim[j]));
+        let light: [Vec2; CHUNK] = std::array::from_fn(|j| draw_2d(key[j], dim[j] + 1));
+        let layer: [f32; CHUNK] = std::array::from_fn(|j| draw_1d(key[j], dim[j] + 2));
+        let bsdf: [Vec2; CHUNK] = std::array::from_fn(|j| draw_2d(key[j], dim[j] + 3));
+        let rr: [f32; CHUNK] = std::array::from_fn(|j| draw_1d(key[j], dim[j] + 4));
+        for j in 0..CHUNK {
+            out[k + j] = VertexDraws {
+                light_sel: light_sel[j],
+                light: light[j],
+                layer: layer[j],
+                bsdf: bsdf[j],
+                rr: rr[j],
+            };
+        }
+        k += CHUNK;
+    }
+    for j in k..n {
+        out[j] = one_vertex(keys[j], dims[j]);
+    }
+}
+
+/// The draws of one vertex, one lane (the tail of a batch).
+#[inline]
+fn one_vertex(key: SampleKey, dim: u32) -> VertexDraws {
+    VertexDraws {
+        light_sel: draw_1d(key, dim),
+        light: draw_2d(key, dim + 1),
+        layer: draw_1d(key, dim + 2),
+        bsdf: draw_2d(key, dim + 3),
+        rr: draw_1d(key, dim + 4),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rt_core::Sampler;
+
+    #[test]
+    fn batched_draws_are_the_samplers_draws() {
+        let mut keys = Vec::new();
+        let mut dims = Vec::new();
+        let mut want = Vec::new();
+        for n in 0..37u32 {
+            let mut s = Sampler::new(11);
+            s.start(n * 7, n / 3, n * 13 + 1);
+            for _ in 0..(n % 4) {
+                s.next_2d();
+            }
+            keys.push(s.key());
+            dims.push(s.dimension());
+            want.push((
+                s.next_1d(),
+                s.next_2d(),
+                s.next_1d(),
+                s.next_2d(),
+                s.next_1d(),
+            ));
+        }
+        let mut out = vec![VertexDraws::default(); keys.len()];
+        draw_vertices(&keys, &dims, &mut out);
+        let mut portable = vec![VertexDraws::default(); keys.len()];
+        draw_vertices_portable(&keys, &dims, &mut portable);
+        for ((o, p), w) in out.iter().zip(&portable).zip(&want) {
+            let got = (o.light_sel, o.light, o.layer, o.bsdf, o.rr);
+            assert_eq!(got, *w);
+            assert_eq!((p.light_sel, p.light, p.layer, p.bsdf, p.rr), *w);
+        }
+    }
+}

@@ -1,0 +1,254 @@
+//! One pass of the wavefront tracer: bands of rows in parallel (as the scalar driver), each
+//! band's samples streamed through one thread's batch.
+//!
+//! A batch holds up to `capacity` paths. Each round: finished lanes are refilled with the
+//! band's next samples (camera rays), every lane's ray is traced in one stream, every lane's
+//! vertex draws are made in one vectorised kernel, every lane is shaded (emission, light
+//! sample, BSDF sample, roulette), the shadow rays are traced in one stream, and the paths
+//! that ended are added to the film and compacted away. A sample's value does not depend on
+//! its lane, its round or its neighbours, and the film's sums are exact integers, so the image
+//! is the same bits for any capacity, thread count or split into passes.
+
+use super::lanes::{draw_vertices, Batch, PathState, DIMS_PER_VERTEX};
+use super::profile::{Profile, Stage};
+use super::shade::Shader;
+use crate::driver::{CameraSampling, RenderStats, SamplePass};
+use crate::{Ctx, PathIntegrator, RayCounters};
+use rayon::prelude::*;
+use rt_core::{Rgb, Sampler};
+use rt_film::{Film, FilmStripe};
+use std::sync::Mutex;
+use std::time::Instant;
+
+/// Rows per parallel work item, as in the scalar driver.
+const BAND_ROWS: u32 = 2;
+
+/// Renders `pass` into `film` with the estimator `settings`; adds what the stages did to
+/// `profile`.
+pub(crate) fn render_pass(
+    ctx: &Ctx<'_>,
+    settings: &PathIntegrator,
+    capacity: usize,
+    film: &mut Film,
+    seed: u32,
+    pass: &SamplePass,
+    progress: &(dyn Fn(u32) + Sync),
+    profile: &Mutex<Profile>,
+) -> RenderStats {
+    let start = Instant::now();
+    let discarded_before = film.discarded();
+    let want_first_hit = film.aovs().any_first_hit();
+    let lights = if settings.next_event {
+        ctx.scene.lights()
+    } else {
+        &rt_core::lights::LightSampler::NONE
+    };
+    let shader = Shader {
+        ctx: *ctx,
+        settings,
+        lights,
+        use_nee: !lights.is_empty(),
+        want_first_hit,
+    };
+    let camera = CameraSampling::new(ctx).centre_first(pass.centre_first);
+    let totals = Mutex::new(RayCounters::default());
+    let rows_done = std::sync::atomic::AtomicU32::new(0);
+    film.stripes_mut(BAND_ROWS).into_par_iter().for_each_init(
+        || (Batch::new(capacity), Profile::default()),
+        |(batch, local), mut stripe| {
+            let mut counters = RayCounters::default();
+            let mut samples = StripeSamples::new(&stripe, pass);
+            render_stripe(
+                &shader,
+                &camera,
+                seed,
+                pass,
+                batch,
+                &mut samples,
+                &mut stripe,
+                &mut counters,
+                local,
+            );
+            let done = rows_done.fetch_add(stripe.rows(), std::sync::atomic::Ordering::Relaxed);
+            progress(done + stripe.rows());
+            *totals.lock().unwrap_or_else(|e| e.into_inner()) += counters;
+            profile
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .take(local);
+        },
+    );
+    let rays = totals.into_inner().unwrap_or_else(|e| e.into_inner());
+    let pixels = match &pass.pixels {
+        Some(mask) => mask.iter().filter(|&&m| m).count() as u64,
+        None => film.width() as u64 * film.height() as u64,
+    };
+    RenderStats {
+        elapsed: start.elapsed(),
+        samples: pixels * pass.indices.len() as u64,
+        rays,
+        discarded: film.discarded() - discarded_before,
+    }
+}
+
+/// The samples of one band in order: pixels row by row, each pixel's indices in order,
+/// skipping the pixels the pass leaves out.
+struct StripeSamples {
+    x: u32,
+    y: u32,
+    i: u32,
+    width: u32,
+    y_end: u32,
+}
+
+impl StripeSamples {
+    fn new(stripe: &FilmStripe<'_>, pass: &SamplePass) -> Self {
+        Self {
+            x: 0,
+            y: stripe.y0,
+            i: pass.indices.start,
+            width: stripe.width,
+            y_end: stripe.y0 + stripe.rows(),
+        }
+    }
+
+    #[inline]
+    fn next(&mut self, pass: &SamplePass) -> Option<(u32, u32, u32)> {
+        loop {
+            if self.y >= self.y_end || pass.indices.is_empty() {
+                return None;
+            }
+            let (x, y, i) = (self.x, self.y, self.i);
+            let taken = pass
+                .pixels
+                .as_ref()
+                .is_none_or(|m| m[(y * self.width + x) as usize]);
+            // Advance: next index, else next pixel.
+            if taken && self.i + 1 < pass.indices.end {
+                self.i += 1;
+            } else {
+                self.i = pass.indices.start;
+                self.x += 1;
+                if self.x == self.width {
+                    self.x = 0;
+                    self.y += 1;
+                }
+            }
+            if taken {
+                return Some((x, y, i));
+            }
+        }
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn render_stripe(
+    shader: &Shader<'_>,
+    camera: &CameraSampling<'_>,
+    seed: u32,
+    pass: &SamplePass,
+    batch: &mut Batch,
+    samples: &mut StripeSamples,
+    stripe: &mut FilmStripe<'_>,
+    counters: &mut RayCounters,
+    profile: &mut Profile,
+) {
+    let accel = shader.ctx.accel;
+    let mut sampler = Sampler::with_stream(seed, pass.stream);
+    let mut exhausted = false;
+    loop {
+        // Refill finished lanes with camera rays.
+        let mut clock = Instant::now();
+        while !exhausted && batch.paths.len() < batch.capacity {
+            let Some(xyi) = samples.next(pass) else {
+                exhausted = true;
+                break;
+            };
+            let ray = camera.ray(&mut sampler, xyi);
+            batch.paths.push(PathState {
+                x: xyi.0,
+                y: xyi.1,
+                index: xyi.2,
+                key: sampler.key(),
+                dim0: sampler.dimension(),
+                ray,
+                beta: Rgb::ONE,
+                l: Rgb::ZERO,
+                prev_delta: true,
+                prev_pdf: 0.0,
+                prev_p: ray.origin,
+                depth: 0,
+                lambda: None,
+                first_hit: None,
+                done: false,
+            });
+        }
+        let n = batch.paths.len();
+        if n == 0 {
+            break;
+        }
+        profile.lap(Stage::Generate, &mut clock);
+        profile.round(n, batch.capacity);
+
+        // Closest hits of every lane, one stream.
+        batch.rays.clear();
+        batch.rays.extend(batch.paths.iter().map(|p| p.ray));
+        accel.intersect_stream(&batch.rays, &batch.t_max[..n], &mut batch.hits[..n]);
+        counters.rays += n as u64;
+        profile.lap(Stage::Trace, &mut clock);
+
+        // Every lane's random numbers for this vertex.
+        batch.keys.clear();
+        batch.dims.clear();
+        for p in &batch.paths {
+            batch.keys.push(p.key);
+            batch.dims.push(p.dim0 + DIMS_PER_VERTEX * p.depth);
+        }
+        draw_vertices(&batch.keys, &batch.dims, &mut batch.draws[..n]);
+        profile.lap(Stage::Draw, &mut clock);
+
+        // Shade; collect the shadow rays.
+        batch.shadow.clear();
+        batch.shadow_rays.clear();
+        batch.shadow_t_max.clear();
+        batch.shadow_toward.clear();
+        for (k, path) in batch.paths.iter_mut().enumerate() {
+            if let Some((q, pending)) =
+                shader.vertex(path, batch.hits[k], &batch.draws[k], k as u32)
+            {
+                batch.shadow_rays.push(q.ray);
+                batch.shadow_t_max.push(q.t_max);
+                batch.shadow_toward.push(q.toward);
+                batch.shadow.push(pending);
+            }
+        }
+        profile.lap(Stage::Shade, &mut clock);
+
+        // Shadow rays, one stream.
+        let m = batch.shadow.len();
+        if m > 0 {
+            accel.occluded_stream(
+                &batch.shadow_rays,
+                &batch.shadow_t_max,
+                &batch.shadow_toward,
+                &mut batch.shadow_occluded[..m],
+            );
+            counters.shadow_rays += m as u64;
+            for (s, &occluded) in batch.shadow.iter().zip(&batch.shadow_occluded[..m]) {
+                if !occluded {
+                    batch.paths[s.lane as usize].l += s.contribution;
+                }
+            }
+        }
+        profile.lap(Stage::Shadow, &mut clock);
+
+        // Finished paths go to the film; the rest move up.
+        batch.paths.retain(|p| {
+            if p.done {
+                stripe.add_sample_split(p.x, p.y, p.index, p.l, p.first_hit.as_ref(), None);
+            }
+            !p.done
+        });
+        profile.lap(Stage::Accumulate, &mut clock);
+    }
+}
