@@ -96,16 +96,7 @@ impl Technique for Wavefront {
             }
             return render_samples(ctx, &self.settings, film, seed, pass, progress);
         }
-        pass::render_pass(
-            ctx,
-            &self.settings,
-            self.lanes,
-            film,
-            seed,
-            pass,
-            progress,
-            &self.profile,
-        )
+        pass::render_pass(self, ctx, film, seed, pass, progress)
     }
 
     fn camera_integrator(&self) -> Option<&dyn Integrator> {

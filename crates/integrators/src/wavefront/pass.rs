@@ -12,8 +12,9 @@
 use super::lanes::{draw_vertices, Batch, PathState, DIMS_PER_VERTEX};
 use super::profile::{Profile, Stage};
 use super::shade::Shader;
+use super::Wavefront;
 use crate::driver::{CameraSampling, RenderStats, SamplePass};
-use crate::{Ctx, PathIntegrator, RayCounters};
+use crate::{Ctx, RayCounters};
 use rayon::prelude::*;
 use rt_core::{Rgb, Sampler};
 use rt_film::{Film, FilmStripe};
@@ -23,18 +24,17 @@ use std::time::Instant;
 /// Rows per parallel work item, as in the scalar driver.
 const BAND_ROWS: u32 = 2;
 
-/// Renders `pass` into `film` with the estimator `settings`; adds what the stages did to
-/// `profile`.
-pub(crate) fn render_pass(
+/// Renders `pass` into `film` with `tracer`'s estimator and batch size; adds what the stages
+/// did to its profile.
+pub(super) fn render_pass(
+    tracer: &Wavefront,
     ctx: &Ctx<'_>,
-    settings: &PathIntegrator,
-    capacity: usize,
     film: &mut Film,
     seed: u32,
     pass: &SamplePass,
     progress: &(dyn Fn(u32) + Sync),
-    profile: &Mutex<Profile>,
 ) -> RenderStats {
+    let (settings, capacity, profile) = (&tracer.settings, tracer.lanes, &tracer.profile);
     let start = Instant::now();
     let discarded_before = film.discarded();
     let want_first_hit = film.aovs().any_first_hit();
