@@ -208,7 +208,8 @@ fn sobol_dim0(i: u32) -> u32 {
 
 /// Direction numbers of the second Sobol' dimension (primitive polynomial x + 1):
 /// `v[k] = v[k-1] ^ (v[k-1] >> 1)`, starting from the top bit.
-const SOBOL1_DIRECTIONS: [u32; 32] = {
+/// Public for vectorised copies of the draws, which the tests pin to [`draw_2d`].
+pub const SOBOL1_DIRECTIONS: [u32; 32] = {
     let mut v = [0u32; 32];
     v[0] = 1 << 31;
     let mut k = 1;

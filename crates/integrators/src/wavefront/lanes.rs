@@ -2,9 +2,9 @@
 //! that draws them eight lanes at a time.
 //!
 //! The draws are the scalar sampler's ([`rt_core::sampler::draw_1d`], [`draw_2d`]): integer
-//! hashing only, so the AVX2 build of the same loop gives the same bits as the portable one,
-//! and a wavefront sample sees exactly the numbers the scalar path tracer's sample sees.
-#![allow(unsafe_code)] // the AVX2 entry point of the draw kernel, behind runtime detection
+//! hashing only, so the AVX2 kernel gives the same bits as the scalar functions, and a
+//! wavefront sample sees exactly the numbers the scalar path tracer's sample sees.
+#![allow(unsafe_code)] // the call into the AVX2 kernel, behind runtime detection
 
 use rt_core::glam::{Vec2, Vec3};
 use rt_core::sampler::{draw_1d, draw_2d};
@@ -95,54 +95,22 @@ impl Batch {
 }
 
 /// Fills `out[k]` with the draws of the vertex whose first dimension is `dims[k]` in the
-/// stream `keys[k]`, for every `k`.
+/// stream `keys[k]`, for every `k`: eight lanes per step with AVX2 when the CPU has it
+/// ([`super::draws_avx2`]), else one by one; the same bits either way.
 pub(crate) fn draw_vertices(keys: &[SampleKey], dims: &[u32], out: &mut [VertexDraws]) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2 (checked just above), the only requirement of
-            // `draw_vertices_avx2`.
-            unsafe { draw_vertices_avx2(keys, dims, out) };
-            return;
-        }
-    }
-    draw_vertices_portable(keys, dims, out);
-}
-
-/// The portable kernel compiled for AVX2: eight lanes per instruction for the hashes (the
-/// compiler vectorises the lane loop), the same integer results.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn draw_vertices_avx2(keys: &[SampleKey], dims: &[u32], out: &mut [VertexDraws]) {
-    draw_vertices_portable(keys, dims, out);
-}
-
-/// Lanes at a time: the loop body works on arrays of this many values, which is what lets
-/// the compiler turn each hash step into one vector instruction.
-const CHUNK: usize = 8;
-
-#[inline(always)]
-fn draw_vertices_portable(keys: &[SampleKey], dims: &[u32], out: &mut [VertexDraws]) {
     let n = keys.len().min(dims.len()).min(out.len());
     let mut k = 0;
-    while k + CHUNK <= n {
-        let key: [SampleKey; CHUNK] = std::array::from_fn(|j| keys[k + j]);
-        let dim: [u32; CHUNK] = std::array::from_fn(|j| dims[k + j]);
-        let light_sel: [f32; CHUNK] = std::array::from_fn(|j| draw_1d(key[j], dim[j]));
-        let light: [Vec2; CHUNK] = std::array::from_fn(|j| draw_2d(key[j], dim[j] + 1));
-        let layer: [f32; CHUNK] = std::array::from_fn(|j| draw_1d(key[j], dim[j] + 2));
-        let bsdf: [Vec2; CHUNK] = std::array::from_fn(|j| draw_2d(key[j], dim[j] + 3));
-        let rr: [f32; CHUNK] = std::array::from_fn(|j| draw_1d(key[j], dim[j] + 4));
-        for j in 0..CHUNK {
-            out[k + j] = VertexDraws {
-                light_sel: light_sel[j],
-                light: light[j],
-                layer: layer[j],
-                bsdf: bsdf[j],
-                rr: rr[j],
-            };
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        while k + 8 <= n {
+            let key: &[SampleKey; 8] = keys[k..k + 8].try_into().expect("eight keys");
+            let dim: &[u32; 8] = dims[k..k + 8].try_into().expect("eight dimensions");
+            let o: &mut [VertexDraws; 8] = (&mut out[k..k + 8]).try_into().expect("eight slots");
+            // SAFETY: the CPU supports AVX2 (checked just above), the only requirement of
+            // `draw_vertices8`.
+            unsafe { super::draws_avx2::draw_vertices8(key, dim, o) };
+            k += 8;
         }
-        k += CHUNK;
     }
     for j in k..n {
         out[j] = one_vertex(keys[j], dims[j]);
@@ -189,11 +157,9 @@ mod tests {
         }
         let mut out = vec![VertexDraws::default(); keys.len()];
         draw_vertices(&keys, &dims, &mut out);
-        let mut portable = vec![VertexDraws::default(); keys.len()];
-        draw_vertices_portable(&keys, &dims, &mut portable);
+        let portable: Vec<_> = keys.iter().zip(&dims).map(|(&k, &d)| one_vertex(k, d)).collect();
         for ((o, p), w) in out.iter().zip(&portable).zip(&want) {
-            let got = (o.light_sel, o.light, o.layer, o.bsdf, o.rr);
-            assert_eq!(got, *w);
+            assert_eq!((o.light_sel, o.light, o.layer, o.bsdf, o.rr), *w);
             assert_eq!((p.light_sel, p.light, p.layer, p.bsdf, p.rr), *w);
         }
     }

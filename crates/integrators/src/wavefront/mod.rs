@@ -23,6 +23,8 @@
 //! the scalar path tracer (the same estimator, so the same image), and says so in
 //! [`Technique::stages`]. Shading is per lane; only the sample draws are SIMD so far.
 
+#[cfg(target_arch = "x86_64")]
+mod draws_avx2;
 mod lanes;
 mod pass;
 mod profile;
