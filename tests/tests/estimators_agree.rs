@@ -11,7 +11,7 @@
 //! so the test can see a bias of that size.
 
 use rt_film::{AovSet, Film, FilmBuffers};
-use rt_integrators::{Integrator, PathIntegrator};
+use rt_integrators::{Integrator, PathIntegrator, Technique, Wavefront, DEFAULT_LANES};
 use rt_testkit::mutants::DroppedShadowRays;
 use rt_testkit::stats::{compare, Comparison, ALPHA};
 use rt_testkit::{scene_from_toml, Renderer};
@@ -132,6 +132,22 @@ fn film(scene: &rt_core::Scene, (integrator, spp, seed): Render, dropped: f64) -
 
 type Render<'a> = (&'a dyn Integrator, u32, u32);
 
+/// [`film`] for any technique (the wavefront tracer).
+fn technique_film(
+    scene: &rt_core::Scene,
+    (technique, spp, seed): (&dyn Technique, u32, u32),
+    dropped: f64,
+) -> Film {
+    let renderer = Renderer::new(scene).threads(2);
+    let mutant = DroppedShadowRays {
+        inner: renderer.accel(),
+        fraction: dropped,
+    };
+    let renderer = Renderer::new(scene).with_accel(&mutant).threads(2);
+    let buffers = FilmBuffers::from(AovSet::default()).with_variance();
+    renderer.render_technique(technique, buffers, spp, seed).0
+}
+
 /// Renders `nee` (with next-event estimation) and `bsdf` (BSDF sampling only), each given with
 /// its samples per pixel and seed, and asserts that they agree within noise.
 fn agree(scene: &rt_core::Scene, nee: Render, bsdf: Render) {
@@ -183,6 +199,44 @@ fn nee_with_mis_and_bsdf_sampling_agree() {
         &scene,
         (&PathIntegrator::new(6), 1024, 11),
         (&PathIntegrator::bsdf_only(6), 8192, 12),
+    );
+}
+
+/// The wavefront tracer (NEE and MIS in batches) against scalar BSDF sampling, with the same
+/// control: its own shadow-ray stream 2 % weaker must disagree.
+#[test]
+fn wavefront_nee_with_mis_and_bsdf_sampling_agree() {
+    let scene = scene_from_toml(ROOM);
+    let wavefront = Wavefront::new(PathIntegrator::new(6), DEFAULT_LANES);
+    let reference = film(&scene, (&PathIntegrator::bsdf_only(6), 8192, 12), 0.0);
+    let honest = compare(
+        &technique_film(&scene, (&wavefront, 1024, 11), 0.0),
+        &reference,
+        BLOCK,
+        ALPHA,
+    );
+    let biased = compare(
+        &technique_film(&scene, (&wavefront, 1024, 11), DROPPED),
+        &reference,
+        BLOCK,
+        ALPHA,
+    );
+    eprintln!(
+        "wavefront: {}; NEE x{}: {}",
+        show(&honest),
+        1.0 - DROPPED,
+        show(&biased)
+    );
+    assert!(
+        honest.same_within_noise(),
+        "estimators disagree: {}",
+        show(&honest)
+    );
+    assert!(
+        !biased.same_within_noise(),
+        "control: NEE x{} passes the same test: {}",
+        1.0 - DROPPED,
+        show(&biased)
     );
 }
 

@@ -9,17 +9,32 @@
 use rt_core::glam::Vec3;
 use rt_core::material::Bsdf;
 use rt_core::Rgb;
-use rt_integrators::PathIntegrator;
+use rt_film::{AovSet, FilmBuffers};
+use rt_integrators::{PathIntegrator, Wavefront, DEFAULT_LANES};
 use rt_testkit::furnace::{one_bounce_plane_toml, scene_toml as furnace, L};
 use rt_testkit::stats::{image_mean, variance_of_mean};
-use rt_testkit::{render, scene_from_toml};
+use rt_testkit::{render, scene_from_toml, Renderer};
 
 /// Checks the image mean against L with a tolerance of 4 standard errors (estimated from the
 /// per-pixel variances), and every pixel against L with 6 of its own standard errors.
 fn check(material: &str, equal: bool, integrator: &PathIntegrator, spp: u32) {
     let scene = scene_from_toml(&furnace(material));
-    let film = render(&scene, integrator, spp, 1);
-    let (mean, se) = image_mean(&film);
+    check_film(material, equal, &render(&scene, integrator, spp, 1));
+}
+
+/// [`check`] for the wavefront tracer with `integrator`'s settings.
+fn check_wavefront(material: &str, equal: bool, integrator: &PathIntegrator, spp: u32) {
+    let scene = scene_from_toml(&furnace(material));
+    let wavefront = Wavefront::new(integrator.clone(), DEFAULT_LANES);
+    let buffers = FilmBuffers::for_outputs(AovSet::default()).with_variance();
+    let (film, _) = Renderer::new(&scene)
+        .threads(2)
+        .render_technique(&wavefront, buffers, spp, 1);
+    check_film(material, equal, &film);
+}
+
+fn check_film(material: &str, equal: bool, film: &rt_film::Film) {
+    let (mean, se) = image_mean(film);
     let tol = 4.0 * se + 1e-4;
     if equal {
         assert!(
@@ -86,6 +101,7 @@ fn energy_conserving_presets_render_as_the_environment() {
     for m in ENERGY_CONSERVING {
         check(m, true, &PathIntegrator::new(1000), 64);
         check(m, true, &PathIntegrator::bsdf_only(1000), 64);
+        check_wavefront(m, true, &PathIntegrator::new(1000), 64);
     }
 }
 
@@ -138,5 +154,6 @@ fn one_bounce_lossy_materials_reflect_their_directional_albedo() {
 fn no_material_is_brighter_than_the_environment() {
     for m in LOSSY {
         check(m, false, &PathIntegrator::new(1000), 32);
+        check_wavefront(m, false, &PathIntegrator::new(1000), 32);
     }
 }

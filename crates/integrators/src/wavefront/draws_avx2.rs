@@ -57,14 +57,14 @@ fn laine_karras(mut x: U32x8, seed: U32x8) -> U32x8 {
 #[inline]
 fn reverse_bits(x: U32x8) -> U32x8 {
     let bswap = _mm256_setr_epi8(
-        3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12, 3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9,
-        8, 15, 14, 13, 12,
+        3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12, 3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8,
+        15, 14, 13, 12,
     );
     let x = _mm256_shuffle_epi8(x, bswap);
     // Reversed nibble values 0..15.
     let rev = _mm256_setr_epi8(
-        0, 8, 4, 12, 2, 10, 6, 14, 1, 9, 5, 13, 3, 11, 7, 15, 0, 8, 4, 12, 2, 10, 6, 14, 1, 9,
-        5, 13, 3, 11, 7, 15,
+        0, 8, 4, 12, 2, 10, 6, 14, 1, 9, 5, 13, 3, 11, 7, 15, 0, 8, 4, 12, 2, 10, 6, 14, 1, 9, 5,
+        13, 3, 11, 7, 15,
     );
     let low = _mm256_set1_epi8(0x0f);
     let lo = _mm256_and_si256(x, low);
@@ -83,10 +83,7 @@ fn sobol_dim1(i: U32x8) -> U32x8 {
     let mut bits = i;
     for v in SOBOL1_DIRECTIONS {
         // All ones where the lowest remaining bit is set.
-        let set = _mm256_sub_epi32(
-            _mm256_setzero_si256(),
-            _mm256_and_si256(bits, splat(1)),
-        );
+        let set = _mm256_sub_epi32(_mm256_setzero_si256(), _mm256_and_si256(bits, splat(1)));
         acc = _mm256_xor_si256(acc, _mm256_and_si256(set, splat(v)));
         bits = _mm256_srli_epi32::<1>(bits);
     }
@@ -146,11 +143,7 @@ fn draw_2d(pixel: U32x8, index_reversed: U32x8, dim: U32x8) -> (__m256, __m256) 
 ///
 /// Only callable where AVX2 is known to be there (`lanes::draw_vertices` checks at run time).
 #[target_feature(enable = "avx2")]
-pub(super) fn draw_vertices8(
-    keys: &[SampleKey; 8],
-    dims: &[u32; 8],
-    out: &mut [VertexDraws; 8],
-) {
+pub(super) fn draw_vertices8(keys: &[SampleKey; 8], dims: &[u32; 8], out: &mut [VertexDraws; 8]) {
     let pixel = _mm256_setr_epi32(
         keys[0].pixel_hash as i32,
         keys[1].pixel_hash as i32,

@@ -157,7 +157,11 @@ mod tests {
         }
         let mut out = vec![VertexDraws::default(); keys.len()];
         draw_vertices(&keys, &dims, &mut out);
-        let portable: Vec<_> = keys.iter().zip(&dims).map(|(&k, &d)| one_vertex(k, d)).collect();
+        let portable: Vec<_> = keys
+            .iter()
+            .zip(&dims)
+            .map(|(&k, &d)| one_vertex(k, d))
+            .collect();
         for ((o, p), w) in out.iter().zip(&portable).zip(&want) {
             assert_eq!((o.light_sel, o.light, o.layer, o.bsdf, o.rr), *w);
             assert_eq!((p.light_sel, p.light, p.layer, p.bsdf, p.rr), *w);
