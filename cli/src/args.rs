@@ -139,7 +139,7 @@ pub struct Args {
     /// from the frame's time; every camera sample draws a time in it, its rays carry it, and
     /// moving instances and cameras are placed at it. Needs a structure that places instances
     /// per ray (two-level or clusters; clusters when --accel is not given) and a camera-ray
-    /// integrator (path, path-bsdf, direct, ao).
+    /// integrator (wavefront, path, path-bsdf, direct, ao).
     #[arg(long, value_name = "S", default_value_t = 0.0)]
     pub shutter: f64,
 

@@ -17,7 +17,7 @@ pub fn render(args: &Args, job: &Job, ctx: &Ctx<'_>, technique: &dyn Technique) 
     let scene_path = job.scene_path.display();
     let Some(integrator) = technique.camera_integrator() else {
         bail!(
-            "{scene_path}: --gree renders filter caches pixel by pixel, which the {} technique cannot (use path, path-bsdf, direct or ao)",
+            "{scene_path}: --gree renders filter caches pixel by pixel, which the {} technique cannot (use wavefront, path, path-bsdf, direct or ao)",
             technique.name()
         );
     };

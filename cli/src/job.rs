@@ -335,7 +335,7 @@ fn set_shutter(args: &Args, job: &Job, scene: &mut Scene) -> Result<()> {
     }
     if !job.settings.integrator.build().motion_blur() {
         bail!(
-            "{path}: --shutter: the {} integrator cannot motion blur (path, path-bsdf, direct and ao can)",
+            "{path}: --shutter: the {} integrator cannot motion blur (wavefront, path, path-bsdf, direct and ao can)",
             job.settings.integrator
         );
     }

@@ -144,7 +144,7 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     let estimator = overrides.integrator_spec(&loaded.render, &args.scene)?;
     if estimator.kind.splats() {
         anyhow::bail!(
-            "{}: integrator `{}` splats light paths and keeps no per-pixel variance; render references with a camera-ray integrator (path, path-bsdf, direct, ao)",
+            "{}: integrator `{}` splats light paths and keeps no per-pixel variance; render references with a camera-ray integrator (wavefront, path, path-bsdf, direct, ao)",
             args.scene.display(),
             estimator.kind
         );

@@ -311,9 +311,9 @@ impl IntegratorSpec {
 }
 
 impl Default for IntegratorSpec {
-    /// `path` with the default bounce limit.
+    /// `wavefront` (the path tracer's estimator, in batches) with the default bounce limit.
     fn default() -> Self {
-        Self::new(IntegratorKind::Path)
+        Self::new(IntegratorKind::Wavefront)
     }
 }
 
@@ -476,7 +476,7 @@ mod tests {
         let e = "vcm".parse::<IntegratorSpec>().unwrap_err();
         assert_eq!(
             e.to_string(),
-            "\"vcm\" is not one of path, path-bsdf, direct, ao, light, bdpt, partitioned"
+            "\"vcm\" is not one of path, wavefront, path-bsdf, direct, ao, light, bdpt, partitioned"
         );
     }
 
