@@ -25,6 +25,7 @@
 #   CACHE        reference cache  [${XDG_CACHE_HOME:-~/.cache}/rt-time-to-error]
 #   DRAGON       the dragon OBJ                        [../shared/data/models/stanford-dragon.obj]
 #   MI_SEED, REF_SEED, VARIANT                         [1, 7, llvm_ad_rgb]
+#   INTEGRATOR   our integrator                        [wavefront]
 #   COMMIT       commit RENDER was built from          [git rev-parse --short HEAD]
 #
 # A cold reference takes long (16384 spp at 256x256: about 10 min for the box, more for the

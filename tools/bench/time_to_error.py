@@ -19,8 +19,9 @@ For each scene:
     * warm: the scene is loaded, a 4-spp warm-up render compiles the kernels, then the timed
       1024-spp render of the same scene (the kernels are size-independent: passes of other
       sizes reuse them). The warm time is the one the ratios use.
- 3. Ours (`render SCENE.toml --spp N --threads THREADS --max-depth 10000 -o out.exr`) at each
-    spp of the ladder SPP.
+ 3. Ours (`render SCENE.toml --spp N --threads THREADS --max-depth 10000 --integrator
+    INTEGRATOR -o out.exr`) at each spp of the ladder SPP; INTEGRATOR is `wavefront` (the
+    default) unless set (`path`: the scalar reference, the same image).
 
 Timing, the same "honest" definition for both renderers, from scene description to image file:
   ours     wall time of the whole `render` command: process start, scene load (OBJ parse),
@@ -202,7 +203,8 @@ def run_ours(render: str, toml: str, spp: int, threads: int, out: str) -> dict:
     la = loadavg()
     c0, t0 = cpu_children(), time.perf_counter()
     p = subprocess.run([render, toml, "--spp", str(spp), "--threads", str(threads),
-                        "--max-depth", "10000", "-o", out], stdout=subprocess.PIPE,
+                        "--max-depth", "10000", "--integrator", env("INTEGRATOR", "wavefront"),
+                        "-o", out], stdout=subprocess.PIPE,
                        stderr=subprocess.PIPE, text=True)
     wall = time.perf_counter() - t0
     cpu = cpu_children() - c0
