@@ -21,8 +21,18 @@ use rt_film::{Film, FilmStripe};
 use std::sync::Mutex;
 use std::time::Instant;
 
-/// Rows per parallel work item, as in the scalar driver.
+/// Fewest rows per parallel work item, as in the scalar driver.
 const BAND_ROWS: u32 = 2;
+
+/// Rows per work item: enough samples to fill the batch several times over (a batch drains
+/// at the end of its band, through the long tail of deep paths), but at least four items per
+/// thread so the threads finish together.
+fn band_rows(film: &Film, pass: &SamplePass, capacity: usize) -> u32 {
+    let per_row = (u64::from(film.width()) * pass.indices.len() as u64).max(1);
+    let wanted = (8 * capacity as u64).div_ceil(per_row);
+    let most = film.height() / (4 * rayon::current_num_threads() as u32).max(1);
+    (wanted.min(u64::from(u32::MAX)) as u32).min(most).max(BAND_ROWS)
+}
 
 /// Renders `pass` into `film` with `tracer`'s estimator and batch size; adds what the stages
 /// did to its profile.
@@ -53,7 +63,8 @@ pub(super) fn render_pass(
     let camera = CameraSampling::new(ctx).centre_first(pass.centre_first);
     let totals = Mutex::new(RayCounters::default());
     let rows_done = std::sync::atomic::AtomicU32::new(0);
-    film.stripes_mut(BAND_ROWS).into_par_iter().for_each_init(
+    let rows = band_rows(film, pass, capacity);
+    film.stripes_mut(rows).into_par_iter().for_each_init(
         || (Batch::new(capacity), Profile::default()),
         |(batch, local), mut stripe| {
             let mut counters = RayCounters::default();
