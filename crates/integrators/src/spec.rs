@@ -13,6 +13,7 @@
 //! | `max-depth=N` | path, wavefront, path-bsdf, light, bdpt, partitioned |
 //! | `vpls=N`, `photons=N`, `clamp=F`, `cull=off\|unbiased\|biased`, `maps=on\|off`, `indirect-caustics=N` | partitioned | VPL paths and caustic photons per pass (16, 100000), G-clamp distance as a fraction of the scene diagonal (0.001), VPL culling (unbiased), projection maps (on), caustic photons also from the VPLs of the first N diffuse bounces (0): [`PartitionOptions`] | bounce limit (default [`DEFAULT_MAX_DEPTH`], at most [`MAX_DEPTH`]) |
 //! | `distance=F` | ao | occluder distance (default unlimited) |
+//! | `lanes=N` | wavefront | paths per thread's batch (default [`crate::DEFAULT_LANES`], 1 to [`MAX_LANES`]); speed only, the image is the same |
 
 use crate::{
     AoIntegrator, Bdpt, CameraRays, Culling, LightTracer, PartitionOptions, Partitioned,
@@ -134,6 +135,9 @@ pub struct IntegratorSpec {
     pub ao_distance: f32,
     /// Parameters of `partitioned`.
     pub partition: PartitionOptions,
+    /// Paths per thread's batch of `wavefront` ([`crate::DEFAULT_LANES`] unless set). Changes
+    /// the speed, never the image.
+    pub lanes: u32,
 }
 
 /// What an estimator converges to. Two estimators with the same target can be measured against
@@ -171,7 +175,7 @@ pub enum IntegratorSpecError {
     #[error("\"{0}\" is not one of {names}", names = IntegratorKind::names())]
     UnknownKind(String),
     /// An option this crate does not know, or one that does not apply to the kind.
-    #[error("option `{option}` does not apply to `{kind}` (options: max-depth=N for path, wavefront, path-bsdf, light, bdpt and partitioned, distance=F for ao, vpls=N, photons=N, clamp=F, cull=off|unbiased|biased, maps=on|off and indirect-caustics=N for partitioned)")]
+    #[error("option `{option}` does not apply to `{kind}` (options: max-depth=N for path, wavefront, path-bsdf, light, bdpt and partitioned, lanes=N for wavefront, distance=F for ao, vpls=N, photons=N, clamp=F, cull=off|unbiased|biased, maps=on|off and indirect-caustics=N for partitioned)")]
     UnknownOption {
         /// The integrator.
         kind: IntegratorKind,
@@ -181,6 +185,9 @@ pub enum IntegratorSpecError {
     /// A bounce limit above [`MAX_DEPTH`] or one that does not parse.
     #[error("max depth must be an integer between 0 and {MAX_DEPTH}, got {0}")]
     BadDepth(String),
+    /// A `wavefront` batch size out of range or not parsing.
+    #[error("wavefront lanes must be an integer from 1 to {MAX_LANES}, got {0}")]
+    BadLanes(String),
     /// An occluder distance that is not positive or does not parse.
     #[error("ao distance must be positive, got {0}")]
     BadDistance(String),
@@ -218,6 +225,7 @@ impl IntegratorSpec {
             max_depth: None,
             ao_distance: f32::INFINITY,
             partition: PartitionOptions::default(),
+            lanes: crate::DEFAULT_LANES,
         }
     }
 
@@ -246,7 +254,7 @@ impl IntegratorSpec {
             IntegratorKind::Path => camera(Box::new(PathIntegrator::new(self.depth()))),
             IntegratorKind::Wavefront => Box::new(crate::Wavefront::new(
                 PathIntegrator::new(self.depth()),
-                crate::DEFAULT_LANES,
+                self.lanes,
             )),
             IntegratorKind::PathBsdf => camera(Box::new(PathIntegrator::bsdf_only(self.depth()))),
             IntegratorKind::Direct => camera(Box::new(PathIntegrator::direct())),
@@ -347,6 +355,15 @@ impl FromStr for IntegratorSpec {
                         })?;
                     spec
                 }
+                ("lanes", IntegratorKind::Wavefront) => {
+                    spec.lanes = value
+                        .trim()
+                        .parse()
+                        .ok()
+                        .filter(|n| (1..=MAX_LANES).contains(n))
+                        .ok_or_else(|| IntegratorSpecError::BadLanes(value.to_string()))?;
+                    spec
+                }
                 ("distance", IntegratorKind::Ao) => {
                     let d: f32 = value
                         .trim()
@@ -365,6 +382,9 @@ impl FromStr for IntegratorSpec {
         Ok(spec)
     }
 }
+
+/// Largest `wavefront` batch a spec may ask for (paths per thread; about 200 bytes each).
+pub const MAX_LANES: u32 = 1 << 20;
 
 /// Most VPL paths per pass a spec may ask for.
 pub const MAX_VPL_PATHS: u32 = 65_536;
@@ -432,6 +452,9 @@ impl fmt::Display for IntegratorSpec {
         if let (true, Some(depth)) = (self.kind.has_depth(), self.max_depth) {
             write!(f, ":max-depth={depth}")?;
         }
+        if self.kind == IntegratorKind::Wavefront && self.lanes != crate::DEFAULT_LANES {
+            write!(f, ":lanes={}", self.lanes)?;
+        }
         if self.kind == IntegratorKind::Ao && self.ao_distance.is_finite() {
             write!(f, ":distance={}", self.ao_distance)?;
         }
@@ -485,6 +508,24 @@ mod tests {
         let s: IntegratorSpec = "path:max-depth=4".parse().unwrap();
         assert_eq!((s.kind, s.max_depth), (IntegratorKind::Path, Some(4)));
         assert_eq!(s.to_string(), "path:max-depth=4");
+        let w: IntegratorSpec = "wavefront:lanes=256:max-depth=3".parse().unwrap();
+        assert_eq!((w.lanes, w.max_depth), (256, Some(3)));
+        assert_eq!(w.to_string().parse::<IntegratorSpec>(), Ok(w));
+        assert_eq!(
+            "wavefront".parse::<IntegratorSpec>().unwrap().to_string(),
+            "wavefront"
+        );
+        for bad in [
+            "wavefront:lanes=0",
+            "wavefront:lanes=x",
+            "wavefront:lanes=2000000",
+        ] {
+            assert!(matches!(
+                bad.parse::<IntegratorSpec>(),
+                Err(IntegratorSpecError::BadLanes(_))
+            ));
+        }
+        assert!("path:lanes=8".parse::<IntegratorSpec>().is_err());
         let a: IntegratorSpec = "ao:distance=0.5".parse().unwrap();
         assert_eq!(a.ao_distance, 0.5);
         assert_eq!(a.to_string().parse::<IntegratorSpec>(), Ok(a));

@@ -40,7 +40,7 @@ use std::sync::Mutex;
 /// Paths per thread's batch when nothing else is asked for: large enough that a stream's
 /// rays and a kernel's lanes amortise their set-up, small enough that the batch's state
 /// (about 150 bytes a lane) stays in the L2 cache.
-pub const DEFAULT_LANES: usize = 1024;
+pub const DEFAULT_LANES: u32 = 1024;
 
 /// The wavefront path tracer (see the module doc).
 pub struct Wavefront {
@@ -54,10 +54,10 @@ pub struct Wavefront {
 impl Wavefront {
     /// The wavefront form of `settings` (a path tracer with or without light sampling) with
     /// `lanes` paths per thread's batch.
-    pub fn new(settings: PathIntegrator, lanes: usize) -> Self {
+    pub fn new(settings: PathIntegrator, lanes: u32) -> Self {
         Self {
             settings,
-            lanes: lanes.max(1),
+            lanes: lanes.max(1) as usize,
             profile: Mutex::new(Profile::default()),
             scalar: Mutex::new((0, "")),
         }

@@ -31,7 +31,9 @@ fn band_rows(film: &Film, pass: &SamplePass, capacity: usize) -> u32 {
     let per_row = (u64::from(film.width()) * pass.indices.len() as u64).max(1);
     let wanted = (8 * capacity as u64).div_ceil(per_row);
     let most = film.height() / (4 * rayon::current_num_threads() as u32).max(1);
-    (wanted.min(u64::from(u32::MAX)) as u32).min(most).max(BAND_ROWS)
+    (wanted.min(u64::from(u32::MAX)) as u32)
+        .min(most)
+        .max(BAND_ROWS)
 }
 
 /// Renders `pass` into `film` with `tracer`'s estimator and batch size; adds what the stages
