@@ -169,12 +169,20 @@ fn show(c: &Comparison) -> String {
 
 /// [`agree`], and the control: `nee` with 2 % of its shadow rays dropped must disagree.
 fn agree_and_control(scene: &rt_core::Scene, nee: Render, bsdf: Render) {
-    let reference = film(scene, bsdf, 0.0);
-    let honest = compare(&film(scene, nee, 0.0), &reference, BLOCK, ALPHA);
-    let biased = compare(&film(scene, nee, DROPPED), &reference, BLOCK, ALPHA);
-    eprintln!(
-        "{}: {}; NEE x{}: {}",
+    control_case(
         nee.0.name(),
+        &|dropped| film(scene, nee, dropped),
+        film(scene, bsdf, 0.0),
+    );
+}
+
+/// The honest film `nee(0)` agrees with `reference` and the film `nee(DROPPED)`, whose shadow
+/// rays are 2 % weaker, does not.
+fn control_case(name: &str, nee: &dyn Fn(f64) -> Film, reference: Film) {
+    let honest = compare(&nee(0.0), &reference, BLOCK, ALPHA);
+    let biased = compare(&nee(DROPPED), &reference, BLOCK, ALPHA);
+    eprintln!(
+        "{name}: {}; NEE x{}: {}",
         show(&honest),
         1.0 - DROPPED,
         show(&biased)
@@ -208,35 +216,10 @@ fn nee_with_mis_and_bsdf_sampling_agree() {
 fn wavefront_nee_with_mis_and_bsdf_sampling_agree() {
     let scene = scene_from_toml(ROOM);
     let wavefront = Wavefront::new(PathIntegrator::new(6), DEFAULT_LANES);
-    let reference = film(&scene, (&PathIntegrator::bsdf_only(6), 8192, 12), 0.0);
-    let honest = compare(
-        &technique_film(&scene, (&wavefront, 1024, 11), 0.0),
-        &reference,
-        BLOCK,
-        ALPHA,
-    );
-    let biased = compare(
-        &technique_film(&scene, (&wavefront, 1024, 11), DROPPED),
-        &reference,
-        BLOCK,
-        ALPHA,
-    );
-    eprintln!(
-        "wavefront: {}; NEE x{}: {}",
-        show(&honest),
-        1.0 - DROPPED,
-        show(&biased)
-    );
-    assert!(
-        honest.same_within_noise(),
-        "estimators disagree: {}",
-        show(&honest)
-    );
-    assert!(
-        !biased.same_within_noise(),
-        "control: NEE x{} passes the same test: {}",
-        1.0 - DROPPED,
-        show(&biased)
+    control_case(
+        "wavefront",
+        &|dropped| technique_film(&scene, (&wavefront, 1024, 11), dropped),
+        film(&scene, (&PathIntegrator::bsdf_only(6), 8192, 12), 0.0),
     );
 }
 

@@ -184,6 +184,18 @@ pub fn render_samples(
         film.add_sample_records(r);
     }
     let rays = totals.into_inner().unwrap_or_else(|e| e.into_inner());
+    pass_stats(film, pass, start, discarded_before, rays)
+}
+
+/// What a camera-ray pass that began at `start` did: its samples (every pixel the pass takes,
+/// each index), `rays`, and the samples the film dropped since it held `discarded_before`.
+pub(crate) fn pass_stats(
+    film: &Film,
+    pass: &SamplePass,
+    start: Instant,
+    discarded_before: u64,
+    rays: RayCounters,
+) -> RenderStats {
     let pixels = match &pass.pixels {
         Some(mask) => mask.iter().filter(|&&m| m).count() as u64,
         None => film.width() as u64 * film.height() as u64,

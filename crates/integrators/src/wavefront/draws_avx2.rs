@@ -100,6 +100,22 @@ fn to_unit(x: U32x8) -> __m256 {
     )
 }
 
+/// Eight values as one vector.
+#[target_feature(enable = "avx2")]
+#[inline]
+fn lanes(v: [u32; 8]) -> U32x8 {
+    _mm256_setr_epi32(
+        v[0] as i32,
+        v[1] as i32,
+        v[2] as i32,
+        v[3] as i32,
+        v[4] as i32,
+        v[5] as i32,
+        v[6] as i32,
+        v[7] as i32,
+    )
+}
+
 /// The eight lanes of `v`.
 #[target_feature(enable = "avx2")]
 #[inline]
@@ -144,36 +160,9 @@ fn draw_2d(pixel: U32x8, index_reversed: U32x8, dim: U32x8) -> (__m256, __m256) 
 /// Only callable where AVX2 is known to be there (`lanes::draw_vertices` checks at run time).
 #[target_feature(enable = "avx2")]
 pub(super) fn draw_vertices8(keys: &[SampleKey; 8], dims: &[u32; 8], out: &mut [VertexDraws; 8]) {
-    let pixel = _mm256_setr_epi32(
-        keys[0].pixel_hash as i32,
-        keys[1].pixel_hash as i32,
-        keys[2].pixel_hash as i32,
-        keys[3].pixel_hash as i32,
-        keys[4].pixel_hash as i32,
-        keys[5].pixel_hash as i32,
-        keys[6].pixel_hash as i32,
-        keys[7].pixel_hash as i32,
-    );
-    let index = _mm256_setr_epi32(
-        keys[0].index_reversed as i32,
-        keys[1].index_reversed as i32,
-        keys[2].index_reversed as i32,
-        keys[3].index_reversed as i32,
-        keys[4].index_reversed as i32,
-        keys[5].index_reversed as i32,
-        keys[6].index_reversed as i32,
-        keys[7].index_reversed as i32,
-    );
-    let dim = _mm256_setr_epi32(
-        dims[0] as i32,
-        dims[1] as i32,
-        dims[2] as i32,
-        dims[3] as i32,
-        dims[4] as i32,
-        dims[5] as i32,
-        dims[6] as i32,
-        dims[7] as i32,
-    );
+    let pixel = lanes(std::array::from_fn(|k| keys[k].pixel_hash));
+    let index = lanes(std::array::from_fn(|k| keys[k].index_reversed));
+    let dim = lanes(*dims);
     let light_sel = draw_1d(pixel, index, dim);
     let (light_x, light_y) = draw_2d(pixel, index, _mm256_add_epi32(dim, splat(1)));
     let layer = draw_1d(pixel, index, _mm256_add_epi32(dim, splat(2)));

@@ -13,7 +13,7 @@ use super::lanes::{draw_vertices, Batch, PathState, DIMS_PER_VERTEX};
 use super::profile::{Profile, Stage};
 use super::shade::Shader;
 use super::Wavefront;
-use crate::driver::{CameraSampling, RenderStats, SamplePass};
+use crate::driver::{pass_stats, CameraSampling, RenderStats, SamplePass};
 use crate::{Ctx, RayCounters};
 use rayon::prelude::*;
 use rt_core::{Rgb, Sampler};
@@ -92,16 +92,7 @@ pub(super) fn render_pass(
         },
     );
     let rays = totals.into_inner().unwrap_or_else(|e| e.into_inner());
-    let pixels = match &pass.pixels {
-        Some(mask) => mask.iter().filter(|&&m| m).count() as u64,
-        None => film.width() as u64 * film.height() as u64,
-    };
-    RenderStats {
-        elapsed: start.elapsed(),
-        samples: pixels * pass.indices.len() as u64,
-        rays,
-        discarded: film.discarded() - discarded_before,
-    }
+    pass_stats(film, pass, start, discarded_before, rays)
 }
 
 /// The samples of one band in order: pixels row by row, each pixel's indices in order,
