@@ -145,7 +145,8 @@ pub struct Args {
 
     /// Denoise the image before writing it, e.g. `atrous`, `sbmf` (filters the samples, which
     /// only a render has), `nlm:radius=5` (docs/denoising.md). The film keeps what the denoiser
-    /// reads; the output is the denoised image.
+    /// reads; the output is the denoised image. `none` turns off the scene's denoiser.
+    /// [default: `[render] denoiser`, else none]
     #[arg(long, value_name = "NAME[:options]", conflicts_with = "gree")]
     pub denoiser: Option<String>,
 

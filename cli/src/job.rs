@@ -78,7 +78,7 @@ impl Job {
             ),
             None => None,
         };
-        let settings = Overrides {
+        let mut settings = Overrides {
             integrator: args.integrator,
             max_depth: args.max_depth,
             ao_distance: args.ao_distance,
@@ -88,8 +88,14 @@ impl Job {
             accel,
             aovs: args.aov.clone(),
             output: args.output.clone(),
+            denoiser: args.denoiser.clone(),
         }
         .resolve(desc, scene)?;
+        if args.gree.is_some() {
+            // GREE chooses among its own bank of filters; the table's denoiser would be a
+            // second, conflicting reconstruction (`--denoiser` itself conflicts with `--gree`).
+            settings.denoiser = None;
+        }
         let output = settings.output.clone().unwrap_or_else(|| {
             PathBuf::from(scene.file_stem().unwrap_or_default()).with_extension("exr")
         });
@@ -193,7 +199,7 @@ fn run_job(args: &Args, resume: Option<(PathBuf, rt_parts::Part)>) -> Result<()>
     }
     set_shutter(args, &job, &mut scene)?;
     check_memory(args, &job, &scene)?;
-    if let Some(spec) = crate::sequence::temporal_spec(args)? {
+    if let Some(spec) = crate::sequence::temporal_spec(&job)? {
         if crate::parts::writes_part(args) {
             bail!(
                 "{}: a part file cannot hold a temporally denoised sequence: its history carries from frame to frame; render the frames' parts without it",
@@ -257,17 +263,35 @@ pub(crate) fn single_frame_denoiser(
     args: &Args,
     job: &Job,
 ) -> Result<Option<Box<dyn rt_denoise::Denoiser>>> {
-    let Some(text) = &args.denoiser else {
+    let Some(text) = &job.settings.denoiser else {
         return Ok(None);
     };
+    let label = denoiser_label(args, job);
     if job.settings.aovs != AovSet::default() {
+        if args.denoiser.is_none() {
+            bail!("{label} writes the denoised image only; add --denoiser none to save a noisy frame's AOVs");
+        }
         bail!("--denoiser writes the denoised image only; save a noisy frame's AOVs with a render without it");
     }
     let d = text
         .parse::<rt_denoise::DenoiserSpec>()
         .and_then(|s| s.build())
-        .map_err(|e| anyhow::anyhow!("--denoiser {text}: {e}"))?;
+        .map_err(|e| anyhow::anyhow!("{label}: {e}"))?;
     Ok(Some(d))
+}
+
+/// Where the render's denoiser comes from, for messages: `--denoiser TEXT`, or the scene's
+/// `[render] denoiser`.
+pub(crate) fn denoiser_label(args: &Args, job: &Job) -> String {
+    let text = job.settings.denoiser.as_deref().unwrap_or_default();
+    if args.denoiser.is_some() {
+        format!("--denoiser {text}")
+    } else {
+        format!(
+            "{}: [render] denoiser = \"{text}\"",
+            job.scene_path.display()
+        )
+    }
 }
 
 /// The film buffers a render keeps: only what its outputs and its denoiser read, no variance
@@ -292,7 +316,7 @@ fn check_memory(args: &Args, job: &Job, scene: &Scene) -> Result<()> {
         .transpose()?;
     let camera = pick_camera(scene, &job.scene_path, job.camera.as_deref())?;
     // A temporal denoiser's needs are its own; the plain film is still the floor.
-    let denoiser = if crate::sequence::temporal_spec(args)?.is_some() {
+    let denoiser = if crate::sequence::temporal_spec(job)?.is_some() {
         None
     } else {
         single_frame_denoiser(args, job)?
@@ -398,8 +422,8 @@ fn render_one(
         .map_or(AovSet::default(), |d| AovSet::for_channels(d.needs()));
     if denoise_aovs.any_split() && !integrator.writes_split() {
         bail!(
-            "--denoiser {}: it reads the lighting split, which the {} technique does not write",
-            args.denoiser.as_deref().unwrap_or_default(),
+            "{}: it reads the lighting split, which the {} technique does not write",
+            denoiser_label(args, job),
             job.settings.integrator
         );
     }

@@ -123,7 +123,7 @@ fn settings(args: &Args, job: &Job, camera: &rt_core::Camera) -> BTreeMap<String
         ("seed", s.seed.to_string()),
         ("camera", camera.name.clone()),
         ("exposure", args.exposure.to_string()),
-        ("denoiser", args.denoiser.clone().unwrap_or_default()),
+        ("denoiser", s.denoiser.clone().unwrap_or_default()),
         ("shutter", args.shutter.to_string()),
         ("fps", args.fps.to_string()),
     ]

@@ -12,10 +12,10 @@ use rt_session::SequenceRenderer;
 use rt_temporal::TemporalSpec;
 use std::time::Instant;
 
-/// The parsed `--denoiser` if it is a temporal one (SVGF); `None` for per-frame denoisers,
-/// which the plain render path runs.
-pub fn temporal_spec(args: &Args) -> Result<Option<TemporalSpec>> {
-    let Some(text) = &args.denoiser else {
+/// The parsed `--denoiser` if it is a temporal one (SVGF); `None` for per-frame denoisers
+/// (and for the scene's `[render] denoiser`, always one), which the plain render path runs.
+pub fn temporal_spec(job: &Job) -> Result<Option<TemporalSpec>> {
+    let Some(text) = &job.settings.denoiser else {
         return Ok(None);
     };
     let spec: TemporalSpec = text
@@ -32,7 +32,7 @@ pub fn run(
     scene: &mut Scene,
     frames: &[Option<u32>],
 ) -> Result<()> {
-    let text = args.denoiser.as_deref().unwrap_or_default();
+    let text = job.settings.denoiser.as_deref().unwrap_or_default();
     let path = job.scene_path.display();
     if job.settings.aovs != AovSet::default() {
         bail!("--denoiser {text} writes the denoised image only; save noisy frames' AOVs with a render without it");

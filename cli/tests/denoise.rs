@@ -185,3 +185,92 @@ fn saved_frames_denoise_like_the_library_and_bad_input_is_one_line() {
     );
     assert!(out.status.success(), "{out:?}");
 }
+
+/// `[render] denoiser`: the scene's default is read and applied like `--denoiser`, a given
+/// `--denoiser` wins (`none` turns it off), and a bad value is one error line naming the file.
+#[test]
+fn the_render_tables_denoiser_is_read_and_a_bad_one_is_one_line() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    scene(dir);
+    let base = std::fs::read_to_string(dir.join("s.toml")).unwrap();
+    let with = |name: &str, table: &str| {
+        std::fs::write(
+            dir.join(name),
+            format!("{base}\n[render]\nspp = 4\n{table}\n"),
+        )
+        .unwrap();
+    };
+    with("t.toml", "denoiser = \"box:radius=2\"");
+    let out = render(dir, &["t.toml", "-o", "t.exr"]);
+    assert!(out.status.success(), "{out:?}");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("denoised by box"), "{stdout}");
+    let out = render(dir, &["t.toml", "--denoiser", "none", "-o", "n.exr"]);
+    assert!(out.status.success(), "{out:?}");
+    let noisy = rt_film::read_rgb(&dir.join("n.exr")).unwrap();
+    let want = |spec: &str| {
+        let d = spec.parse::<DenoiserSpec>().unwrap().build().unwrap();
+        d.denoise(&NoisyFrame::new(noisy.clone())).unwrap()
+    };
+    assert_eq!(
+        rt_film::read_rgb(&dir.join("t.exr")).unwrap(),
+        want("box:radius=2")
+    );
+    assert_ne!(noisy, want("box:radius=2"));
+    // The command line wins over the table.
+    let out = render(
+        dir,
+        &["t.toml", "--denoiser", "box:radius=1", "-o", "g.exr"],
+    );
+    assert!(out.status.success(), "{out:?}");
+    assert_eq!(
+        rt_film::read_rgb(&dir.join("g.exr")).unwrap(),
+        want("box:radius=1")
+    );
+    // AOVs with the table's denoiser: one line saying how to keep them.
+    let err = one_error_line(&render(
+        dir,
+        &["t.toml", "--aov", "variance", "-o", "a.exr"],
+    ));
+    assert!(
+        err.contains("t.toml: [render] denoiser = \"box:radius=2\"")
+            && err.contains("--denoiser none"),
+        "{err}"
+    );
+    let out = render(
+        dir,
+        &[
+            "t.toml",
+            "--denoiser",
+            "none",
+            "--aov",
+            "variance",
+            "-o",
+            "a.exr",
+        ],
+    );
+    assert!(out.status.success(), "{out:?}");
+    // Bad values: one line naming the file and the key (and the position when the type or
+    // the emptiness is wrong).
+    for (table, want) in [
+        (
+            "denoiser = \"optix\"",
+            "b.toml: [render] denoiser = \"optix\": unknown denoiser 'optix'",
+        ),
+        (
+            "denoiser = \"nlm:size=3\"",
+            "b.toml: [render] denoiser = \"nlm:size=3\"",
+        ),
+        ("denoiser = \"\"", "denoiser must name a denoiser"),
+        ("denoiser = 3", "b.toml:"),
+    ] {
+        with("b.toml", table);
+        let err = one_error_line(&render(dir, &["b.toml", "-o", "b.exr"]));
+        assert!(
+            err.starts_with("error: ") && err.contains(want),
+            "{table}: {err}"
+        );
+        assert!(!dir.join("b.exr").exists());
+    }
+}

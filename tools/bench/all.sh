@@ -34,7 +34,7 @@ tools/bench/scenes.sh 64 2
 echo; echo "## Side by side with Mitsuba 3"
 load
 cornell=scenes/cornell-box.toml
-line=$("$render" "$cornell" -o "$out/o64.exr" --spp 64 --threads 1 --max-depth 16)
+line=$("$render" "$cornell" -o "$out/o64.exr" --spp 64 --threads 1 --max-depth 16 --denoiser none)
 ours=$(sed -E 's/.*: ([0-9.]+) s render.*/\1/' <<<"$line")
 echo "render: $line"
 if python3 -c "import mitsuba" 2>/dev/null; then

@@ -21,7 +21,7 @@ trap 'rm -rf "$out"' EXIT
 
 # `render`'s summary: "...: 12.34 s render (...)": the render alone, without load and build.
 render_seconds() {
-    "$bin" "$scene" -o "$out/x.exr" --spp "$spp" --threads "$1" |
+    "$bin" "$scene" -o "$out/x.exr" --spp "$spp" --threads "$1" --denoiser none |
         sed -E 's/.*: ([0-9.]+) s render.*/\1/'
 }
 median() { sort -g | awk '{a[NR] = $1} END {print a[int((NR + 1) / 2)]}'; }

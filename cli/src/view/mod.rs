@@ -96,6 +96,9 @@ impl View {
             accel,
             aovs: None,
             output: None,
+            // The window's denoiser is its own `--denoiser` (temporal); `[render] denoiser`
+            // is for still images.
+            denoiser: Some("none".into()),
         }
         .resolve(&loaded.render, &path)?;
         let scene = loaded.scene;

@@ -323,6 +323,7 @@ pub(crate) struct RenderTableDesc {
     pub threads: Option<Spanned<usize>>,
     pub aov: Option<Vec<String>>,
     pub output: Option<String>,
+    pub denoiser: Option<Spanned<String>>,
 }
 
 /// Parses the TOML text into a [`SceneDesc`].

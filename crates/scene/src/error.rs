@@ -281,7 +281,7 @@ mod tests {
         // Messages that name their key are left alone.
         assert_eq!(
             toml_err("[render]\nsamples = 4\n"),
-            "x.toml:2:1: unknown field `samples`, expected one of `spp`, `integrator`, `accel`, `max_depth`, `seed`, `threads`, `aov`, `output`"
+            "x.toml:2:1: unknown field `samples`, expected one of `spp`, `integrator`, `accel`, `max_depth`, `seed`, `threads`, `aov`, `output`, `denoiser`"
         );
     }
 

@@ -86,7 +86,8 @@ pub struct LoadedScene {
 
 /// The optional `[render]` table: defaults for the `render` command's options. A missing key
 /// is `None`; the CLI decides what that means. Only ranges are checked here (`spp >= 1`,
-/// `threads >= 1`): the names of integrators, accelerators and AOVs belong to the CLI.
+/// `threads >= 1`, a non-empty `denoiser`): the names of integrators, accelerators, AOVs and
+/// denoisers belong to the crates that build them, checked when settings are resolved.
 #[derive(Default, Clone, Debug)]
 pub struct RenderDesc {
     /// Samples per pixel.
@@ -105,6 +106,10 @@ pub struct RenderDesc {
     pub aov: Option<Vec<String>>,
     /// Output image path, as `-o` would take it.
     pub output: Option<String>,
+    /// Denoiser spec (`nlm`, `atrous:iterations=4`, ...) the `render` command filters its
+    /// image with, as `--denoiser` would take it; its name and options are checked where
+    /// settings are resolved (`rt_session`).
+    pub denoiser: Option<String>,
 }
 
 /// Loads the scene file at `path`, or generates the procedural scene `gen:NAME`

@@ -541,6 +541,14 @@ fn render(ctx: &Ctx, r: Option<RenderTableDesc>) -> Result<RenderDesc> {
             return Err(ctx.src.error_at(t.span(), "threads must be at least 1"));
         }
     }
+    if let Some(d) = &r.denoiser {
+        if d.get_ref().trim().is_empty() {
+            return Err(ctx.src.error_at(
+                d.span(),
+                "denoiser must name a denoiser, e.g. \"nlm\" (leave the key out for none)",
+            ));
+        }
+    }
     Ok(RenderDesc {
         spp: r.spp.map(Spanned::into_inner),
         integrator: r.integrator,
@@ -550,6 +558,7 @@ fn render(ctx: &Ctx, r: Option<RenderTableDesc>) -> Result<RenderDesc> {
         threads: r.threads.map(Spanned::into_inner),
         aov: r.aov,
         output: r.output,
+        denoiser: r.denoiser.map(Spanned::into_inner),
     })
 }
 
@@ -1087,7 +1096,7 @@ material = "light"
 
     #[test]
     fn render_table_keys() {
-        let s = ok("[render]\nspp = 64\nintegrator = \"path\"\naccel = \"bvh\"\nmax_depth = 16\nseed = 7\nthreads = 2\naov = [\"albedo\", \"normal\"]\noutput = \"out.exr\"");
+        let s = ok("[render]\nspp = 64\nintegrator = \"path\"\naccel = \"bvh\"\nmax_depth = 16\nseed = 7\nthreads = 2\naov = [\"albedo\", \"normal\"]\noutput = \"out.exr\"\ndenoiser = \"nlm:k=0.3\"");
         let r = s.render;
         assert_eq!(r.spp, Some(64));
         assert_eq!(r.integrator.as_deref(), Some("path"));
@@ -1100,8 +1109,18 @@ material = "light"
             Some(vec!["albedo".to_string(), "normal".to_string()])
         );
         assert_eq!(r.output.as_deref(), Some("out.exr"));
+        assert_eq!(r.denoiser.as_deref(), Some("nlm:k=0.3"));
         let r = ok("").render;
         assert!(r.spp.is_none() && r.integrator.is_none() && r.aov.is_none());
+        assert!(r.denoiser.is_none());
+        let extra = "[render]\ndenoiser = \" \"";
+        let e = err(extra);
+        assert!(
+            e.starts_with(&format!("t.toml:{}:", line_of(extra, "denoiser")))
+                && e.contains("denoiser must name a denoiser"),
+            "{e}"
+        );
+        assert!(err("[render]\ndenoiser = 3").contains("expected a string"));
         assert!(err("[render]\nspp = 0").contains("spp must be at least 1"));
         assert!(err("[render]\nthreads = 0").contains("threads must be at least 1"));
         assert!(err("[render]\nspp = -4").contains("-4"));

@@ -120,7 +120,8 @@ fn cornell_box_matches_the_published_data() {
         }
     }
     assert_eq!(sc.lights().emitter_count(), 2);
-    assert_eq!(s.render.spp, Some(256));
+    assert_eq!(s.render.spp, Some(32));
+    assert_eq!(s.render.denoiser.as_deref(), Some("nlm"));
     assert_eq!(s.render.max_depth, Some(16));
     assert_eq!(s.render.integrator.as_deref(), Some("wavefront"));
 }

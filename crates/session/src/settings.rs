@@ -43,6 +43,9 @@ pub struct Overrides {
     pub aovs: Option<Vec<String>>,
     /// Output path.
     pub output: Option<PathBuf>,
+    /// Denoiser (`--denoiser`), as text: the caller checks it (it may be a temporal one);
+    /// `none` turns the table's off.
+    pub denoiser: Option<String>,
 }
 
 /// Fully resolved settings of one render.
@@ -62,6 +65,9 @@ pub struct Settings {
     pub aovs: AovSet,
     /// Output path, if the caller or the table named one.
     pub output: Option<PathBuf>,
+    /// The denoiser the image is filtered with, as text (`None`: no denoising). From the
+    /// table it is a single-frame [`rt_denoise::DenoiserSpec`], checked here.
+    pub denoiser: Option<String>,
 }
 
 /// Where a value came from, for error messages.
@@ -139,6 +145,16 @@ pub enum SettingsError {
         origin: Origin,
         /// The technique's name.
         technique: &'static str,
+    },
+    /// A bad denoiser name or option.
+    #[error("{origin} = \"{text}\": {message}")]
+    Denoiser {
+        /// Where it came from.
+        origin: Origin,
+        /// The spec as written.
+        text: String,
+        /// What is wrong.
+        message: String,
     },
     /// An unknown AOV name.
     #[error("{origin}: {source}")]
@@ -257,7 +273,34 @@ impl Overrides {
                 .output
                 .clone()
                 .or_else(|| desc.output.as_ref().map(PathBuf::from)),
+            denoiser: self.denoiser(desc, scene_path)?,
         })
+    }
+
+    /// The denoiser alone: the given text (`none`: no denoiser), else the table's, which must
+    /// build as a single-frame denoiser.
+    pub fn denoiser(
+        &self,
+        desc: &RenderDesc,
+        scene_path: &Path,
+    ) -> Result<Option<String>, SettingsError> {
+        if let Some(text) = &self.denoiser {
+            return Ok((!text.trim().eq_ignore_ascii_case("none")).then(|| text.clone()));
+        }
+        let Some(text) = &desc.denoiser else {
+            return Ok(None);
+        };
+        text.parse::<rt_denoise::DenoiserSpec>()
+            .and_then(|spec| spec.build())
+            .map_err(|e| SettingsError::Denoiser {
+                origin: Origin::Table {
+                    file: scene_path.to_path_buf(),
+                    key: "denoiser",
+                },
+                text: text.clone(),
+                message: e.to_string(),
+            })?;
+        Ok(Some(text.clone()))
     }
 
     /// The integrator alone (experiments and references need no more).
@@ -375,6 +418,18 @@ mod tests {
         };
         let g = o.resolve(&desc, path).unwrap();
         assert_eq!((g.spp, g.integrator.depth()), (2, 5));
+        // The denoiser: none by default, the table's, the given one, or `none` given.
+        assert_eq!(none.denoiser, None);
+        let desc = table(|d| d.denoiser = Some("nlm:k=0.3".into()));
+        let t = Overrides::default().resolve(&desc, path).unwrap();
+        assert_eq!(t.denoiser.as_deref(), Some("nlm:k=0.3"));
+        let given = |d: &str| Overrides {
+            denoiser: Some(d.into()),
+            ..Overrides::default()
+        };
+        let g = given("atrous").resolve(&desc, path).unwrap();
+        assert_eq!(g.denoiser.as_deref(), Some("atrous"));
+        assert_eq!(given("none").resolve(&desc, path).unwrap().denoiser, None);
         // An explicit option in the spec text is the most specific setting.
         let o = Overrides {
             integrator: Some("path:max-depth=2".parse().unwrap()),
@@ -416,6 +471,23 @@ mod tests {
             .resolve(&table(|d| d.accel = Some("kd".into())), path)
             .unwrap_err();
         assert!(e.to_string().contains("[render] accel = \"kd\""), "{e}");
+        for (bad, why) in [
+            ("optix", "unknown denoiser 'optix'"),
+            ("nlm:k=-1", "k"),
+            ("nlm:size=3", "size"),
+            ("svgf", "unknown denoiser 'svgf'"),
+        ] {
+            let e = Overrides::default()
+                .resolve(&table(|d| d.denoiser = Some(bad.into())), path)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.starts_with(&format!("s.toml: [render] denoiser = \"{bad}\": "))
+                    && e.contains(why)
+                    && !e.contains('\n'),
+                "{e}"
+            );
+        }
         let e = Overrides::default()
             .resolve(
                 &table(|d| d.max_depth = Some(rt_integrators::MAX_DEPTH + 1)),
