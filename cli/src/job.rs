@@ -532,6 +532,27 @@ fn render_one(
         }
         return Ok(());
     }
+    // `--stats`: one row per stage, after the image is written.
+    let report = |film: &rt_film::Film, write_time| {
+        if args.stats {
+            print!(
+                "{}",
+                RenderReport::collect(&ReportInputs {
+                    scene,
+                    camera,
+                    accel,
+                    accel_spec: job.settings.accel.to_string(),
+                    film,
+                    render: &stats,
+                    technique: &integrator.stages(),
+                    load_time,
+                    accel_time: build_time,
+                    write_time,
+                    output: &job.output,
+                })
+            );
+        }
+    };
     if let Some(d) = &denoiser {
         let t = Instant::now();
         write_denoised(
@@ -542,6 +563,8 @@ fn render_one(
             &job.scene_path,
         )?;
         let denoise_time = t.elapsed();
+        // The denoiser's time stands where the plain image's write would.
+        report(&film, denoise_time);
         if !job.quiet {
             println!(
                 "{}: {}x{} {} spp {} ({:.2} s render), denoised by {} in {:.3} s -> {}",
@@ -598,24 +621,7 @@ fn render_one(
             pool.current_num_threads(),
         );
     }
-    if args.stats {
-        print!(
-            "{}",
-            RenderReport::collect(&ReportInputs {
-                scene,
-                camera,
-                accel,
-                accel_spec: job.settings.accel.to_string(),
-                film: &film,
-                render: &stats,
-                technique: &integrator.stages(),
-                load_time,
-                accel_time: build_time,
-                write_time,
-                output: &job.output,
-            })
-        );
-    }
+    report(&film, write_time);
     end_checkpoint(args, job, interrupted)
 }
 
