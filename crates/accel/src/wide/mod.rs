@@ -410,7 +410,7 @@ impl<N: WideNode> Accel for WideBvh<N> {
         self.closest_stream(rays, t_max, hits);
     }
 
-    /// As [`WideBvh::intersect_stream`], for occlusion: the same answers as
+    /// As [`Accel::intersect_stream`], for occlusion: the same answers as
     /// [`Accel::occluded_toward`] (or [`Accel::occluded`]) ray by ray.
     fn occluded_stream(&self, rays: &[Ray], t_max: &[f32], toward: &[Vec3], occluded: &mut [bool]) {
         self.occluded_stream_impl(rays, t_max, toward, occluded);

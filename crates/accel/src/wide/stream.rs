@@ -2,8 +2,10 @@
 //! [`Accel::occluded_stream`](rt_core::Accel::occluded_stream)) through a wide BVH: one
 //! dispatch on the instruction set and the traversal options per stream instead of per ray, the
 //! traversal loop inlined into a loop over the rays (so its stack frame is set up once), and
-//! the next rays fetched ahead. Each ray runs exactly the single-ray traversal, so a stream's
-//! answers are the single-ray queries' bit for bit.
+//! the next rays fetched ahead. A [`Bvh8`](super::Bvh8) on a CPU with AVX2 traces each run of
+//! eight consecutive rays that point into one octant as a packet (`packet.rs`); every other ray
+//! runs exactly the single-ray traversal. Either way a stream's answers are the single-ray
+//! queries' bit for bit (`tests/streams.rs`).
 
 #[cfg(target_arch = "x86_64")]
 use super::bvh::Avx2;

@@ -423,14 +423,15 @@ pub(crate) mod avx {
 #[inline(always)]
 pub(crate) fn intersect4_sse(pre: &RayPrecomp4, p: &Tri4, t_max: f32) -> Hits4 {
     use std::arch::x86_64::*;
-    // SAFETY: `_mm_load_ps` reads a 16-byte row of `p.v`; rows start at multiples of 16 bytes
-    // in a 16-byte-aligned `Tri4`. (SSE2 is enabled for the whole x86_64 build.)
+    // One 16-byte row of `p.v` (expanded inside the `unsafe` block below).
     macro_rules! load {
         ($vertex:expr, $axis:expr) => {
             _mm_load_ps(p.v[3 * $vertex + $axis].as_ptr())
         };
     }
-    // SAFETY: the lane operations need SSE2, which the `cfg` guarantees for the whole build.
+    // SAFETY: the lane operations need SSE2, which the `cfg` guarantees for the whole build;
+    // `load!`'s `_mm_load_ps` reads a 16-byte row of `p.v`, and rows start at multiples of 16
+    // bytes in a 16-byte-aligned `Tri4`.
     let (zero_edge, sign_ok, t, b1, b2) = unsafe { watertight_lanes!(sse, pre, t_max, load) };
     let mut h = Hits4::default();
     // SAFETY: each store writes 16 bytes to a whole local `[f32; 4]`, unaligned.
