@@ -72,7 +72,8 @@ impl Counter for TraversalCounters {
 /// The closest hit of one query so far, and the leaf test that improves it.
 ///
 /// Triangles are tested against the caller's `t_max`, not against the closest hit so far, and
-/// the closest is kept with an exact `<`. The result is then the minimum of exactly the values
+/// the closest is kept with an exact `<` (ties to the lower triangle index). The result is then
+/// the minimum of exactly the values
 /// [`intersect_triangle`] computes over the leaves entered, independent of visiting order, and
 /// agrees bit for bit with a brute-force loop unless a triangle's computed hit lies outside its
 /// own box by more than the culling margin (overlapping coplanar triangles, nearly degenerate
@@ -131,7 +132,10 @@ impl Closest {
         b1: f32,
         b2: f32,
     ) -> bool {
-        if t < self.t {
+        // Equal distances go to the lower triangle index, as in a brute-force loop over the
+        // triangles in order: the answer is then the same whatever order leaves are visited
+        // in (ray streams trace packets of rays in an order of their own).
+        if t < self.t || (t == self.t && self.hit.is_some_and(|h| prim < h.prim)) {
             self.hit = Some(Hit { t, prim, b1, b2 });
             if ANY_HIT {
                 return true;

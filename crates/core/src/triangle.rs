@@ -42,29 +42,31 @@ impl RayPrecomp {
     /// Precomputes the shear for `ray`. The direction must be non-zero and finite.
     #[inline]
     pub fn new(ray: &Ray) -> Self {
-        let d = ray.dir;
-        let a = d.abs();
-        let kz = if a.x >= a.y && a.x >= a.z {
+        let d = ray.dir.to_array();
+        let a = ray.dir.abs();
+        // Written with selects on a plain array (not `Vec3` indexing, whose bounds checks
+        // and branches made this a hundred instructions): every traversal that reaches a leaf
+        // pays for it once per ray.
+        let kz: usize = if a.x >= a.y && a.x >= a.z {
             0
         } else if a.y >= a.z {
             1
         } else {
             2
         };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
+        let next = |k: usize| if k == 2 { 0 } else { k + 1 };
+        let (kx, ky) = (next(kz), next(next(kz)));
+        let dz = d[kz];
         // Keep the winding of the sheared triangle: swapping kx, ky when looking down -kz.
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
+        let (kx, ky) = if dz < 0.0 { (ky, kx) } else { (kx, ky) };
         Self {
             org: ray.origin,
             kx,
             ky,
             kz,
-            sx: d[kx] / d[kz],
-            sy: d[ky] / d[kz],
-            sz: 1.0 / d[kz],
+            sx: d[kx] / dz,
+            sy: d[ky] / dz,
+            sz: 1.0 / dz,
         }
     }
 

@@ -73,6 +73,48 @@ struct RtcRayHit {
     hit: RtcHit,
 }
 
+/// `struct RTC_ALIGN(32) RTCRay8`: the fields of eight rays, structure of arrays.
+#[repr(C, align(32))]
+#[derive(Clone, Copy)]
+struct RtcRay8 {
+    org: [[f32; 8]; 3],
+    tnear: [f32; 8],
+    dir: [[f32; 8]; 3],
+    time: [f32; 8],
+    tfar: [f32; 8],
+    mask: [u32; 8],
+    id: [u32; 8],
+    flags: [u32; 8],
+}
+
+/// `struct RTC_ALIGN(32) RTCHit8`, with an oversized tail for the instance fields (as
+/// [`RtcHit`]).
+#[repr(C, align(32))]
+#[derive(Clone, Copy)]
+struct RtcHit8 {
+    ng: [[f32; 8]; 3],
+    u: [f32; 8],
+    v: [f32; 8],
+    prim_id: [u32; 8],
+    geom_id: [u32; 8],
+    inst_tail: [[u32; 8]; 34],
+}
+
+/// `struct RTCRayHit8 { RTCRay8 ray; RTCHit8 hit; }`.
+#[repr(C, align(32))]
+#[derive(Clone, Copy)]
+struct RtcRayHit8 {
+    ray: RtcRay8,
+    hit: RtcHit8,
+}
+
+/// `valid` argument of the eight-wide queries: -1 for an active lane, 0 for an inactive one.
+#[repr(C, align(32))]
+struct Valid8([i32; 8]);
+
+const _: () = assert!(std::mem::size_of::<RtcRay8>() == 384);
+const _: () = assert!(std::mem::offset_of!(RtcRayHit8, hit) == 384);
+const _: () = assert!(std::mem::offset_of!(RtcHit8, prim_id) == 160);
 const _: () = assert!(std::mem::size_of::<RtcRay>() == 48);
 const _: () = assert!(std::mem::offset_of!(RtcRayHit, hit) == 48);
 const _: () = assert!(std::mem::offset_of!(RtcHit, prim_id) == 20);
@@ -98,6 +140,8 @@ struct Api {
     release_geometry: unsafe extern "C" fn(Geometry),
     intersect1: unsafe extern "C" fn(Scene, *mut RtcRayHit, *mut c_void),
     occluded1: unsafe extern "C" fn(Scene, *mut RtcRay, *mut c_void),
+    intersect8: unsafe extern "C" fn(*const i32, Scene, *mut RtcRayHit8, *mut c_void),
+    occluded8: unsafe extern "C" fn(*const i32, Scene, *mut RtcRay8, *mut c_void),
 }
 
 static LIB_PATH: OnceLock<Option<PathBuf>> = OnceLock::new();
@@ -154,6 +198,8 @@ fn load(path: &Path) -> Result<Api> {
         release_geometry: sym!("rtcReleaseGeometry"),
         intersect1: sym!("rtcIntersect1"),
         occluded1: sym!("rtcOccluded1"),
+        intersect8: sym!("rtcIntersect8"),
+        occluded8: sym!("rtcOccluded8"),
         _lib: lib,
     };
     // SAFETY: a null config is allowed; the device is released right after the query.
@@ -188,6 +234,8 @@ pub fn version() -> Option<String> {
 /// A committed scene of one triangle mesh.
 pub struct Embree {
     name: String,
+    /// `embree@8`: streams traced eight rays per `rtcIntersect8` / `rtcOccluded8` call.
+    packets: bool,
     api: &'static Api,
     device: Device,
     scene: Scene,
@@ -212,10 +260,14 @@ impl Drop for Embree {
 
 /// Builds `embree` or `embree:high` with as many TBB threads as the current rayon pool.
 pub fn build(name: &str, tris: &[[Vec3; 3]]) -> Result<Box<dyn Peer>> {
-    let high = match name {
+    let (base, packets) = match name.strip_suffix("@8") {
+        Some(base) => (base, true),
+        None => (name, false),
+    };
+    let high = match base {
         "embree" => false,
         "embree:high" => true,
-        _ => bail!("{name}: unknown Embree variant (embree, embree:high)"),
+        _ => bail!("{name}: unknown Embree variant (embree, embree:high, each with @8)"),
     };
     let api = api()?;
     let threads = rayon::current_num_threads();
@@ -277,6 +329,7 @@ pub fn build(name: &str, tris: &[[Vec3; 3]]) -> Result<Box<dyn Peer>> {
     let err = unsafe { (api.get_device_error)(device) };
     let peer = Embree {
         name: name.to_string(),
+        packets,
         api,
         device,
         scene,
@@ -285,6 +338,29 @@ pub fn build(name: &str, tris: &[[Vec3; 3]]) -> Result<Box<dyn Peer>> {
         bail!("{name}: the scene build failed (RTCError {err})");
     }
     Ok(Box::new(peer))
+}
+
+/// Up to eight rays as an `RTCRay8` and the lanes to trace.
+fn rtc_ray8(rays: &[Ray], t_max: f32) -> (RtcRay8, Valid8) {
+    let mut r = RtcRay8 {
+        org: [[0.0; 8]; 3],
+        tnear: [0.0; 8],
+        dir: [[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0], [0.0; 8], [1.0; 8]],
+        time: [0.0; 8],
+        tfar: [t_max; 8],
+        mask: [u32::MAX; 8],
+        id: [0; 8],
+        flags: [0; 8],
+    };
+    let mut valid = Valid8([0; 8]);
+    for (i, ray) in rays.iter().enumerate().take(8) {
+        for a in 0..3 {
+            r.org[a][i] = ray.origin[a];
+            r.dir[a][i] = ray.dir[a];
+        }
+        valid.0[i] = -1;
+    }
+    (r, valid)
 }
 
 fn rtc_ray(ray: &Ray, t_max: f32) -> RtcRay {
@@ -325,6 +401,51 @@ impl Peer for Embree {
         // any instance fields) that lives across the call; null arguments are allowed.
         unsafe { (self.api.intersect1)(self.scene, &mut rh, std::ptr::null_mut()) };
         (rh.hit.geom_id != RTC_INVALID_GEOMETRY_ID).then_some((rh.ray.tfar, rh.hit.prim_id))
+    }
+
+    fn is_stream(&self) -> bool {
+        self.packets
+    }
+
+    fn closest_stream(&self, rays: &[Ray], t_max: f32, out: &mut [Option<(f32, u32)>]) {
+        for (rays, out) in rays.chunks(8).zip(out.chunks_mut(8)) {
+            let (ray, valid) = rtc_ray8(rays, t_max);
+            let mut rh = RtcRayHit8 {
+                ray,
+                hit: RtcHit8 {
+                    ng: [[0.0; 8]; 3],
+                    u: [0.0; 8],
+                    v: [0.0; 8],
+                    prim_id: [RTC_INVALID_GEOMETRY_ID; 8],
+                    geom_id: [RTC_INVALID_GEOMETRY_ID; 8],
+                    inst_tail: [[RTC_INVALID_GEOMETRY_ID; 8]; 34],
+                },
+            };
+            // SAFETY: the scene is committed; `valid` and `rh` are 32-byte aligned
+            // (RTCRayHit8 with room for any instance fields) and live across the call; null
+            // arguments are allowed.
+            unsafe {
+                (self.api.intersect8)(valid.0.as_ptr(), self.scene, &mut rh, std::ptr::null_mut())
+            };
+            for (i, o) in out.iter_mut().enumerate() {
+                *o = (rh.hit.geom_id[i] != RTC_INVALID_GEOMETRY_ID)
+                    .then_some((rh.ray.tfar[i], rh.hit.prim_id[i]));
+            }
+        }
+    }
+
+    fn occluded_stream(&self, rays: &[Ray], t_max: f32, out: &mut [bool]) {
+        for (rays, out) in rays.chunks(8).zip(out.chunks_mut(8)) {
+            let (mut ray, valid) = rtc_ray8(rays, t_max);
+            // SAFETY: as in `closest_stream`, with an RTCRay8. Embree sets an occluded lane's
+            // tfar to -inf.
+            unsafe {
+                (self.api.occluded8)(valid.0.as_ptr(), self.scene, &mut ray, std::ptr::null_mut())
+            };
+            for (i, o) in out.iter_mut().enumerate() {
+                *o = ray.tfar[i] == f32::NEG_INFINITY;
+            }
+        }
     }
 
     fn occluded(&self, ray: &Ray, t_max: f32) -> bool {

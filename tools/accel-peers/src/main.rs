@@ -259,7 +259,7 @@ fn main() -> Result<()> {
         .then(embree_peer::version)
         .flatten()
     {
-        println!("embree: Embree {v}, single-ray API (rtcIntersect1 / rtcOccluded1)");
+        println!("embree: Embree {v}, single-ray API (rtcIntersect1 / rtcOccluded1); embree@8: rtcIntersect8 / rtcOccluded8 on consecutive rays, in chunks of {STREAM_CHUNK}");
     }
     println!(
         "\nCheck against ours (bvh), first {} rays of each set:",
@@ -326,6 +326,9 @@ fn trace(p: &dyn Peer, s: &RaySet, threads: usize) -> Timing {
             p.closest(r, t_max).is_some() as usize
         }
     };
+    if p.is_stream() {
+        return trace_stream(p, s, threads);
+    }
     if threads == 1 {
         let (start, cpu) = (Instant::now(), thread_cpu_seconds());
         let hits = s.rays.iter().map(one).sum();
@@ -340,6 +343,68 @@ fn trace(p: &dyn Peer, s: &RaySet, threads: usize) -> Timing {
             .rays
             .par_chunks(256)
             .map(|c| c.iter().map(one).sum::<usize>())
+            .sum();
+        Timing {
+            wall: start.elapsed().as_secs_f64(),
+            cpu: None,
+            hits,
+        }
+    }
+}
+
+/// Rays per stream call of a streaming peer: a wavefront stage's worth.
+const STREAM_CHUNK: usize = 4096;
+
+/// Answers of a streaming peer for `rays`, in chunks of [`STREAM_CHUNK`].
+fn stream_answers(p: &dyn Peer, rays: &[Ray], shadow: bool) -> Vec<Answer> {
+    let t_max = t_max(shadow);
+    if shadow {
+        let mut out = vec![false; rays.len()];
+        for (r, o) in rays.chunks(STREAM_CHUNK).zip(out.chunks_mut(STREAM_CHUNK)) {
+            p.occluded_stream(r, t_max, o);
+        }
+        out.into_iter().map(Answer::Occluded).collect()
+    } else {
+        let mut out = vec![None; rays.len()];
+        for (r, o) in rays.chunks(STREAM_CHUNK).zip(out.chunks_mut(STREAM_CHUNK)) {
+            p.closest_stream(r, t_max, o);
+        }
+        out.into_iter().map(Answer::Closest).collect()
+    }
+}
+
+/// [`trace`] for a streaming peer: chunks of [`STREAM_CHUNK`] rays per call, into buffers made
+/// before the clock starts.
+fn trace_stream(p: &dyn Peer, s: &RaySet, threads: usize) -> Timing {
+    let t_max = t_max(s.shadow);
+    let chunk = |rays: &[Ray], occ: &mut Vec<bool>, hit: &mut Vec<Option<(f32, u32)>>| {
+        if s.shadow {
+            p.occluded_stream(rays, t_max, &mut occ[..rays.len()]);
+            occ[..rays.len()].iter().filter(|&&o| o).count()
+        } else {
+            p.closest_stream(rays, t_max, &mut hit[..rays.len()]);
+            hit[..rays.len()].iter().filter(|h| h.is_some()).count()
+        }
+    };
+    if threads == 1 {
+        let (mut occ, mut hit) = (vec![false; STREAM_CHUNK], vec![None; STREAM_CHUNK]);
+        let (start, cpu) = (Instant::now(), thread_cpu_seconds());
+        let hits = s
+            .rays
+            .chunks(STREAM_CHUNK)
+            .map(|r| chunk(r, &mut occ, &mut hit))
+            .sum();
+        Timing {
+            wall: start.elapsed().as_secs_f64(),
+            cpu: Some(thread_cpu_seconds() - cpu),
+            hits,
+        }
+    } else {
+        let start = Instant::now();
+        let hits = s
+            .rays
+            .par_chunks(STREAM_CHUNK)
+            .map(|r| chunk(r, &mut vec![false; r.len()], &mut vec![None; r.len()]))
             .sum();
         Timing {
             wall: start.elapsed().as_secs_f64(),
@@ -376,8 +441,16 @@ fn mean_work(p: &dyn Peer, s: &RaySet) -> [Option<f64>; 3] {
 /// Compares a structure's answers with the reference's; one report line.
 fn check(p: &dyn Peer, s: &RaySet, expected: &[Answer]) -> (String, usize) {
     let (mut wrong, mut other_prim) = (0, 0);
-    for (r, exp) in s.rays.iter().zip(expected) {
-        match (answer(p, r, s.shadow), *exp) {
+    let answers: Vec<Answer> = if p.is_stream() {
+        stream_answers(p, &s.rays[..expected.len()], s.shadow)
+    } else {
+        s.rays[..expected.len()]
+            .iter()
+            .map(|r| answer(p, r, s.shadow))
+            .collect()
+    };
+    for (a, exp) in answers.into_iter().zip(expected) {
+        match (a, *exp) {
             (Answer::Closest(Some((t, prim))), Answer::Closest(Some((te, prim_e)))) => {
                 if (t - te).abs() > 1e-4 * te.abs() {
                     wrong += 1;

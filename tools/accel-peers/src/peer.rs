@@ -27,6 +27,26 @@ pub trait Peer: Send + Sync {
     /// True if anything is hit with `t ∈ (0, t_max)`.
     fn occluded(&self, ray: &Ray, t_max: f32) -> bool;
 
+    /// True if the benchmark should hand this structure whole chunks of rays
+    /// ([`Peer::closest_stream`], [`Peer::occluded_stream`]) instead of one ray per call.
+    fn is_stream(&self) -> bool {
+        false
+    }
+
+    /// [`Peer::closest`] of every ray of `rays` into `out`; one by one unless overridden.
+    fn closest_stream(&self, rays: &[Ray], t_max: f32, out: &mut [Option<(f32, u32)>]) {
+        for (r, o) in rays.iter().zip(out) {
+            *o = self.closest(r, t_max);
+        }
+    }
+
+    /// [`Peer::occluded`] of every ray of `rays` into `out`; one by one unless overridden.
+    fn occluded_stream(&self, rays: &[Ray], t_max: f32, out: &mut [bool]) {
+        for (r, o) in rays.iter().zip(out) {
+            *o = self.occluded(r, t_max);
+        }
+    }
+
     /// The query again (closest hit, or occlusion if `shadow`), counting its work. Not timed.
     fn work(&self, ray: &Ray, t_max: f32, shadow: bool) -> Work {
         let _ = (ray, t_max, shadow);

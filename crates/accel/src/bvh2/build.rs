@@ -5,6 +5,7 @@ use super::node::Node;
 use super::{compact, split, BuildParams};
 use glam::{Vec3, Vec3A};
 use rt_core::Aabb;
+use std::mem::MaybeUninit;
 
 /// Size of the traversal stack. The build keeps every leaf at depth `MAX_DEPTH - 1` or less, and
 /// ordered traversal pushes at most one entry per inner ancestor, so the stack cannot overflow.
@@ -334,7 +335,22 @@ impl Bin {
 /// (all coincide) or every candidate's cost overflows.
 fn find_sah_split(refs: &[PrimRef], centroids: &Aabb, cfg: &Config) -> Option<Split> {
     let binner = Binner::new(centroids, cfg.bins);
-    let mut bins = [[EMPTY_BIN; MAX_BINS]; 3];
+    // Only the `cfg.bins` bins in use are initialised: copying three whole `MAX_BINS` rows of
+    // empty bins (9 KB) was a tenth of the build's instructions, once per node.
+    let mut store = [[MaybeUninit::<Bin>::uninit(); MAX_BINS]; 3];
+    let bins: [&mut [Bin]; 3] = store.each_mut().map(|row| {
+        let row = &mut row[..cfg.bins];
+        for b in row.iter_mut() {
+            b.write(EMPTY_BIN);
+        }
+        // SAFETY: every element of `row` was just initialised, and `MaybeUninit<Bin>` has the
+        // layout of `Bin`.
+        #[allow(unsafe_code)]
+        unsafe {
+            std::slice::from_raw_parts_mut(row.as_mut_ptr().cast::<Bin>(), row.len())
+        }
+    });
+    let mut bins = bins;
     for r in refs {
         let c = r.centroid();
         let (min, max) = (Vec3A::from(r.bounds.min), Vec3A::from(r.bounds.max));
@@ -348,11 +364,11 @@ fn find_sah_split(refs: &[PrimRef], centroids: &Aabb, cfg: &Config) -> Option<Sp
         // A boundary between two empty bins gives the same partition as the boundary after the
         // last non-empty bin before it, so only boundaries after non-empty bins are candidates.
         // For the many small nodes near the leaves this skips most of the sweep.
-        let mut occupied = [0usize; MAX_BINS];
+        let mut occupied = [0u8; MAX_BINS];
         let mut m = 0;
         for (i, bin) in axis_bins[..cfg.bins].iter().enumerate() {
             if bin.count > 0 {
-                occupied[m] = i;
+                occupied[m] = i as u8;
                 m += 1;
             }
         }
@@ -361,18 +377,18 @@ fn find_sah_split(refs: &[PrimRef], centroids: &Aabb, cfg: &Config) -> Option<Sp
         let mut right_cost = [0.0f64; MAX_BINS];
         let mut run = EMPTY_BIN;
         for k in (1..m).rev() {
-            run.merge(&axis_bins[occupied[k]]);
+            run.merge(&axis_bins[usize::from(occupied[k])]);
             right_cost[k] = run.cost();
         }
         let mut run = EMPTY_BIN;
         for k in 0..m.saturating_sub(1) {
-            run.merge(&axis_bins[occupied[k]]);
+            run.merge(&axis_bins[usize::from(occupied[k])]);
             let cost = run.cost() + right_cost[k + 1];
             // NaN and infinite costs never compare less, so they are never chosen.
             if cost < best.map_or(f64::INFINITY, |b| b.cost) {
                 best = Some(Split {
                     axis,
-                    last_left_bin: occupied[k],
+                    last_left_bin: usize::from(occupied[k]),
                     cost,
                     binner,
                 });

@@ -134,9 +134,14 @@ unsafe fn gather8_avx2(
     let first = _mm256_mullo_epi32(at, nine);
     // SAFETY: float `9 * slot + 3 * vertex + axis` of the array lies inside `tris` because
     // each slot is below `tris.len()` (the caller's contract), and fits an `i32`.
-    let load = |vertex: usize, axis: usize| unsafe {
+    let gather = |vertex: usize, axis: usize| unsafe {
         _mm256_i32gather_ps::<4>(base.add(3 * vertex + axis), first)
     };
+    macro_rules! load {
+        ($vertex:expr, $axis:expr) => {
+            gather($vertex, $axis)
+        };
+    }
     let (zero_edge, hits, t, b1, b2) = watertight_lanes!(avx, pre, t_max, load);
     let mut h = Hits8 {
         mask: hits,

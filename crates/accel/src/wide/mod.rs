@@ -16,7 +16,10 @@ mod collapse;
 mod node;
 mod node8;
 mod options;
+#[cfg(target_arch = "x86_64")]
+mod packet;
 mod shadow_cache;
+mod stream;
 mod traverse;
 pub(crate) mod tri4;
 mod validate;
@@ -399,6 +402,18 @@ impl<N: WideNode> Accel for WideBvh<N> {
                 .query::<true, _>(0, ray, t_max, c)
                 .is_some()),
         }
+    }
+
+    /// One dispatch per stream, the single-ray traversal inlined into the loop over the rays
+    /// (`stream.rs`): the same answers as [`Accel::intersect`] ray by ray.
+    fn intersect_stream(&self, rays: &[Ray], t_max: &[f32], hits: &mut [Option<Hit>]) {
+        self.closest_stream(rays, t_max, hits);
+    }
+
+    /// As [`Accel::intersect_stream`], for occlusion: the same answers as
+    /// [`Accel::occluded_toward`] (or [`Accel::occluded`]) ray by ray.
+    fn occluded_stream(&self, rays: &[Ray], t_max: &[f32], toward: &[Vec3], occluded: &mut [bool]) {
+        self.occluded_stream_impl(rays, t_max, toward, occluded);
     }
 
     fn bounds(&self) -> Aabb {

@@ -120,8 +120,9 @@ impl Slab {
             for axis in 0..3 {
                 let o = _mm_set1_ps(self.org[axis]);
                 let inv = _mm_set1_ps(self.inv[axis]);
-                let lo = _mm_load_ps(bounds[self.near[axis]].as_ptr().add(lane0));
-                let hi = _mm_load_ps(bounds[self.far[axis]].as_ptr().add(lane0));
+                // `near`/`far` indices are below 6 (see `Slab::new`), so the rows exist.
+                let lo = _mm_load_ps(bounds.get_unchecked(self.near[axis]).as_ptr().add(lane0));
+                let hi = _mm_load_ps(bounds.get_unchecked(self.far[axis]).as_ptr().add(lane0));
                 let near = _mm_mul_ps(_mm_sub_ps(lo, o), inv);
                 let far = _mm_mul_ps(_mm_sub_ps(hi, o), inv);
                 t0 = _mm_max_ps(near, t0);
@@ -184,11 +185,13 @@ impl Slab {
         for axis in 0..3 {
             let o = _mm256_set1_ps(self.org[axis]);
             let inv = _mm256_set1_ps(self.inv[axis]);
-            // SAFETY: each row is an `[f32; 8]`, 32 bytes, read whole without alignment needs.
+            // SAFETY: `Slab::new` makes every `near`/`far` index `a` or `a + 3` with `a < 3`, so
+            // both rows exist; each row is an `[f32; 8]`, 32 bytes, read whole without
+            // alignment needs. (Unchecked: the bounds checks cost a dozen instructions a node.)
             let (lo, hi) = unsafe {
                 (
-                    _mm256_loadu_ps(bounds[self.near[axis]].as_ptr()),
-                    _mm256_loadu_ps(bounds[self.far[axis]].as_ptr()),
+                    _mm256_loadu_ps(bounds.get_unchecked(self.near[axis]).as_ptr()),
+                    _mm256_loadu_ps(bounds.get_unchecked(self.far[axis]).as_ptr()),
                 )
             };
             let near = _mm256_mul_ps(_mm256_sub_ps(lo, o), inv);
@@ -226,6 +229,13 @@ impl PreparedRay {
             oct: octant(ray),
             pre: None,
         }
+    }
+
+    /// The triangle test's set-up, made on first use.
+    #[inline(always)]
+    pub(crate) fn precomp(&mut self) -> &RayPrecomp4 {
+        let ray = &self.ray;
+        self.pre.get_or_insert_with(|| RayPrecomp4::new(ray))
     }
 }
 
@@ -369,7 +379,12 @@ impl<N: WideNode> WideBvh<N> {
         let mut cur: u32 = start;
         loop {
             if cur & LEAF_BIT != 0 {
-                let pre = pre.get_or_insert_with(|| RayPrecomp4::new(ray));
+                if pre.is_none() {
+                    *pre = Some(RayPrecomp4::new(ray));
+                }
+                let Some(pre) = pre else {
+                    unreachable!("set above")
+                };
                 if self.test_leaf::<ANY_HIT, I, C>(pre, cur, t_max, &mut closest, isa, counter) {
                     return closest.hit;
                 }
@@ -478,7 +493,7 @@ impl<N: WideNode> WideBvh<N> {
     /// one path depend on each other, the fetches of pushed siblings need not wait (Embree
     /// prefetches hit children likewise).
     #[inline(always)]
-    fn prefetch(&self, code: u32) {
+    pub(crate) fn prefetch(&self, code: u32) {
         #[cfg(target_arch = "x86_64")]
         {
             use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};

@@ -61,15 +61,16 @@ pub(crate) struct RayPrecomp4 {
 }
 
 impl RayPrecomp4 {
-    #[inline]
+    #[inline(always)]
     pub(crate) fn new(ray: &Ray) -> Self {
         let scalar = RayPrecomp::new(ray);
-        let k = scalar.axes();
+        let k = scalar.axes().map(|a| a.min(2));
+        let o = ray.origin.to_array();
         Self {
             ray: *ray,
             scalar,
             k,
-            org: k.map(|a| ray.origin[a]),
+            org: k.map(|a| o[a]),
             shear: scalar.shear(),
         }
     }
@@ -120,11 +121,14 @@ pub(crate) fn intersect4_scalar(pre: &RayPrecomp4, p: &Tri4, t_max: f32) -> Hits
 /// edge function was zero (to be redone by the scalar test) and of lanes that hit, and the
 /// vectors `t`, `b1`, `b2`.
 macro_rules! watertight_lanes {
-    ($ops:ident, $pre:expr, $t_max:expr, $load:expr) => {{
+    ($ops:ident, $pre:expr, $t_max:expr, $load:ident) => {{
+        // No closures here: a closure is a function of its own, without the caller's
+        // `#[target_feature]`, and an AVX2 lane operation called from it is not inlined.
         use $ops::*;
         let pre: &RayPrecomp4 = $pre;
-        let [kx, ky, kz] = pre.k;
-        let load = $load;
+        // Axes are below 3 (`RayPrecomp::axes`); clamping tells the compiler so, and the row
+        // loads then need no bounds checks.
+        let [kx, ky, kz] = pre.k.map(|a| a.min(2));
         let (ox, oy, oz) = (splat(pre.org[0]), splat(pre.org[1]), splat(pre.org[2]));
         let (sx, sy, sz) = (
             splat(pre.shear[0]),
@@ -132,15 +136,17 @@ macro_rules! watertight_lanes {
             splat(pre.shear[2]),
         );
         // Vertex relative to the origin, sheared: (x - sx z, y - sy z) and z.
-        let rel = |vertex: usize| {
-            let x = sub(load(vertex, kx), ox);
-            let y = sub(load(vertex, ky), oy);
-            let z = sub(load(vertex, kz), oz);
-            (sub(x, mul(sx, z)), sub(y, mul(sy, z)), z)
-        };
-        let (ax, ay, az) = rel(0);
-        let (bx, by, bz) = rel(1);
-        let (cx, cy, cz) = rel(2);
+        macro_rules! rel {
+            ($vertex:expr) => {{
+                let x = sub($load!($vertex, kx), ox);
+                let y = sub($load!($vertex, ky), oy);
+                let z = sub($load!($vertex, kz), oz);
+                (sub(x, mul(sx, z)), sub(y, mul(sy, z)), z)
+            }};
+        }
+        let (ax, ay, az) = rel!(0);
+        let (bx, by, bz) = rel!(1);
+        let (cx, cy, cz) = rel!(2);
         let u = sub(mul(cx, by), mul(cy, bx));
         let v = sub(mul(ax, cy), mul(ay, cx));
         let w = sub(mul(bx, ay), mul(by, ax));
@@ -152,10 +158,14 @@ macro_rules! watertight_lanes {
         let det = add(add(u, v), w);
         // det != 0 and finite: |det| < inf (false for NaN too).
         let abs_mask = abs_mask();
-        let abs = |x| and(x, abs_mask);
+        macro_rules! abs {
+            ($x:expr) => {
+                and($x, abs_mask)
+            };
+        }
         let inf = splat(f32::INFINITY);
         ok = and(ok, neq(det, zero));
-        ok = and(ok, lt(abs(det), inf));
+        ok = and(ok, lt(abs!(det), inf));
         let (zs_a, zs_b, zs_c) = (mul(sz, az), mul(sz, bz), mul(sz, cz));
         let t_scaled = add(add(mul(u, zs_a), mul(v, zs_b)), mul(w, zs_c));
         // ts = t_scaled with det's sign flipped away; must be > 0 (false for NaN).
@@ -167,24 +177,28 @@ macro_rules! watertight_lanes {
         ok = and(ok, le(t, splat($t_max)));
         // Finite `t` and `1 / det`, as the scalar test requires.
         ok = and(ok, lt(t, inf));
-        ok = and(ok, lt(abs(inv), inf));
+        ok = and(ok, lt(abs!(inv), inf));
         // `t` above its rounding error bound: `t_error_bound`, operation for operation. Most
         // packets hit nothing by here, and they skip the bound's two dozen operations.
         let hits = movemask(ok);
         let hits = if hits == 0 {
             0
         } else {
-            let max3 = |a, b, c| max(max(abs(a), abs(b)), abs(c));
-            let (max_x, max_y) = (max3(ax, bx, cx), max3(ay, by, cy));
-            let (max_z, max_e) = (max3(zs_a, zs_b, zs_c), max3(u, v, w));
-            let g = |n: u32| splat(gamma(n));
-            let delta_z = mul(g(3), max_z);
-            let delta_x = mul(g(5), add(max_x, max_z));
-            let delta_y = mul(g(5), add(max_y, max_z));
+            macro_rules! max3 {
+                ($a:expr, $b:expr, $c:expr) => {
+                    max(max(abs!($a), abs!($b)), abs!($c))
+                };
+            }
+            let (max_x, max_y) = (max3!(ax, bx, cx), max3!(ay, by, cy));
+            let (max_z, max_e) = (max3!(zs_a, zs_b, zs_c), max3!(u, v, w));
+            let (g2, g3, g5) = (splat(gamma(2)), splat(gamma(3)), splat(gamma(5)));
+            let delta_z = mul(g3, max_z);
+            let delta_x = mul(g5, add(max_x, max_z));
+            let delta_y = mul(g5, add(max_y, max_z));
             let delta_e = mul(
                 splat(2.0),
                 add(
-                    add(mul(mul(g(2), max_x), max_y), mul(delta_y, max_x)),
+                    add(mul(mul(g2, max_x), max_y), mul(delta_y, max_x)),
                     mul(delta_x, max_y),
                 ),
             );
@@ -192,11 +206,11 @@ macro_rules! watertight_lanes {
                 mul(
                     splat(3.0),
                     add(
-                        add(mul(mul(g(3), max_e), max_z), mul(delta_e, max_z)),
+                        add(mul(mul(g3, max_e), max_z), mul(delta_e, max_z)),
                         mul(delta_z, max_e),
                     ),
                 ),
-                abs(inv),
+                abs!(inv),
             );
             movemask(and(ok, gt(t, delta_t)))
         };
@@ -409,10 +423,15 @@ pub(crate) mod avx {
 #[inline(always)]
 pub(crate) fn intersect4_sse(pre: &RayPrecomp4, p: &Tri4, t_max: f32) -> Hits4 {
     use std::arch::x86_64::*;
-    // SAFETY: `_mm_load_ps` reads a 16-byte row of `p.v`; rows start at multiples of 16 bytes
-    // in a 16-byte-aligned `Tri4`. (SSE2 is enabled for the whole x86_64 build.)
-    let load = |vertex: usize, axis: usize| unsafe { _mm_load_ps(p.v[3 * vertex + axis].as_ptr()) };
-    // SAFETY: the lane operations need SSE2, which the `cfg` guarantees for the whole build.
+    // One 16-byte row of `p.v` (expanded inside the `unsafe` block below).
+    macro_rules! load {
+        ($vertex:expr, $axis:expr) => {
+            _mm_load_ps(p.v[3 * $vertex + $axis].as_ptr())
+        };
+    }
+    // SAFETY: the lane operations need SSE2, which the `cfg` guarantees for the whole build;
+    // `load!`'s `_mm_load_ps` reads a 16-byte row of `p.v`, and rows start at multiples of 16
+    // bytes in a 16-byte-aligned `Tri4`.
     let (zero_edge, sign_ok, t, b1, b2) = unsafe { watertight_lanes!(sse, pre, t_max, load) };
     let mut h = Hits4::default();
     // SAFETY: each store writes 16 bytes to a whole local `[f32; 4]`, unaligned.
@@ -436,19 +455,23 @@ pub(crate) fn intersect4_sse(pre: &RayPrecomp4, p: &Tri4, t_max: f32) -> Hits4 {
 ///
 /// # Safety
 ///
-/// The CPU must support AVX2.
+/// The CPU must support AVX2. (No `#[target_feature]` of its own, so that it is inlined
+/// into the traversal compiled for AVX2 that calls it, registers and all: out of line, the
+/// call made the traversal spill and reload its ray state at every leaf.)
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
 #[allow(unsafe_code)]
-#[inline]
+#[inline(always)]
 pub(crate) unsafe fn intersect8_avx2(pre: &RayPrecomp4, p: &Tri4, q: &Tri4, t_max: f32) -> Hits8 {
     use std::arch::x86_64::*;
-    // SAFETY: each `_mm_loadu_ps` reads one whole 16-byte row of a packet.
-    let load = |vertex: usize, axis: usize| unsafe {
-        let r = 3 * vertex + axis;
-        _mm256_set_m128(_mm_loadu_ps(q.v[r].as_ptr()), _mm_loadu_ps(p.v[r].as_ptr()))
-    };
-    let (zero_edge, sign_ok, t, b1, b2) = watertight_lanes!(avx, pre, t_max, load);
+    // Each `_mm_loadu_ps` reads one whole 16-byte row of a packet.
+    macro_rules! load {
+        ($vertex:expr, $axis:expr) => {{
+            let r = 3 * $vertex + $axis;
+            _mm256_set_m128(_mm_loadu_ps(q.v[r].as_ptr()), _mm_loadu_ps(p.v[r].as_ptr()))
+        }};
+    }
+    // SAFETY: the caller guarantees AVX2, which is all the loads and lane operations need.
+    let (zero_edge, sign_ok, t, b1, b2) = unsafe { watertight_lanes!(avx, pre, t_max, load) };
     let mut h = Hits8::default();
     // SAFETY: each store writes 32 bytes to a whole local `[f32; 8]`, unaligned.
     unsafe {
