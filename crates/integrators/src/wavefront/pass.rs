@@ -18,6 +18,7 @@ use crate::{Ctx, RayCounters};
 use rayon::prelude::*;
 use rt_core::{Rgb, Sampler};
 use rt_film::{Film, FilmStripe};
+use std::cell::RefCell;
 use std::sync::Mutex;
 use std::time::Instant;
 
@@ -66,22 +67,24 @@ pub(super) fn render_pass(
     let totals = Mutex::new(RayCounters::default());
     let rows_done = std::sync::atomic::AtomicU32::new(0);
     let rows = band_rows(film, pass, capacity);
-    film.stripes_mut(rows).into_par_iter().for_each_init(
-        || (Batch::new(capacity), Profile::default()),
-        |(batch, local), mut stripe| {
+    film.stripes_mut(rows)
+        .into_par_iter()
+        .for_each_init(Profile::default, |local, mut stripe| {
             let mut counters = RayCounters::default();
             let mut samples = StripeSamples::new(&stripe, pass);
-            render_stripe(
-                &shader,
-                &camera,
-                seed,
-                pass,
-                batch,
-                &mut samples,
-                &mut stripe,
-                &mut counters,
-                local,
-            );
+            with_batch(capacity, |batch| {
+                render_stripe(
+                    &shader,
+                    &camera,
+                    seed,
+                    pass,
+                    batch,
+                    &mut samples,
+                    &mut stripe,
+                    &mut counters,
+                    local,
+                )
+            });
             let done = rows_done.fetch_add(stripe.rows(), std::sync::atomic::Ordering::Relaxed);
             progress(done + stripe.rows());
             *totals.lock().unwrap_or_else(|e| e.into_inner()) += counters;
@@ -89,10 +92,28 @@ pub(super) fn render_pass(
                 .lock()
                 .unwrap_or_else(|e| e.into_inner())
                 .take(local);
-        },
-    );
+        });
     let rays = totals.into_inner().unwrap_or_else(|e| e.into_inner());
     pass_stats(film, pass, start, discarded_before, rays)
+}
+
+thread_local! {
+    /// Each worker thread's batch, kept from band to band and pass to pass: allocated once
+    /// per thread (and again only for another batch size), never per sample or per band.
+    static BATCH: RefCell<Option<Batch>> = const { RefCell::new(None) };
+}
+
+/// Runs `f` on this thread's batch of `capacity` lanes.
+fn with_batch<R>(capacity: usize, f: impl FnOnce(&mut Batch) -> R) -> R {
+    BATCH.with(|cell| {
+        let mut slot = cell.borrow_mut();
+        let batch = match slot.take() {
+            Some(b) if b.capacity == capacity => slot.insert(b),
+            _ => slot.insert(Batch::new(capacity)),
+        };
+        batch.paths.clear();
+        f(batch)
+    })
 }
 
 /// The samples of one band in order: pixels row by row, each pixel's indices in order,
