@@ -344,64 +344,27 @@ fn stats_give_the_structure_bytes_apart_from_the_triangles() {
 fn stats_say_which_path_tracer_ran_and_cover_denoised_renders() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("lamp.toml"), lamp()).unwrap();
+    let table = |out: &str, extra: &[&str]| {
+        let mut args = vec!["lamp.toml", "--spp", "2", "--stats", "-o", out];
+        args.extend_from_slice(extra);
+        render(dir.path(), &args)
+    };
     // The default integrator is the wavefront tracer: its row gives the stage shares.
-    let table = render(
-        dir.path(),
-        &["lamp.toml", "--spp", "2", "--stats", "-q", "-o", "a.exr"],
-    );
-    let w = row(&table, "wavefront batches");
+    let w = row(&table("a.exr", &["-q"]), "wavefront batches");
     assert_eq!(w.status, "done");
     assert!(
         w.details.contains("lanes per thread") && w.details.contains("shade"),
         "{w:?}"
     );
     // The lighting split runs on the scalar tracer, and the table says so.
-    let table = render(
-        dir.path(),
-        &[
-            "lamp.toml",
-            "--spp",
-            "2",
-            "--stats",
-            "-q",
-            "--aov",
-            "direct",
-            "-o",
-            "b.exr",
-        ],
-    );
-    let s = row(&table, "scalar path tracer");
+    let split = table("b.exr", &["-q", "--aov", "direct"]);
+    let s = row(&split, "scalar path tracer");
     assert!(s.details.contains("lighting-split"), "{s:?}");
-    assert!(!table.contains("wavefront batches"), "{table}");
+    assert!(!split.contains("wavefront batches"), "{split}");
     // `--integrator path` is the scalar tracer alone.
-    let table = render(
-        dir.path(),
-        &[
-            "lamp.toml",
-            "--spp",
-            "2",
-            "--stats",
-            "-q",
-            "--integrator",
-            "path",
-            "-o",
-            "c.exr",
-        ],
-    );
-    assert!(!table.contains("wavefront batches"), "{table}");
+    let scalar = table("c.exr", &["-q", "--integrator", "path"]);
+    assert!(!scalar.contains("wavefront batches"), "{scalar}");
     // A denoised render prints the table too.
-    let table = render(
-        dir.path(),
-        &[
-            "lamp.toml",
-            "--spp",
-            "2",
-            "--stats",
-            "--denoiser",
-            "box",
-            "-o",
-            "d.exr",
-        ],
-    );
-    assert_eq!(row(&table, "wavefront batches").status, "done");
+    let denoised = table("d.exr", &["--denoiser", "box"]);
+    assert_eq!(row(&denoised, "wavefront batches").status, "done");
 }

@@ -120,14 +120,9 @@ material = "frosted"
 /// Renders `(integrator, spp, seed)` on two threads with a fraction `dropped` of the shadow
 /// rays reported occluded (0 for the real renderer).
 fn film(scene: &rt_core::Scene, (integrator, spp, seed): Render, dropped: f64) -> Film {
-    let renderer = Renderer::new(scene).threads(2);
-    let mutant = DroppedShadowRays {
-        inner: renderer.accel(),
-        fraction: dropped,
-    };
-    let renderer = Renderer::new(scene).with_accel(&mutant).threads(2);
-    let buffers = FilmBuffers::from(AovSet::default()).with_variance();
-    renderer.render(integrator, buffers, spp, seed).0
+    weakened(scene, dropped, &|r, buffers| {
+        r.render(integrator, buffers, spp, seed).0
+    })
 }
 
 type Render<'a> = (&'a dyn Integrator, u32, u32);
@@ -138,14 +133,28 @@ fn technique_film(
     (technique, spp, seed): (&dyn Technique, u32, u32),
     dropped: f64,
 ) -> Film {
-    let renderer = Renderer::new(scene).threads(2);
+    weakened(scene, dropped, &|r, buffers| {
+        r.render_technique(technique, buffers, spp, seed).0
+    })
+}
+
+/// `render` through a two-thread renderer whose structure reports a fraction `dropped` of
+/// the shadow rays occluded, into a film that keeps the variance.
+fn weakened(
+    scene: &rt_core::Scene,
+    dropped: f64,
+    render: &dyn Fn(&Renderer<'_>, FilmBuffers) -> Film,
+) -> Film {
+    let plain = Renderer::new(scene).threads(2);
     let mutant = DroppedShadowRays {
-        inner: renderer.accel(),
+        inner: plain.accel(),
         fraction: dropped,
     };
     let renderer = Renderer::new(scene).with_accel(&mutant).threads(2);
-    let buffers = FilmBuffers::from(AovSet::default()).with_variance();
-    renderer.render_technique(technique, buffers, spp, seed).0
+    render(
+        &renderer,
+        FilmBuffers::from(AovSet::default()).with_variance(),
+    )
 }
 
 /// Renders `nee` (with next-event estimation) and `bsdf` (BSDF sampling only), each given with
