@@ -16,7 +16,7 @@
 //! are delta lobes, which light sampling skips.
 
 use crate::radiance_cache::{CacheRef, CacheTrail, RadianceCache, DIFFUSE_DOMINATED};
-use crate::transport::{light_visible, survives_roulette};
+use crate::transport::{emission_weight, light_visible, survives_roulette};
 use crate::{Ctx, Integrator, RayCounters, SampleAux};
 use rt_core::material::{Bsdf, LayerClass};
 use rt_core::{lights::LightSampler, sampling::power_heuristic, Ray, Rgb, Sampler};
@@ -194,11 +194,9 @@ impl Integrator for PathIntegrator {
             let Some(hit) = ctx.accel.intersect(&ray, f32::INFINITY) else {
                 let le = scene.environment.radiance(ray.dir);
                 if le.max_element() > 0.0 {
-                    let w = if prev_delta || !use_nee {
-                        1.0
-                    } else {
-                        power_heuristic(prev_pdf, lights.pdf_env(scene, ray.dir))
-                    };
+                    let w = emission_weight(prev_delta, use_nee, prev_pdf, || {
+                        lights.pdf_env(scene, ray.dir)
+                    });
                     l += beta * le * w;
                     if want_split {
                         let share = tracker.diffuse_share;
@@ -212,12 +210,9 @@ impl Integrator for PathIntegrator {
             let wo = -ray.dir;
             let le = material.emitted(si.ng, wo);
             if le.max_element() > 0.0 {
-                let w = if prev_delta || !use_nee {
-                    1.0
-                } else {
-                    let pdf_light = lights.pdf_triangle(scene, si.prim, prev_p, si.p, si.ng);
-                    power_heuristic(prev_pdf, pdf_light)
-                };
+                let w = emission_weight(prev_delta, use_nee, prev_pdf, || {
+                    lights.pdf_triangle(scene, si.prim, prev_p, si.p, si.ng)
+                });
                 l += beta * le * w;
                 if want_split {
                     let share = tracker.diffuse_share;

@@ -69,12 +69,60 @@ pub(crate) fn light_visible(
     time: f32,
     ls: &LightSample,
 ) -> bool {
+    let q = shadow_query(p, p_error, ng, time, ls);
+    match q.toward {
+        Some(target) => !ctx.accel.occluded_toward(&q.ray, q.t_max, target),
+        None => !ctx.accel.occluded(&q.ray, q.t_max),
+    }
+}
+
+/// The shadow ray [`light_visible`] traces: the ray, its extent, and the light-side point it
+/// aims at (`None` for the environment).
+pub(crate) struct ShadowQuery {
+    pub ray: rt_core::Ray,
+    pub t_max: f32,
+    pub toward: Option<Vec3>,
+}
+
+/// The shadow ray of light sample `ls` from surface point `p` (see [`light_visible`]).
+#[inline]
+pub(crate) fn shadow_query(
+    p: Vec3,
+    p_error: Vec3,
+    ng: Vec3,
+    time: f32,
+    ls: &LightSample,
+) -> ShadowQuery {
     if ls.dist.is_infinite() {
-        let r = spawn_ray(p, p_error, ng, ls.wi).at_time(time);
-        !ctx.accel.occluded(&r, f32::INFINITY)
+        ShadowQuery {
+            ray: spawn_ray(p, p_error, ng, ls.wi).at_time(time),
+            t_max: f32::INFINITY,
+            toward: None,
+        }
     } else {
         let (r, t_max) = shadow_segment(p, p_error, ng, ls.point, ls.point_error, ls.normal);
-        !ctx.accel.occluded_toward(&r.at_time(time), t_max, ls.point)
+        ShadowQuery {
+            ray: r.at_time(time),
+            t_max,
+            toward: Some(ls.point),
+        }
+    }
+}
+
+/// MIS weight of emission found by BSDF sampling: 1 after a delta bounce or without light
+/// sampling, else the power heuristic of the BSDF pdf `prev_pdf` against light sampling's pdf
+/// for the same point (`light_pdf`, only evaluated when needed).
+#[inline]
+pub(crate) fn emission_weight(
+    prev_delta: bool,
+    use_nee: bool,
+    prev_pdf: f32,
+    light_pdf: impl FnOnce() -> f32,
+) -> f32 {
+    if prev_delta || !use_nee {
+        1.0
+    } else {
+        rt_core::sampling::power_heuristic(prev_pdf, light_pdf())
     }
 }
 

@@ -16,6 +16,7 @@ use super::Wavefront;
 use crate::driver::{pass_stats, CameraSampling, RenderStats, SamplePass};
 use crate::{Ctx, RayCounters};
 use rayon::prelude::*;
+use rt_core::glam::Vec3;
 use rt_core::{Rgb, Sampler};
 use rt_film::{Film, FilmStripe};
 use std::cell::RefCell;
@@ -243,7 +244,7 @@ fn render_stripe(
             {
                 batch.shadow_rays.push(q.ray);
                 batch.shadow_t_max.push(q.t_max);
-                batch.shadow_toward.push(q.toward);
+                batch.shadow_toward.push(q.toward.unwrap_or(Vec3::INFINITY));
                 batch.shadow.push(pending);
             }
         }

@@ -3,13 +3,12 @@
 //! step for step and in the same order, so a sample gives the same bits in both.
 
 use super::lanes::{PathState, PendingShadow, VertexDraws};
-use crate::transport::survives_roulette;
+use crate::transport::{emission_weight, shadow_query, survives_roulette, ShadowQuery};
 use crate::{Ctx, PathIntegrator};
-use rt_core::lights::{LightSample, LightSampler};
+use rt_core::lights::LightSampler;
 use rt_core::material::Bsdf;
-use rt_core::ray::{shadow_segment, spawn_ray};
 use rt_core::sampling::power_heuristic;
-use rt_core::{glam::Vec3, Hit, Ray};
+use rt_core::Hit;
 
 /// What shading needs besides the lane: the estimator's settings and the scene's lights.
 pub(crate) struct Shader<'a> {
@@ -18,14 +17,6 @@ pub(crate) struct Shader<'a> {
     pub lights: &'a LightSampler,
     pub use_nee: bool,
     pub want_first_hit: bool,
-}
-
-/// A shadow ray to trace: the ray, its extent and the light-side point it aims at (infinite
-/// for the environment).
-pub(crate) struct ShadowQuery {
-    pub ray: Ray,
-    pub t_max: f32,
-    pub toward: Vec3,
 }
 
 impl Shader<'_> {
@@ -46,11 +37,9 @@ impl Shader<'_> {
         let Some(hit) = hit else {
             let le = scene.environment.radiance(ray.dir);
             if le.max_element() > 0.0 {
-                let w = if path.prev_delta || !self.use_nee {
-                    1.0
-                } else {
-                    power_heuristic(path.prev_pdf, lights.pdf_env(scene, ray.dir))
-                };
+                let w = emission_weight(path.prev_delta, self.use_nee, path.prev_pdf, || {
+                    lights.pdf_env(scene, ray.dir)
+                });
                 path.l += path.beta * le * w;
             }
             path.done = true;
@@ -61,12 +50,9 @@ impl Shader<'_> {
         let wo = -ray.dir;
         let le = material.emitted(si.ng, wo);
         if le.max_element() > 0.0 {
-            let w = if path.prev_delta || !self.use_nee {
-                1.0
-            } else {
-                let pdf_light = lights.pdf_triangle(scene, si.prim, path.prev_p, si.p, si.ng);
-                power_heuristic(path.prev_pdf, pdf_light)
-            };
+            let w = emission_weight(path.prev_delta, self.use_nee, path.prev_pdf, || {
+                lights.pdf_triangle(scene, si.prim, path.prev_p, si.p, si.ng)
+            });
             path.l += path.beta * le * w;
         }
         let max_depth = self.settings.max_depth;
@@ -123,25 +109,5 @@ impl Shader<'_> {
             path.done = true;
         }
         shadow
-    }
-}
-
-/// The shadow ray of light sample `ls` from surface point `p` (as
-/// [`crate::transport::light_visible`] traces it).
-#[inline]
-fn shadow_query(p: Vec3, p_error: Vec3, ng: Vec3, time: f32, ls: &LightSample) -> ShadowQuery {
-    if ls.dist.is_infinite() {
-        ShadowQuery {
-            ray: spawn_ray(p, p_error, ng, ls.wi).at_time(time),
-            t_max: f32::INFINITY,
-            toward: Vec3::INFINITY,
-        }
-    } else {
-        let (r, t_max) = shadow_segment(p, p_error, ng, ls.point, ls.point_error, ls.normal);
-        ShadowQuery {
-            ray: r.at_time(time),
-            t_max,
-            toward: ls.point,
-        }
     }
 }
