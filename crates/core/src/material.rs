@@ -296,6 +296,20 @@ impl Material {
         }
     }
 
+    /// `colour · tint · weight / π` for a material that is one plain Lambertian layer (one
+    /// colour at all angles, no coat, no transmission) of positive weight: its BSDF value at
+    /// every pair of directions on one side, the same bits [`Bsdf`] uses. `None` for any other
+    /// material. Shading kernels that handle only this case ask here.
+    #[inline]
+    pub fn plain_lambert(&self, tint: Rgb) -> Option<Rgb> {
+        match self.layers.as_slice() {
+            [l] if is_plain_lambert(l) && l.weight > 0.0 => {
+                Some(l.color * tint * FRAC_1_PI * l.weight)
+            }
+            _ => None,
+        }
+    }
+
     /// Number of faces that emit (for light power).
     pub fn emitting_faces(&self) -> f32 {
         if self.two_sided {
@@ -396,13 +410,9 @@ impl<'a> Bsdf<'a> {
             has_non_delta |= *w > 0.0 && !l.is_delta();
         }
         let total = weights.iter().sum();
-        // `color_at` of a plain Lambertian layer is `color · tint` at every angle.
-        let lambert = match material.layers.as_slice() {
-            [l] if is_plain_lambert(l) && weights[0] > 0.0 => {
-                Some(l.color * tint * FRAC_1_PI * weights[0])
-            }
-            _ => None,
-        };
+        // `color_at` of a plain Lambertian layer is `color · tint` at every angle, and its
+        // one weight is `1 · weight`.
+        let lambert = material.plain_lambert(tint);
         Self {
             layers: &material.layers,
             tint,

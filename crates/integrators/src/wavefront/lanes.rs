@@ -6,6 +6,7 @@
 //! wavefront sample sees exactly the numbers the scalar path tracer's sample sees.
 #![allow(unsafe_code)] // the call into the AVX2 kernel, behind runtime detection
 
+use crate::transport::ShadowQuery;
 use rt_core::glam::{Vec2, Vec3};
 use rt_core::sampler::{draw_1d, draw_2d};
 use rt_core::{Hit, Ray, Rgb, SampleKey};
@@ -57,6 +58,45 @@ pub(crate) struct PendingShadow {
     pub contribution: Rgb,
 }
 
+/// The shadow rays of one round, as the stream query takes them, and the lanes they serve.
+pub(crate) struct ShadowQueue {
+    pub rays: Vec<Ray>,
+    pub t_max: Vec<f32>,
+    /// The light point, or infinity for the environment.
+    pub toward: Vec<Vec3>,
+    pub occluded: Vec<bool>,
+    pub pending: Vec<PendingShadow>,
+}
+
+impl ShadowQueue {
+    fn new(capacity: usize) -> Self {
+        Self {
+            rays: Vec::with_capacity(capacity),
+            t_max: Vec::with_capacity(capacity),
+            toward: Vec::with_capacity(capacity),
+            occluded: vec![false; capacity],
+            pending: Vec::with_capacity(capacity),
+        }
+    }
+
+    pub fn clear(&mut self) {
+        self.rays.clear();
+        self.t_max.clear();
+        self.toward.clear();
+        self.pending.clear();
+    }
+
+    #[inline]
+    pub fn push(&mut self, shadow: Option<(ShadowQuery, PendingShadow)>) {
+        if let Some((q, pending)) = shadow {
+            self.rays.push(q.ray);
+            self.t_max.push(q.t_max);
+            self.toward.push(q.toward.unwrap_or(Vec3::INFINITY));
+            self.pending.push(pending);
+        }
+    }
+}
+
 /// Every buffer of one thread's batch, allocated once.
 pub(crate) struct Batch {
     pub capacity: usize,
@@ -67,11 +107,9 @@ pub(crate) struct Batch {
     pub keys: Vec<SampleKey>,
     pub dims: Vec<u32>,
     pub draws: Vec<VertexDraws>,
-    pub shadow_rays: Vec<Ray>,
-    pub shadow_t_max: Vec<f32>,
-    pub shadow_toward: Vec<Vec3>,
-    pub shadow_occluded: Vec<bool>,
-    pub shadow: Vec<PendingShadow>,
+    pub shadows: ShadowQueue,
+    /// This round's plain Lambertian vertices, for the vectorised BSDF stage.
+    pub lambert: super::lambert::LambertQueue,
 }
 
 impl Batch {
@@ -85,11 +123,8 @@ impl Batch {
             keys: Vec::with_capacity(capacity),
             dims: Vec::with_capacity(capacity),
             draws: vec![VertexDraws::default(); capacity],
-            shadow_rays: Vec::with_capacity(capacity),
-            shadow_t_max: Vec::with_capacity(capacity),
-            shadow_toward: Vec::with_capacity(capacity),
-            shadow_occluded: vec![false; capacity],
-            shadow: Vec::with_capacity(capacity),
+            shadows: ShadowQueue::new(capacity),
+            lambert: super::lambert::LambertQueue::new(capacity),
         }
     }
 }

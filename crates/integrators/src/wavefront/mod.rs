@@ -25,10 +25,12 @@
 
 #[cfg(target_arch = "x86_64")]
 mod draws_avx2;
+mod lambert;
 mod lanes;
 mod pass;
 mod profile;
 mod shade;
+mod simd;
 
 use crate::driver::{render_samples, RenderStats, SamplePass};
 use crate::technique::{Technique, TechniqueStage};

@@ -16,7 +16,6 @@ use super::Wavefront;
 use crate::driver::{pass_stats, CameraSampling, RenderStats, SamplePass};
 use crate::{Ctx, RayCounters};
 use rayon::prelude::*;
-use rt_core::glam::Vec3;
 use rt_core::{Rgb, Sampler};
 use rt_film::{Film, FilmStripe};
 use std::cell::RefCell;
@@ -234,33 +233,48 @@ fn render_stripe(
         profile.lap(Stage::Draw, &mut clock);
 
         // Shade; collect the shadow rays.
-        batch.shadow.clear();
-        batch.shadow_rays.clear();
-        batch.shadow_t_max.clear();
-        batch.shadow_toward.clear();
+        batch.shadows.clear();
+        batch.lambert.clear();
         for (k, path) in batch.paths.iter_mut().enumerate() {
-            if let Some((q, pending)) =
-                shader.vertex(path, batch.hits[k], &batch.draws[k], k as u32)
-            {
-                batch.shadow_rays.push(q.ray);
-                batch.shadow_t_max.push(q.t_max);
-                batch.shadow_toward.push(q.toward.unwrap_or(Vec3::INFINITY));
-                batch.shadow.push(pending);
-            }
+            let shadow = shader.vertex(
+                path,
+                batch.hits[k],
+                &batch.draws[k],
+                k as u32,
+                &mut batch.lambert,
+            );
+            batch.shadows.push(shadow);
         }
         profile.lap(Stage::Shade, &mut clock);
 
+        // The plain Lambertian vertices' BSDF stage, eight lanes at a time.
+        batch.lambert.run();
+        for j in 0..batch.lambert.len() {
+            let lane = batch.lambert.lane[j];
+            let shadow = shader.finish_lambert(
+                &mut batch.paths[lane as usize],
+                &batch.lambert.surface[j],
+                batch.lambert.light[j].as_ref(),
+                &batch.lambert.result(j),
+                batch.draws[lane as usize].rr,
+                lane,
+            );
+            batch.shadows.push(shadow);
+        }
+        profile.lap(Stage::Bsdf, &mut clock);
+
         // Shadow rays, one stream.
-        let m = batch.shadow.len();
+        let shadows = &mut batch.shadows;
+        let m = shadows.pending.len();
         if m > 0 {
             accel.occluded_stream(
-                &batch.shadow_rays,
-                &batch.shadow_t_max,
-                &batch.shadow_toward,
-                &mut batch.shadow_occluded[..m],
+                &shadows.rays,
+                &shadows.t_max,
+                &shadows.toward,
+                &mut shadows.occluded[..m],
             );
             counters.shadow_rays += m as u64;
-            for (s, &occluded) in batch.shadow.iter().zip(&batch.shadow_occluded[..m]) {
+            for (s, &occluded) in shadows.pending.iter().zip(&shadows.occluded[..m]) {
                 if !occluded {
                     batch.paths[s.lane as usize].l += s.contribution;
                 }

@@ -12,8 +12,10 @@ pub(crate) enum Stage {
     Trace,
     /// The vertex's random numbers, all lanes at once.
     Draw,
-    /// Emission, light sampling, BSDF sampling, roulette.
+    /// Emission, light sampling, BSDF sampling, roulette (lane by lane).
     Shade,
+    /// The plain Lambertian vertices' BSDF, eight lanes at a time, and their finish.
+    Bsdf,
     /// Shadow-ray stream and its contributions.
     Shadow,
     /// Finished paths into the film, compaction.
@@ -21,11 +23,12 @@ pub(crate) enum Stage {
 }
 
 impl Stage {
-    pub const ALL: [Stage; 6] = [
+    pub const ALL: [Stage; 7] = [
         Stage::Generate,
         Stage::Trace,
         Stage::Draw,
         Stage::Shade,
+        Stage::Bsdf,
         Stage::Shadow,
         Stage::Accumulate,
     ];
@@ -36,6 +39,7 @@ impl Stage {
             Stage::Trace => "trace",
             Stage::Draw => "sample draws",
             Stage::Shade => "shade",
+            Stage::Bsdf => "lambert bsdf",
             Stage::Shadow => "shadow rays",
             Stage::Accumulate => "accumulate",
         }
@@ -45,7 +49,7 @@ impl Stage {
 /// Per-stage time (summed over threads) and batch occupancy.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Profile {
-    pub time: [Duration; 6],
+    pub time: [Duration; 7],
     /// Rounds run, lanes busy over all rounds, lane slots over all rounds.
     pub rounds: u64,
     pub busy: u64,
