@@ -5,12 +5,13 @@
 //!
 //! The kernel is [`rt_core::material::Bsdf`]'s arithmetic for such a layer (`Frame::from_normal`,
 //! `sides`, `eval_pdf`'s Lambertian branch, `sample`, `cosine_hemisphere`, the power heuristic)
-//! written once against [`Lanes`], in the same order, so the AVX and the one-lane forms and the
-//! scalar tracer give the same bits (the wavefront tests compare whole images). The one step not
+//! written once on eight lanes ([`L8`]), in the same order, so the AVX and the portable forms and
+//! the scalar tracer give the same bits (the tests here compare every lane with `Bsdf`; the
+//! wavefront tests compare whole images). The one step not
 //! vectorised is the concentric map's sine and cosine, evaluated lane by lane with `f32::sin`
 //! and `f32::cos` as the scalar tracer does.
 
-use super::simd::{Lanes, L1};
+use super::simd::{L8, LANES, M8};
 use rt_core::glam::Vec3;
 use rt_core::lights::LightSample;
 use rt_core::scene::SurfaceHit;
@@ -47,16 +48,16 @@ impl Column3 {
     }
 
     #[inline(always)]
-    fn load<V: Lanes>(&self, k: usize) -> V3<V> {
+    fn load(&self, k: usize) -> V3 {
         V3 {
-            x: V::load(&self.x[k..]),
-            y: V::load(&self.y[k..]),
-            z: V::load(&self.z[k..]),
+            x: L8::load(&self.x[k..]),
+            y: L8::load(&self.y[k..]),
+            z: L8::load(&self.z[k..]),
         }
     }
 
     #[inline(always)]
-    fn store<V: Lanes>(&mut self, k: usize, v: V3<V>) {
+    fn store(&mut self, k: usize, v: V3) {
         v.x.store(&mut self.x[k..]);
         v.y.store(&mut self.y[k..]);
         v.z.store(&mut self.z[k..]);
@@ -65,16 +66,16 @@ impl Column3 {
 
 /// Three lanes-wide components (a vector per lane).
 #[derive(Clone, Copy)]
-struct V3<V> {
-    x: V,
-    y: V,
-    z: V,
+struct V3 {
+    x: L8,
+    y: L8,
+    z: L8,
 }
 
-impl<V: Lanes> V3<V> {
+impl V3 {
     /// `Vec3::dot`: `(x·x') + (y·y') + (z·z')`.
     #[inline(always)]
-    fn dot(self, o: Self) -> V {
+    fn dot(self, o: Self) -> L8 {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
 
@@ -88,7 +89,7 @@ impl<V: Lanes> V3<V> {
     }
 
     #[inline(always)]
-    fn scale(self, s: V) -> Self {
+    fn scale(self, s: L8) -> Self {
         V3 {
             x: self.x * s,
             y: self.y * s,
@@ -97,37 +98,37 @@ impl<V: Lanes> V3<V> {
     }
 
     #[inline(always)]
-    fn select(m: V::Mask, a: Self, b: Self) -> Self {
+    fn select(m: M8, a: Self, b: Self) -> Self {
         V3 {
-            x: V::select(m, a.x, b.x),
-            y: V::select(m, a.y, b.y),
-            z: V::select(m, a.z, b.z),
+            x: L8::select(m, a.x, b.x),
+            y: L8::select(m, a.y, b.y),
+            z: L8::select(m, a.z, b.z),
         }
     }
 
     /// True where some component is positive: `Vec3::max_element() > 0` (NaN components
     /// count as not positive in both).
     #[inline(always)]
-    fn any_positive(self) -> V::Mask {
-        let zero = V::splat(0.0);
+    fn any_positive(self) -> M8 {
+        let zero = L8::splat(0.0);
         self.x.gt(zero) | self.y.gt(zero) | self.z.gt(zero)
     }
 }
 
 /// `rt_core::Frame` (Duff et al. 2017) around unit normal `n`.
 #[derive(Clone, Copy)]
-struct Frame<V> {
-    s: V3<V>,
-    t: V3<V>,
-    n: V3<V>,
+struct Frame {
+    s: V3,
+    t: V3,
+    n: V3,
 }
 
-impl<V: Lanes> Frame<V> {
+impl Frame {
     #[inline(always)]
-    fn from_normal(n: V3<V>) -> Self {
-        let one = V::splat(1.0);
+    fn from_normal(n: V3) -> Self {
+        let one = L8::splat(1.0);
         let sign = n.z.sign_one();
-        let a = V::splat(-1.0) / (sign + n.z);
+        let a = L8::splat(-1.0) / (sign + n.z);
         let b = n.x * n.y * a;
         let s = V3 {
             x: one + sign * n.x * n.x * a,
@@ -143,7 +144,7 @@ impl<V: Lanes> Frame<V> {
     }
 
     #[inline(always)]
-    fn to_local(self, v: V3<V>) -> V3<V> {
+    fn to_local(self, v: V3) -> V3 {
         V3 {
             x: v.dot(self.s),
             y: v.dot(self.t),
@@ -153,7 +154,7 @@ impl<V: Lanes> Frame<V> {
 
     /// `s·v.x + t·v.y + n·v.z`, summed left to right as `Vec3` does.
     #[inline(always)]
-    fn to_world(self, v: V3<V>) -> V3<V> {
+    fn to_world(self, v: V3) -> V3 {
         V3 {
             x: self.s.x * v.x + self.t.x * v.y + self.n.x * v.z,
             y: self.s.y * v.x + self.t.y * v.y + self.n.y * v.z,
@@ -200,7 +201,7 @@ pub(crate) struct LambertResult {
 impl LambertQueue {
     /// Room for `capacity` vertices (rounded up to whole vectors).
     pub fn new(capacity: usize) -> Self {
-        let n = capacity.div_ceil(8) * 8;
+        let n = capacity.div_ceil(LANES) * LANES;
         let column = || vec![0.0; n];
         Self {
             len: 0,
@@ -289,36 +290,33 @@ impl LambertQueue {
 
     /// `run`, with the AVX form allowed or not (tests compare the two).
     fn run_with(&mut self, allow_avx: bool) {
-        let mut k = 0;
+        // Pad the last vector with copies of a queued vertex so every lane computes
+        // something finite; the copies' results are never read.
+        let padded = self.len.div_ceil(LANES) * LANES;
+        for j in self.len..padded {
+            self.copy_inputs(0, j);
+        }
         #[cfg(target_arch = "x86_64")]
         if allow_avx && std::arch::is_x86_feature_detected!("avx") {
-            // Pad the last vector with copies of a queued vertex so every lane computes
-            // something finite; the copies' results are never read.
-            let padded = self.len.div_ceil(8) * 8;
-            for j in self.len..padded {
-                self.copy_inputs(0, j);
-            }
             self.run_avx(padded);
-            k = padded;
+            return;
         }
-        while k < self.len {
-            vertex::<L1>(self, k);
-            k += 1;
+        let _ = allow_avx;
+        for k in (0..padded).step_by(LANES) {
+            vertex(self, k);
         }
     }
 
     #[cfg(target_arch = "x86_64")]
-    #[allow(unsafe_code)] // the call into the AVX kernel, behind the check in `run`
+    #[allow(unsafe_code)] // the call into the AVX form, behind the check in `run_with`
     fn run_avx(&mut self, padded: usize) {
         #[target_feature(enable = "avx")]
         fn kernel(q: &mut LambertQueue, padded: usize) {
-            let mut k = 0;
-            while k < padded {
-                vertex::<super::simd::avx::L8>(q, k);
-                k += 8;
+            for k in (0..padded).step_by(LANES) {
+                vertex(q, k);
             }
         }
-        // SAFETY: `run` checked that the CPU supports AVX, `kernel`'s only requirement.
+        // SAFETY: `run_with` checked that the CPU supports AVX, `kernel`'s only requirement.
         unsafe { kernel(self, padded) }
     }
 
@@ -355,106 +353,110 @@ impl LambertQueue {
     }
 }
 
-/// `Bsdf::sides` for a world direction `wi` and its local form `wi_local`: whether the pair is
-/// consistent (`valid`) and, if so, a reflection (`reflect`).
-#[inline(always)]
-fn sides<V: Lanes>(
-    wi: V3<V>,
-    wi_local: V3<V>,
-    wo_ng_front: V::Mask,
-    wo_local_front: V::Mask,
-    ng: V3<V>,
-) -> (V::Mask, V::Mask) {
-    let zero = V::splat(0.0);
-    let geo_same = V::same(wi.dot(ng).gt(zero), wo_ng_front);
-    let sh_same = V::same(wi_local.z.gt(zero), wo_local_front);
-    let valid = !wi_local.z.eq(zero) & V::same(geo_same, sh_same);
-    (valid, geo_same)
+/// What `Bsdf::sides` needs of the vertex: its frame, geometric normal, and on which side of
+/// each normal `wo` lies.
+#[derive(Clone, Copy)]
+struct Side {
+    frame: Frame,
+    ng: V3,
+    wo_ng_front: M8,
+    wo_local_front: M8,
+}
+
+impl Side {
+    /// `Bsdf::sides` for a world direction `wi` and its local form `wi_local`: whether the pair
+    /// is consistent (`valid`) and, if so, a reflection (`reflect`).
+    #[inline(always)]
+    fn sides(self, wi: V3, wi_local: V3) -> (M8, M8) {
+        let zero = L8::splat(0.0);
+        let geo_same = wi.dot(self.ng).gt(zero).same(self.wo_ng_front);
+        let sh_same = wi_local.z.gt(zero).same(self.wo_local_front);
+        let valid = !wi_local.z.eq(zero) & geo_same.same(sh_same);
+        (valid, geo_same)
+    }
+
+    /// `(f, pdf)` of `Bsdf::eval_pdf` for a Lambertian layer of value `f`: zero unless `wi` is
+    /// a reflection.
+    #[inline(always)]
+    fn eval(self, f: V3, wi: V3) -> (V3, L8) {
+        let zero = L8::splat(0.0);
+        let wi_local = self.frame.to_local(wi);
+        let (valid, reflect) = self.sides(wi, wi_local);
+        let ok = valid & reflect;
+        let none = V3 {
+            x: zero,
+            y: zero,
+            z: zero,
+        };
+        let pdf = wi_local.z.abs() * L8::splat(FRAC_1_PI);
+        (V3::select(ok, f, none), L8::select(ok, pdf, zero))
+    }
 }
 
 /// `power_heuristic(f, g)`.
 #[inline(always)]
-fn power_heuristic<V: Lanes>(f: V, g: V) -> V {
+fn power_heuristic(f: L8, g: L8) -> L8 {
     let (f2, g2) = (f * f, g * g);
-    let zero = V::splat(0.0);
+    let zero = L8::splat(0.0);
     let w = f2 / (f2 + g2);
-    let w = V::select((f2 + g2).eq(zero), zero, w);
-    V::select(f2.abs().eq(V::splat(f32::INFINITY)), V::splat(1.0), w)
+    let w = L8::select((f2 + g2).eq(zero), zero, w);
+    L8::select(f2.abs().eq(L8::splat(f32::INFINITY)), L8::splat(1.0), w)
 }
 
-/// `concentric_disk(u)`'s sine and cosine, lane by lane with the standard library.
+/// `concentric_disk(u)`'s cosine and sine, lane by lane with the standard library.
 #[inline(always)]
-fn cos_sin<V: Lanes>(theta: V) -> (V, V) {
-    let mut t = [0.0f32; 8];
-    let (mut c, mut s) = ([0.0f32; 8], [0.0f32; 8]);
-    theta.store(&mut t);
-    for j in 0..V::N {
-        c[j] = t[j].cos();
-        s[j] = t[j].sin();
-    }
-    (V::load(&c), V::load(&s))
+fn cos_sin(theta: L8) -> (L8, L8) {
+    (L8(theta.0.map(f32::cos)), L8(theta.0.map(f32::sin)))
 }
 
 /// One vector of queued vertices from index `k`.
 #[inline(always)]
-fn vertex<V: Lanes>(q: &mut LambertQueue, k: usize) {
-    let zero = V::splat(0.0);
-    let one = V::splat(1.0);
-    let frac_1_pi = V::splat(FRAC_1_PI);
-    let ns = q.ns.load::<V>(k);
-    let ng = q.ng.load::<V>(k);
-    let wo = q.wo.load::<V>(k);
-    let f = q.f.load::<V>(k);
-    let beta = q.beta.load::<V>(k);
+fn vertex(q: &mut LambertQueue, k: usize) {
+    let zero = L8::splat(0.0);
+    let one = L8::splat(1.0);
+    let ns = q.ns.load(k);
+    let ng = q.ng.load(k);
+    let wo = q.wo.load(k);
+    let f = q.f.load(k);
+    let beta = q.beta.load(k);
     let frame = Frame::from_normal(ns);
     let wo_local = frame.to_local(wo);
     let wo_ng_front = wo.dot(ng).gt(zero);
     let wo_local_front = wo_local.z.gt(zero);
-    // `(f, pdf)` of `Bsdf::eval_pdf` for a Lambertian layer: zero unless `wi` is a reflection.
-    let eval = |wi: V3<V>| {
-        let wi_local = frame.to_local(wi);
-        let (valid, reflect) = sides(wi, wi_local, wo_ng_front, wo_local_front, ng);
-        let ok = valid & reflect;
-        let f = V3::select(
-            ok,
-            f,
-            V3 {
-                x: zero,
-                y: zero,
-                z: zero,
-            },
-        );
-        (f, V::select(ok, wi_local.z.abs() * frac_1_pi, zero))
+    let shading = Side {
+        frame,
+        ng,
+        wo_ng_front,
+        wo_local_front,
     };
 
     // The light sample: f, MIS weight and contribution.
-    let light_wi = q.light_wi.load::<V>(k);
-    let light_pdf = V::load(&q.light_pdf[k..]);
-    let (fl, bsdf_pdf) = eval(light_wi);
+    let light_wi = q.light_wi.load(k);
+    let light_pdf = L8::load(&q.light_pdf[k..]);
+    let (fl, bsdf_pdf) = shading.eval(f, light_wi);
     let cos = light_wi.dot(ns).abs();
-    let contributes = V::load(&q.has_light[k..]).gt(zero) & fl.any_positive() & cos.gt(zero);
+    let contributes = L8::load(&q.has_light[k..]).gt(zero) & fl.any_positive() & cos.gt(zero);
     let w = power_heuristic(light_pdf, bsdf_pdf);
-    let le = q.light_le.load::<V>(k);
+    let le = q.light_le.load(k);
     let c = beta.mul(fl).mul(le).scale(cos * w / light_pdf);
     q.contribution.store(k, c);
-    V::select(contributes, one, zero).store(&mut q.contributes[k..]);
+    L8::select(contributes, one, zero).store(&mut q.contributes[k..]);
 
     // The cosine-weighted sample (`sample_lobe`, `cosine_hemisphere`, `concentric_disk`).
-    let ox = V::splat(2.0) * V::load(&q.u0[k..]) - one;
-    let oy = V::splat(2.0) * V::load(&q.u1[k..]) - one;
+    let ox = L8::splat(2.0) * L8::load(&q.u0[k..]) - one;
+    let oy = L8::splat(2.0) * L8::load(&q.u1[k..]) - one;
     let centre = ox.eq(zero) & oy.eq(zero);
     let x_major = ox.abs().gt(oy.abs());
-    let r = V::select(x_major, ox, oy);
-    let theta = V::select(
-        x_major,
-        V::splat(FRAC_PI_4) * (oy / ox),
-        V::splat(FRAC_PI_2) - V::splat(FRAC_PI_4) * (ox / oy),
-    );
+    let r = L8::select(x_major, ox, oy);
+    // `oy / ox` where x is the major axis, else `ox / oy`: one division for both branches.
+    let ratio = L8::select(x_major, oy, ox) / r;
+    let quarter = L8::splat(FRAC_PI_4) * ratio;
+    let theta = L8::select(x_major, quarter, L8::splat(FRAC_PI_2) - quarter);
     let (cos_t, sin_t) = cos_sin(theta);
-    let dx = V::select(centre, zero, r * cos_t);
-    let dy = V::select(centre, zero, r * sin_t);
+    let dx = L8::select(centre, zero, r * cos_t);
+    let dy = L8::select(centre, zero, r * sin_t);
     let dz = (one - (dx * dx + dy * dy)).max_zero().sqrt();
-    let side = V::select(wo_local.z.ge(zero), one, V::splat(-1.0));
+    let side = L8::select(wo_local.z.ge(zero), one, L8::splat(-1.0));
     let wi_local = V3 {
         x: dx,
         y: dy,
@@ -462,13 +464,13 @@ fn vertex<V: Lanes>(q: &mut LambertQueue, k: usize) {
     };
     let wi = frame.to_world(wi_local);
     let wi = wi.scale(one / wi.dot(wi).sqrt());
-    let (valid, _) = sides(wi, wi_local, wo_ng_front, wo_local_front, ng);
-    let (fs, pdf) = eval(wi);
-    let sampled = valid & pdf.gt(zero) & pdf.abs().lt(V::splat(f32::INFINITY));
+    let (valid, _) = shading.sides(wi, wi_local);
+    let (fs, pdf) = shading.eval(f, wi);
+    let sampled = valid & pdf.gt(zero) & pdf.abs().lt(L8::splat(f32::INFINITY));
     q.wi.store(k, wi);
     q.weight.store(k, fs.scale(wi_local.z.abs() / pdf));
     pdf.store(&mut q.pdf[k..]);
-    V::select(sampled, one, zero).store(&mut q.sampled[k..]);
+    L8::select(sampled, one, zero).store(&mut q.sampled[k..]);
 }
 
 #[cfg(test)]

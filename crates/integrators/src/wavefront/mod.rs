@@ -21,7 +21,13 @@
 //! Deviations, and what is left to the scalar tracer: a render that asks for the lighting
 //! split AOVs, per-sample records (SBMF) or a world-space radiance cache runs its passes on
 //! the scalar path tracer (the same estimator, so the same image), and says so in
-//! [`Technique::stages`]. Shading is per lane; only the sample draws are SIMD so far.
+//! [`Technique::stages`].
+//!
+//! Shading is sorted by material kind: plain Lambertian vertices, the common case, go to a
+//! structure-of-arrays queue whose BSDF stage runs eight lanes at a time ([`lambert`], after
+//! Áfra et al., HPG 2016, "Local Shading Coherence Extraction for SIMD-Efficient Path Tracing
+//! on CPUs"); every other vertex, emission, surface reconstruction and light sampling are
+//! shaded one lane at a time ([`shade`]).
 
 #[cfg(target_arch = "x86_64")]
 mod draws_avx2;
