@@ -35,6 +35,7 @@ pub mod image;
 pub mod instance;
 pub mod lights;
 pub mod material;
+pub mod microfacet;
 pub mod ray;
 pub mod rng;
 pub mod sampler;
