@@ -40,6 +40,7 @@
 //! dispersive event too. Dispersion is limited to delta layers: their `eval` is zero, so light
 //! connections never need a wavelength the path does not have yet.
 
+use crate::microfacet::{LocalBsdf, Microfacet};
 use crate::{
     frame::Frame,
     sampling::{blinn_phong_half, blinn_phong_half_pdf, cosine_hemisphere},
@@ -143,6 +144,9 @@ pub struct Material {
     pub two_sided: bool,
     /// Texture (index into `Scene::textures`) that modulates every non-coat layer's colours.
     pub texture: Option<u32>,
+    /// A BSDF of Mitsuba's microfacet family in place of the layer stack (`layers` is then
+    /// empty): [`crate::microfacet`].
+    pub microfacet: Option<Microfacet>,
 }
 
 /// A material parameter outside its valid range.
@@ -168,6 +172,9 @@ pub enum MaterialError {
     /// Bad emission.
     #[error("emission must be finite, non-negative and at most {MAX_RADIANCE:e}, got {0:?}")]
     Emission([f32; 3]),
+    /// A microfacet BSDF's parameter out of range.
+    #[error("{0}")]
+    Microfacet(String),
 }
 
 fn check_color(c: Rgb, what: &str, layer: usize) -> Result<(), MaterialError> {
@@ -191,7 +198,15 @@ impl Material {
             emission: Rgb::ZERO,
             two_sided: false,
             texture: None,
+            microfacet: None,
         }
+    }
+
+    /// A material of the microfacet family ([`crate::microfacet`]).
+    pub fn microfacet(name: &str, bsdf: Microfacet) -> Self {
+        let mut m = Self::with_layers(name, Vec::new());
+        m.microfacet = Some(bsdf);
+        m
     }
 
     /// Lambertian reflector.
@@ -241,6 +256,9 @@ impl Material {
         let e = self.emission;
         if !e.is_finite() || e.min_element() < 0.0 || e.max_element() > MAX_RADIANCE {
             return Err(MaterialError::Emission(e.to_array()));
+        }
+        if let Some(m) = &self.microfacet {
+            m.validate().map_err(MaterialError::Microfacet)?;
         }
         let mut sum = 0.0;
         for (i, l) in self.layers.iter().enumerate() {
@@ -380,6 +398,8 @@ pub struct Bsdf<'a> {
     /// [`Bsdf::sample`], need no layer loop. The arithmetic is the general path's, operation
     /// for operation, so both give the same bits.
     lambert: Option<Rgb>,
+    /// The material's microfacet BSDF, which replaces the layers when present.
+    micro: Option<&'a Microfacet>,
     /// The path's wavelength, nm (`None`: an RGB path).
     wavelength: Option<f32>,
     /// Dispersive layers use their wavelength-dependent index (false: `ior` = `n_d`, as an RGB
@@ -409,7 +429,15 @@ impl<'a> Bsdf<'a> {
             }
             has_non_delta |= *w > 0.0 && !l.is_delta();
         }
-        let total = weights.iter().sum();
+        let micro = material.microfacet.as_ref();
+        let total = match micro {
+            // One "layer" of weight one: the checks of `total` below hold as for layers.
+            Some(m) => {
+                has_non_delta = m.distribution().is_some();
+                1.0
+            }
+            None => weights.iter().sum(),
+        };
         // `color_at` of a plain Lambertian layer is `color · tint` at every angle, and its
         // one weight is `1 · weight`.
         let lambert = material.plain_lambert(tint);
@@ -424,6 +452,7 @@ impl<'a> Bsdf<'a> {
             total,
             has_non_delta,
             lambert,
+            micro,
             wavelength: None,
             spectral: true,
         }
@@ -463,6 +492,10 @@ impl<'a> Bsdf<'a> {
         if self.total <= 0.0 {
             return 0.0;
         }
+        if self.micro.is_some() {
+            // The microfacet family is glossy or specular throughout.
+            return (class == LayerClass::Specular) as u8 as f32;
+        }
         let kept: f32 = self
             .layers
             .iter()
@@ -479,6 +512,14 @@ impl<'a> Bsdf<'a> {
     /// splits a vertex into its diffuse and its specular part.
     pub fn restricted(&self, class: LayerClass) -> Self {
         let mut b = self.clone();
+        if b.micro.is_some() {
+            if class != LayerClass::Specular {
+                b.micro = None;
+                b.total = 0.0;
+                b.has_non_delta = false;
+            }
+            return b;
+        }
         let mut has_non_delta = false;
         for (w, l) in b.weights.iter_mut().zip(b.layers) {
             if !class.contains(l) {
@@ -496,6 +537,9 @@ impl<'a> Bsdf<'a> {
 
     /// Reflectance at normal incidence summed over layers: the albedo AOV.
     pub fn albedo(&self) -> Rgb {
+        if let Some(m) = self.micro {
+            return m.albedo();
+        }
         self.layers
             .iter()
             .zip(&self.weights)
@@ -538,6 +582,9 @@ impl<'a> Bsdf<'a> {
         if let Some(f) = self.lambert {
             return lambert_eval_pdf(f, wi_local, reflect);
         }
+        if let Some(m) = self.micro {
+            return m.eval_pdf(self.wo_local, wi_local);
+        }
         let mut f = Rgb::ZERO;
         let mut pdf = 0.0;
         for (l, &w) in self.layers.iter().zip(&self.weights) {
@@ -556,6 +603,9 @@ impl<'a> Bsdf<'a> {
     pub fn sample(&self, u_layer: f32, u: Vec2) -> Option<BsdfSample> {
         if self.total <= 0.0 {
             return None;
+        }
+        if let Some(m) = self.micro {
+            return self.sample_microfacet(m, u_layer, u);
         }
         // Pick a layer in proportion to its weight; rounding past the end lands on the last
         // layer with weight.
@@ -623,6 +673,24 @@ impl<'a> Bsdf<'a> {
             delta: false,
             transmitted: !reflect,
             wavelength,
+        })
+    }
+}
+
+impl Bsdf<'_> {
+    /// [`Bsdf::sample`] for a microfacet material: the local sample in world space, kept only
+    /// where it is consistent with the geometric normal too.
+    fn sample_microfacet(&self, m: &Microfacet, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        let s = m.sample(self.wo_local, u_lobe, u)?;
+        let wi = self.frame.to_world(s.wi).normalize();
+        let reflect = self.sides(wi, s.wi)?;
+        Some(BsdfSample {
+            wi,
+            weight: s.weight,
+            pdf: s.pdf,
+            delta: s.delta,
+            transmitted: !reflect,
+            wavelength: self.wavelength,
         })
     }
 }
@@ -823,12 +891,16 @@ impl crate::content_hash::ContentHash for Material {
             emission,
             two_sided,
             texture,
+            microfacet,
         } = self;
         name.content_hash(out);
         layers.content_hash(out);
         emission.content_hash(out);
         two_sided.content_hash(out);
         texture.content_hash(out);
+        if let Some(m) = microfacet {
+            m.content_hash(out);
+        }
     }
 }
 

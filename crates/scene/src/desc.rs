@@ -173,6 +173,17 @@ pub(crate) struct MaterialDesc {
     /// A preset name or an inline table; `material.rs` reads it (its forms are easier to
     /// explain in an error there than through an untagged serde enum).
     pub dispersion: Option<Spanned<toml::Value>>,
+    // The microfacet family (`microfacet.rs`), with Mitsuba's parameter names.
+    pub distribution: Option<Spanned<String>>,
+    pub alpha: Option<Spanned<f32>>,
+    pub alpha_u: Option<Spanned<f32>>,
+    pub alpha_v: Option<Spanned<f32>>,
+    pub eta: Option<Spanned<V3>>,
+    pub k: Option<Spanned<V3>>,
+    pub int_ior: Option<Spanned<f32>>,
+    pub ext_ior: Option<Spanned<f32>>,
+    pub specular_reflectance: Option<Spanned<V3>>,
+    pub specular_transmittance: Option<Spanned<V3>>,
 }
 
 /// One entry of a material's `layers` array.

@@ -61,6 +61,7 @@ mod image_io;
 mod instances;
 mod load;
 mod material;
+mod microfacet;
 mod obj;
 pub mod procedural;
 pub mod raw;

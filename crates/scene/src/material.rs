@@ -4,6 +4,7 @@
 use crate::desc::{LayerDesc, MaterialDesc};
 use crate::error::Result;
 use crate::load::{finite3, Ctx};
+use crate::microfacet;
 use rt_core::material::MaterialError;
 use rt_core::spectral::{Dispersion, LAMBDA_D, PRESETS};
 use rt_core::{Layer, Material, Rgb};
@@ -100,21 +101,35 @@ pub(crate) fn build(ctx: &mut Ctx, d: &Spanned<MaterialDesc>) -> Result<Material
     }
     let kind = match (&d.kind, &d.layers) {
         (Some(k), _) => {
-            if !TYPES.contains(&k.get_ref().as_str()) {
+            let k_str = k.get_ref().as_str();
+            if !TYPES.contains(&k_str) && !microfacet::TYPES.contains(&k_str) {
                 return Err(err(
                     k.span(),
                     format!(
-                        "unknown material type \"{}\"; valid types are {}",
+                        "unknown material type \"{}\"; valid types are {}, {}",
                         k.get_ref(),
-                        TYPES.join(", ")
+                        TYPES.join(", "),
+                        microfacet::TYPES.join(", ")
                     ),
                 ));
             }
-            k.get_ref().as_str()
+            k_str
         }
         (None, Some(_)) => "layered",
         (None, None) => "diffuse",
     };
+    if microfacet::TYPES.contains(&kind) {
+        return microfacet::build(ctx, d, kind);
+    }
+    if let Some((key, span)) = microfacet::stray_key(d) {
+        return Err(err(
+            span,
+            format!(
+                "`{key}` does not apply to type \"{kind}\" (it applies to {})",
+                microfacet::TYPES.join(", ")
+            ),
+        ));
+    }
     if let (Some(l), true) = (&d.layers, kind != "layered") {
         return Err(err(
             l.span(),
@@ -641,5 +656,81 @@ mod tests {
         );
         let e = bad("texture = \"nope.png\"");
         assert!(e.contains("nope.png: cannot open"), "{e}");
+    }
+
+    #[test]
+    fn microfacet_types_take_mitsubas_parameters_and_defaults() {
+        use rt_core::microfacet::{DistributionKind, Microfacet};
+        let m = ok("type = \"roughconductor\"");
+        let Some(Microfacet::Conductor(c)) = m.microfacet else {
+            panic!("{m:?}")
+        };
+        let d = c.distribution.expect("rough");
+        assert_eq!(
+            (d.kind, d.alpha_x, d.alpha_y),
+            (DistributionKind::Beckmann, 0.1, 0.1)
+        );
+        assert_eq!((c.eta, c.k), (Rgb::ZERO, Rgb::ONE));
+        assert!(m.layers.is_empty());
+        let m = ok("type = \"roughdielectric\"\ndistribution = \"ggx\"\nalpha_u = 0.1\nalpha_v = 0.3\nint_ior = 1.33\next_ior = 1.0");
+        let Some(Microfacet::Dielectric(g)) = m.microfacet else {
+            panic!("{m:?}")
+        };
+        let d = g.distribution.expect("rough");
+        assert_eq!(
+            (d.kind, d.alpha_x, d.alpha_y, g.eta),
+            (DistributionKind::Ggx, 0.1, 0.3, 1.33)
+        );
+        assert!(ok("type = \"dielectric\"")
+            .microfacet
+            .is_some_and(|m| m.distribution().is_none()));
+    }
+
+    #[test]
+    fn microfacet_keys_are_checked() {
+        for (body, says) in [
+            (
+                "type = \"conductor\"\nalpha = 0.2",
+                "`alpha` does not apply to type \"conductor\"",
+            ),
+            (
+                "type = \"roughconductor\"\nint_ior = 1.5",
+                "`int_ior` does not apply",
+            ),
+            (
+                "type = \"roughdielectric\"\neta = [1, 1, 1]",
+                "`eta` does not apply",
+            ),
+            (
+                "type = \"roughconductor\"\ncolor = [1, 1, 1]",
+                "use specular_reflectance",
+            ),
+            (
+                "type = \"roughconductor\"\ndistribution = \"phong\"",
+                "unknown distribution \"phong\"",
+            ),
+            (
+                "type = \"roughconductor\"\nalpha = 0.1\nalpha_u = 0.2\nalpha_v = 0.2",
+                "not both",
+            ),
+            ("type = \"roughconductor\"\nalpha_u = 0.2", "needs both"),
+            ("type = \"roughconductor\"\nalpha = -1", "positive"),
+            (
+                "type = \"dielectric\"\nint_ior = 1.0\next_ior = 1.0",
+                "other than 1",
+            ),
+            (
+                "type = \"conductor\"\nspecular_reflectance = [2, 1, 1]",
+                "specular_reflectance must be in [0, 1]",
+            ),
+            (
+                "type = \"diffuse\"\nalpha = 0.2",
+                "`alpha` does not apply to type \"diffuse\"",
+            ),
+        ] {
+            let e = bad(body);
+            assert!(e.contains(says), "{body}: {e}");
+            assert!(e.contains("m.toml"), "{e}");
+        }
     }
 }

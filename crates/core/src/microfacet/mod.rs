@@ -54,3 +54,94 @@ pub trait LocalBsdf {
 pub fn reflect(wo: Vec3, m: Vec3) -> Vec3 {
     2.0 * wo.dot(m) * m - wo
 }
+
+/// One BSDF of the family, as a material holds it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Microfacet {
+    /// `conductor`, `roughconductor`.
+    Conductor(RoughConductor),
+    /// `dielectric`, `roughdielectric`.
+    Dielectric(RoughDielectric),
+}
+
+impl Microfacet {
+    /// The surface's normal distribution (`None`: smooth, every lobe a delta).
+    pub fn distribution(&self) -> Option<Distribution> {
+        match self {
+            Microfacet::Conductor(c) => c.distribution,
+            Microfacet::Dielectric(d) => d.distribution,
+        }
+    }
+
+    /// Reflectance at normal incidence, for the albedo AOV.
+    pub fn albedo(&self) -> Rgb {
+        match self {
+            Microfacet::Conductor(c) => fresnel_conductor(1.0, c.eta, c.k) * c.specular_reflectance,
+            Microfacet::Dielectric(d) => d.transmittance,
+        }
+    }
+
+    /// Checks every parameter's range; the message names the parameter.
+    pub fn validate(&self) -> Result<(), String> {
+        let colour = |c: Rgb, what: &str| {
+            if !c.is_finite() || c.min_element() < 0.0 || c.max_element() > 1.0 {
+                Err(format!("{what} must be in [0, 1], got {:?}", c.to_array()))
+            } else {
+                Ok(())
+            }
+        };
+        if let Some(d) = self.distribution() {
+            for (a, what) in [(d.alpha_x, "alpha_u"), (d.alpha_y, "alpha_v")] {
+                if !(a.is_finite() && a > 0.0) {
+                    return Err(format!("{what} must be a positive number, got {a}"));
+                }
+            }
+        }
+        match self {
+            Microfacet::Conductor(c) => {
+                for (v, what) in [(c.eta, "eta"), (c.k, "k")] {
+                    if !v.is_finite() || v.min_element() < 0.0 {
+                        return Err(format!(
+                            "{what} must be finite and non-negative, got {:?}",
+                            v.to_array()
+                        ));
+                    }
+                }
+                colour(c.specular_reflectance, "specular_reflectance")
+            }
+            Microfacet::Dielectric(d) => {
+                if !(d.eta.is_finite() && d.eta > 0.0) || d.eta == 1.0 {
+                    return Err(format!(
+                        "int_ior / ext_ior must be a positive number other than 1, got {}",
+                        d.eta
+                    ));
+                }
+                colour(d.reflectance, "specular_reflectance")?;
+                colour(d.transmittance, "specular_transmittance")
+            }
+        }
+    }
+}
+
+impl LocalBsdf for Microfacet {
+    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        match self {
+            Microfacet::Conductor(c) => c.eval_pdf(wo, wi),
+            Microfacet::Dielectric(d) => d.eval_pdf(wo, wi),
+        }
+    }
+
+    fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<LocalSample> {
+        match self {
+            Microfacet::Conductor(c) => c.sample(wo, u_lobe, u),
+            Microfacet::Dielectric(d) => d.sample(wo, u_lobe, u),
+        }
+    }
+}
+
+impl crate::content_hash::ContentHash for Microfacet {
+    fn content_hash(&self, out: &mut crate::content_hash::Sink<'_>) {
+        // The Debug form names every field and prints floats exactly (shortest round-trip).
+        format!("{self:?}").content_hash(out);
+    }
+}

@@ -1,0 +1,207 @@
+//! `[[material]]` tables of the microfacet family (`rt_core::microfacet`): `conductor`,
+//! `roughconductor`, `dielectric`, `roughdielectric`, with Mitsuba 3's parameter names and
+//! defaults (a conductor without `eta`/`k` is Mitsuba's `material = "none"`, a perfect
+//! mirror; distribution `beckmann`, `alpha` 0.1; `int_ior` BK7's 1.5046, `ext_ior` air's
+//! 1.000277).
+
+use crate::desc::MaterialDesc;
+use crate::error::Result;
+use crate::load::{finite3, Ctx};
+use rt_core::microfacet::{
+    Distribution, DistributionKind, Microfacet, RoughConductor, RoughDielectric,
+};
+use rt_core::{Material, Rgb};
+use std::ops::Range;
+
+/// The material types of the family.
+pub(crate) const TYPES: [&str; 4] = [
+    "conductor",
+    "roughconductor",
+    "dielectric",
+    "roughdielectric",
+];
+
+const DEFAULT_ALPHA: f32 = 0.1;
+const BK7_IOR: f32 = 1.5046;
+const AIR_IOR: f32 = 1.000277;
+
+/// The family's keys present in `d`, with their spans.
+fn keys(d: &MaterialDesc) -> Vec<(&'static str, Range<usize>)> {
+    let mut out = Vec::new();
+    macro_rules! key {
+        ($($f:ident),*) => {$(
+            if let Some(v) = &d.$f {
+                out.push((stringify!($f), v.span()));
+            }
+        )*};
+    }
+    key!(
+        distribution,
+        alpha,
+        alpha_u,
+        alpha_v,
+        eta,
+        k,
+        int_ior,
+        ext_ior,
+        specular_reflectance,
+        specular_transmittance
+    );
+    out
+}
+
+/// The first key of the family in a table of another type, for its error.
+pub(crate) fn stray_key(d: &MaterialDesc) -> Option<(&'static str, Range<usize>)> {
+    keys(d).into_iter().next()
+}
+
+/// Builds a material of type `kind` (one of [`TYPES`]).
+pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Material> {
+    let name = d.name.get_ref();
+    let err = |span: Range<usize>, msg: String| {
+        ctx.src
+            .error_at(span, format!("material \"{name}\": {msg}"))
+    };
+    // Keys of the layered model have no meaning here.
+    let layered = [
+        ("color", d.color.as_ref().map(|v| v.span())),
+        ("hardness", d.hardness.as_ref().map(|v| v.span())),
+        ("ior", d.ior.as_ref().map(|v| v.span())),
+        ("dispersion", d.dispersion.as_ref().map(|v| v.span())),
+        ("layers", d.layers.as_ref().map(|v| v.span())),
+        ("texture", d.texture.as_ref().map(|v| v.span())),
+    ];
+    for (key, span) in layered {
+        if let Some(span) = span {
+            let hint = match key {
+                "ior" => " (use int_ior and ext_ior)",
+                "color" => " (use specular_reflectance)",
+                "hardness" => " (use alpha)",
+                "texture" => " (textures on microfacet parameters are not supported yet)",
+                _ => "",
+            };
+            return Err(err(
+                span,
+                format!("`{key}` does not apply to type \"{kind}\"{hint}"),
+            ));
+        }
+    }
+    let rough = kind.starts_with("rough");
+    let conductor = kind.ends_with("conductor");
+    for (key, span) in keys(d) {
+        let applies = match key {
+            "distribution" | "alpha" | "alpha_u" | "alpha_v" => rough,
+            "eta" | "k" => conductor,
+            "int_ior" | "ext_ior" | "specular_transmittance" => !conductor,
+            _ => true,
+        };
+        if !applies {
+            return Err(err(
+                span,
+                format!("`{key}` does not apply to type \"{kind}\""),
+            ));
+        }
+    }
+    let distribution = if rough {
+        let kind_d = match d
+            .distribution
+            .as_ref()
+            .map(|s| (s.get_ref().as_str(), s.span()))
+        {
+            None | Some(("beckmann", _)) => DistributionKind::Beckmann,
+            Some(("ggx", _)) => DistributionKind::Ggx,
+            Some((other, span)) => {
+                return Err(err(
+                    span,
+                    format!("unknown distribution \"{other}\"; valid are \"beckmann\" and \"ggx\""),
+                ))
+            }
+        };
+        if let (Some(a), Some(_)) = (&d.alpha, d.alpha_u.as_ref().or(d.alpha_v.as_ref())) {
+            return Err(err(
+                a.span(),
+                "give `alpha` or `alpha_u` and `alpha_v`, not both".into(),
+            ));
+        }
+        if d.alpha_u.is_some() != d.alpha_v.is_some() {
+            let span = d
+                .alpha_u
+                .as_ref()
+                .or(d.alpha_v.as_ref())
+                .map(|v| v.span())
+                .expect("one of them");
+            return Err(err(
+                span,
+                "an anisotropic surface needs both `alpha_u` and `alpha_v`".into(),
+            ));
+        }
+        let alpha = |v: &Option<toml::Spanned<f32>>| -> Result<f32> {
+            match v {
+                None => Ok(DEFAULT_ALPHA),
+                Some(s) => {
+                    let a = *s.get_ref();
+                    if a.is_finite() && a > 0.0 {
+                        Ok(a)
+                    } else {
+                        Err(err(
+                            s.span(),
+                            format!("roughness must be a positive number, got {a}"),
+                        ))
+                    }
+                }
+            }
+        };
+        let (ax, ay) = match &d.alpha {
+            Some(_) => (alpha(&d.alpha)?, alpha(&d.alpha)?),
+            None => (alpha(&d.alpha_u)?, alpha(&d.alpha_v)?),
+        };
+        Some(Distribution::new(kind_d, ax, ay))
+    } else {
+        None
+    };
+    let rgb = |v: &Option<toml::Spanned<crate::desc::V3>>, what: &str, default: Rgb| match v {
+        Some(v) => finite3(ctx, v, what),
+        None => Ok(default),
+    };
+    let bsdf = if conductor {
+        Microfacet::Conductor(RoughConductor {
+            distribution,
+            eta: rgb(&d.eta, "eta", Rgb::ZERO)?,
+            k: rgb(&d.k, "k", Rgb::ONE)?,
+            specular_reflectance: rgb(&d.specular_reflectance, "specular_reflectance", Rgb::ONE)?,
+        })
+    } else {
+        let int = d.int_ior.as_ref().map_or(BK7_IOR, |v| *v.get_ref());
+        let ext = d.ext_ior.as_ref().map_or(AIR_IOR, |v| *v.get_ref());
+        for (v, key) in [(&d.int_ior, "int_ior"), (&d.ext_ior, "ext_ior")] {
+            if let Some(s) = v {
+                let x = *s.get_ref();
+                if !(x.is_finite() && x > 0.0) {
+                    return Err(err(
+                        s.span(),
+                        format!("`{key}` must be a positive number, got {x}"),
+                    ));
+                }
+            }
+        }
+        Microfacet::Dielectric(RoughDielectric {
+            distribution,
+            eta: int / ext,
+            reflectance: rgb(&d.specular_reflectance, "specular_reflectance", Rgb::ONE)?,
+            transmittance: rgb(
+                &d.specular_transmittance,
+                "specular_transmittance",
+                Rgb::ONE,
+            )?,
+        })
+    };
+    let mut m = Material::microfacet(name, bsdf);
+    if let Some(e) = &d.emission {
+        m.emission = finite3(ctx, e, "emission")?;
+    }
+    m.two_sided = d.two_sided.unwrap_or(false);
+    if let Err(e) = m.validate() {
+        return Err(err(d.name.span(), e.to_string()));
+    }
+    Ok(m)
+}
