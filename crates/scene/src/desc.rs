@@ -180,8 +180,11 @@ pub(crate) struct MaterialDesc {
     pub alpha_v: Option<Spanned<f32>>,
     pub eta: Option<Spanned<V3>>,
     pub k: Option<Spanned<V3>>,
-    pub int_ior: Option<Spanned<f32>>,
-    pub ext_ior: Option<Spanned<f32>>,
+    /// A number or one of Mitsuba's named indices (`"water"`, `"bk7"`, ...).
+    pub int_ior: Option<Spanned<toml::Value>>,
+    pub ext_ior: Option<Spanned<toml::Value>>,
+    /// A conductor's named metal (`"Au"`, ...), as Mitsuba's `material`.
+    pub material: Option<Spanned<String>>,
     pub specular_reflectance: Option<Spanned<V3>>,
     pub specular_transmittance: Option<Spanned<V3>>,
 }

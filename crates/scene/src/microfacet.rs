@@ -7,8 +7,10 @@
 use crate::desc::MaterialDesc;
 use crate::error::Result;
 use crate::load::{finite3, Ctx};
+use rt_core::microfacet::named::{CONDUCTORS, DIELECTRICS};
 use rt_core::microfacet::{
-    Distribution, DistributionKind, Microfacet, RoughConductor, RoughDielectric,
+    named_conductor, named_ior, Distribution, DistributionKind, Microfacet, RoughConductor,
+    RoughDielectric,
 };
 use rt_core::{Material, Rgb};
 use std::ops::Range;
@@ -91,7 +93,7 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
     for (key, span) in keys(d) {
         let applies = match key {
             "distribution" | "alpha" | "alpha_u" | "alpha_v" => rough,
-            "eta" | "k" => conductor,
+            "eta" | "k" | "material" => conductor,
             "int_ior" | "ext_ior" | "specular_transmittance" => !conductor,
             _ => true,
         };
@@ -164,26 +166,37 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
         None => Ok(default),
     };
     let bsdf = if conductor {
+        let (eta, k) = match &d.material {
+            Some(named) => {
+                if let Some(v) = d.eta.as_ref().or(d.k.as_ref()) {
+                    return Err(err(
+                        v.span(),
+                        "give `material` or `eta` and `k`, not both".into(),
+                    ));
+                }
+                named_conductor(named.get_ref()).ok_or_else(|| {
+                    let names: Vec<&str> = CONDUCTORS.iter().map(|(n, _, _)| *n).collect();
+                    err(
+                        named.span(),
+                        format!(
+                            "unknown conductor \"{}\"; Mitsuba's named conductors are {}",
+                            named.get_ref(),
+                            names.join(", ")
+                        ),
+                    )
+                })?
+            }
+            None => (rgb(&d.eta, "eta", Rgb::ZERO)?, rgb(&d.k, "k", Rgb::ONE)?),
+        };
         Microfacet::Conductor(RoughConductor {
             distribution,
-            eta: rgb(&d.eta, "eta", Rgb::ZERO)?,
-            k: rgb(&d.k, "k", Rgb::ONE)?,
+            eta,
+            k,
             specular_reflectance: rgb(&d.specular_reflectance, "specular_reflectance", Rgb::ONE)?,
         })
     } else {
-        let int = d.int_ior.as_ref().map_or(BK7_IOR, |v| *v.get_ref());
-        let ext = d.ext_ior.as_ref().map_or(AIR_IOR, |v| *v.get_ref());
-        for (v, key) in [(&d.int_ior, "int_ior"), (&d.ext_ior, "ext_ior")] {
-            if let Some(s) = v {
-                let x = *s.get_ref();
-                if !(x.is_finite() && x > 0.0) {
-                    return Err(err(
-                        s.span(),
-                        format!("`{key}` must be a positive number, got {x}"),
-                    ));
-                }
-            }
-        }
+        let int = ior(&d.int_ior, "int_ior", BK7_IOR).map_err(|(s, e)| err(s, e))?;
+        let ext = ior(&d.ext_ior, "ext_ior", AIR_IOR).map_err(|(s, e)| err(s, e))?;
         Microfacet::Dielectric(RoughDielectric {
             distribution,
             eta: int / ext,
@@ -204,4 +217,37 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
         return Err(err(d.name.span(), e.to_string()));
     }
     Ok(m)
+}
+
+/// An index of refraction: a positive number or one of Mitsuba's names; `default` when absent.
+fn ior(
+    v: &Option<toml::Spanned<toml::Value>>,
+    key: &str,
+    default: f32,
+) -> std::result::Result<f32, (Range<usize>, String)> {
+    let Some(v) = v else {
+        return Ok(default);
+    };
+    let x = match v.get_ref() {
+        toml::Value::Float(x) => *x as f32,
+        toml::Value::Integer(i) => *i as f32,
+        toml::Value::String(name) => named_ior(name).ok_or_else(|| {
+            let names: Vec<&str> = DIELECTRICS.iter().map(|(n, _)| *n).collect();
+            (
+                v.span(),
+                format!(
+                    "unknown index of refraction \"{name}\" for `{key}`; Mitsuba's names are {}",
+                    names.join(", ")
+                ),
+            )
+        })?,
+        _ => return Err((v.span(), format!("`{key}` must be a number or a name"))),
+    };
+    if !(x.is_finite() && x > 0.0) {
+        return Err((
+            v.span(),
+            format!("`{key}` must be a positive number, got {x}"),
+        ));
+    }
+    Ok(x)
 }

@@ -16,6 +16,7 @@ mod conductor;
 mod dielectric;
 mod distribution;
 mod fresnel;
+pub mod named;
 
 pub use conductor::RoughConductor;
 pub use dielectric::RoughDielectric;
@@ -47,6 +48,22 @@ pub trait LocalBsdf {
     /// Samples `wi` for `wo`; `u_lobe` chooses between lobes (reflection or refraction), `u`
     /// the microfacet normal. `None` where the sample carries nothing.
     fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<LocalSample>;
+}
+
+/// The complex index `(η, κ)` of Mitsuba's named conductor `name` ([`named::CONDUCTORS`]).
+pub fn named_conductor(name: &str) -> Option<(Rgb, Rgb)> {
+    named::CONDUCTORS
+        .iter()
+        .find(|(n, _, _)| *n == name)
+        .map(|&(_, eta, k)| (eta, k))
+}
+
+/// The index of refraction of Mitsuba's named dielectric `name` ([`named::DIELECTRICS`]).
+pub fn named_ior(name: &str) -> Option<f32> {
+    named::DIELECTRICS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|&(_, ior)| ior)
 }
 
 /// Mirror reflection of `wo` about unit normal `m`.
