@@ -20,7 +20,7 @@ pub mod named;
 
 pub use conductor::RoughConductor;
 pub use dielectric::RoughDielectric;
-pub use distribution::{Distribution, DistributionKind};
+pub use distribution::{Distribution, DistributionKind, MIN_ALPHA};
 pub use fresnel::fresnel_conductor;
 
 use crate::Rgb;
