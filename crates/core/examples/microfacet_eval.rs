@@ -37,6 +37,7 @@ fn main() {
                 eta: Rgb::splat(x[2]),
                 k: Rgb::splat(x[3]),
                 specular_reflectance: Rgb::ONE,
+                two_sided: false,
             }),
             _ => Microfacet::Dielectric(RoughDielectric {
                 distribution,

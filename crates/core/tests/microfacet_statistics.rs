@@ -21,6 +21,7 @@ fn white_conductor(kind: DistributionKind, ax: f32, ay: f32, reflectance: f32) -
         eta: Rgb::ZERO,
         k: Rgb::splat(1e4),
         specular_reflectance: Rgb::splat(reflectance),
+        two_sided: false,
     }
 }
 
@@ -30,6 +31,7 @@ fn gold(kind: DistributionKind, ax: f32, ay: f32) -> RoughConductor {
         eta: Rgb::new(0.143, 0.374, 1.442),
         k: Rgb::new(3.983, 2.385, 1.603),
         specular_reflectance: Rgb::ONE,
+        two_sided: false,
     }
 }
 
@@ -332,4 +334,36 @@ fn smooth_conductor_and_dielectric_are_delta_lobes() {
         "smooth glass loses or creates energy: {}",
         flux / n as f64
     );
+}
+
+/// A two-sided conductor (Mitsuba's `twosided`) is the one-sided one mirrored below the
+/// surface, in value, pdf and samples; a one-sided one reflects nothing from below (control).
+#[test]
+fn two_sided_conductors_mirror_the_front() {
+    let front = gold(Ggx, 0.3, 0.3);
+    let both = RoughConductor {
+        two_sided: true,
+        ..front
+    };
+    let mirror = |w: Vec3| Vec3::new(w.x, w.y, -w.z);
+    let mut rng = Rng::new(9);
+    for _ in 0..1000 {
+        let (wo, wi) = (
+            wo_at(0.2 + 0.7 * rng.f32(), 1.0),
+            wo_at(0.2 + 0.7 * rng.f32(), 1.0),
+        );
+        let wi = Vec3::new(-wi.x, wi.y, wi.z);
+        assert_eq!(
+            both.eval_pdf(mirror(wo), mirror(wi)),
+            front.eval_pdf(wo, wi)
+        );
+        assert_eq!(front.eval_pdf(mirror(wo), mirror(wi)), (Rgb::ZERO, 0.0));
+        let (ul, u) = (rng.f32(), rng.vec2());
+        let (a, b) = (both.sample(mirror(wo), ul, u), front.sample(wo, ul, u));
+        assert_eq!(
+            a.map(|s| (mirror(s.wi), s.weight, s.pdf)),
+            b.map(|s| (s.wi, s.weight, s.pdf))
+        );
+        assert!(front.sample(mirror(wo), ul, u).is_none());
+    }
 }

@@ -193,6 +193,7 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
             eta,
             k,
             specular_reflectance: rgb(&d.specular_reflectance, "specular_reflectance", Rgb::ONE)?,
+            two_sided: d.two_sided.unwrap_or(false),
         })
     } else {
         let int = ior(&d.int_ior, "int_ior", BK7_IOR).map_err(|(s, e)| err(s, e))?;

@@ -1,6 +1,6 @@
 //! Mitsuba's `conductor` and `roughconductor`: specular or microfacet reflection with the
-//! Fresnel reflectance of a complex index of refraction. One-sided: light from below the
-//! surface is not reflected (Mitsuba's `twosided` wraps it for two sides).
+//! Fresnel reflectance of a complex index of refraction. One-sided unless `two_sided` (then it
+//! reflects alike on both sides, as inside Mitsuba's `twosided` wrapper).
 
 use super::{reflect, Distribution, LocalBsdf, LocalSample};
 use crate::microfacet::fresnel_conductor;
@@ -18,6 +18,8 @@ pub struct RoughConductor {
     pub k: Rgb,
     /// A factor on the reflectance (Mitsuba's `specular_reflectance`; 1 for physical metals).
     pub specular_reflectance: Rgb,
+    /// Reflect light from below the surface too, mirrored (Mitsuba's `twosided`).
+    pub two_sided: bool,
 }
 
 impl RoughConductor {
@@ -26,8 +28,20 @@ impl RoughConductor {
     }
 }
 
+/// `w` mirrored into the upper hemisphere when `flip`.
+#[inline]
+fn up(w: Vec3, flip: bool) -> Vec3 {
+    if flip {
+        Vec3::new(w.x, w.y, -w.z)
+    } else {
+        w
+    }
+}
+
 impl LocalBsdf for RoughConductor {
     fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        let flip = self.two_sided && wo.z < 0.0;
+        let (wo, wi) = (up(wo, flip), up(wi, flip));
         let Some(d) = self.distribution else {
             return (Rgb::ZERO, 0.0);
         };
@@ -46,7 +60,18 @@ impl LocalBsdf for RoughConductor {
         (f, pdf)
     }
 
-    fn sample(&self, wo: Vec3, _u_lobe: f32, u: Vec2) -> Option<LocalSample> {
+    fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<LocalSample> {
+        if self.two_sided && wo.z < 0.0 {
+            let one_sided = RoughConductor {
+                two_sided: false,
+                ..*self
+            };
+            let s = one_sided.sample(up(wo, true), u_lobe, u)?;
+            return Some(LocalSample {
+                wi: up(s.wi, true),
+                ..s
+            });
+        }
         if wo.z <= 0.0 {
             return None;
         }
