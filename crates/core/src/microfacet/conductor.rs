@@ -60,13 +60,14 @@ impl LocalBsdf for RoughConductor {
         (f, pdf)
     }
 
-    fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<LocalSample> {
+    fn sample(&self, wo: Vec3, _u_lobe: f32, u: Vec2) -> Option<LocalSample> {
         if self.two_sided && wo.z < 0.0 {
             let one_sided = RoughConductor {
                 two_sided: false,
                 ..*self
             };
-            let s = one_sided.sample(up(wo, true), u_lobe, u)?;
+            // One lobe: nothing to choose.
+            let s = one_sided.sample(up(wo, true), 0.0, u)?;
             return Some(LocalSample {
                 wi: up(s.wi, true),
                 ..s
