@@ -1,7 +1,7 @@
 //! The microfacet materials (`type = "conductor"`, `"roughconductor"`, `"dielectric"`,
-//! `"roughdielectric"`) end to end, through the TOML loader, `Bsdf` and both path tracers, in
+//! `"roughdielectric"`, `"smoothplastic"`) end to end, through the TOML loader, `Bsdf` and both path tracers, in
 //! the white furnace (`rt_testkit::furnace`): smooth ones are lossless, so the image is the
-//! environment within 4 standard errors; rough ones lose energy to single scattering but never
+//! environment within 4 standard errors; rough ones and plastic lose energy to single scattering but never
 //! gain it. Control: a conductor reflecting 97 % is told apart from a lossless one.
 
 use rt_integrators::{PathIntegrator, Wavefront, DEFAULT_LANES};
@@ -55,6 +55,7 @@ fn rough_microfacet_materials_never_gain_energy() {
         "type = \"roughconductor\"\ndistribution = \"ggx\"\nalpha_u = 0.05\nalpha_v = 0.4",
         "type = \"roughdielectric\"\ndistribution = \"ggx\"\nalpha = 0.2",
         "type = \"roughdielectric\"\nalpha = 0.5\nint_ior = 1.33",
+        "type = \"smoothplastic\"\ndiffuse_reflectance = [1, 1, 1]",
     ] {
         for (mean, se) in means(m, 32) {
             assert!(

@@ -2,14 +2,15 @@
 //! per line, and prints `f·|cos θi|` (red channel) and the pdf: the quantities Mitsuba's
 //! `BSDF.eval` and `BSDF.pdf` return, for `tools/reference/compare_microfacet.py`.
 //!
-//! A line: `conductor|dielectric beckmann|ggx|smooth αx αy η κ wo.x wo.y wo.z wi.x wi.y wi.z`
-//! (κ is ignored for dielectrics; η is interior over exterior for them).
+//! A line: `conductor|dielectric|plastic beckmann|ggx|smooth αx αy η κ wo.x wo.y wo.z wi.x wi.y wi.z`
+//! (η is interior over exterior for dielectrics and plastic; κ is plastic's diffuse
+//! reflectance and ignored for dielectrics).
 //!
 //!     echo "conductor ggx 0.3 0.3 0.2 3.9 0 0.6 0.8 0.3 0 0.95" | cargo run -p rt-core --example microfacet_eval
 
 use rt_core::glam::Vec3;
 use rt_core::microfacet::{
-    Distribution, DistributionKind, LocalBsdf, Microfacet, RoughConductor, RoughDielectric,
+    Distribution, DistributionKind, LocalBsdf, Microfacet, Plastic, RoughConductor, RoughDielectric,
 };
 use rt_core::Rgb;
 use std::io::BufRead;
@@ -38,6 +39,12 @@ fn main() {
                 k: Rgb::splat(x[3]),
                 specular_reflectance: Rgb::ONE,
                 two_sided: false,
+            }),
+            "plastic" => Microfacet::Plastic(Plastic {
+                diffuse: Rgb::splat(x[3]),
+                specular: Rgb::ONE,
+                eta: x[2],
+                nonlinear: false,
             }),
             _ => Microfacet::Dielectric(RoughDielectric {
                 distribution,

@@ -433,7 +433,7 @@ impl<'a> Bsdf<'a> {
         let total = match micro {
             // One "layer" of weight one: the checks of `total` below hold as for layers.
             Some(m) => {
-                has_non_delta = m.distribution().is_some();
+                has_non_delta = m.has_non_delta();
                 1.0
             }
             None => weights.iter().sum(),

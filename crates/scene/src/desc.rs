@@ -187,6 +187,8 @@ pub(crate) struct MaterialDesc {
     pub material: Option<Spanned<String>>,
     pub specular_reflectance: Option<Spanned<V3>>,
     pub specular_transmittance: Option<Spanned<V3>>,
+    pub diffuse_reflectance: Option<Spanned<V3>>,
+    pub nonlinear: Option<Spanned<bool>>,
 }
 
 /// One entry of a material's `layers` array.

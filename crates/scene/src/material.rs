@@ -684,6 +684,30 @@ mod tests {
         assert!(ok("type = \"dielectric\"")
             .microfacet
             .is_some_and(|m| m.distribution().is_none()));
+        // Named metals and indices are Mitsuba's (tools/reference/mitsuba_named_iors.py).
+        let Some(Microfacet::Conductor(au)) =
+            ok("type = \"conductor\"\nmaterial = \"Au\"").microfacet
+        else {
+            panic!()
+        };
+        assert!(
+            (au.eta.x - 0.143).abs() < 1e-3 && (au.k.x - 3.983).abs() < 1e-3,
+            "{au:?}"
+        );
+        let Some(Microfacet::Dielectric(w)) =
+            ok("type = \"dielectric\"\nint_ior = \"water\"\next_ior = \"vacuum\"").microfacet
+        else {
+            panic!()
+        };
+        assert_eq!(w.eta, 1.333);
+        let Some(Microfacet::Plastic(p)) = ok("type = \"smoothplastic\"").microfacet else {
+            panic!()
+        };
+        assert_eq!(
+            (p.diffuse, p.specular, p.nonlinear),
+            (Rgb::splat(0.5), Rgb::ONE, false)
+        );
+        assert!((p.eta - 1.49 / 1.000277).abs() < 1e-6);
     }
 
     #[test]
@@ -726,6 +750,26 @@ mod tests {
             (
                 "type = \"diffuse\"\nalpha = 0.2",
                 "`alpha` does not apply to type \"diffuse\"",
+            ),
+            (
+                "type = \"smoothplastic\"\nalpha = 0.1",
+                "`alpha` does not apply to type \"smoothplastic\"",
+            ),
+            (
+                "type = \"roughconductor\"\ndiffuse_reflectance = [1, 1, 1]",
+                "`diffuse_reflectance` does not apply",
+            ),
+            (
+                "type = \"conductor\"\nmaterial = \"Xx\"",
+                "unknown conductor \"Xx\"; Mitsuba's named conductors are a-C, Ag",
+            ),
+            (
+                "type = \"conductor\"\nmaterial = \"Au\"\nk = [1, 1, 1]",
+                "not both",
+            ),
+            (
+                "type = \"dielectric\"\nint_ior = \"glas\"",
+                "unknown index of refraction \"glas\"",
             ),
         ] {
             let e = bad(body);

@@ -9,23 +9,26 @@ use crate::error::Result;
 use crate::load::{finite3, Ctx};
 use rt_core::microfacet::named::{CONDUCTORS, DIELECTRICS};
 use rt_core::microfacet::{
-    named_conductor, named_ior, Distribution, DistributionKind, Microfacet, RoughConductor,
-    RoughDielectric,
+    named_conductor, named_ior, Distribution, DistributionKind, Microfacet, Plastic,
+    RoughConductor, RoughDielectric,
 };
 use rt_core::{Material, Rgb};
 use std::ops::Range;
 
-/// The material types of the family.
-pub(crate) const TYPES: [&str; 4] = [
+/// The material types of the family. `smoothplastic` is Mitsuba's `plastic`: our `plastic`
+/// names the thesis' layered preset.
+pub(crate) const TYPES: [&str; 5] = [
     "conductor",
     "roughconductor",
     "dielectric",
     "roughdielectric",
+    "smoothplastic",
 ];
 
 const DEFAULT_ALPHA: f32 = 0.1;
 const BK7_IOR: f32 = 1.5046;
 const AIR_IOR: f32 = 1.000277;
+const POLYPROPYLENE_IOR: f32 = 1.49;
 
 /// The family's keys present in `d`, with their spans.
 fn keys(d: &MaterialDesc) -> Vec<(&'static str, Range<usize>)> {
@@ -47,7 +50,9 @@ fn keys(d: &MaterialDesc) -> Vec<(&'static str, Range<usize>)> {
         int_ior,
         ext_ior,
         specular_reflectance,
-        specular_transmittance
+        specular_transmittance,
+        diffuse_reflectance,
+        nonlinear
     );
     out
 }
@@ -90,11 +95,14 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
     }
     let rough = kind.starts_with("rough");
     let conductor = kind.ends_with("conductor");
+    let plastic = kind == "smoothplastic";
     for (key, span) in keys(d) {
         let applies = match key {
             "distribution" | "alpha" | "alpha_u" | "alpha_v" => rough,
             "eta" | "k" | "material" => conductor,
-            "int_ior" | "ext_ior" | "specular_transmittance" => !conductor,
+            "int_ior" | "ext_ior" => !conductor,
+            "specular_transmittance" => !conductor && !plastic,
+            "diffuse_reflectance" | "nonlinear" => plastic,
             _ => true,
         };
         if !applies {
@@ -194,6 +202,19 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
             k,
             specular_reflectance: rgb(&d.specular_reflectance, "specular_reflectance", Rgb::ONE)?,
             two_sided: d.two_sided.unwrap_or(false),
+        })
+    } else if plastic {
+        let int = ior(&d.int_ior, "int_ior", POLYPROPYLENE_IOR).map_err(|(s, e)| err(s, e))?;
+        let ext = ior(&d.ext_ior, "ext_ior", AIR_IOR).map_err(|(s, e)| err(s, e))?;
+        Microfacet::Plastic(Plastic {
+            diffuse: rgb(
+                &d.diffuse_reflectance,
+                "diffuse_reflectance",
+                Rgb::splat(0.5),
+            )?,
+            specular: rgb(&d.specular_reflectance, "specular_reflectance", Rgb::ONE)?,
+            eta: int / ext,
+            nonlinear: d.nonlinear.as_ref().is_some_and(|v| *v.get_ref()),
         })
     } else {
         let int = ior(&d.int_ior, "int_ior", BK7_IOR).map_err(|(s, e)| err(s, e))?;

@@ -17,11 +17,13 @@ mod dielectric;
 mod distribution;
 mod fresnel;
 pub mod named;
+mod plastic;
 
 pub use conductor::RoughConductor;
 pub use dielectric::RoughDielectric;
 pub use distribution::{Distribution, DistributionKind, MIN_ALPHA};
 pub use fresnel::fresnel_conductor;
+pub use plastic::{fresnel_diffuse_reflectance, Plastic};
 
 use crate::Rgb;
 use glam::{Vec2, Vec3};
@@ -79,6 +81,8 @@ pub enum Microfacet {
     Conductor(RoughConductor),
     /// `dielectric`, `roughdielectric`.
     Dielectric(RoughDielectric),
+    /// `plastic`.
+    Plastic(Plastic),
 }
 
 impl Microfacet {
@@ -87,7 +91,13 @@ impl Microfacet {
         match self {
             Microfacet::Conductor(c) => c.distribution,
             Microfacet::Dielectric(d) => d.distribution,
+            Microfacet::Plastic(_) => None,
         }
+    }
+
+    /// True if some lobe is not a delta (light sampling can contribute).
+    pub fn has_non_delta(&self) -> bool {
+        matches!(self, Microfacet::Plastic(_)) || self.distribution().is_some()
     }
 
     /// Reflectance at normal incidence, for the albedo AOV.
@@ -95,6 +105,7 @@ impl Microfacet {
         match self {
             Microfacet::Conductor(c) => fresnel_conductor(1.0, c.eta, c.k) * c.specular_reflectance,
             Microfacet::Dielectric(d) => d.transmittance,
+            Microfacet::Plastic(p) => p.diffuse,
         }
     }
 
@@ -136,6 +147,16 @@ impl Microfacet {
                 colour(d.reflectance, "specular_reflectance")?;
                 colour(d.transmittance, "specular_transmittance")
             }
+            Microfacet::Plastic(p) => {
+                if !(p.eta.is_finite() && p.eta > 0.0) || p.eta == 1.0 {
+                    return Err(format!(
+                        "int_ior / ext_ior must be a positive number other than 1, got {}",
+                        p.eta
+                    ));
+                }
+                colour(p.diffuse, "diffuse_reflectance")?;
+                colour(p.specular, "specular_reflectance")
+            }
         }
     }
 }
@@ -145,6 +166,7 @@ impl LocalBsdf for Microfacet {
         match self {
             Microfacet::Conductor(c) => c.eval_pdf(wo, wi),
             Microfacet::Dielectric(d) => d.eval_pdf(wo, wi),
+            Microfacet::Plastic(p) => p.eval_pdf(wo, wi),
         }
     }
 
@@ -152,6 +174,7 @@ impl LocalBsdf for Microfacet {
         match self {
             Microfacet::Conductor(c) => c.sample(wo, u_lobe, u),
             Microfacet::Dielectric(d) => d.sample(wo, u_lobe, u),
+            Microfacet::Plastic(p) => p.sample(wo, u_lobe, u),
         }
     }
 }
