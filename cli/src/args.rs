@@ -230,15 +230,6 @@ pub struct Args {
     pub error_maps: Option<PathBuf>,
 }
 
-/// Frames per second, as `--frames`, `--frame`, `--shutter` and `bench-anim` need it: a
-/// positive finite number.
-pub fn check_fps(fps: f64) -> anyhow::Result<()> {
-    if !(fps.is_finite() && fps > 0.0) {
-        anyhow::bail!("--fps must be a positive number, got {fps}");
-    }
-    Ok(())
-}
-
 /// `A..B` with `A < B`.
 pub fn parse_frames(s: &str) -> Result<std::ops::Range<u32>, String> {
     let bad = || format!("frames must be A..B with integers 0 <= A < B (half-open), got `{s}`");

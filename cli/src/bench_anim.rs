@@ -148,7 +148,7 @@ pub fn run(args: &BenchAnimArgs) -> Result<()> {
             args.threads
         );
     }
-    crate::args::check_fps(args.fps)?;
+    rt_session::job::check_fps(args.fps)?;
     if args.repeat == 0 {
         bail!("--repeat must be at least 1");
     }
@@ -158,7 +158,7 @@ pub fn run(args: &BenchAnimArgs) -> Result<()> {
         }
     };
     let t = Instant::now();
-    let loaded = crate::job::load_scene(std::path::Path::new(&args.input))?;
+    let loaded = rt_session::load_scene(std::path::Path::new(&args.input), None)?.loaded;
     for w in &loaded.warnings {
         info(&format!("warning: {w}"));
     }

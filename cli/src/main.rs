@@ -15,20 +15,14 @@
 mod args;
 mod bench_accel;
 mod bench_anim;
-mod cache;
-mod checkpoint;
 mod compare;
 mod compare_frames;
 mod denoise;
 mod experiment;
-mod frame_pattern;
-mod gree;
-mod job;
-mod memory;
 mod parts;
 mod progress;
 mod reference;
-mod sequence;
+mod render;
 mod stress;
 mod view;
 
@@ -72,7 +66,7 @@ pub(crate) fn run(args: &args::Args) -> anyhow::Result<()> {
         Some(args::Command::GenScene { name, output }) => {
             bench_accel::input::write_obj(name, output)
         }
-        None => job::run(args),
+        None => render::run(args),
     }
 }
 

@@ -6,9 +6,9 @@
 //! rendering, guiding and denoising the frame; writing `-o` files is not counted.
 
 use super::{View, ViewArgs};
-use crate::frame_pattern::frame_path;
 use anyhow::{Context, Result};
 use rt_film::OutputOptions;
+use rt_session::frames::frame_path;
 use std::time::{Duration, Instant};
 
 /// Renders `args.frames`.

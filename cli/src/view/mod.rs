@@ -73,7 +73,7 @@ pub struct View {
 impl View {
     fn load(args: &ViewArgs, spp: u32, fps: f64, size: Option<(u32, u32)>) -> Result<View> {
         let path = args.scene.clone();
-        let loaded = crate::job::load_scene(&path)?;
+        let loaded = rt_session::load_scene(&path, None)?.loaded;
         if !args.quiet {
             for w in &loaded.warnings {
                 eprintln!("warning: {w}");
@@ -86,7 +86,7 @@ impl View {
             ),
             None => None,
         };
-        let mut settings = Overrides {
+        let settings = Overrides {
             integrator: args.integrator,
             max_depth: args.max_depth,
             ao_distance: None,
@@ -100,11 +100,8 @@ impl View {
             // is for still images.
             denoiser: Some("none".into()),
         }
-        .resolve(&loaded.render, &path)?;
+        .resolve(&loaded, &path)?;
         let scene = loaded.scene;
-        if args.accel.is_none() && loaded.render.accel.is_none() {
-            settings.accel = AccelSpec::default_for_scene(&scene);
-        }
         let camera = pick_camera(&scene, &path, args.camera.as_deref())?;
         let size = size.unwrap_or((camera.width, camera.height));
         let text = &args.denoiser;
