@@ -18,8 +18,7 @@ const DEFAULT_ACCEL: &str = "bvh8,two-level,two-level:top=refit,clusters:t=1,clu
 clusters:t=4,clusters:t=8,clusters:t=16,clusters:t=32,clusters:t=64,clusters:t=128,\
 clusters:t=256,clusters:t=512";
 use crate::bench_accel::input::{MAX_PIXELS, MAX_SIDE};
-/// Most threads accepted by `--threads`.
-const MAX_THREADS: usize = 1024;
+use rt_core::limits::MAX_THREADS;
 
 /// Arguments of `render bench-anim`.
 #[derive(clap::Args, Debug)]

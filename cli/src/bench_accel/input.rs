@@ -36,10 +36,8 @@ pub enum View {
 const MESH_EXTENSIONS: [&str; 4] = ["obj", "gltf", "glb", "ra2"];
 /// Longest side of the primary ray grid by default.
 const DEFAULT_WIDTH: u32 = 512;
-/// Largest primary ray grid (the scene format's limits).
-pub const MAX_SIDE: u32 = 16_384;
-/// Most primary rays (pixels) a benchmark generates.
-pub const MAX_PIXELS: u64 = 1 << 26;
+/// Largest primary ray grid (the renderer's image limits).
+pub use rt_core::limits::{MAX_IMAGE_PIXELS as MAX_PIXELS, MAX_IMAGE_SIDE as MAX_SIDE};
 
 /// Loads `input`: `gen:NAME`, a `.toml` scene, or a mesh file.
 pub fn load(input: &str, camera: Option<&str>) -> Result<Input> {

@@ -18,11 +18,10 @@ mod report;
 use anyhow::{bail, Context, Result};
 use rt_accel::bench::{self as rays, measure, Query, RaySet};
 use rt_accel::AccelSpec;
+use rt_core::limits::MAX_THREADS;
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// Most threads accepted by `--threads`.
-const MAX_THREADS: usize = 1024;
 /// A structure fails the check when more than this fraction of the checked rays disagree with
 /// the binary BVH (a handful may differ legitimately: a ray grazing a shared edge in the
 /// crack-free test modes, or a nearly degenerate triangle whose `t` is noisy).

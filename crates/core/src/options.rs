@@ -63,8 +63,8 @@ pub enum Problem {
 pub struct OptionsError {
     /// The spec's kind.
     pub spec: String,
-    /// What is wrong.
-    pub problem: Problem,
+    /// What is wrong (boxed: errors that carry this one stay small).
+    pub problem: Box<Problem>,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -144,7 +144,7 @@ impl Options {
     pub fn error(&self, problem: Problem) -> OptionsError {
         OptionsError {
             spec: self.kind.clone(),
-            problem,
+            problem: Box::new(problem),
         }
     }
 

@@ -1095,7 +1095,7 @@ seconds = [0.5, 0.1]
             ),
             (
                 GOOD.replace("name = \"b\"", "name = \"b\"\ndenoiser = \"box:size=2\""),
-                "unknown option 'size'",
+                "unknown option `size`",
             ),
             (
                 GOOD.replace("name = \"b\"", "name = \"b\"\ndenoiser = 3"),
