@@ -362,7 +362,7 @@ impl SequenceRenderer {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use rt_core::Rgb;
     use rt_integrators::IntegratorSpec;
@@ -370,8 +370,8 @@ mod tests {
     use std::path::Path;
 
     /// A small moving scene at a small resolution: the shared lit floor with a moving ball.
-    fn scene() -> Scene {
-        let toml = format!(
+    pub(crate) fn moving_ball() -> String {
+        format!(
             "{}{}",
             rt_testkit::scenes::LIT_FLOOR,
             r#"
@@ -385,8 +385,11 @@ mod tests {
             target = "ball"
             keys = [ { time = 0.0 }, { time = 1.0, translate = [0.5, 0, 0] } ]
         "#
-        );
-        rt_scene::load_str(&toml, Path::new("."), Path::new("test.toml"))
+        )
+    }
+
+    fn scene() -> Scene {
+        rt_scene::load_str(&moving_ball(), Path::new("."), Path::new("test.toml"))
             .unwrap()
             .scene
     }

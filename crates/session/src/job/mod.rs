@@ -22,7 +22,7 @@ mod report;
 mod run;
 
 pub use parts::{merge, read_parts, MergeReport};
-pub use report::{FrameReport, JobReport, JobSink, Rendered};
+pub use report::{AdaptiveSummary, FrameReport, GreeSummary, JobReport, JobSink, Rendered};
 pub use run::thread_pool;
 
 use crate::text;
@@ -543,28 +543,10 @@ mod run_tests {
     use crate::Overrides;
     use std::sync::atomic::AtomicBool;
 
-    /// A small moving scene (the box slides), 24x16 pixels.
+    /// The moving ball of the sequence tests, 24x16 pixels.
     fn job(dir: &Path, spp: u32) -> RenderJob {
         let path = dir.join("s.toml");
-        std::fs::write(
-            &path,
-            format!(
-                "{}{}",
-                rt_testkit::scenes::LIT_FLOOR,
-                r#"
-                [[geometry]]
-                name = "ball"
-                shape = "sphere"
-                center = [0, 0.3, 0]
-                radius = 0.3
-                material = "white"
-                [[animation]]
-                target = "ball"
-                keys = [ { time = 0.0 }, { time = 1.0, translate = [0.5, 0, 0] } ]
-                "#
-            ),
-        )
-        .unwrap();
+        std::fs::write(&path, crate::sequence::tests::moving_ball()).unwrap();
         let loaded = rt_scene::load_any(&path).unwrap();
         let o = Overrides {
             spp: Some(spp),
