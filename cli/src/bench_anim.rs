@@ -187,10 +187,7 @@ pub fn run(args: &BenchAnimArgs) -> Result<()> {
         scene.instances.len(),
         t.elapsed().as_secs_f64()
     ));
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads)
-        .build()
-        .context("cannot start worker threads")?;
+    let pool = rt_session::job::thread_pool(Some(args.threads))?;
     scene.set_time((f64::from(args.frames.start) / args.fps) as f32);
     let mut contenders = Vec::with_capacity(specs.len());
     for spec in &specs {

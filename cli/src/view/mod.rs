@@ -17,7 +17,7 @@ mod window;
 
 pub use args::ViewArgs;
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, bail, Result};
 use rt_accel::AccelSpec;
 use rt_core::{Camera, Scene};
 use rt_session::{pick_camera, Overrides, SequenceFrame, SequenceRenderer};
@@ -132,11 +132,7 @@ impl View {
             fps,
         )
         .map_err(|e| anyhow!("{}: {e}", path.display()))?;
-        let mut pool = rayon::ThreadPoolBuilder::new();
-        if let Some(t) = settings.threads {
-            pool = pool.num_threads(t);
-        }
-        let pool = pool.build().context("cannot start worker threads")?;
+        let pool = rt_session::job::thread_pool(settings.threads)?;
         Ok(View {
             path,
             scene,
