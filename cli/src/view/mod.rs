@@ -48,7 +48,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     let mut view = View::load(args, spp, fps, size)?;
     view.renderer.set_budget(budget);
     if args.headless {
-        headless::run(args, view, budget)
+        headless::run(args, view)
     } else {
         window::run(args, view)
     }
@@ -158,6 +158,20 @@ impl View {
         self.pool
             .install(|| renderer.render_with(scene, f, Some(camera)))
             .map_err(|e| anyhow!("{}: frame {f}: {e}", self.path.display()))
+    }
+
+    /// Renders `frames` one after another through the scene camera at the view's size
+    /// (`rt_session::SequenceRenderer::run`), calling `each` with every frame and its time.
+    pub fn run(
+        &mut self,
+        frames: std::ops::Range<u32>,
+        each: &mut (dyn FnMut(&SequenceFrame, std::time::Duration) -> Result<()> + Send),
+    ) -> Result<rt_session::RunSummary> {
+        let (renderer, scene, size) = (&mut self.renderer, &mut self.scene, Some(self.size));
+        let path = self.path.display().to_string();
+        self.pool
+            .install(|| renderer.run(scene, frames, size, each))
+            .map_err(|e: anyhow::Error| anyhow!("{path}: {e}"))
     }
 
     /// Forgets the denoiser's history (the animation restarts).

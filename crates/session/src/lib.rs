@@ -67,7 +67,7 @@ pub use job::{
 };
 pub use progressive::{Budgets, Checkpoint, Session};
 pub use report::{RenderReport, ReportInputs, Stage, Status};
-pub use sequence::{FrameTimes, SequenceError, SequenceFrame, SequenceRenderer};
+pub use sequence::{FrameTimes, RunSummary, SequenceError, SequenceFrame, SequenceRenderer};
 pub use settings::{
     fold_seed, frame_seed, Origin, Overrides, Settings, SettingsError, DEFAULT_SPP, MAX_SPP,
     MAX_THREADS,
