@@ -59,9 +59,9 @@ pub struct Args {
     /// one camera and one light subpath per pixel per spp; no AOVs), partitioned (the
     /// path-space-partitioned renderer: VPLs, caustic histogram, specular gathering; options
     /// vpls=N, photons=N, clamp=F, cull=off|unbiased|biased, maps=on|off, indirect-caustics=N); options
-    /// max-depth=N (path, path-bsdf, light, bdpt, partitioned) and distance=F (ao), e.g.
-    /// path:max-depth=4 (crates/integrators/src/spec.rs).
-    /// [default: `[render] integrator`, else path]
+    /// max-depth=N (wavefront, path, path-bsdf, light, bdpt, partitioned), lanes=N
+    /// (wavefront) and distance=F (ao), separated by `:` or `,`, e.g. path:max-depth=4
+    /// (crates/integrators/src/spec.rs). [default: `[render] integrator`, else wavefront]
     #[arg(long, value_name = "SPEC", value_parser = parse_integrator)]
     pub integrator: Option<IntegratorSpec>,
 
@@ -183,7 +183,7 @@ pub struct Args {
     #[arg(
         long,
         value_name = "SECONDS",
-        default_value_t = 60.0,
+        default_value_t = rt_session::job::DEFAULT_CHECKPOINT_EVERY,
         requires = "checkpoint"
     )]
     pub checkpoint_every: f64,
@@ -207,9 +207,9 @@ pub struct Args {
     /// Denoise by GREE (Bauszat, thesis ch. 5): --spp is the budget b; render the noisy image
     /// at n = fraction x b spp, run the filter bank (--bank), render filter caches at a share
     /// 1 - sparsity of the pixels with independent samples, pick a filter per pixel by the
-    /// caches' errors (graph cut) and fuse. Options `key=value` separated by `:`: fraction
-    /// (0.875), sparsity (0.95), kappa (0.6), sigma-r (0.15), lambda (0.05), jacobi (2), metric
-    /// (squared|relative). Camera-ray integrators only (docs/denoising.md).
+    /// caches' errors (graph cut) and fuse. Options `key=value` separated by `:` or `,`:
+    /// fraction (0.875), sparsity (0.95), kappa (0.6), sigma-r (0.15), lambda (0.5), jacobi
+    /// (2), metric (squared|relative). Camera-ray integrators only (docs/denoising.md).
     #[arg(long, value_name = "OPTIONS", num_args = 0..=1, default_missing_value = "")]
     pub gree: Option<String>,
 
@@ -228,15 +228,6 @@ pub struct Args {
     /// on one log scale for all filters) into this directory.
     #[arg(long, value_name = "DIR", requires = "gree")]
     pub error_maps: Option<PathBuf>,
-}
-
-/// Frames per second, as `--frames`, `--frame`, `--shutter` and `bench-anim` need it: a
-/// positive finite number.
-pub fn check_fps(fps: f64) -> anyhow::Result<()> {
-    if !(fps.is_finite() && fps > 0.0) {
-        anyhow::bail!("--fps must be a positive number, got {fps}");
-    }
-    Ok(())
 }
 
 /// `A..B` with `A < B`.

@@ -18,8 +18,7 @@ const DEFAULT_ACCEL: &str = "bvh8,two-level,two-level:top=refit,clusters:t=1,clu
 clusters:t=4,clusters:t=8,clusters:t=16,clusters:t=32,clusters:t=64,clusters:t=128,\
 clusters:t=256,clusters:t=512";
 use crate::bench_accel::input::{MAX_PIXELS, MAX_SIDE};
-/// Most threads accepted by `--threads`.
-const MAX_THREADS: usize = 1024;
+use rt_core::limits::MAX_THREADS;
 
 /// Arguments of `render bench-anim`.
 #[derive(clap::Args, Debug)]
@@ -148,7 +147,7 @@ pub fn run(args: &BenchAnimArgs) -> Result<()> {
             args.threads
         );
     }
-    crate::args::check_fps(args.fps)?;
+    rt_session::job::check_fps(args.fps)?;
     if args.repeat == 0 {
         bail!("--repeat must be at least 1");
     }
@@ -158,7 +157,7 @@ pub fn run(args: &BenchAnimArgs) -> Result<()> {
         }
     };
     let t = Instant::now();
-    let loaded = crate::job::load_scene(std::path::Path::new(&args.input))?;
+    let loaded = rt_session::load_scene(std::path::Path::new(&args.input), None)?.loaded;
     for w in &loaded.warnings {
         info(&format!("warning: {w}"));
     }
@@ -188,10 +187,7 @@ pub fn run(args: &BenchAnimArgs) -> Result<()> {
         scene.instances.len(),
         t.elapsed().as_secs_f64()
     ));
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads)
-        .build()
-        .context("cannot start worker threads")?;
+    let pool = rt_session::job::thread_pool(Some(args.threads))?;
     scene.set_time((f64::from(args.frames.start) / args.fps) as f32);
     let mut contenders = Vec::with_capacity(specs.len());
     for spec in &specs {

@@ -3,13 +3,13 @@
 //! false-colour error image. With `--frames`, A and B are numbered sequences and
 //! `compare_frames.rs` adds the temporal metrics. Definitions: docs/experiments.md.
 
-use crate::frame_pattern::names_frame;
 use anyhow::{anyhow, Result};
 use rt_film::read_rgb as load_rgb;
 use rt_metrics::{
     compare, error_image, CompareOptions, FalseColourOptions, Metrics, MetricsError, RgbImage,
     Role, DEFAULT_EPSILON, DEFAULT_PEAK,
 };
+use rt_session::frames::names_frame;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 

@@ -4,13 +4,13 @@
 //! one JSON object. Frames are read one pair at a time; only the previous pair is kept.
 
 use crate::compare::{crop, explain, CompareArgs};
-use crate::frame_pattern::{frame_path, names_frame};
 use anyhow::{anyhow, bail, Result};
 use rt_core::RgbImage;
 use rt_metrics::temporal::{
     lag, FrameMetrics, Lag, LagOptions, SequenceComparison, SequenceMetrics, TemporalError,
 };
 use rt_metrics::{error_image, CompareOptions, FalseColourOptions, Role};
+use rt_session::frames::{frame_path, names_frame};
 use serde::Serialize;
 use std::ops::Range;
 use std::path::{Path, PathBuf};

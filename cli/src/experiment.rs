@@ -3,7 +3,7 @@
 //! Markdown report and an HTML one; docs/experiments.md), and this prints what it found.
 
 use crate::progress::Progress;
-use anyhow::{bail, Context, Result};
+use anyhow::Result;
 use rt_experiment::{Cache, DEFAULT_CACHE_DIR};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -41,25 +41,13 @@ pub struct ExperimentArgs {
     pub confine: Option<PathBuf>,
 }
 
-/// A rayon pool of `threads` workers (all cores by default).
-pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
-    let mut pool = rayon::ThreadPoolBuilder::new();
-    if let Some(t) = threads {
-        if t == 0 || t > rt_session::MAX_THREADS {
-            bail!(
-                "--threads must be between 1 and {}, got {t}",
-                rt_session::MAX_THREADS
-            );
-        }
-        pool = pool.num_threads(t);
-    }
-    pool.build().context("cannot start worker threads")
-}
-
 /// Runs `render experiment`.
 pub fn run(args: &ExperimentArgs) -> Result<()> {
     let wall = Instant::now();
-    let access = crate::job::file_access(args.confine.as_deref())?;
+    let access = match &args.confine {
+        Some(dir) => rt_scene::FileAccess::confined_to(dir)?,
+        None => rt_scene::FileAccess::open(),
+    };
     let plan = rt_experiment::config::load_with(&args.config, &access)?;
     if args.check {
         for w in &plan.warnings {
@@ -74,7 +62,7 @@ pub fn run(args: &ExperimentArgs) -> Result<()> {
         );
         return Ok(());
     }
-    let pool = thread_pool(args.threads)?;
+    let pool = rt_session::job::thread_pool(args.threads)?;
     let out = args
         .out
         .clone()

@@ -1,34 +1,27 @@
-//! `render`: the command-line front end. It parses arguments (clap), loads the scene
-//! (`rt-scene`), builds the acceleration structure (`rt-accel`), runs the integrator over the
-//! film (`rt-integrators`, `rt-film`) and writes the image. All error reporting to the user
-//! happens here: libraries return typed errors, this turns them into one line on stderr and a
-//! non-zero exit code (2 for usage errors, 1 for everything else). `render bench-accel` (in
-//! `bench_accel/`) measures the acceleration structures instead of rendering, `render
-//! bench-anim` (`bench_anim.rs`) their seconds per frame on an animated scene; `render compare`
-//! (`compare.rs`, `compare_frames.rs`) measures the error of one image against another, or
-//! the per-frame and temporal errors of a sequence; `render reference` and
-//! `render experiment` (`reference/`, `experiment/`) render references and measured grids,
-//! sharing `session.rs` (one configuration, rendered progressively) with plain rendering;
-//! `render stress` (`stress.rs`) runs the numerical stress suite; `render view` (`view/`) is
-//! the real-time mode: a window, or a headless sequence within a per-frame time budget.
+//! `render`: the command-line front end. It parses arguments (clap), calls the libraries and
+//! prints: `render SCENE` turns its flags into an `rt_session::RenderJob` and runs it
+//! (`render.rs`); `render plan`, `render part` and `render merge` (`parts.rs`) cut, run and
+//! merge jobs; `render reference` and `render experiment` (`reference.rs`, `experiment.rs`)
+//! call `rt-experiment`; `render bench-accel` (`bench_accel/`) and `render bench-anim`
+//! (`bench_anim.rs`) measure the acceleration structures; `render compare` (`compare.rs`,
+//! `compare_frames.rs`) measures the error of one image against another, or the per-frame and
+//! temporal errors of a sequence; `render denoise` filters a saved frame; `render stress`
+//! (`stress.rs`) runs the numerical stress suite; `render view` (`view/`) is the real-time
+//! mode: a window, or a headless sequence within a per-frame time budget. All error reporting
+//! to the user happens here: libraries return typed errors, this turns them into one line on
+//! stderr and a non-zero exit code (2 for usage errors, 1 for everything else).
 
 mod args;
 mod bench_accel;
 mod bench_anim;
-mod cache;
-mod checkpoint;
 mod compare;
 mod compare_frames;
 mod denoise;
 mod experiment;
-mod frame_pattern;
-mod gree;
-mod job;
-mod memory;
 mod parts;
 mod progress;
 mod reference;
-mod sequence;
+mod render;
 mod stress;
 mod view;
 
@@ -72,7 +65,7 @@ pub(crate) fn run(args: &args::Args) -> anyhow::Result<()> {
         Some(args::Command::GenScene { name, output }) => {
             bench_accel::input::write_obj(name, output)
         }
-        None => job::run(args),
+        None => render::run(args),
     }
 }
 

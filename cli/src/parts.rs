@@ -1,207 +1,16 @@
-//! Parts, merges and plans on the command line (`rt-parts` does the work):
-//! `render SCENE --sample-range A..B --region x0,y0,x1,y1 -o P.rpart` writes a part;
-//! `render merge P... -o OUT` (or `--plan plan.json DIR`) writes what the whole render would
-//! have; `render plan` cuts a render for a scheduler and `render part` runs one piece of it.
+//! Parts, merges and plans on the command line (`rt-parts` holds the format, `rt_session`'s
+//! jobs render and merge them): `render SCENE --sample-range A..B --region x0,y0,x1,y1 -o
+//! P.rpart` writes a part; `render merge P... -o OUT` (or `--plan plan.json DIR`) writes what
+//! the whole render would have; `render plan` cuts a render's job for a scheduler and `render
+//! part` runs one piece of it.
 
 use crate::args::Args;
-use crate::job::Job;
-use anyhow::{bail, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use clap::Parser;
-use rt_film::{Film, Rect};
-use rt_parts::{Part, PartHeader, PartKind, Plan, PlanRequest, PlannedRender};
-use std::collections::BTreeMap;
+use rt_parts::{Plan, PlanRequest, PlannedRender};
+use rt_session::{Frames, RenderJob, Slice};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
-
-/// The slice of a render a part holds.
-#[derive(Clone, Debug)]
-pub struct Slice {
-    /// Sample indices.
-    pub samples: Range<u32>,
-    /// Pixels.
-    pub region: Rect,
-}
-
-impl Slice {
-    /// The pixels to render, `None` for all of them.
-    pub fn mask(&self, width: u32, height: u32) -> Option<std::sync::Arc<[bool]>> {
-        if self.region == Rect::full(width, height) {
-            return None;
-        }
-        Some(
-            (0..height)
-                .flat_map(|y| (0..width).map(move |x| self.region.contains(x, y)))
-                .collect(),
-        )
-    }
-}
-
-/// True if the render writes a part file (its output ends in `.rpart`).
-pub fn writes_part(args: &Args) -> bool {
-    args.output
-        .as_ref()
-        .and_then(|o| o.extension())
-        .is_some_and(|e| e.eq_ignore_ascii_case("rpart"))
-}
-
-/// The slice a render computes: `None` for a whole render written as an image. Refuses what a
-/// part cannot hold or what would not merge exactly, with one line each.
-pub fn slice_of(
-    args: &Args,
-    job: &Job,
-    camera: &rt_core::Camera,
-    film: &Film,
-) -> Result<Option<Slice>> {
-    let part = writes_part(args);
-    if !part {
-        if args.sample_range.is_some() || args.region.is_some() {
-            bail!(
-                "{}: --sample-range and --region write a part file: -o must end in .rpart",
-                job.output.display()
-            );
-        }
-        return Ok(None);
-    }
-    let refuse = |what: &str, why: &str| -> Result<Option<Slice>> {
-        bail!(
-            "{}: a part file cannot hold {what}: {why}",
-            job.output.display()
-        )
-    };
-    if job.stop.is_some() {
-        return refuse(
-            "an adaptive render (--error, --time-limit)",
-            "the stopping criterion decides on the whole image; render parts with a fixed --spp and merge",
-        );
-    }
-    if args.gree.is_some() {
-        return refuse("GREE", "its filter caches need the whole noisy image");
-    }
-    if args.cache.is_some() {
-        return refuse(
-            "a world-space cache",
-            "the cache carries light from one sample to the next",
-        );
-    }
-    if film.buffers().samples {
-        return refuse(
-            "per-sample records (--denoiser sbmf)",
-            "denoise after merging with a pixel-space denoiser",
-        );
-    }
-    if job.settings.aovs.blocks {
-        return refuse("--aov blocks", "it needs --error");
-    }
-    let spp = job.settings.spp;
-    let samples = args.sample_range.clone().unwrap_or(0..spp);
-    if samples.end > spp {
-        bail!(
-            "--sample-range {}..{}: the render takes samples 0..{spp} (--spp)",
-            samples.start,
-            samples.end
-        );
-    }
-    let region = args
-        .region
-        .unwrap_or(Rect::full(camera.width, camera.height));
-    if !region.is_inside(camera.width, camera.height) {
-        bail!(
-            "--region {region}: outside the {}x{} image",
-            camera.width,
-            camera.height
-        );
-    }
-    Ok(Some(Slice { samples, region }))
-}
-
-/// Every setting that changes the image's bits (`--threads`, `-o` and `-q` do not).
-fn settings(args: &Args, job: &Job, camera: &rt_core::Camera) -> BTreeMap<String, String> {
-    let s = &job.settings;
-    [
-        ("integrator", s.integrator.to_string()),
-        ("accel", s.accel.to_string()),
-        ("seed", s.seed.to_string()),
-        ("camera", camera.name.clone()),
-        ("exposure", args.exposure.to_string()),
-        ("denoiser", s.denoiser.clone().unwrap_or_default()),
-        ("shutter", args.shutter.to_string()),
-        ("fps", args.fps.to_string()),
-    ]
-    .into_iter()
-    .map(|(k, v)| (k.to_string(), v))
-    .collect()
-}
-
-/// The header of a part or checkpoint of this render.
-pub fn header(
-    args: &Args,
-    job: &Job,
-    camera: &rt_core::Camera,
-    film: &Film,
-    slice: &Slice,
-    scene_hash: &str,
-    kind: PartKind,
-) -> PartHeader {
-    PartHeader {
-        scene: job.scene_path.display().to_string(),
-        scene_hash: scene_hash.to_string(),
-        settings: settings(args, job, camera),
-        frame: job.frame,
-        spp: job.settings.spp,
-        args: job.command.clone(),
-        ..film_header(film, slice, kind)
-    }
-}
-
-/// A header with what the film and the slice say (format, build, size, region, samples,
-/// buffers); the caller fills in the scene, settings, spp, frame and command line.
-pub fn film_header(film: &Film, slice: &Slice, kind: PartKind) -> PartHeader {
-    let b = film.buffers();
-    PartHeader {
-        format: rt_parts::FORMAT,
-        kind,
-        binary: rt_parts::binary_id(env!("CARGO_PKG_VERSION")),
-        scene: String::new(),
-        scene_hash: String::new(),
-        settings: BTreeMap::new(),
-        frame: None,
-        width: film.width(),
-        height: film.height(),
-        spp: slice.samples.end,
-        region: [
-            slice.region.x0,
-            slice.region.y0,
-            slice.region.x1,
-            slice.region.y1,
-        ],
-        samples: [slice.samples.start, slice.samples.end],
-        aovs: b.aovs.names().into_iter().map(str::to_string).collect(),
-        variance: b.variance,
-        halves: b.halves,
-        args: Vec::new(),
-        seconds: 0.0,
-    }
-}
-
-/// Writes the film's sums of `slice` as a part file at the job's output, atomically.
-pub fn write(
-    args: &Args,
-    job: &Job,
-    camera: &rt_core::Camera,
-    film: &Film,
-    slice: &Slice,
-    (scene_hash, seconds): (&str, f64),
-) -> Result<()> {
-    let part = Part {
-        header: PartHeader {
-            seconds,
-            ..header(args, job, camera, film, slice, scene_hash, PartKind::Part)
-        },
-        sums: film.encode_sums(slice.region),
-    };
-    part.write(&job.output)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", job.output.display()))
-}
 
 /// `render merge`.
 #[derive(clap::Args, Debug)]
@@ -226,8 +35,8 @@ pub struct MergeArgs {
 /// `render merge`.
 pub fn merge(m: &MergeArgs) -> Result<()> {
     let limit = match &m.max_memory {
-        Some(s) => Some(crate::memory::parse_size(s)?),
-        None => crate::memory::available(),
+        Some(s) => Some(rt_session::memory::parse_size(s)?),
+        None => rt_session::memory::available(),
     };
     let Some(plan_path) = &m.plan else {
         let output = m.output.as_ref().expect("clap requires -o without --plan");
@@ -246,19 +55,14 @@ pub fn merge(m: &MergeArgs) -> Result<()> {
             .iter()
             .map(|&i| dir.join(&plan.parts[i].file))
             .collect();
-        merge_files(
-            &files,
-            Path::new(&out.output),
-            out.into_cache,
-            limit,
-            m.quiet,
-        )?;
+        let output = Path::new(&out.output);
+        merge_files(&files, output, out.into_cache, limit, m.quiet)?;
     }
     Ok(())
 }
 
 /// Merges `files` into `output` (or, `into_cache`, into the reference cache directory
-/// `output`).
+/// `output`, where `render reference` and experiments find it).
 fn merge_files(
     files: &[PathBuf],
     output: &Path,
@@ -266,135 +70,28 @@ fn merge_files(
     limit: Option<u64>,
     quiet: bool,
 ) -> Result<()> {
-    if into_cache {
-        return merge_reference(files, output, limit, quiet);
-    }
-    match output
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase)
-        .as_deref()
-    {
-        Some("exr") | Some("png") => {}
-        _ => bail!(
-            "{}: the merged image must end in .exr or .png",
-            output.display()
-        ),
-    }
-    let parts = read_parts(files)?;
+    let parts = rt_session::job::read_parts(files)?;
     let t = std::time::Instant::now();
-    let mut merged = rt_parts::merge(&parts, limit).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let h = &merged.header;
-    let exposure: f32 = h
-        .settings
-        .get("exposure")
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(0.0);
-    let scene = PathBuf::from(&h.scene);
-    match h.settings.get("denoiser").filter(|d| !d.is_empty()) {
-        Some(text) => {
-            let d = text
-                .parse::<rt_denoise::DenoiserSpec>()
-                .and_then(|s| s.build())
-                .map_err(|e| anyhow::anyhow!("--denoiser {text}: {e}"))?;
-            crate::job::write_denoised(&mut merged.film, d.as_ref(), output, exposure, &scene)?;
-        }
-        None => {
-            if output
-                .extension()
-                .is_some_and(|e| e.eq_ignore_ascii_case("png"))
-                && !h.aovs.is_empty()
-            {
-                bail!(
-                    "{}: the parts hold AOVs, which need an .exr output",
-                    output.display()
-                );
-            }
-            rt_film::write_image_with(
-                output,
-                &merged.film,
-                &rt_film::OutputOptions { exposure },
-                &[],
-            )
-            .map_err(|e| anyhow::anyhow!("{e}"))?;
-        }
-    }
-    if !quiet {
-        println!(
-            "merged {} parts ({} sample ranges) of {} ({}x{}, {} spp) in {:.2} s -> {}",
-            parts.len(),
-            merged.ranges.len(),
-            h.scene,
-            h.width,
-            h.height,
-            h.spp,
-            t.elapsed().as_secs_f64(),
-            output.display()
-        );
-    }
-    Ok(())
-}
-
-/// Reads part files (checkpoints are refused: they are resumed, not merged).
-fn read_parts(files: &[PathBuf]) -> Result<Vec<(String, Part)>> {
-    let mut parts = Vec::with_capacity(files.len());
-    for f in files {
-        let p = Part::read(f).map_err(|e| anyhow::anyhow!("{}: {e}", f.display()))?;
-        if p.header.kind != PartKind::Part {
-            bail!(
-                "{}: a checkpoint, not a part: continue it with render --resume",
-                f.display()
+    if into_cache {
+        let (path, s) = rt_experiment::Cache::new(output).store_parts(&parts, limit)?;
+        if !quiet {
+            println!(
+                "merged {} parts of the reference of {} ({}x{}, {} spp, {:.1} s of rendering) -> {}",
+                parts.len(),
+                s.scene,
+                s.width,
+                s.height,
+                s.spp,
+                s.seconds,
+                path.display()
             );
         }
-        parts.push((f.display().to_string(), p));
+        return Ok(());
     }
-    Ok(parts)
-}
-
-/// Merges the parts of a reference (`render reference --sample-range/--region`) and stores
-/// it in the reference cache `dir`, where `render reference` and experiments find it.
-fn merge_reference(files: &[PathBuf], dir: &Path, limit: Option<u64>, quiet: bool) -> Result<()> {
-    let parts = read_parts(files)?;
-    let merged = rt_parts::merge(&parts, limit).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let h = &merged.header;
-    let setting = |k: &str| {
-        h.settings
-            .get(k)
-            .cloned()
-            .ok_or_else(|| anyhow::anyhow!("{}: not a reference's part (no {k})", parts[0].0))
-    };
-    if setting("stream")? != "reference" {
-        bail!("{}: not a reference's part", parts[0].0);
-    }
-    let key = rt_experiment::cache::Key {
-        hex: setting("cache key")?,
-        description: setting("cache description")?,
-    };
-    let seconds: f64 = parts.iter().map(|(_, p)| p.header.seconds).sum();
-    let samples = u64::from(h.width) * u64::from(h.height) * u64::from(h.spp);
-    let sidecar = rt_experiment::cache::Sidecar {
-        key: key.hex.clone(),
-        description: key.description.clone(),
-        scene: h.scene.clone(),
-        width: h.width,
-        height: h.height,
-        spp: h.spp,
-        seconds,
-        samples_per_second: samples as f64 / seconds.max(1e-9),
-    };
-    let path =
-        rt_experiment::Cache::new(dir).store(Path::new(&h.scene), &key, &merged.film, &sidecar)?;
+    let report = rt_session::job::merge(&parts, output, limit)?;
     if !quiet {
-        println!(
-            "merged {} parts of the reference of {} ({}x{}, {} spp, {:.1} s of rendering) -> {}",
-            parts.len(),
-            h.scene,
-            h.width,
-            h.height,
-            h.spp,
-            seconds,
-            path.display()
-        );
+        let secs = t.elapsed().as_secs_f64();
+        println!("{report} in {secs:.2} s -> {}", output.display());
     }
     Ok(())
 }
@@ -421,15 +118,15 @@ pub struct PlanArgs {
     /// With --experiment: the reference cache the merge stores into.
     #[arg(long, value_name = "DIR", default_value = rt_experiment::DEFAULT_CACHE_DIR)]
     pub cache: PathBuf,
-    /// Refuse any file the scene (or experiment) refers to outside DIR; give it after `--`
-    /// too for the parts' renders.
+    /// Refuse any file the scene (or experiment) refers to outside DIR, here and in the
+    /// parts' renders.
     #[arg(long, value_name = "DIR")]
     pub confine: Option<PathBuf>,
     /// The plan to write (JSON).
     #[arg(short, long)]
     pub output: PathBuf,
-    /// Everything else is passed to each part's render, e.g. `-- --spp 256 --integrator bdpt
-    /// -o out.exr` (its -o is the merged image's path).
+    /// The render's flags, as `render SCENE` takes them, e.g. `-- --spp 256 --integrator bdpt
+    /// -o out.exr` (its -o is the merged image's path); the plan stores the job they make.
     #[arg(last = true)]
     pub render_args: Vec<String>,
 }
@@ -461,9 +158,8 @@ pub fn plan(p: &PlanArgs) -> Result<()> {
     } else {
         vec![render_request(p)?]
     };
-    let plan = Plan::new(&requests).map_err(|e| anyhow::anyhow!("render plan: {e}"))?;
-    rt_film::write_bytes_atomic(&p.output, plan.to_json().as_bytes())
-        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    let plan = Plan::new(&requests).map_err(|e| anyhow!("render plan: {e}"))?;
+    rt_film::write_bytes_atomic(&p.output, plan.to_json().as_bytes())?;
     println!(
         "{} parts, {} outputs -> {}",
         plan.parts.len(),
@@ -473,54 +169,47 @@ pub fn plan(p: &PlanArgs) -> Result<()> {
     Ok(())
 }
 
-/// One render, its frames and outputs, cut as `p` asks.
+/// One render's job, its frames and outputs, cut as `p` asks.
 fn render_request(p: &PlanArgs) -> Result<PlanRequest> {
-    let rest = p.render_args.clone();
-    for flag in ["--frames", "--frame", "--sample-range", "--region"] {
-        if rest
-            .iter()
-            .any(|a| a == flag || a.starts_with(&format!("{flag}=")))
-        {
+    let mut all = vec![p.scene.display().to_string()];
+    all.extend(p.render_args.iter().cloned());
+    let args = parse_args(&all)?;
+    for (given, flag) in [
+        (args.frames.is_some(), "--frames"),
+        (args.frame.is_some(), "--frame"),
+        (args.sample_range.is_some(), "--sample-range"),
+        (args.region.is_some(), "--region"),
+    ] {
+        if given {
             bail!(
                 "render plan: {flag} is the plan's to set; give --frames to the plan, not after --"
             );
         }
     }
-    let mut all = vec![p.scene.display().to_string()];
-    all.extend(rest.iter().cloned());
-    let args = parse_args(&all)?;
-    let access = crate::job::file_access(p.confine.as_deref())?;
-    let loaded = crate::job::load_scene_with(&p.scene, &access)?;
-    let job = Job::resolve(&args, &loaded.render)?;
-    let camera = rt_session::pick_camera(&loaded.scene, &job.scene_path, job.camera.as_deref())?;
+    let confine = p.confine.as_deref().or(args.confine.as_deref());
+    let scene = rt_session::load_scene(&p.scene, confine)?;
+    let mut job = crate::render::job(&args, &scene.loaded)?;
+    job.confine = confine.map(Path::to_path_buf);
+    let camera = rt_session::pick_camera(&scene.loaded.scene, &job.scene, job.camera.as_deref())?;
+    let camera = job.size.apply(camera);
     let output = job.output.display().to_string();
     let frames: Vec<(Option<u32>, String)> = match &p.frames {
         None => vec![(None, output.clone())],
         Some(r) => {
-            if !output.contains("{frame") {
+            if !rt_session::frames::names_frame(&job.output) {
                 bail!("{output}: --frames needs an output that names the frame, e.g. -o 'out/frame_{{frame:04}}.exr'");
             }
             r.clone()
                 .map(|f| {
-                    let path = crate::frame_pattern::frame_path(&job.output, f);
+                    let path = rt_session::frames::frame_path(&job.output, f);
                     (Some(f), path.display().to_string())
                 })
                 .collect()
         }
     };
-    // The parts' command line: the scene, the render's arguments without its -o.
-    let mut part_args = vec![p.scene.display().to_string()];
-    let mut it = rest.into_iter();
-    while let Some(a) = it.next() {
-        if a == "-o" || a == "--output" {
-            it.next();
-        } else if !(a.starts_with("--output=") || a.starts_with("-o=")) {
-            part_args.push(a);
-        }
-    }
     Ok(PlanRequest {
         render: PlannedRender {
-            args: part_args,
+            job: job.to_json(),
             width: camera.width,
             height: camera.height,
             spp: job.settings.spp,
@@ -532,10 +221,13 @@ fn render_request(p: &PlanArgs) -> Result<PlanRequest> {
     })
 }
 
-/// The references an experiment renders, each a `render reference` cut as `p` asks and
-/// merged into the cache. Sequence scenes (one reference per frame) are refused for now.
+/// The references an experiment renders, each a reference job cut as `p` asks and merged
+/// into the cache. Sequence scenes (one reference per frame) are refused for now.
 fn experiment_requests(p: &PlanArgs) -> Result<Vec<PlanRequest>> {
-    let access = crate::job::file_access(p.confine.as_deref())?;
+    let access = match &p.confine {
+        Some(dir) => rt_scene::FileAccess::confined_to(dir)?,
+        None => rt_scene::FileAccess::open(),
+    };
     let exp = rt_experiment::config::load_with(&p.scene, &access)?;
     let mut requests = Vec::new();
     for scene in &exp.scenes {
@@ -555,22 +247,21 @@ fn experiment_requests(p: &PlanArgs) -> Result<Vec<PlanRequest>> {
                 scene.name
             );
         }
-        let c = &scene.camera;
-        let args = [
-            "reference".to_string(),
-            scene.path.display().to_string(),
-            format!("--spp={spp}"),
-            format!("--seed={seed}"),
-            format!("--integrator={estimator}"),
-            format!("--camera={}", c.name),
-            format!("--resolution={}x{}", c.width, c.height),
-            format!("--accel={accel}"),
-        ];
+        let req = rt_experiment::ReferenceRequest {
+            scene_path: &scene.path,
+            scene: &scene.loaded.scene,
+            camera: &scene.camera,
+            estimator: *estimator,
+            spp: *spp,
+            seed: *seed,
+        };
+        let mut job = rt_experiment::reference::job(&req, *accel, &req.key()?, &p.cache);
+        job.confine = p.confine.clone();
         requests.push(PlanRequest {
             render: PlannedRender {
-                args: args.to_vec(),
-                width: c.width,
-                height: c.height,
+                job: job.to_json(),
+                width: scene.camera.width,
+                height: scene.camera.height,
                 spp: *spp,
             },
             into_cache: true,
@@ -588,7 +279,7 @@ fn experiment_requests(p: &PlanArgs) -> Result<Vec<PlanRequest>> {
 fn read_plan(path: &Path) -> Result<Plan> {
     let text = std::fs::read_to_string(path)
         .with_context(|| format!("{}: cannot read", path.display()))?;
-    Plan::from_json(&text).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+    Plan::from_json(&text).map_err(|e| anyhow!("{}: {e}", path.display()))
 }
 
 /// `render part`.
@@ -607,7 +298,7 @@ pub struct PartArgs {
     pub quiet: bool,
 }
 
-/// `render part`.
+/// `render part`: the plan's job with the part's frame, slice and file.
 pub fn part(p: &PartArgs) -> Result<()> {
     let plan = read_plan(&p.plan)?;
     let Some(part) = plan.parts.get(p.index) else {
@@ -620,22 +311,14 @@ pub fn part(p: &PartArgs) -> Result<()> {
     };
     std::fs::create_dir_all(&p.output)
         .with_context(|| format!("{}: cannot create the parts directory", p.output.display()))?;
-    let [x0, y0, x1, y1] = part.region;
+    let mut job = RenderJob::from_json(&plan.renders[part.render].job)
+        .map_err(|e| anyhow!("{}: {e}", p.plan.display()))?;
     let [a, b] = part.samples;
-    let mut argv: Vec<String> = plan.renders[part.render].args.clone();
-    argv.extend([
-        "--sample-range".into(),
-        format!("{a}..{b}"),
-        "--region".into(),
-        format!("{x0},{y0},{x1},{y1}"),
-        "-o".into(),
-        p.output.join(&part.file).display().to_string(),
-    ]);
-    if let Some(f) = part.frame {
-        argv.extend(["--frame".into(), f.to_string()]);
-    }
-    if p.quiet {
-        argv.push("-q".into());
-    }
-    crate::run(&parse_args(&argv)?)
+    job.slice = Slice {
+        samples: Some(a..b),
+        region: Some(part.region),
+    };
+    job.frames = part.frame.map_or(Frames::Still, Frames::One);
+    job.output = p.output.join(&part.file);
+    crate::render::run_job(&job, None, p.quiet, false)
 }

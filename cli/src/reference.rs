@@ -102,16 +102,11 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
             args.spp
         );
     }
-    let part = args.output.as_ref().is_some_and(|o| {
-        o.extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("rpart"))
-    });
+    let ext =
+        |o: &std::path::Path, e: &str| o.extension().is_some_and(|x| x.eq_ignore_ascii_case(e));
+    let part = args.output.as_ref().is_some_and(|o| ext(o, "rpart"));
     if let Some(out) = &args.output {
-        if !part
-            && !out
-                .extension()
-                .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
-        {
+        if !part && !ext(out, "exr") {
             bail!(
                 "{}: a reference is written as .exr (or .rpart for a part)",
                 out.display()
@@ -131,8 +126,10 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         Some(a) => Some(a.parse().map_err(|e| anyhow!("--accel {a}: {e}"))?),
         None => None,
     };
-    let access = crate::job::file_access(args.confine.as_deref())?;
-    let loaded = crate::job::load_scene_with(&args.scene, &access)?;
+    let t = std::time::Instant::now();
+    let scene = rt_session::load_scene(&args.scene, args.confine.as_deref())?;
+    let load = t.elapsed();
+    let loaded = &scene.loaded;
     let overrides = Overrides {
         integrator: args.integrator,
         max_depth: args.max_depth,
@@ -142,14 +139,14 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         ..Overrides::default()
     };
     let estimator = overrides.integrator_spec(&loaded.render, &args.scene)?;
-    if estimator.kind.splats() {
+    if estimator.build().splats() {
         anyhow::bail!(
             "{}: integrator `{}` splats light paths and keeps no per-pixel variance; render references with a camera-ray integrator (wavefront, path, path-bsdf, direct, ao)",
             args.scene.display(),
             estimator.kind
         );
     }
-    let accel_spec = overrides.accel_spec(&loaded.render, &args.scene)?;
+    let accel_spec = overrides.accel_spec(loaded, &args.scene)?;
     let camera = size.apply(pick_camera(
         &loaded.scene,
         &args.scene,
@@ -163,11 +160,20 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         spp: args.spp,
         seed: overrides.seed(&loaded.render),
     };
-    let pool = crate::experiment::thread_pool(args.threads)?;
     if part {
-        let hash = rt_parts::content_hash(&access.files_used(), &args.scene.to_string_lossy());
-        return pool.install(|| render_part(args, &req, &accel_spec, &hash));
+        // A slice of the reference, as a part file whose header carries the cache key for
+        // `render merge --plan` to store the merged parts under.
+        let out = args.output.as_ref().expect("a part has an output");
+        let mut job = rt_experiment::reference::job(&req, accel_spec, &req.key()?, out);
+        job.slice = rt_session::Slice {
+            samples: args.sample_range.clone(),
+            region: args.region.map(|r| [r.x0, r.y0, r.x1, r.y1]),
+        };
+        job.confine = args.confine.clone();
+        job.settings.threads = args.threads;
+        return crate::render::run_job(&job, Some((scene, load)), args.quiet, false);
     }
+    let pool = rt_session::job::thread_pool(args.threads)?;
     let progress = Progress::new(
         args.quiet,
         1000,
@@ -178,7 +184,7 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         let accel = accel_spec.build_scene(&loaded.scene);
         rt_experiment::reference::obtain(
             &req,
-            accel.as_ref(),
+            (&accel_spec, accel.as_ref()),
             cache.as_ref(),
             args.output.as_deref(),
             &|f| progress.bar().set_position((f * 1000.0) as u64),
@@ -209,88 +215,5 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         _ => obtained.path,
     };
     println!("{}", printed.display());
-    Ok(())
-}
-
-/// A slice of the reference (`--sample-range`, `--region`) as a part file: the reference's
-/// stream, its variance, and the cache key in the header for the merge to store it under.
-fn render_part(
-    args: &ReferenceArgs,
-    req: &ReferenceRequest<'_>,
-    accel_spec: &rt_accel::AccelSpec,
-    scene_hash: &str,
-) -> Result<()> {
-    let (w, h) = (req.camera.width, req.camera.height);
-    let samples = args.sample_range.clone().unwrap_or(0..req.spp);
-    if samples.end > req.spp {
-        bail!(
-            "--sample-range {}..{}: the reference takes samples 0..{} (--spp)",
-            samples.start,
-            samples.end,
-            req.spp
-        );
-    }
-    let region = args.region.unwrap_or(rt_film::Rect::full(w, h));
-    if !region.is_inside(w, h) {
-        bail!("--region {region}: outside the {w}x{h} image");
-    }
-    let key = req.key()?;
-    let integrator = req.estimator.build();
-    let mut film = rt_film::Film::new(
-        w,
-        h,
-        rt_film::AovSet {
-            variance: true,
-            ..Default::default()
-        },
-    );
-    let slice = crate::parts::Slice { samples, region };
-    let pass = rt_integrators::SamplePass {
-        indices: slice.samples.clone(),
-        stream: rt_core::SampleStream::Reference,
-        pixels: slice.mask(w, h),
-        centre_first: false,
-    };
-    let accel = accel_spec.build_scene(req.scene);
-    let ctx = rt_integrators::Ctx {
-        scene: req.scene,
-        accel: accel.as_ref(),
-        camera: req.camera,
-    };
-    let stats = integrator.render_pass(&ctx, &mut film, req.seed, &pass, &|_| {});
-    let settings = [
-        ("stream", "reference".to_string()),
-        ("cache key", key.hex.clone()),
-        ("cache description", key.description.clone()),
-    ];
-    let header = rt_parts::PartHeader {
-        scene: req.scene_path.display().to_string(),
-        scene_hash: scene_hash.to_string(),
-        settings: settings
-            .into_iter()
-            .map(|(k, v)| (k.to_string(), v))
-            .collect(),
-        spp: req.spp,
-        args: std::env::args().skip(1).collect(),
-        seconds: stats.elapsed.as_secs_f64(),
-        ..crate::parts::film_header(&film, &slice, rt_parts::PartKind::Part)
-    };
-    let out = args.output.as_ref().expect("a part has an output");
-    rt_parts::Part {
-        header,
-        sums: film.encode_sums(region),
-    }
-    .write(out)
-    .map_err(|e| anyhow!("{}: {e}", out.display()))?;
-    if !args.quiet {
-        println!(
-            "{}: reference samples {}..{} of pixels {region} ({:.2} s) -> {}",
-            req.scene_path.display(),
-            slice.samples.start,
-            slice.samples.end,
-            stats.elapsed.as_secs_f64(),
-            out.display()
-        );
-    }
     Ok(())
 }

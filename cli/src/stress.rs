@@ -53,7 +53,7 @@ pub fn run(args: &StressArgs) -> Result<()> {
     if cases.is_empty() {
         bail!("--only {}: no stress case has that prefix", args.only);
     }
-    let pool = crate::experiment::thread_pool(args.threads)?;
+    let pool = rt_session::job::thread_pool(args.threads)?;
     println!(
         "stress ({}): {} spp, {}x{} images, {} rays per surface, seed {}",
         if args.long { "long" } else { "short" },

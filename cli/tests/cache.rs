@@ -190,10 +190,11 @@ fn bad_cache_options_are_one_line_naming_the_option() {
         args.extend_from_slice(extra);
         one_error_line(&render(dir, &args))
     };
-    assert!(err("worldspace:lod=x", &[]).contains("option `lod`: `x` is not an integer"));
+    assert!(err("worldspace:lod=x", &[]).contains("worldspace: lod: `x` is not an integer"));
     assert!(err("octree", &[]).contains("unknown cache `octree`"));
     assert!(err("grid:bogus=1", &[]).contains("unknown option `bogus`"));
-    assert!(err("worldspace:capacity=100", &[]).contains("`capacity`"));
+    assert!(err("worldspace:capacity=100", &[]).contains("capacity: `100`"));
+    assert!(err("worldspace:lod=3,lod=4", &[]).contains("option `lod` given twice"));
     assert!(err("worldspace", &["--integrator", "light"]).contains("cannot use a cache"));
     assert!(!dir.join("x.exr").exists());
 }

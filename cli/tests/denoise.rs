@@ -79,7 +79,7 @@ fn saved_frames_denoise_like_the_library_and_bad_input_is_one_line() {
             "x.exr",
         ],
     ));
-    assert!(err.contains("box: unknown option 'size'"), "{err}");
+    assert!(err.contains("box: unknown option `size`"), "{err}");
     let err = one_error_line(&render(
         dir,
         &["denoise", "f.exr", "--denoiser", "nope", "-o", "x.exr"],

@@ -309,7 +309,7 @@ fn bad_experiment_files_give_one_line_naming_the_file() {
     );
     expect_error(
         &CONFIG.replacen("spp = [2, 8]", "spp = [2, 8]\ndenoiser = \"box:radius=-1\"", 1),
-        "[[method]] \"nee\": denoiser = \"box:radius=-1\": box: radius: '-1' is not a non-negative integer",
+        "[[method]] \"nee\": denoiser = \"box:radius=-1\": box: radius: `-1` is not a non-negative integer",
     );
     let d = Dir::new();
     let o = d.render(&["experiment", "none.toml"]);

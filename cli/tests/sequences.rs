@@ -115,7 +115,7 @@ fn what_a_temporal_denoiser_cannot_honour_is_one_error_line() {
         one_error_line(&render(d, &a))
     };
     assert!(run(&["--denoiser", "svgf:alpha=3"]).contains("svgf: alpha: must be in (0, 1], got 3"));
-    assert!(run(&["--denoiser", "svgf:sigma-q=1"]).contains("unknown option 'sigma-q'"));
+    assert!(run(&["--denoiser", "svgf:sigma-q=1"]).contains("unknown option `sigma-q`"));
     assert!(
         run(&["--denoiser", "svgf", "--aov", "albedo"]).contains("writes the denoised image only")
     );

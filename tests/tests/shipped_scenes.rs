@@ -63,7 +63,7 @@ fn render(path: &Path, technique: &str, camera: Option<&str>) -> Result<Film, St
         ..Overrides::default()
     };
     let settings = overrides
-        .resolve(&loaded.render, path)
+        .resolve(&loaded, path)
         .map_err(|e| e.to_string())?;
     let camera = ImageSize::Pixels(SIZE.0, SIZE.1)
         .apply(pick_camera(&loaded.scene, path, camera).map_err(|e| e.to_string())?);

@@ -36,10 +36,8 @@ pub enum View {
 const MESH_EXTENSIONS: [&str; 4] = ["obj", "gltf", "glb", "ra2"];
 /// Longest side of the primary ray grid by default.
 const DEFAULT_WIDTH: u32 = 512;
-/// Largest primary ray grid (the scene format's limits).
-pub const MAX_SIDE: u32 = 16_384;
-/// Most primary rays (pixels) a benchmark generates.
-pub const MAX_PIXELS: u64 = 1 << 26;
+/// Largest primary ray grid (the renderer's image limits).
+pub use rt_core::limits::{MAX_IMAGE_PIXELS as MAX_PIXELS, MAX_IMAGE_SIDE as MAX_SIDE};
 
 /// Loads `input`: `gen:NAME`, a `.toml` scene, or a mesh file.
 pub fn load(input: &str, camera: Option<&str>) -> Result<Input> {
@@ -50,7 +48,7 @@ pub fn load(input: &str, camera: Option<&str>) -> Result<Input> {
         .map(str::to_ascii_lowercase)
         .unwrap_or_default();
     let (loaded, is_mesh) = if input.starts_with("gen:") || ext == "toml" {
-        (crate::job::load_scene(path)?, false)
+        (rt_session::load_scene(path, None)?.loaded, false)
     } else if MESH_EXTENSIONS.contains(&ext.as_str()) {
         (
             rt_scene::load_mesh(path).map_err(|e| anyhow::anyhow!("{e}"))?,

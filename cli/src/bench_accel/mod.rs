@@ -15,14 +15,13 @@
 pub mod input;
 mod report;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use rt_accel::bench::{self as rays, measure, Query, RaySet};
 use rt_accel::AccelSpec;
+use rt_core::limits::MAX_THREADS;
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// Most threads accepted by `--threads`.
-const MAX_THREADS: usize = 1024;
 /// A structure fails the check when more than this fraction of the checked rays disagree with
 /// the binary BVH (a handful may differ legitimately: a ray grazing a shared edge in the
 /// crack-free test modes, or a nearly degenerate triangle whose `t` is noisy).
@@ -228,10 +227,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         scene.triangle_count(),
         t.elapsed().as_secs_f64()
     ));
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .context("cannot start worker threads")?;
+    let pool = rt_session::job::thread_pool(Some(threads))?;
 
     // The reference every structure is checked against, which also generates the rays.
     let reference_spec: AccelSpec = "bvh".parse().expect("static spec");

@@ -133,7 +133,7 @@ impl ViewArgs {
 
     /// The other checks: fps, cap, exposure, spp, output pattern.
     pub fn check(&self) -> Result<()> {
-        crate::args::check_fps(self.fps)?;
+        rt_session::job::check_fps(self.fps)?;
         if let Some(cap) = self.fps_cap {
             if !(cap.is_finite() && cap > 0.0) {
                 bail!("--fps-cap must be a positive number of frames per second, got {cap}");

@@ -17,7 +17,7 @@ mod window;
 
 pub use args::ViewArgs;
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{anyhow, bail, Result};
 use rt_accel::AccelSpec;
 use rt_core::{Camera, Scene};
 use rt_session::{pick_camera, Overrides, SequenceFrame, SequenceRenderer};
@@ -48,7 +48,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     let mut view = View::load(args, spp, fps, size)?;
     view.renderer.set_budget(budget);
     if args.headless {
-        headless::run(args, view, budget)
+        headless::run(args, view)
     } else {
         window::run(args, view)
     }
@@ -73,7 +73,7 @@ pub struct View {
 impl View {
     fn load(args: &ViewArgs, spp: u32, fps: f64, size: Option<(u32, u32)>) -> Result<View> {
         let path = args.scene.clone();
-        let loaded = crate::job::load_scene(&path)?;
+        let loaded = rt_session::load_scene(&path, None)?.loaded;
         if !args.quiet {
             for w in &loaded.warnings {
                 eprintln!("warning: {w}");
@@ -86,7 +86,7 @@ impl View {
             ),
             None => None,
         };
-        let mut settings = Overrides {
+        let settings = Overrides {
             integrator: args.integrator,
             max_depth: args.max_depth,
             ao_distance: None,
@@ -100,11 +100,8 @@ impl View {
             // is for still images.
             denoiser: Some("none".into()),
         }
-        .resolve(&loaded.render, &path)?;
+        .resolve(&loaded, &path)?;
         let scene = loaded.scene;
-        if args.accel.is_none() && loaded.render.accel.is_none() {
-            settings.accel = AccelSpec::default_for_scene(&scene);
-        }
         let camera = pick_camera(&scene, &path, args.camera.as_deref())?;
         let size = size.unwrap_or((camera.width, camera.height));
         let text = &args.denoiser;
@@ -135,11 +132,7 @@ impl View {
             fps,
         )
         .map_err(|e| anyhow!("{}: {e}", path.display()))?;
-        let mut pool = rayon::ThreadPoolBuilder::new();
-        if let Some(t) = settings.threads {
-            pool = pool.num_threads(t);
-        }
-        let pool = pool.build().context("cannot start worker threads")?;
+        let pool = rt_session::job::thread_pool(settings.threads)?;
         Ok(View {
             path,
             scene,
@@ -165,6 +158,20 @@ impl View {
         self.pool
             .install(|| renderer.render_with(scene, f, Some(camera)))
             .map_err(|e| anyhow!("{}: frame {f}: {e}", self.path.display()))
+    }
+
+    /// Renders `frames` one after another through the scene camera at the view's size
+    /// (`rt_session::SequenceRenderer::run`), calling `each` with every frame and its time.
+    pub fn run(
+        &mut self,
+        frames: std::ops::Range<u32>,
+        each: &mut (dyn FnMut(&SequenceFrame, std::time::Duration) -> Result<()> + Send),
+    ) -> Result<rt_session::RunSummary> {
+        let (renderer, scene, size) = (&mut self.renderer, &mut self.scene, Some(self.size));
+        let path = self.path.display().to_string();
+        self.pool
+            .install(|| renderer.run(scene, frames, size, each))
+            .map_err(|e: anyhow::Error| anyhow!("{path}: {e}"))
     }
 
     /// Forgets the denoiser's history (the animation restarts).

@@ -1,19 +1,12 @@
-//! Linear RGB to the window's pixels: the PNG rule of `render` (`rt_film::output`): multiply
-//! by `2^exposure`, clamp to [0, 1] (NaN and infinities to 0), sRGB transfer curve, 8 bits
-//! rounded; packed as softbuffer's `0x00RRGGBB`.
+//! Linear RGB to the window's pixels: the PNG rule of `render` (`rt_film::srgb8`), packed as
+//! softbuffer's `0x00RRGGBB`.
 
 use rayon::prelude::*;
-use rt_core::color::linear_to_srgb;
 use rt_core::Rgb;
 
 /// One channel to 8 bits.
 fn encode(v: f32, scale: f32) -> u32 {
-    let v = if v.is_finite() {
-        (v * scale).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (linear_to_srgb(v) * 255.0 + 0.5) as u32
+    u32::from(rt_film::srgb8(v, scale))
 }
 
 /// One pixel as `0x00RRGGBB`.

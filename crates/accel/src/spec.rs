@@ -1,7 +1,8 @@
 //! Naming a structure and its options in one string, and building it.
 //!
 //! The CLI's `--accel`, the scene's `[render] accel` and `render bench-accel --accel` all take
-//! the same text: a kind followed by `:`-separated options, e.g. `qbvh`, `bvh`,
+//! the same text, in the one option grammar of every spec ([`rt_core::options`]): a kind
+//! followed by options separated by `:` or `,`, e.g. `qbvh`, `bvh`,
 //! `qbvh:order=distance:tstack`, `qbvh:evh=14:compact`, `qbvh:isect=hybrid`, `qbvh:lazy`.
 //! [`AccelSpec`] parses it ([`std::str::FromStr`]), prints it back in a canonical form
 //! ([`std::fmt::Display`]) and [`AccelSpec::build`] makes the structure, so a program that
@@ -36,6 +37,7 @@
 use crate::wide::{Order, TriangleTest, WideOptions};
 use crate::{BruteForce, BuildParams, Bvh2, Bvh8, Qbvh, Split};
 use glam::Vec3;
+use rt_core::options::Options;
 use rt_core::Accel;
 use std::fmt;
 use std::str::FromStr;
@@ -212,6 +214,9 @@ pub enum SpecError {
         /// The option as written.
         option: String,
     },
+    /// The text breaks the option grammar (a key given twice, a piece that is no option).
+    #[error(transparent)]
+    Options(#[from] rt_core::options::OptionsError),
     /// An option value that does not parse or is out of range.
     #[error("bad value in `{option}`: {reason}")]
     BadValue {
@@ -382,12 +387,9 @@ impl AccelSpec {
         })
     }
 
-    fn apply(&mut self, option: &str) -> Result<(), SpecError> {
+    /// Applies option `key` (given as `option`, with `value` after its `=`).
+    fn apply(&mut self, key: &str, value: Option<&str>, option: &str) -> Result<(), SpecError> {
         let kind = self.kind.name();
-        let (key, value) = match option.split_once('=') {
-            Some((k, v)) => (k, Some(v)),
-            None => (option, None),
-        };
         let bad = |reason| SpecError::BadValue {
             option: option.to_string(),
             reason,
@@ -517,19 +519,61 @@ impl AccelSpec {
     }
 }
 
+/// Every option of every kind, in the order they are applied.
+const KEYS: [&str; 16] = [
+    "leaf",
+    "bins",
+    "icost",
+    "evh",
+    "bbah",
+    "compact",
+    "order",
+    "tstack",
+    "no-tstack",
+    "shadow-cache",
+    "isect",
+    "lazy",
+    "top",
+    "t",
+    "lambda",
+    "depth",
+];
+
 impl FromStr for AccelSpec {
     type Err = SpecError;
 
+    /// Parses the spec in the one option grammar ([`rt_core::options`]): a key given twice
+    /// is refused, and so is a key of no structure ([`SpecError::UnknownOption`]) or of
+    /// another one ([`SpecError::NotApplicable`]).
     fn from_str(s: &str) -> Result<Self, SpecError> {
-        let mut parts = s.trim().split(':');
-        let name = parts.next().unwrap_or_default();
+        let mut o = Options::parse(s)?;
+        let name = o.kind().to_string();
         let kind = AccelKind::ALL
             .into_iter()
             .find(|k| k.name() == name)
-            .ok_or_else(|| SpecError::UnknownKind(name.to_string()))?;
+            .ok_or(SpecError::UnknownKind(name))?;
         let mut spec = AccelSpec::new(kind);
-        for option in parts {
-            spec.apply(option)?;
+        if o.take("tstack").is_some() && o.take("no-tstack").is_some() {
+            return Err(SpecError::BadValue {
+                option: "tstack:no-tstack".into(),
+                reason: "tstack and no-tstack contradict each other",
+            });
+        }
+        for key in KEYS {
+            let value = o.take(key);
+            if let Some(value) = value {
+                let value = value.map(str::to_string);
+                let option = value
+                    .as_ref()
+                    .map_or(key.to_string(), |v| format!("{key}={v}"));
+                spec.apply(key, value.as_deref(), &option)?;
+            }
+        }
+        if let Some(key) = o.unread() {
+            return Err(SpecError::UnknownOption {
+                kind: kind.name(),
+                option: key.to_string(),
+            });
         }
         Ok(spec)
     }
@@ -640,6 +684,27 @@ mod tests {
     }
 
     #[test]
+    fn every_kind_displays_a_spec_that_parses_back_to_it() {
+        for kind in AccelKind::ALL {
+            let s = AccelSpec::new(kind);
+            assert_eq!(s.to_string(), kind.name());
+            assert_eq!(s.to_string().parse::<AccelSpec>(), Ok(s));
+        }
+        for text in [
+            "two-level:top=refit:leaf=8",
+            "clusters:t=16",
+            "grid:lambda=2",
+            "irregular-grid:depth=2",
+        ] {
+            let s: AccelSpec = text.parse().unwrap();
+            assert_eq!(s.to_string().parse::<AccelSpec>(), Ok(s), "{text}");
+        }
+        // Either separator.
+        let s: AccelSpec = "qbvh:evh=14,compact".parse().unwrap();
+        assert_eq!(s.to_string(), "qbvh:evh=14:compact");
+    }
+
+    #[test]
     fn rejects_bad_specs() {
         let err = |s: &str| s.parse::<AccelSpec>().unwrap_err();
         assert!(matches!(err("kd"), SpecError::UnknownKind(_)));
@@ -660,5 +725,13 @@ mod tests {
         assert!(matches!(err("bvh8:lazy"), SpecError::NotApplicable { .. }));
         assert!(matches!(err("bvh8:leaf=17"), SpecError::BadValue { .. }));
         assert!(err("qbvh:leaf=0").to_string().contains("leaf=0"));
+        assert_eq!(
+            err("qbvh:leaf=8:leaf=4").to_string(),
+            "qbvh: option `leaf` given twice"
+        );
+        assert!(matches!(
+            err("bvh8:tstack:no-tstack"),
+            SpecError::BadValue { .. }
+        ));
     }
 }

@@ -46,16 +46,8 @@ fn main() {
         .iter()
         .position(|a| a == "--out")
         .and_then(|i| args.get(i + 1));
-    let given: Vec<(String, String)> = arg("--params", "")
-        .split(':')
-        .filter(|s| !s.is_empty())
-        .map(|kv| {
-            let (k, v) = kv.split_once('=').expect("params are key=value");
-            (k.to_string(), v.to_string())
-        })
-        .collect();
-    let mut o = Options::new("sbmf", &given);
-    let sbmf = Sbmf::from_options(&mut o).and_then(|s| o.finish().map(|_| s));
+    let mut o = Options::of("sbmf", &arg("--params", "")).unwrap_or_else(|e| panic!("{e}"));
+    let sbmf = Sbmf::from_options(&mut o).and_then(|s| o.finish().map(|_| s).map_err(Into::into));
     let sbmf = sbmf.unwrap_or_else(|e| panic!("{e}"));
     println!("{}", sbmf.name());
     let integrator = PathIntegrator::new(5);

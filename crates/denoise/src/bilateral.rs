@@ -26,7 +26,7 @@
 //!   units.
 
 use crate::blocks::{check_positive, check_range, exp_neg};
-use crate::{Channel, DenoiseError, Denoiser, NoisyFrame, Options};
+use crate::{Channel, DenoiseError, Denoiser, DenoiserOptions, NoisyFrame, Options};
 use rayon::prelude::*;
 use rt_core::glam::{Vec3, Vec4};
 use rt_core::{Image, Rgb, RgbImage};
@@ -170,7 +170,7 @@ impl JointBilateral {
             o.f32("albedo", 0.25)?,
             o.f32("colour", 0.0)?,
         ];
-        let variances = match o.choice("variances", &["auto", "on", "off"], "auto")? {
+        let variances = match o.pick("variances", &["auto", "on", "off"], "auto")? {
             "on" => VarianceUse::On,
             "off" => VarianceUse::Off,
             _ => VarianceUse::Auto,

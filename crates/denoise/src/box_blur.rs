@@ -1,6 +1,6 @@
 //! The k×k box filter: the simplest member of a filter bank, and a baseline.
 
-use crate::{DenoiseError, Denoiser, NoisyFrame, Options};
+use crate::{DenoiseError, Denoiser, DenoiserOptions, NoisyFrame, Options};
 use rt_core::{Image, RgbImage};
 
 /// Mean over a `(2r+1)²` window, clamped at the image border (the window shrinks, so a constant

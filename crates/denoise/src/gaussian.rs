@@ -7,7 +7,7 @@
 //! constant image stays constant up to the edge.
 
 use crate::blocks::{check_range, separable};
-use crate::{DenoiseError, Denoiser, NoisyFrame, Options};
+use crate::{DenoiseError, Denoiser, DenoiserOptions, NoisyFrame, Options};
 use rt_core::{Image, RgbImage};
 
 /// Isotropic Gaussian blur of standard deviation `sigma` pixels.

@@ -24,7 +24,7 @@
 
 use crate::blocks::sat::BoxMean;
 use crate::blocks::{check_count, check_positive};
-use crate::{Channel, DenoiseError, Denoiser, NoisyFrame, Options};
+use crate::{Channel, DenoiseError, Denoiser, DenoiserOptions, NoisyFrame, Options};
 use rayon::prelude::*;
 use rt_core::glam::{DMat3, DVec3, Vec3};
 use rt_core::{Image, Rgb, RgbImage};
@@ -78,7 +78,7 @@ impl GuidedFilter {
     pub fn from_options(o: &mut Options) -> Result<Self, DenoiseError> {
         let radius = o.usize("radius", 8)?;
         let eps = o.f32("eps", 0.01)?;
-        let guide = match o.choice("guide", &["albedo", "normal", "colour"], "albedo")? {
+        let guide = match o.pick("guide", &["albedo", "normal", "colour"], "albedo")? {
             "normal" => Guide::Normal,
             "colour" => Guide::Colour,
             _ => Guide::Albedo,

@@ -62,7 +62,7 @@ pub use nlm::Nlm;
 pub use oidn::{Oidn, OidnParams, OidnQuality, OIDN_LIB_DEFAULTS, OIDN_LIB_ENV};
 pub use rt_film::{Channel, FrameError, NoisyFrame};
 pub use sbmf::{Sbmf, SbmfParams};
-pub use spec::{DenoiserKind, DenoiserSpec, Options};
+pub use spec::{DenoiserKind, DenoiserOptions, DenoiserSpec, Options};
 
 use rt_core::RgbImage;
 
@@ -86,6 +86,7 @@ pub enum DenoiseError {
     /// A denoiser spec that does not parse.
     #[error("{0}")]
     Spec(String),
+
     /// A native library the denoiser calls is missing or failed (e.g. Open Image Denoise).
     #[error("{denoiser}: {message}")]
     Native {
@@ -94,6 +95,14 @@ pub enum DenoiseError {
         /// What was tried and what went wrong.
         message: String,
     },
+}
+
+/// An option that breaks the option grammar, or that nothing reads, is a spec error (values
+/// out of range are [`DenoiseError::Param`]s, from [`DenoiserOptions`]).
+impl From<rt_core::options::OptionsError> for DenoiseError {
+    fn from(e: rt_core::options::OptionsError) -> Self {
+        DenoiseError::Spec(e.to_string())
+    }
 }
 
 /// An image-space denoiser: pure and deterministic (the same frame gives the same bits on any

@@ -22,7 +22,7 @@
 
 use crate::blocks::patch::PatchScratch;
 use crate::blocks::{check_count, check_range, exp_neg, STRIP_ROWS};
-use crate::{Channel, DenoiseError, Denoiser, NoisyFrame, Options};
+use crate::{Channel, DenoiseError, Denoiser, DenoiserOptions, NoisyFrame, Options};
 use rayon::prelude::*;
 use rt_core::glam::Vec3A;
 use rt_core::{Image, Rgb, RgbImage};

@@ -2,15 +2,18 @@
 //! for denoisers, as `rt_accel::AccelSpec` is for acceleration structures.
 //!
 //! `render denoise --denoiser`, GREE's bank files and experiment methods all take the same
-//! text: a kind followed by `:`-separated `key=value` options, e.g. `box:radius=2`. Unknown
-//! kinds, unknown keys, values that do not parse and values out of range are each one error
-//! naming the denoiser and the key.
+//! text, in the one option grammar of every spec ([`rt_core::options`]): a kind followed by
+//! `key=value` options separated by `:` or `,`, e.g. `box:radius=2`. Unknown kinds, repeated
+//! keys, keys nothing reads, values that do not parse and values out of range are each one
+//! error naming the denoiser and the key.
 
 #[cfg(feature = "oidn")]
 use crate::Oidn;
 use crate::{
     Atrous, BoxBlur, DenoiseError, Denoiser, Gaussian, GuidedFilter, JointBilateral, Nlm, Sbmf,
 };
+pub use rt_core::options::Options;
+use rt_core::options::{OptionsError, Problem, SEPARATORS};
 use std::fmt;
 use std::str::FromStr;
 
@@ -81,19 +84,20 @@ impl fmt::Display for DenoiserKind {
     }
 }
 
-/// A denoiser kind and its options as given (validated when built).
+/// A denoiser kind and its options as given (validated when built, where a key nothing
+/// reads is refused), in the one option grammar ([`rt_core::options`]).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct DenoiserSpec {
     /// Which denoiser.
     pub kind: DenoiserKind,
-    /// `key=value` options in the order given.
-    pub options: Vec<(String, String)>,
+    /// The options in the order given.
+    pub options: Options,
 }
 
 impl DenoiserSpec {
     /// Builds the denoiser, validating every option.
     pub fn build(&self) -> Result<Box<dyn Denoiser>, DenoiseError> {
-        let mut o = Options::new(self.kind.name(), &self.options);
+        let mut o = self.options.clone();
         let d: Box<dyn Denoiser> = match self.kind {
             DenoiserKind::Box => Box::new(BoxBlur::from_options(&mut o)?),
             DenoiserKind::Gaussian => Box::new(Gaussian::from_options(&mut o)?),
@@ -114,8 +118,8 @@ impl FromStr for DenoiserSpec {
     type Err = DenoiseError;
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let mut parts = s.trim().split(':');
-        let kind_name = parts.next().unwrap_or_default();
+        let given = Options::parse(s)?;
+        let kind_name = given.kind();
         let kind = DenoiserKind::ALL
             .iter()
             .copied()
@@ -133,21 +137,11 @@ impl FromStr for DenoiserSpec {
                     DenoiserKind::names()
                 ))
             })?;
-        let mut options = Vec::new();
-        for p in parts {
-            let Some((k, v)) = p.split_once('=') else {
-                return Err(DenoiseError::Spec(format!(
-                    "{kind}: option '{p}' is not key=value"
-                )));
-            };
-            let k = k.trim().to_string();
-            if options.iter().any(|(o, _)| *o == k) {
-                return Err(DenoiseError::Spec(format!(
-                    "{kind}: option '{k}' given twice"
-                )));
-            }
-            options.push((k, v.trim().to_string()));
-        }
+        // The kind as this crate names it, for errors and the printed spec.
+        let options = Options::of(
+            kind.name(),
+            &s[s.find(SEPARATORS).map_or(s.len(), |i| i + 1)..],
+        )?;
         Ok(Self { kind, options })
     }
 }
@@ -155,115 +149,93 @@ impl FromStr for DenoiserSpec {
 impl fmt::Display for DenoiserSpec {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.kind.name())?;
-        for (k, v) in &self.options {
-            write!(f, ":{k}={v}")?;
-        }
-        Ok(())
+        write_options(f, &self.options)
     }
 }
 
-/// The options of one spec, read by a denoiser's `from_options`; [`Options::finish`] refuses
-/// any key nobody read.
-#[derive(Debug)]
-pub struct Options<'a> {
-    denoiser: &'static str,
-    given: &'a [(String, String)],
-    used: Vec<bool>,
-}
-
-impl<'a> Options<'a> {
-    /// The options `given` to denoiser kind `denoiser`.
-    pub fn new(denoiser: &'static str, given: &'a [(String, String)]) -> Self {
-        Self {
-            denoiser,
-            given,
-            used: vec![false; given.len()],
+/// `:key=value` (or `:flag`) for every option, in the order given.
+pub fn write_options(f: &mut fmt::Formatter<'_>, options: &Options) -> fmt::Result {
+    for (k, v) in options.entries() {
+        match v {
+            Some(v) => write!(f, ":{k}={v}")?,
+            None => write!(f, ":{k}")?,
         }
     }
+    Ok(())
+}
 
-    /// The denoiser these options are for.
-    pub fn denoiser(&self) -> &'static str {
-        self.denoiser
-    }
-
-    fn raw(&mut self, key: &str) -> Option<&'a str> {
-        let i = self.given.iter().position(|(k, _)| k == key)?;
-        self.used[i] = true;
-        Some(self.given[i].1.as_str())
-    }
-
-    fn parse<T: FromStr>(
+/// The typed getters denoisers read their options with, over the one option type
+/// ([`Options`]): each takes a default and returns a [`DenoiseError`] naming the denoiser and
+/// the key.
+pub trait DenoiserOptions {
+    /// A finite number (`default` if absent).
+    fn f32(&mut self, key: &'static str, default: f32) -> Result<f32, DenoiseError>;
+    /// A non-negative integer.
+    fn usize(&mut self, key: &'static str, default: usize) -> Result<usize, DenoiseError>;
+    /// `on`/`off` (also `true`/`false`, `1`/`0`).
+    fn on_off(&mut self, key: &'static str, default: bool) -> Result<bool, DenoiseError>;
+    /// One of `choices` (`default` if absent).
+    fn pick(
         &mut self,
         key: &'static str,
-        default: T,
-        what: &str,
-    ) -> Result<T, DenoiseError> {
-        match self.raw(key) {
-            None => Ok(default),
-            Some(v) => v.parse().map_err(|_| DenoiseError::Param {
-                denoiser: self.denoiser,
-                name: key,
-                message: format!("'{v}' is not {what}"),
-            }),
-        }
+        choices: &[&'static str],
+        default: &'static str,
+    ) -> Result<&'static str, DenoiseError>;
+    /// A parameter error for `key`.
+    fn param_error(&self, key: &'static str, message: String) -> DenoiseError;
+}
+
+/// The denoiser's name as a `'static` string, for [`DenoiseError::Param`].
+fn static_kind(kind: &str) -> &'static str {
+    DenoiserKind::ALL
+        .iter()
+        .map(|k| k.name())
+        .chain(["svgf"])
+        .find(|n| n.eq_ignore_ascii_case(kind))
+        .unwrap_or("denoiser")
+}
+
+/// A value out of range is a parameter error naming the key; the rest are spec errors.
+fn value_error(o: &Options, key: &'static str, e: OptionsError) -> DenoiseError {
+    match *e.problem {
+        Problem::BadValue {
+            value, expected, ..
+        } => o.param_error(key, format!("`{value}` is not {expected}")),
+        _ => e.into(),
+    }
+}
+
+impl DenoiserOptions for Options {
+    fn f32(&mut self, key: &'static str, default: f32) -> Result<f32, DenoiseError> {
+        let v = self.value_in(key, "a finite number", |v: &f32| v.is_finite());
+        Ok(v.map_err(|e| value_error(self, key, e))?.unwrap_or(default))
     }
 
-    /// A finite number (`default` if absent).
-    pub fn f32(&mut self, key: &'static str, default: f32) -> Result<f32, DenoiseError> {
-        let v = self.parse(key, default, "a number")?;
-        if !v.is_finite() {
-            return Err(self.error(key, format!("must be finite, got {v}")));
-        }
-        Ok(v)
+    fn usize(&mut self, key: &'static str, default: usize) -> Result<usize, DenoiseError> {
+        let v = self.value(key, "a non-negative integer");
+        Ok(v.map_err(|e| value_error(self, key, e))?.unwrap_or(default))
     }
 
-    /// A non-negative integer.
-    pub fn usize(&mut self, key: &'static str, default: usize) -> Result<usize, DenoiseError> {
-        self.parse(key, default, "a non-negative integer")
+    fn on_off(&mut self, key: &'static str, default: bool) -> Result<bool, DenoiseError> {
+        let v = self.switch(key);
+        Ok(v.map_err(|e| value_error(self, key, e))?.unwrap_or(default))
     }
 
-    /// `on`/`off` (also `true`/`false`, `1`/`0`).
-    pub fn flag(&mut self, key: &'static str, default: bool) -> Result<bool, DenoiseError> {
-        match self.raw(key) {
-            None => Ok(default),
-            Some("on" | "true" | "1") => Ok(true),
-            Some("off" | "false" | "0") => Ok(false),
-            Some(v) => Err(self.error(key, format!("'{v}' is not on or off"))),
-        }
-    }
-
-    /// One of `choices` (`default` if absent).
-    pub fn choice(
+    fn pick(
         &mut self,
         key: &'static str,
         choices: &[&'static str],
         default: &'static str,
     ) -> Result<&'static str, DenoiseError> {
-        match self.raw(key) {
-            None => Ok(default),
-            Some(v) => choices.iter().copied().find(|c| *c == v).ok_or_else(|| {
-                self.error(key, format!("'{v}' is not one of {}", choices.join(", ")))
-            }),
-        }
+        let v = self.choice(key, choices);
+        Ok(v.map_err(|e| value_error(self, key, e))?.unwrap_or(default))
     }
 
-    /// A parameter error for `key`.
-    pub fn error(&self, key: &'static str, message: String) -> DenoiseError {
+    fn param_error(&self, key: &'static str, message: String) -> DenoiseError {
         DenoiseError::Param {
-            denoiser: self.denoiser,
+            denoiser: static_kind(self.kind()),
             name: key,
             message,
-        }
-    }
-
-    /// Refuses keys nobody read.
-    pub fn finish(self) -> Result<(), DenoiseError> {
-        match self.used.iter().position(|u| !u) {
-            Some(i) => Err(DenoiseError::Spec(format!(
-                "{}: unknown option '{}'",
-                self.denoiser, self.given[i].0
-            ))),
-            None => Ok(()),
         }
     }
 }
@@ -284,15 +256,45 @@ mod tests {
         assert!(err("fancy").contains("unknown denoiser 'fancy'"));
         assert_eq!(
             err("box:radius=x"),
-            "box: radius: 'x' is not a non-negative integer"
+            "box: radius: `x` is not a non-negative integer"
         );
         assert_eq!(
             err("box:radius=100"),
             "box: radius: must be at most 64, got 100"
         );
-        assert_eq!(err("box:size=2"), "box: unknown option 'size'");
-        assert_eq!(err("box:radius"), "box: option 'radius' is not key=value");
-        assert!(err("box:radius=1:radius=2").contains("given twice"));
+        assert_eq!(err("box:size=2"), "box: unknown option `size`");
+        assert_eq!(
+            err("box:radius"),
+            "box: option `radius` needs a value (`radius=...`)"
+        );
+        assert_eq!(
+            err("box:radius=1,radius=2"),
+            "box: option `radius` given twice"
+        );
+        assert_eq!(err("BOX:radius=1"), "", "the kind in any case");
+        assert_eq!(err("nlm:k=inf"), "nlm: k: `inf` is not a finite number");
+    }
+
+    #[test]
+    fn every_kind_displays_a_spec_that_parses_back_to_it() {
+        for text in [
+            "box:radius=3",
+            "gaussian:sigma=4",
+            "bilateral:sigma=3:normal=0.5:variances=off",
+            "nlm:radius=5:patch=2:k=0.3",
+            "guided:radius=4:eps=0.02:guide=normal",
+            "atrous:iterations=3:colour=off:scale=absolute",
+            "sbmf:manifolds=3:layers=3",
+            "atrous",
+        ] {
+            let s: DenoiserSpec = text.parse().unwrap();
+            assert_eq!(s.to_string(), text);
+            assert_eq!(s.to_string().parse::<DenoiserSpec>().unwrap(), s);
+            s.build().unwrap();
+        }
+        // Either separator, any case of the kind; printed canonically.
+        let s: DenoiserSpec = "NLM:radius=5,k=0.3".parse().unwrap();
+        assert_eq!(s.to_string(), "nlm:radius=5:k=0.3");
     }
 
     #[cfg(not(feature = "oidn"))]

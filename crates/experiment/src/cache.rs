@@ -191,6 +191,49 @@ impl Cache {
         rt_film::write_bytes_atomic(&json, text.as_bytes())?;
         Ok(exr)
     }
+
+    /// Merges the parts of one reference (a reference job's parts, `render reference
+    /// --sample-range/--region` or a plan's) and stores it under the cache key their headers
+    /// carry; returns the EXR's path and the sidecar. Refuses parts of a normal render.
+    /// `limit`: the most bytes the merged film may hold.
+    pub fn store_parts(
+        &self,
+        parts: &[(String, rt_parts::Part)],
+        limit: Option<u64>,
+    ) -> Result<(PathBuf, Sidecar)> {
+        let merged =
+            rt_parts::merge(parts, limit).map_err(|e| ExperimentError::Run(e.to_string()))?;
+        let h = &merged.header;
+        let first = &parts[0].0;
+        let setting = |k: &str| {
+            h.settings.get(k).cloned().ok_or_else(|| {
+                ExperimentError::Run(format!("{first}: not a reference's part (no {k})"))
+            })
+        };
+        if setting("stream")? != "reference" {
+            return Err(ExperimentError::Run(format!(
+                "{first}: not a reference's part"
+            )));
+        }
+        let key = Key {
+            hex: setting("cache key")?,
+            description: setting("cache description")?,
+        };
+        let seconds: f64 = parts.iter().map(|(_, p)| p.header.seconds).sum();
+        let samples = u64::from(h.width) * u64::from(h.height) * u64::from(h.spp);
+        let sidecar = Sidecar {
+            key: key.hex.clone(),
+            description: key.description.clone(),
+            scene: h.scene.clone(),
+            width: h.width,
+            height: h.height,
+            spp: h.spp,
+            seconds,
+            samples_per_second: samples as f64 / seconds.max(1e-9),
+        };
+        let path = self.store(Path::new(&h.scene), &key, &merged.film, &sidecar)?;
+        Ok((path, sidecar))
+    }
 }
 
 #[cfg(test)]

@@ -18,10 +18,9 @@ use serde::{Deserialize, Deserializer};
 use std::collections::HashSet;
 use std::fmt;
 use std::path::{Path, PathBuf};
-use std::time::Duration;
 
 /// Longest time budget accepted, in seconds (a day): anything longer is a typo.
-const MAX_SECONDS: f64 = 86_400.0;
+const MAX_SECONDS: f64 = rt_session::adaptive::MAX_TIME_LIMIT;
 
 /// Validation inside [`build`] speaks in messages about one entry; [`load`] makes them a
 /// [`ExperimentError::Config`] naming the file.
@@ -282,8 +281,8 @@ pub struct MethodPlan {
 /// A GREE method's settings, checked at load.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GreePlan {
-    /// `--gree` option text (`key=value:...`).
-    pub options: String,
+    /// GREE's options (`key=value:...`).
+    pub options: rt_session::GreeSpec,
     /// The filter bank's denoiser specs.
     pub bank: Vec<String>,
 }
@@ -546,7 +545,7 @@ fn build(desc: ConfigDesc, path: &Path, access: &rt_scene::FileAccess) -> Result
                     estimator,
                     seed: overrides.seed(&loaded.render),
                     accel: overrides
-                        .accel_spec(&loaded.render, &scene_path)
+                        .accel_spec(&loaded, &scene_path)
                         .map_err(|e| e.to_string())?,
                 }
             }
@@ -644,8 +643,11 @@ fn build(desc: ConfigDesc, path: &Path, access: &rt_scene::FileAccess) -> Result
                 let Runs::Progressive(Budgets::Spp(budgets)) = &runs else {
                     bail!("{here}: gree spends sample budgets: give spp = [...], not seconds or error");
                 };
+                let options: rt_session::GreeSpec = options
+                    .parse()
+                    .map_err(|e: rt_core::options::OptionsError| at(e.to_string()))?;
                 for &b in budgets {
-                    rt_session::parse_gree_options(&options, b, 0).map_err(at)?;
+                    options.params(b, 0).map_err(|e| at(format!("gree: {e}")))?;
                 }
                 let bank = bank.unwrap_or_else(|| {
                     rt_denoise::DEFAULT_BANK
@@ -711,7 +713,7 @@ fn build(desc: ConfigDesc, path: &Path, access: &rt_scene::FileAccess) -> Result
                 scene: si,
                 method: mi,
                 estimator,
-                accel: o.accel_spec(desc, &scene.path).map_err(here)?,
+                accel: o.accel_spec(&scene.loaded, &scene.path).map_err(here)?,
                 seed: o.seed(desc),
             });
         }
@@ -876,23 +878,20 @@ fn stop_rules(
     let mut errors: Vec<Option<f32>> = match error.map(OneOrMany::into_vec) {
         None => vec![None],
         Some(v) if v.is_empty() => bail!("error is an empty list"),
-        Some(v) => {
-            for &e in &v {
-                rt_film::stopping::StoppingCriterion::new(1, 1, e).map_err(|b| {
-                    format!("error: {b} (the hierarchical stopping criterion's threshold; the thesis uses 2e-4)")
-                })?;
-            }
-            v.into_iter().map(Some).collect()
-        }
+        Some(v) => v.into_iter().map(Some).collect(),
     };
     let mut limits: Vec<Option<f64>> = match time_limit.map(OneOrMany::into_vec) {
         None => vec![None],
         Some(v) if v.is_empty() => bail!("time_limit is an empty list"),
-        Some(v) => {
-            check_seconds("time_limit", &v)?;
-            v.into_iter().map(Some).collect()
-        }
+        Some(v) => v.into_iter().map(Some).collect(),
     };
+    // Every value checked once, by the rule itself.
+    for &e in errors.iter().flatten() {
+        StopRule::new(Some(e), None, max_spp).map_err(|b| b.named("error", "time_limit"))?;
+    }
+    for &t in limits.iter().flatten() {
+        StopRule::new(None, Some(t), max_spp).map_err(|b| b.named("error", "time_limit"))?;
+    }
     if errors.len() > 1 && limits.len() > 1 {
         bail!("error and time_limit are both lists: give a list for one of them, a single value for the other");
     }
@@ -904,11 +903,9 @@ fn stop_rules(
     Ok(errors
         .iter()
         .flat_map(|&error| {
-            limits.iter().map(move |&t| StopRule {
-                error,
-                time_limit: t.map(Duration::from_secs_f64),
-                max_spp,
-            })
+            limits
+                .iter()
+                .map(move |&t| StopRule::new(error, t, max_spp).expect("checked above"))
         })
         .collect())
 }
@@ -921,6 +918,7 @@ fn describe(e: &IntegratorSpec) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::time::Duration;
 
     const SCENE: &str = r#"
 [[camera]]
@@ -1097,7 +1095,7 @@ seconds = [0.5, 0.1]
             ),
             (
                 GOOD.replace("name = \"b\"", "name = \"b\"\ndenoiser = \"box:size=2\""),
-                "unknown option 'size'",
+                "unknown option `size`",
             ),
             (
                 GOOD.replace("name = \"b\"", "name = \"b\"\ndenoiser = 3"),
@@ -1160,11 +1158,11 @@ seconds = [0.5, 0.1]
         let cases = [
             (
                 "error = -2e-4",
-                "error: error threshold must be a positive finite number, got -0.0002",
+                "error must be a positive finite number, got -0.0002",
             ),
             (
                 "error = 0.0",
-                "error threshold must be a positive finite number, got 0",
+                "error must be a positive finite number, got 0",
             ),
             ("error = [2e-4, 0.0]", "positive finite number, got 0"),
             ("error = nan", "positive finite number, got NaN"),
@@ -1176,9 +1174,9 @@ seconds = [0.5, 0.1]
             ),
             (
                 "time_limit = 0",
-                "time_limit values must be in (0, 86400], got 0",
+                "time_limit must be a positive number of seconds, at most 86400, got 0",
             ),
-            ("time_limit = -1.5", "time_limit values must be in"),
+            ("time_limit = -1.5", "time_limit must be a positive number"),
             ("time_limit = []", "time_limit is an empty list"),
             (
                 "error = 2e-4\nspp = [16, 64]",

@@ -194,10 +194,13 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
                 };
                 let base = done_runs * UNITS;
                 let built = accel.build_scene(&scene.loaded.scene);
-                let got =
-                    crate::reference::obtain(&req, built.as_ref(), Some(cache), None, &|f| {
-                        bar.set_position(base + (f * UNITS as f64) as u64)
-                    })?;
+                let got = crate::reference::obtain(
+                    &req,
+                    (accel, built.as_ref()),
+                    Some(cache),
+                    None,
+                    &|f| bar.set_position(base + (f * UNITS as f64) as u64),
+                )?;
                 let origin = if got.cached {
                     progress.message(&format!(
                         "{}: reference from the cache: {}",
@@ -474,8 +477,11 @@ fn run_gree(
     };
     let mut last = None;
     for &b in budgets {
-        let params =
-            rt_session::parse_gree_options(&m.plan.options, b, session.seed).map_err(fail)?;
+        let params = m
+            .plan
+            .options
+            .params(b, session.seed)
+            .map_err(|e| fail(format!("gree: {e}")))?;
         let run = rt_session::render_gree(
             &session.ctx,
             integrator,

@@ -352,7 +352,8 @@ bank = ["box:radius=0", "box:radius=2"]
         assert_eq!(rows.len(), 2);
         let pixels = 24 * 16;
         for (r, b) in rows.iter().zip([4u32, 8]) {
-            let params = rt_session::parse_gree_options("sparsity=0.9", b, 0).unwrap();
+            let spec: rt_session::GreeSpec = "sparsity=0.9".parse().unwrap();
+            let params = spec.params(b, 0).unwrap();
             let budget = params.budget_split();
             assert_eq!(r.spp, b);
             assert_eq!(r.samples, budget.total_samples(pixels));

@@ -7,10 +7,11 @@
 
 use crate::cache::{Cache, Key, ReferenceRequest, Sidecar};
 use crate::error::{ExperimentError, Result};
-use rt_core::{Accel, SampleStream};
+use rt_accel::AccelSpec;
+use rt_core::Accel;
 use rt_film::{AovSet, Film};
-use rt_integrators::Ctx;
-use rt_session::{Budgets, Checkpoint, Session};
+use rt_integrators::{Ctx, RenderStats};
+use rt_session::{RenderJob, Settings, Stream};
 use std::path::{Path, PathBuf};
 
 /// A reference ready to use.
@@ -23,11 +24,41 @@ pub struct Obtained {
     pub seconds: f64,
 }
 
-/// Finds `req` in `cache` or renders it (with `accel`) and stores it there. With no cache, the
-/// reference is rendered and written to `write_to`. Call inside the thread pool to use.
+/// The render job of the reference `req` with `key` (its cache key, which part headers
+/// carry so that the merged parts are stored under it), over `accel`, written to `output`:
+/// the reference stream, the camera at the request's size, the variance AOV kept where the
+/// film knows it. A technique that splats (bdpt, light; the reference for caustics that
+/// camera paths rarely find) has no per-pixel variance, so its reference has no noise floor.
+pub fn job(req: &ReferenceRequest<'_>, accel: AccelSpec, key: &Key, output: &Path) -> RenderJob {
+    let settings = Settings {
+        integrator: req.estimator,
+        accel,
+        spp: req.spp,
+        threads: None,
+        seed: req.seed,
+        aovs: AovSet {
+            variance: !req.estimator.build().splats(),
+            ..AovSet::default()
+        },
+        output: Some(output.to_path_buf()),
+        denoiser: None,
+    };
+    let mut job = RenderJob::new(req.scene_path, settings);
+    job.camera = Some(req.camera.name.clone());
+    job.size = rt_session::ImageSize::Pixels(req.camera.width, req.camera.height);
+    job.stream = Stream::Reference;
+    job.labels.insert("cache key".into(), key.hex.clone());
+    job.labels
+        .insert("cache description".into(), key.description.clone());
+    job
+}
+
+/// Finds `req` in `cache` or renders it (with `accel`, built from `accel_spec`) and stores it
+/// there. With no cache, the reference is rendered and written to `write_to`. Call inside the
+/// thread pool to use.
 pub fn obtain(
     req: &ReferenceRequest<'_>,
-    accel: &dyn Accel,
+    (accel_spec, accel): (&AccelSpec, &dyn Accel),
     cache: Option<&Cache>,
     write_to: Option<&Path>,
     progress: &(dyn Fn(f64) + Sync),
@@ -42,7 +73,10 @@ pub fn obtain(
             });
         }
     }
-    let (film, at) = render(req, accel, progress)?;
+    let out = write_to.unwrap_or(Path::new("reference.exr"));
+    let job = job(req, *accel_spec, &key, out);
+    let (film, stats) = render(&job, req, accel, progress)?;
+    let seconds = stats.elapsed.as_secs_f64();
     let sidecar = Sidecar {
         key: key.hex.clone(),
         description: key.description.clone(),
@@ -50,8 +84,8 @@ pub fn obtain(
         width: req.camera.width,
         height: req.camera.height,
         spp: req.spp,
-        seconds: at.seconds,
-        samples_per_second: at.samples as f64 / at.seconds.max(1e-9),
+        seconds,
+        samples_per_second: stats.samples as f64 / seconds.max(1e-9),
     };
     let path = match (cache, write_to) {
         (Some(cache), _) => cache.store(req.scene_path, &key, &film, &sidecar)?,
@@ -68,38 +102,32 @@ pub fn obtain(
     Ok(Obtained {
         path,
         cached: false,
-        seconds: at.seconds,
+        seconds,
     })
 }
 
-/// Renders the reference: the reference stream, the variance AOV kept where the film knows
-/// it. A technique that splats (bdpt, light; the reference for caustics that camera paths
-/// rarely find) has no per-pixel variance, so its reference has no noise floor.
+/// Reports a job's progress to a closure.
+struct Progress<'a>(&'a (dyn Fn(f64) + Sync));
+
+impl rt_session::JobSink for Progress<'_> {
+    fn progress(&self, done: f64) {
+        (self.0)(done)
+    }
+}
+
+/// Renders the reference job over the request's scene and camera.
 fn render(
+    job: &RenderJob,
     req: &ReferenceRequest<'_>,
     accel: &dyn Accel,
     progress: &(dyn Fn(f64) + Sync),
-) -> Result<(Film, Checkpoint)> {
-    let integrator = req.estimator.build();
-    let session = Session {
-        ctx: Ctx {
-            scene: req.scene,
-            accel,
-            camera: req.camera,
-        },
-        integrator: integrator.as_ref(),
-        seed: req.seed,
-        stream: SampleStream::Reference,
-        aovs: AovSet {
-            variance: !req.estimator.kind.splats(),
-            ..AovSet::default()
-        },
+) -> Result<(Film, RenderStats)> {
+    let ctx = Ctx {
+        scene: req.scene,
+        accel,
+        camera: req.camera,
     };
-    let mut last = Checkpoint::default();
-    let film = session.render(&Budgets::Spp(vec![req.spp]), progress, &mut |_, at| {
-        last = *at;
-        Ok::<(), std::convert::Infallible>(())
-    });
-    let Ok(film) = film;
-    Ok((film, last))
+    let technique = job.settings.integrator.build();
+    job.render_film(&ctx, technique.as_ref(), &Progress(progress))
+        .map_err(|e| ExperimentError::Run(e.to_string()))
 }

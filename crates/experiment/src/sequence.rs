@@ -397,9 +397,13 @@ fn references(
                 }
                 let built = accel.as_deref().expect("built above");
                 let base = *done;
-                let got = crate::reference::obtain(&req, built, Some(cache), None, &|_| {
-                    progress.set_position(base)
-                })?;
+                let got = crate::reference::obtain(
+                    &req,
+                    (accel_spec, built),
+                    Some(cache),
+                    None,
+                    &|_| progress.set_position(base),
+                )?;
                 rendered += 1;
                 seconds += got.seconds;
                 got.path

@@ -238,6 +238,18 @@ fn write_exr_channels(
         .map_err(|e| e.to_string())
 }
 
+/// One linear channel as an 8-bit PNG value: scaled by `scale` (`2^exposure`), clamped to
+/// [0, 1] (NaN and infinities to 0), sRGB transfer curve, rounded. The one tone map of PNG
+/// outputs and of `render view`'s window.
+pub fn srgb8(v: f32, scale: f32) -> u8 {
+    let v = if v.is_finite() {
+        (v * scale).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (linear_to_srgb(v) * 255.0 + 0.5) as u8
+}
+
 fn write_png(
     w: &mut BufWriter<File>,
     width: u32,
@@ -249,14 +261,7 @@ fn write_png(
     let bytes: Vec<u8> = pixels
         .iter()
         .flat_map(|p| p.to_array())
-        .map(|v| {
-            let v = if v.is_finite() {
-                (v * scale).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            (linear_to_srgb(v) * 255.0 + 0.5) as u8
-        })
+        .map(|v| srgb8(v, scale))
         .collect();
     let img = image::RgbImage::from_raw(width, height, bytes).ok_or("image size mismatch")?;
     img.write_to(w, image::ImageFormat::Png)

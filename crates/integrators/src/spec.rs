@@ -2,7 +2,8 @@
 //! for integrators, as `rt_accel::AccelSpec` is for acceleration structures.
 //!
 //! `--integrator`, the scene's `[render] integrator` and an experiment's `methods` all take the
-//! same text: a kind followed by `:`-separated options, e.g. `path`, `path:max-depth=4`,
+//! same text, in the one option grammar of every spec ([`rt_core::options`]): a kind followed
+//! by options separated by `:` or `,`, e.g. `path`, `path:max-depth=4`,
 //! `path-bsdf`, `direct`, `ao:distance=0.5`. [`IntegratorSpec`] parses it
 //! ([`std::str::FromStr`]), prints it back in a canonical form ([`std::fmt::Display`]: the
 //! options it sets), builds the integrator ([`IntegratorSpec::build`]) and says
@@ -19,6 +20,7 @@ use crate::{
     AoIntegrator, Bdpt, CameraRays, Culling, LightTracer, PartitionOptions, Partitioned,
     PathIntegrator, Technique,
 };
+use rt_core::options::Options;
 use std::fmt;
 use std::str::FromStr;
 
@@ -92,12 +94,6 @@ impl IntegratorKind {
                 | IntegratorKind::Bdpt
                 | IntegratorKind::Partitioned
         )
-    }
-
-    /// True for the techniques whose light paths splat onto any pixel (their films know no
-    /// per-pixel variance and no first hits).
-    pub fn splats(self) -> bool {
-        matches!(self, IntegratorKind::Light | IntegratorKind::Bdpt)
     }
 
     fn names() -> String {
@@ -191,6 +187,9 @@ pub enum IntegratorSpecError {
     /// An occluder distance that is not positive or does not parse.
     #[error("ao distance must be positive, got {0}")]
     BadDistance(String),
+    /// The text breaks the option grammar (a key given twice, a key without its value).
+    #[error(transparent)]
+    Options(#[from] rt_core::options::OptionsError),
     /// A `partitioned` option out of range or not parsing.
     #[error("partitioned option `{option}`: {what}")]
     BadPartitionOption {
@@ -329,59 +328,68 @@ impl FromStr for IntegratorSpec {
     type Err = IntegratorSpecError;
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let mut parts = s.split(':');
-        let kind: IntegratorKind = parts.next().unwrap_or_default().trim().parse()?;
+        let mut o = Options::parse(s)?;
+        let kind: IntegratorKind = o.kind().parse()?;
         let mut spec = IntegratorSpec::new(kind);
-        for option in parts {
-            let (key, value) = option.split_once('=').unwrap_or((option, ""));
-            spec = match (key.trim(), kind) {
-                ("max-depth", k) if k.has_depth() => {
-                    let depth = value
-                        .trim()
-                        .parse()
-                        .map_err(|_| IntegratorSpecError::BadDepth(value.to_string()))?;
-                    spec.with_max_depth(depth)?
-                }
-                (key, IntegratorKind::Partitioned)
-                    if matches!(
-                        key,
-                        "vpls" | "photons" | "clamp" | "cull" | "maps" | "indirect-caustics"
-                    ) =>
-                {
-                    spec.partition = parse_partition_option(spec.partition, key, value.trim())
-                        .map_err(|what| IntegratorSpecError::BadPartitionOption {
-                            option: option.to_string(),
-                            what,
+        if kind.has_depth() {
+            if let Some(v) = o.text("max-depth")? {
+                let depth = v
+                    .parse()
+                    .map_err(|_| IntegratorSpecError::BadDepth(v.clone()))?;
+                spec = spec.with_max_depth(depth)?;
+            }
+        }
+        if kind == IntegratorKind::Wavefront {
+            if let Some(v) = o.text("lanes")? {
+                spec.lanes = v
+                    .parse()
+                    .ok()
+                    .filter(|n| (1..=MAX_LANES).contains(n))
+                    .ok_or(IntegratorSpecError::BadLanes(v))?;
+            }
+        }
+        if kind == IntegratorKind::Ao {
+            if let Some(v) = o.text("distance")? {
+                let d: f32 = v
+                    .parse()
+                    .map_err(|_| IntegratorSpecError::BadDistance(v.clone()))?;
+                spec = spec.with_ao_distance(d)?;
+            }
+        }
+        if kind == IntegratorKind::Partitioned {
+            for key in PARTITION_KEYS {
+                if let Some(v) = o.text(key)? {
+                    spec.partition =
+                        parse_partition_option(spec.partition, key, &v).map_err(|what| {
+                            IntegratorSpecError::BadPartitionOption {
+                                option: format!("{key}={v}"),
+                                what,
+                            }
                         })?;
-                    spec
                 }
-                ("lanes", IntegratorKind::Wavefront) => {
-                    spec.lanes = value
-                        .trim()
-                        .parse()
-                        .ok()
-                        .filter(|n| (1..=MAX_LANES).contains(n))
-                        .ok_or_else(|| IntegratorSpecError::BadLanes(value.to_string()))?;
-                    spec
-                }
-                ("distance", IntegratorKind::Ao) => {
-                    let d: f32 = value
-                        .trim()
-                        .parse()
-                        .map_err(|_| IntegratorSpecError::BadDistance(value.to_string()))?;
-                    spec.with_ao_distance(d)?
-                }
-                _ => {
-                    return Err(IntegratorSpecError::UnknownOption {
-                        kind,
-                        option: option.to_string(),
-                    })
-                }
-            };
+            }
+        }
+        if let Some(key) = o.unread() {
+            let option = o
+                .entries()
+                .find(|(k, _)| *k == key)
+                .map(|(k, v)| v.map_or(k.to_string(), |v| format!("{k}={v}")))
+                .unwrap_or_default();
+            return Err(IntegratorSpecError::UnknownOption { kind, option });
         }
         Ok(spec)
     }
 }
+
+/// The options of `partitioned`.
+const PARTITION_KEYS: [&str; 6] = [
+    "vpls",
+    "photons",
+    "clamp",
+    "cull",
+    "maps",
+    "indirect-caustics",
+];
 
 /// Largest `wavefront` batch a spec may ask for (paths per thread; about 200 bytes each).
 pub const MAX_LANES: u32 = 1 << 20;
@@ -551,6 +559,37 @@ mod tests {
         ] {
             assert!(bad.parse::<IntegratorSpec>().is_err(), "{bad}");
         }
+    }
+
+    #[test]
+    fn every_kind_displays_a_spec_that_parses_back_and_refusals_name_the_spec() {
+        for text in [
+            "path:max-depth=4",
+            "wavefront:max-depth=3:lanes=64",
+            "path-bsdf:max-depth=2",
+            "direct",
+            "ao:distance=0.25",
+            "light:max-depth=5",
+            "bdpt:max-depth=6",
+            "partitioned:max-depth=4:vpls=8:cull=off",
+        ] {
+            let s: IntegratorSpec = text.parse().unwrap();
+            assert_eq!(s.to_string(), text);
+            assert_eq!(s.to_string().parse::<IntegratorSpec>(), Ok(s));
+        }
+        let s: IntegratorSpec = "wavefront,lanes=64,max-depth=3".parse().unwrap();
+        assert_eq!(s.to_string(), "wavefront:max-depth=3:lanes=64");
+        let e = |t: &str| t.parse::<IntegratorSpec>().unwrap_err().to_string();
+        assert_eq!(
+            e("path:max-depth=3:max-depth=4"),
+            "path: option `max-depth` given twice"
+        );
+        assert!(
+            e("wavefront:lanes=8:fast").starts_with("option `fast` does not apply to `wavefront`"),
+            "{}",
+            e("wavefront:lanes=8:fast")
+        );
+        assert!(e("path:max-depth").contains("option `max-depth` needs a value"));
     }
 
     #[test]

@@ -49,7 +49,8 @@ pub trait Technique: Send + Sync {
     }
 
     /// True if the technique splats light paths onto the film, whose per-pixel variance the
-    /// film then does not know.
+    /// film then does not know: the one answer (settings, references, adaptive passes and the
+    /// memory estimate all ask the built technique).
     fn splats(&self) -> bool {
         false
     }

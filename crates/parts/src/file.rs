@@ -16,10 +16,11 @@ use std::path::Path;
 
 /// First bytes of every part file.
 pub const MAGIC: &[u8; 8] = b"RTPART\r\n";
-/// Version of the layout and of the header's meaning.
-pub const FORMAT: u32 = 1;
-/// Largest image side a part may describe (the renderer's own limit is far below).
-pub const MAX_SIDE: u32 = 1 << 16;
+/// Version of the layout and of the header's meaning (2: the header holds the render's typed
+/// job, not its command line).
+pub const FORMAT: u32 = 2;
+/// Largest image side a part may describe ([`rt_core::limits::MAX_IMAGE_SIDE`]).
+pub const MAX_SIDE: u32 = rt_core::limits::MAX_IMAGE_SIDE;
 /// Largest header accepted, in bytes.
 const MAX_HEADER: u32 = 1 << 20;
 
@@ -35,7 +36,7 @@ pub enum PartKind {
 }
 
 /// Everything about a part except its sums. Parts merge only if every field but `kind`,
-/// `region`, `samples`, `args` and `seconds` is equal.
+/// `region`, `samples`, `job` and `seconds` is equal.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PartHeader {
@@ -69,8 +70,9 @@ pub struct PartHeader {
     pub variance: bool,
     /// Whether the film keeps the even samples' sums.
     pub halves: bool,
-    /// The command line that wrote it, after the program name (to resume a checkpoint).
-    pub args: Vec<String>,
+    /// The render job that wrote it, as JSON with its own format version (`rt_session`'s
+    /// `RenderJob::to_json`): what a checkpoint resumes and a merge denoises and exposes by.
+    pub job: serde_json::Value,
     /// Seconds its samples took to render (a checkpoint: all of them so far).
     #[serde(default)]
     pub seconds: f64,
@@ -239,7 +241,7 @@ pub(crate) mod tests {
             aovs: vec!["albedo".into()],
             variance: true,
             halves: false,
-            args: vec!["s.toml".into()],
+            job: serde_json::json!({"format": 1, "job": {}}),
             seconds: 1.5,
         }
     }

@@ -20,7 +20,7 @@
 //!     format: FORMAT, kind: PartKind::Part, binary: "b".into(), scene: "s".into(),
 //!     scene_hash: "h".into(), settings: Default::default(), frame: None, width: 2, height: 1,
 //!     spp: 4, region: [0, 0, 2, 1], samples, aovs: vec![], variance: true, halves: false,
-//!     args: vec![], seconds: 0.0,
+//!     job: serde_json::json!({}), seconds: 0.0,
 //! };
 //! let render = |samples: [u32; 2]| {
 //!     let mut film = Film::new(2, 1, rt_film::FilmBuffers::for_outputs(AovSet::default()).with_variance());

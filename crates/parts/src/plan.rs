@@ -7,17 +7,16 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Version of the plan format.
-pub const PLAN_FORMAT: u32 = 1;
+/// Version of the plan format (2: renders are typed jobs, not command lines).
+pub const PLAN_FORMAT: u32 = 2;
 
 /// One render of a plan: what its parts run.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PlannedRender {
-    /// The command line after the program name, without `-o`, `--frames`, `--frame`,
-    /// `--sample-range` and `--region` (each part adds its own): `SCENE ARGS...` for an image,
-    /// `reference SCENE ARGS...` for an experiment's reference.
-    pub args: Vec<String>,
+    /// The render job, as JSON with its own format version (`rt_session`'s
+    /// `RenderJob::to_json`); each part sets its own frame, slice and output.
+    pub job: serde_json::Value,
     /// Image width.
     pub width: u32,
     /// Image height.
@@ -191,8 +190,8 @@ impl Plan {
                 p.format
             )));
         }
-        if p.renders.iter().any(|r| r.args.is_empty()) {
-            return Err(PlanError::Invalid("a render without arguments".into()));
+        if p.renders.iter().any(|r| !r.job.is_object()) {
+            return Err(PlanError::Invalid("a render without a job".into()));
         }
         if p.parts.len() > MAX_PARTS {
             return Err(PlanError::Invalid(format!("{} parts", p.parts.len())));
@@ -233,7 +232,7 @@ mod tests {
     fn request(tile: Option<(u32, u32)>, splits: u32, frames: usize) -> PlanRequest {
         PlanRequest {
             render: PlannedRender {
-                args: vec!["scene.toml".into()],
+                job: serde_json::json!({"format": 1, "job": {"scene": "scene.toml"}}),
                 width: 10,
                 height: 7,
                 spp: 9,

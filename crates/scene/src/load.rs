@@ -22,9 +22,9 @@ use std::path::{Path, PathBuf};
 use toml::Spanned;
 
 /// Largest image side in pixels.
-pub(crate) const MAX_RESOLUTION: u32 = 16384;
+pub(crate) const MAX_RESOLUTION: u32 = rt_core::limits::MAX_IMAGE_SIDE;
 /// Largest pixel count (2^26, e.g. 8192×8192).
-pub(crate) const MAX_PIXELS: u64 = 1 << 26;
+pub(crate) const MAX_PIXELS: u64 = rt_core::limits::MAX_IMAGE_PIXELS;
 
 /// State shared by the sections while a scene loads.
 pub(crate) struct Ctx<'a> {

@@ -24,8 +24,13 @@ use std::time::{Duration, Instant};
 /// `docs/experiments.md`, "Stopping criterion").
 pub const FIRST_DECISION_SPP: u32 = 16;
 
-/// When an adaptive render stops.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Longest time limit a stop rule accepts: a day.
+pub const MAX_TIME_LIMIT: f64 = 86_400.0;
+
+/// When an adaptive render stops: validated once, by [`StopRule::new`], wherever it comes from
+/// (`render --error --time-limit`, an experiment's method).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct StopRule {
     /// Error threshold of the stopping criterion (`ε_t`); `None`: no criterion.
     pub error: Option<f32>,
@@ -33,6 +38,54 @@ pub struct StopRule {
     pub time_limit: Option<Duration>,
     /// Most samples any pixel takes.
     pub max_spp: u32,
+}
+
+/// A stop rule's value out of range.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub enum StopRuleError {
+    /// An error threshold that is not a positive finite number.
+    #[error("must be a positive finite number, got {0} (the hierarchical stopping criterion's threshold; the thesis uses 2e-4)")]
+    Error(f32),
+    /// A time limit that is not a positive number of seconds up to [`MAX_TIME_LIMIT`].
+    #[error("must be a positive number of seconds, at most {MAX_TIME_LIMIT}, got {0}")]
+    TimeLimit(f64),
+}
+
+impl StopRuleError {
+    /// The message with the value's name in front: `error_name` or `time_name`, as the
+    /// caller's vocabulary calls them (`--error`, `time_limit`).
+    pub fn named(&self, error_name: &str, time_name: &str) -> String {
+        match self {
+            StopRuleError::Error(_) => format!("{error_name} {self}"),
+            StopRuleError::TimeLimit(_) => format!("{time_name} {self}"),
+        }
+    }
+}
+
+impl StopRule {
+    /// A rule stopping at error threshold `error`, after `time_limit` seconds, or at
+    /// `max_spp` samples per pixel, whichever comes first; the values are checked here.
+    pub fn new(
+        error: Option<f32>,
+        time_limit: Option<f64>,
+        max_spp: u32,
+    ) -> Result<StopRule, StopRuleError> {
+        if let Some(e) = error {
+            if StoppingCriterion::new(1, 1, e).is_err() {
+                return Err(StopRuleError::Error(e));
+            }
+        }
+        if let Some(t) = time_limit {
+            if !(t.is_finite() && t > 0.0 && t <= MAX_TIME_LIMIT) {
+                return Err(StopRuleError::TimeLimit(t));
+            }
+        }
+        Ok(StopRule {
+            error,
+            time_limit: time_limit.map(Duration::from_secs_f64),
+            max_spp,
+        })
+    }
 }
 
 /// Why an adaptive render stopped.

@@ -6,9 +6,9 @@ use crate::SessionError;
 use rt_core::{Camera, Scene};
 use std::path::Path;
 
-/// Largest image side a size override may ask for; beyond it the film alone would not fit in
-/// memory.
-pub const MAX_SIDE: u32 = 1 << 15;
+/// Largest image side a size override may ask for ([`rt_core::limits::MAX_IMAGE_SIDE`], the
+/// scene format's own limit).
+pub const MAX_SIDE: u32 = rt_core::limits::MAX_IMAGE_SIDE;
 
 /// The camera named `name`, or the scene's first one. Errors name `scene_path`.
 pub fn pick_camera<'s>(
@@ -33,7 +33,8 @@ pub fn pick_camera<'s>(
 }
 
 /// How big to render, relative to the camera's own resolution.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum ImageSize {
     /// The camera's resolution.
     #[default]

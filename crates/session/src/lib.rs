@@ -1,64 +1,73 @@
-//! `rt-session`: rendering one configuration, the part that `render`, `render reference` and
-//! `render experiment` share, and that a program using the crates would otherwise copy.
+//! `rt-session`: rendering, as a library. The `render` CLI is one client of it; a program
+//! that wants images, frames, parts, checkpoints or the memory check uses the same types.
 //!
+//! - [`job`]: [`RenderJob`], a render as one typed, serialisable value (scene, settings,
+//!   frames, slice, stop rule, checkpointing, outputs, denoiser, cache), with one
+//!   [`RenderJob::run`] that takes a progress sink and a stop flag; plans and checkpoints store
+//!   it; [`job::merge`] merges its parts.
 //! - [`settings`]: the one place settings are resolved (given values, then the scene's
-//!   `[render]` table, then defaults) and their limits checked.
+//!   `[render]` table, then defaults), with their limits ([`rt_core::limits`]) and the
+//!   combinations they cannot honour.
 //! - [`camera`]: which camera renders ([`pick_camera`]) and at what size ([`ImageSize`]).
+//! - [`adaptive`]: rendering until a [`StopRule`] says stop.
 //! - [`progressive`]: a list of budgets, samples per pixel or seconds, rendered pass after pass
-//!   into one film ([`Session`], [`Budgets`], [`Checkpoint`]).
+//!   into one film ([`Session`], [`Budgets`], [`Checkpoint`]), as experiments measure them.
 //! - [`sequence`]: an animation rendered frame after frame, denoised by a denoiser that may
 //!   remember earlier frames (SVGF), with the guide pass in between ([`SequenceRenderer`]).
+//! - [`gree`]: GREE over the renderer; [`worldcache`]: the world-space cache behind the
+//!   integrators' cache seam; [`memory`]: the memory estimate a job checks; [`frames`]: frame
+//!   file names.
 //! - [`report`]: what a render built and skipped, with time and bytes ([`RenderReport`], the
 //!   table `render --stats` prints).
 //!
-//! Depends on `rt-core`, `rt-accel` (the default structure and [`rt_accel::AccelSpec`]),
-//! `rt-film`, `rt-scene` (the `[render]` table) and `rt-integrators`
-//! ([`rt_integrators::IntegratorSpec`]).
+//! Depends on `rt-core`, `rt-accel` ([`rt_accel::AccelSpec`]), `rt-film`, `rt-scene` (the
+//! `[render]` table), `rt-integrators` ([`rt_integrators::IntegratorSpec`]), the denoisers
+//! (`rt-denoise`, `rt-temporal`, `rt-gree`), `rt-worldcache` and `rt-parts` (part files).
 //!
-//! Render a scene at 16 spp and write it, without the CLI (`examples/render_scene.rs` is the same
-//! with a real scene file):
+//! Render a scene at 4 spp into a 16x12 EXR, without the CLI (`examples/job.rs` renders two
+//! frames in parts, merges them and resumes a checkpoint):
 //!
 //! ```
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
-//! use rt_session::{pick_camera, Budgets, Overrides, Session};
+//! use rt_session::{load_scene, ImageSize, Overrides, RenderJob};
 //! let path = std::path::Path::new("gen:worst-case");
-//! let loaded = rt_scene::load_any(path)?;
-//! let settings = Overrides::default().resolve(&loaded.render, path)?;
-//! let camera = rt_session::ImageSize::Pixels(16, 12).apply(pick_camera(&loaded.scene, path, None)?);
-//! let accel = settings.accel.build_scene(&loaded.scene);
-//! let integrator = settings.integrator.build();
-//! let session = Session {
-//!     ctx: rt_integrators::Ctx { scene: &loaded.scene, accel: accel.as_ref(), camera: &camera },
-//!     integrator: integrator.as_ref(),
-//!     seed: settings.seed,
-//!     stream: rt_core::SampleStream::Render,
-//!     aovs: settings.aovs,
-//! };
-//! let mut spp_seen = Vec::new();
-//! let film = session.render(&Budgets::Spp(vec![4, 16]), &|_| {}, &mut |_, at| {
-//!     spp_seen.push(at.spp);
-//!     Ok::<(), std::io::Error>(())
-//! })?;
-//! assert_eq!(spp_seen, [4, 16]);
-//! assert_eq!(film.width(), 16);
+//! let scene = load_scene(path, None)?;
+//! let overrides = Overrides { spp: Some(4), ..Overrides::default() };
+//! let mut job = RenderJob::new(path, overrides.resolve(&scene.loaded, path)?);
+//! job.size = ImageSize::Pixels(16, 12);
+//! job.output = std::env::temp_dir().join("rt-session-doc.exr");
+//! let report = job.run(&(), &std::sync::atomic::AtomicBool::new(false))?;
+//! assert_eq!(report.frames, 1);
+//! assert_eq!(rt_film::read_rgb(&job.output)?.width(), 16);
 //! # Ok(()) }
 //! ```
 #![forbid(unsafe_code)]
 
 pub mod adaptive;
 pub mod camera;
+pub mod frames;
 pub mod gree;
+pub mod job;
+pub mod memory;
 pub mod progressive;
 pub mod report;
 pub mod sequence;
 pub mod settings;
+mod text;
+pub mod worldcache;
 
-pub use adaptive::{render_adaptive, Adaptive, StopReason, StopRule, FIRST_DECISION_SPP};
+pub use adaptive::{
+    render_adaptive, Adaptive, StopReason, StopRule, StopRuleError, FIRST_DECISION_SPP,
+};
 pub use camera::{parse_resolution, pick_camera, ImageSize, MAX_SIDE};
-pub use gree::{gree_aovs, parse_gree_options, render_gree, GreeRun, GreeRunError};
+pub use gree::{gree_aovs, render_gree, GreeRun, GreeRunError, GreeSpec};
+pub use job::{
+    load_scene, Checkpointing, FrameReport, Frames, GreeJob, JobError, JobReport, JobScene,
+    JobSink, RenderJob, Rendered, Slice, Stream,
+};
 pub use progressive::{Budgets, Checkpoint, Session};
 pub use report::{RenderReport, ReportInputs, Stage, Status};
-pub use sequence::{FrameTimes, SequenceError, SequenceFrame, SequenceRenderer};
+pub use sequence::{FrameTimes, RunSummary, SequenceError, SequenceFrame, SequenceRenderer};
 pub use settings::{
     fold_seed, frame_seed, Origin, Overrides, Settings, SettingsError, DEFAULT_SPP, MAX_SPP,
     MAX_THREADS,

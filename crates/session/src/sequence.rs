@@ -97,6 +97,55 @@ pub struct SequenceFrame {
     pub spp: u32,
 }
 
+/// How a run of frames went ([`SequenceRenderer::run`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RunSummary {
+    /// Each frame's wall-clock time.
+    pub times: Vec<Duration>,
+    /// Samples per pixel of all frames together.
+    pub spp: u64,
+    /// Image size.
+    pub size: (u32, u32),
+    /// The denoiser's name, or `none`.
+    pub denoiser: String,
+    /// The per-frame time budget, if any.
+    pub budget: Option<Duration>,
+}
+
+impl std::fmt::Display for RunSummary {
+    /// Frames per second, mean and worst frame time, mean spp per frame and, with a budget,
+    /// how many frames overran it.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let ms = |d: Duration| d.as_secs_f64() * 1000.0;
+        let n = self.times.len().max(1) as f64;
+        let total: Duration = self.times.iter().sum();
+        let worst = self.times.iter().max().copied().unwrap_or_default();
+        let (w, h) = self.size;
+        write!(
+            f,
+            "{} frames {w}x{h}, {}: {:.2} frames per second; frame time mean {:.1} ms, worst {:.1} ms; mean {:.2} spp per frame",
+            self.times.len(),
+            self.denoiser,
+            self.times.len() as f64 / total.as_secs_f64().max(1e-9),
+            ms(total) / n,
+            ms(worst),
+            self.spp as f64 / n,
+        )?;
+        match self.budget {
+            Some(b) => {
+                let over = self.times.iter().filter(|t| **t > b).count();
+                let frames = self.times.len();
+                write!(
+                    f,
+                    "; {over} of {frames} frames over the {:.1} ms budget",
+                    ms(b)
+                )
+            }
+            None => f.write_str("; no budget"),
+        }
+    }
+}
+
 /// A sequence being rendered: the structure, the denoiser's memory and the previous view carry
 /// from frame to frame.
 pub struct SequenceRenderer {
@@ -195,6 +244,42 @@ impl SequenceRenderer {
     /// Renders frame `f` of `scene` (moving it to the frame's time).
     pub fn render(&mut self, scene: &mut Scene, f: u32) -> Result<SequenceFrame, SequenceError> {
         self.render_with(scene, f, None)
+    }
+
+    /// Renders frames `frames` of `scene` one after another through the scene's camera at
+    /// each frame's time, at `size` if given (`render view --headless`), calling `each` with
+    /// every frame and its wall-clock time (moving the scene, rendering, guiding and
+    /// denoising; not what `each` does). Returns the run's timings.
+    pub fn run<E: From<SequenceError>>(
+        &mut self,
+        scene: &mut Scene,
+        frames: Range<u32>,
+        size: Option<(u32, u32)>,
+        each: &mut dyn FnMut(&SequenceFrame, Duration) -> Result<(), E>,
+    ) -> Result<RunSummary, E> {
+        let mut run = RunSummary {
+            denoiser: self.denoiser_name().unwrap_or("none").to_string(),
+            budget: self.budget,
+            ..RunSummary::default()
+        };
+        for f in frames {
+            let t = Instant::now();
+            scene.set_time(self.time_of(f));
+            let camera = match &self.camera {
+                Some(name) => scene.cameras.iter().find(|c| &c.name == name),
+                None => scene.cameras.first(),
+            }
+            .ok_or_else(|| SequenceError::NoCamera(self.camera.clone().unwrap_or_default()))?;
+            let (w, h) = size.unwrap_or((camera.width, camera.height));
+            let camera = camera.resized(w, h);
+            let out = self.render_with(scene, f, Some(&camera))?;
+            let dt = t.elapsed();
+            run.size = (w, h);
+            run.times.push(dt);
+            run.spp += u64::from(out.spp);
+            each(&out, dt)?;
+        }
+        Ok(run)
     }
 
     /// Renders frame `f` seen by `camera` instead of the scene's (an interactive viewer's
@@ -362,7 +447,7 @@ impl SequenceRenderer {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use rt_core::Rgb;
     use rt_integrators::IntegratorSpec;
@@ -370,8 +455,8 @@ mod tests {
     use std::path::Path;
 
     /// A small moving scene at a small resolution: the shared lit floor with a moving ball.
-    fn scene() -> Scene {
-        let toml = format!(
+    pub(crate) fn moving_ball() -> String {
+        format!(
             "{}{}",
             rt_testkit::scenes::LIT_FLOOR,
             r#"
@@ -385,8 +470,11 @@ mod tests {
             target = "ball"
             keys = [ { time = 0.0 }, { time = 1.0, translate = [0.5, 0, 0] } ]
         "#
-        );
-        rt_scene::load_str(&toml, Path::new("."), Path::new("test.toml"))
+        )
+    }
+
+    fn scene() -> Scene {
+        rt_scene::load_str(&moving_ball(), Path::new("."), Path::new("test.toml"))
             .unwrap()
             .scene
     }

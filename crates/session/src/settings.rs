@@ -1,21 +1,23 @@
 //! The one place where a render's settings are resolved: each value comes from what the caller
 //! gives (command-line flags, an experiment method, `render reference` flags), else from the
-//! scene's `[render]` table, else from the default. Limits are checked here, for both sources,
-//! and errors name where the bad value came from (the flag, or the scene file and key).
+//! scene's `[render]` table, else from the default. Limits ([`rt_core::limits`]) are checked
+//! here, for both sources, and errors name where the bad value came from (the flag, or the
+//! scene file and key). What the settings cannot honour together (AOVs a technique does not
+//! write, a denoiser beside saved AOVs, a denoiser reading channels the technique leaves
+//! empty) is refused here too, so every caller refuses it alike.
 
+use crate::text;
 use rt_accel::AccelSpec;
 use rt_film::AovSet;
 use rt_integrators::spec::check_max_depth;
 use rt_integrators::{IntegratorSpec, IntegratorSpecError};
-use rt_scene::RenderDesc;
+use rt_scene::{LoadedScene, RenderDesc};
+use rt_temporal::TemporalSpec;
+use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-/// Largest sample count of one render.
-pub const MAX_SPP: u32 = 1 << 20;
-
-/// Most worker threads a render may ask for.
-pub const MAX_THREADS: usize = 1024;
+pub use rt_core::limits::{MAX_SPP, MAX_THREADS};
 
 /// Samples per pixel when nothing sets them.
 pub const DEFAULT_SPP: u32 = 64;
@@ -43,17 +45,21 @@ pub struct Overrides {
     pub aovs: Option<Vec<String>>,
     /// Output path.
     pub output: Option<PathBuf>,
-    /// Denoiser (`--denoiser`), as text: the caller checks it (it may be a temporal one);
+    /// Denoiser (`--denoiser`), as text: a single-frame spec or a temporal one (`svgf`);
     /// `none` turns the table's off.
     pub denoiser: Option<String>,
 }
 
 /// Fully resolved settings of one render.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Settings {
     /// Integrator and its parameters.
+    #[serde(with = "text")]
     pub integrator: IntegratorSpec,
-    /// Acceleration structure.
+    /// Acceleration structure (the scene's default, [`AccelSpec::default_for_scene`], when
+    /// nothing names one).
+    #[serde(with = "text")]
     pub accel: AccelSpec,
     /// Samples per pixel.
     pub spp: u32,
@@ -62,12 +68,15 @@ pub struct Settings {
     /// The 32-bit stream key ([`fold_seed`] of the 64-bit seed).
     pub seed: u32,
     /// AOVs to write.
+    #[serde(with = "text::aovs")]
     pub aovs: AovSet,
     /// Output path, if the caller or the table named one.
     pub output: Option<PathBuf>,
-    /// The denoiser the image is filtered with, as text (`None`: no denoising). From the
-    /// table it is a single-frame [`rt_denoise::DenoiserSpec`], checked here.
-    pub denoiser: Option<String>,
+    /// The denoiser the image is filtered with (`None`: no denoising): a single-frame spec
+    /// ([`TemporalSpec::PerFrame`]; the table's is always one) or a temporal one
+    /// ([`TemporalSpec::Svgf`], for sequences).
+    #[serde(with = "text::option")]
+    pub denoiser: Option<TemporalSpec>,
 }
 
 /// Where a value came from, for error messages.
@@ -156,6 +165,25 @@ pub enum SettingsError {
         /// What is wrong.
         message: String,
     },
+    /// A bad `--denoiser` name or option.
+    #[error("--denoiser {text}: {message}")]
+    GivenDenoiser {
+        /// The spec as written.
+        text: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A denoiser the other settings cannot honour: beside saved AOVs, or reading the
+    /// lighting split of a technique that does not write it.
+    #[error("{scene}{denoiser} {why}", scene = scene_prefix(scene, denoiser))]
+    DenoiserConflict {
+        /// The scene file.
+        scene: PathBuf,
+        /// The denoiser as the user gave it (`--denoiser X`, `[render] denoiser = "X"`).
+        denoiser: String,
+        /// What it cannot do.
+        why: String,
+    },
     /// An unknown AOV name.
     #[error("{origin}: {source}")]
     Aov {
@@ -164,6 +192,15 @@ pub enum SettingsError {
         /// The name.
         source: rt_film::UnknownAov,
     },
+}
+
+/// `file: ` before a denoiser named on the command line (the table's names its file).
+fn scene_prefix(scene: &Path, denoiser: &str) -> String {
+    if denoiser.starts_with("--") {
+        format!("{}: ", scene.display())
+    } else {
+        String::new()
+    }
 }
 
 /// The stream key of frame `frame` of an animation rendered with stream key `seed`: every
@@ -201,8 +238,13 @@ fn in_range(
 }
 
 impl Overrides {
-    /// Resolves every setting for the scene at `scene_path` with `[render]` table `desc`.
-    pub fn resolve(&self, desc: &RenderDesc, scene_path: &Path) -> Result<Settings, SettingsError> {
+    /// Resolves every setting for the scene `loaded`, read from `scene_path`.
+    pub fn resolve(
+        &self,
+        loaded: &LoadedScene,
+        scene_path: &Path,
+    ) -> Result<Settings, SettingsError> {
+        let desc = &loaded.render;
         let table = |key: &'static str| Origin::Table {
             file: scene_path.to_path_buf(),
             key,
@@ -233,38 +275,72 @@ impl Overrides {
             )?;
         }
         let names = self.aovs.as_ref().or(desc.aov.as_ref());
+        let aov_origin = || origin(self.aovs.is_some(), "aov", "aov");
         let aovs = match names {
             None => AovSet::default(),
             Some(list) => {
                 AovSet::parse_list(list.iter().map(String::as_str)).map_err(|source| {
                     SettingsError::Aov {
-                        origin: origin(self.aovs.is_some(), "aov", "aov"),
+                        origin: aov_origin(),
                         source,
                     }
                 })?
             }
         };
         let integrator = self.integrator_spec(desc, scene_path)?;
+        let technique = integrator.build();
         // The block map is the stopping criterion's, which serves every technique.
         let per_pixel = AovSet {
             blocks: false,
             ..aovs
         };
-        if integrator.kind.splats() && per_pixel != AovSet::default() {
+        if technique.splats() && per_pixel != AovSet::default() {
             return Err(SettingsError::AovUnsupported {
-                origin: origin(self.aovs.is_some(), "aov", "aov"),
+                origin: aov_origin(),
                 technique: integrator.kind.name(),
             });
         }
-        if aovs.any_split() && !integrator.build().writes_split() {
+        if aovs.any_split() && !technique.writes_split() {
             return Err(SettingsError::SplitUnsupported {
-                origin: origin(self.aovs.is_some(), "aov", "aov"),
+                origin: aov_origin(),
                 technique: integrator.kind.name(),
             });
+        }
+        let denoiser = self.denoiser(desc, scene_path)?;
+        if let Some(d) = &denoiser {
+            let conflict = |why: String| {
+                let denoiser = if self.denoiser.is_some() {
+                    format!("--denoiser {d}")
+                } else {
+                    format!("{}: [render] denoiser = \"{d}\"", scene_path.display())
+                };
+                Err(SettingsError::DenoiserConflict {
+                    scene: scene_path.to_path_buf(),
+                    denoiser,
+                    why,
+                })
+            };
+            if aovs != AovSet::default() {
+                return conflict(if self.denoiser.is_some() {
+                    "writes the denoised image only; save a noisy frame's AOVs with a render without it".into()
+                } else {
+                    "writes the denoised image only; add --denoiser none to save a noisy frame's AOVs".into()
+                });
+            }
+            let reads = match d.build() {
+                Ok(built) => AovSet::for_channels(built.needs()),
+                Err(_) => AovSet::default(),
+            };
+            if reads.any_split() && !technique.writes_split() {
+                return conflict(format!(
+                    "reads the lighting split (emission, direct, indirect), which the {} technique does not write",
+                    integrator.kind.name()
+                ));
+            }
         }
         Ok(Settings {
             integrator,
-            accel: self.accel_spec(desc, scene_path)?,
+            accel: self.accel_spec(loaded, scene_path)?,
             spp,
             threads,
             seed: self.seed(desc),
@@ -273,25 +349,36 @@ impl Overrides {
                 .output
                 .clone()
                 .or_else(|| desc.output.as_ref().map(PathBuf::from)),
-            denoiser: self.denoiser(desc, scene_path)?,
+            denoiser,
         })
     }
 
-    /// The denoiser alone: the given text (`none`: no denoiser), else the table's, which must
-    /// build as a single-frame denoiser.
+    /// The denoiser alone: the given text (`none`: no denoiser; a single-frame or a temporal
+    /// spec), else the table's, which must be a single-frame denoiser. Both are built once
+    /// here, so a bad option is found before anything renders.
     pub fn denoiser(
         &self,
         desc: &RenderDesc,
         scene_path: &Path,
-    ) -> Result<Option<String>, SettingsError> {
+    ) -> Result<Option<TemporalSpec>, SettingsError> {
         if let Some(text) = &self.denoiser {
-            return Ok((!text.trim().eq_ignore_ascii_case("none")).then(|| text.clone()));
+            if text.trim().eq_ignore_ascii_case("none") {
+                return Ok(None);
+            }
+            let given = |message: String| SettingsError::GivenDenoiser {
+                text: text.clone(),
+                message,
+            };
+            let spec: TemporalSpec = text.parse().map_err(|e| given(format!("{e}")))?;
+            spec.build().map_err(|e| given(e.to_string()))?;
+            return Ok(Some(spec));
         }
         let Some(text) = &desc.denoiser else {
             return Ok(None);
         };
-        text.parse::<rt_denoise::DenoiserSpec>()
-            .and_then(|spec| spec.build())
+        let spec = text
+            .parse::<rt_denoise::DenoiserSpec>()
+            .and_then(|spec| spec.build().map(|_| spec))
             .map_err(|e| SettingsError::Denoiser {
                 origin: Origin::Table {
                     file: scene_path.to_path_buf(),
@@ -300,7 +387,7 @@ impl Overrides {
                 text: text.clone(),
                 message: e.to_string(),
             })?;
-        Ok(Some(text.clone()))
+        Ok(Some(TemporalSpec::PerFrame(spec)))
     }
 
     /// The integrator alone (experiments and references need no more).
@@ -347,16 +434,17 @@ impl Overrides {
         Ok(spec)
     }
 
-    /// The acceleration structure alone.
+    /// The acceleration structure alone: the given one, else the table's, else the scene's
+    /// default ([`AccelSpec::default_for_scene`]: `clusters` when instances move).
     pub fn accel_spec(
         &self,
-        desc: &RenderDesc,
+        loaded: &LoadedScene,
         scene_path: &Path,
     ) -> Result<AccelSpec, SettingsError> {
         if let Some(a) = self.accel {
             return Ok(a);
         }
-        match &desc.accel {
+        match &loaded.render.accel {
             Some(text) => text.parse().map_err(|source| SettingsError::Accel {
                 origin: Origin::Table {
                     file: scene_path.to_path_buf(),
@@ -365,7 +453,7 @@ impl Overrides {
                 text: text.clone(),
                 source,
             }),
-            None => Ok(AccelSpec::default()),
+            None => Ok(AccelSpec::default_for_scene(&loaded.scene)),
         }
     }
 
@@ -380,18 +468,20 @@ mod tests {
     use super::*;
     use rt_integrators::IntegratorKind;
 
-    fn table(toml_like: impl FnOnce(&mut RenderDesc)) -> RenderDesc {
-        let mut d = RenderDesc::default();
-        toml_like(&mut d);
-        d
+    fn table(toml_like: impl FnOnce(&mut RenderDesc)) -> LoadedScene {
+        let mut render = RenderDesc::default();
+        toml_like(&mut render);
+        LoadedScene {
+            scene: rt_core::Scene::empty(),
+            render,
+            warnings: Vec::new(),
+        }
     }
 
     #[test]
     fn given_wins_over_table_over_default() {
         let path = Path::new("s.toml");
-        let none = Overrides::default()
-            .resolve(&RenderDesc::default(), path)
-            .unwrap();
+        let none = Overrides::default().resolve(&table(|_| {}), path).unwrap();
         assert_eq!(none.spp, DEFAULT_SPP);
         // The resolved spec states its bounce limit: the default one.
         assert_eq!(
@@ -422,13 +512,13 @@ mod tests {
         assert_eq!(none.denoiser, None);
         let desc = table(|d| d.denoiser = Some("nlm:k=0.3".into()));
         let t = Overrides::default().resolve(&desc, path).unwrap();
-        assert_eq!(t.denoiser.as_deref(), Some("nlm:k=0.3"));
+        assert_eq!(t.denoiser.unwrap().to_string(), "nlm:k=0.3");
         let given = |d: &str| Overrides {
             denoiser: Some(d.into()),
             ..Overrides::default()
         };
         let g = given("atrous").resolve(&desc, path).unwrap();
-        assert_eq!(g.denoiser.as_deref(), Some("atrous"));
+        assert_eq!(g.denoiser.unwrap().to_string(), "atrous");
         assert_eq!(given("none").resolve(&desc, path).unwrap().denoiser, None);
         // An explicit option in the spec text is the most specific setting.
         let o = Overrides {
@@ -457,7 +547,7 @@ mod tests {
             threads: Some(0),
             ..Overrides::default()
         }
-        .resolve(&RenderDesc::default(), path)
+        .resolve(&table(|_| {}), path)
         .unwrap_err();
         assert!(e.to_string().starts_with("--threads: thread count"), "{e}");
         let e = Overrides::default()
@@ -499,8 +589,78 @@ mod tests {
             aovs: Some(vec!["gloss".into()]),
             ..Overrides::default()
         }
-        .resolve(&RenderDesc::default(), path)
+        .resolve(&table(|_| {}), path)
         .unwrap_err();
         assert!(e.to_string().contains("--aov") && e.to_string().contains("gloss"));
+    }
+
+    #[test]
+    fn denoisers_the_settings_cannot_honour_are_refused_naming_their_origin() {
+        let path = Path::new("s.toml");
+        let desc = table(|d| d.denoiser = Some("box:radius=2".into()));
+        let with =
+            |o: Overrides, desc: &LoadedScene| o.resolve(desc, path).unwrap_err().to_string();
+        let aovs = |d: Option<&str>| Overrides {
+            aovs: Some(vec!["albedo".into()]),
+            denoiser: d.map(str::to_string),
+            ..Overrides::default()
+        };
+        let e = with(aovs(None), &desc);
+        assert!(
+            e.starts_with(
+                "s.toml: [render] denoiser = \"box:radius=2\" writes the denoised image only"
+            ) && e.contains("--denoiser none"),
+            "{e}"
+        );
+        let e = with(aovs(Some("svgf")), &desc);
+        assert!(
+            e.starts_with("s.toml: --denoiser svgf writes the denoised image only"),
+            "{e}"
+        );
+        assert!(aovs(Some("none")).resolve(&desc, path).is_ok());
+        let split = Overrides {
+            integrator: Some("ao".parse().unwrap()),
+            denoiser: Some("svgf".into()),
+            ..Overrides::default()
+        };
+        let e = with(split, &desc);
+        assert!(
+            e.starts_with("s.toml: --denoiser svgf reads the lighting split"),
+            "{e}"
+        );
+        let bad = Overrides {
+            denoiser: Some("nlm:k=-1".into()),
+            ..Overrides::default()
+        };
+        assert!(with(bad, &desc).starts_with("--denoiser nlm:k=-1: "));
+    }
+
+    #[test]
+    fn the_default_structure_follows_the_scene_and_settings_round_trip_as_json() {
+        let path = Path::new("s.toml");
+        let mut moving = table(|_| {});
+        moving.scene = rt_scene::load_any(Path::new("gen:car")).unwrap().scene;
+        let s = Overrides::default().resolve(&moving, path).unwrap();
+        assert_eq!(s.accel, AccelSpec::default_for_scene(&moving.scene));
+        assert_eq!(s.accel.kind, rt_accel::AccelKind::Clusters);
+        let still = Overrides::default().resolve(&table(|_| {}), path).unwrap();
+        assert_eq!(still.accel, AccelSpec::default());
+        let given = Overrides {
+            integrator: Some("path:max-depth=3".parse().unwrap()),
+            aovs: Some(vec!["albedo".into(), "variance".into()]),
+            denoiser: Some("svgf:alpha=0.1".into()),
+            ..Overrides::default()
+        };
+        let given = Overrides {
+            aovs: None,
+            ..given
+        }
+        .resolve(&moving, path)
+        .unwrap();
+        for s in [s, still, given] {
+            let json = serde_json::to_string(&s).unwrap();
+            let back: Settings = serde_json::from_str(&json).unwrap();
+            assert_eq!(back, s, "{json}");
+        }
     }
 }

@@ -1,10 +1,12 @@
-//! Naming a sequence denoiser in one string: `svgf[:key=value...]` for SVGF, any other text a
-//! single-frame denoiser spec (`atrous:demodulate=on`) run per frame. Errors are one line naming
-//! the denoiser and the option.
+//! Naming a sequence denoiser in one string, in the one option grammar of every spec
+//! ([`rt_core::options`]): `svgf[:key=value...]` for SVGF, any other text a single-frame
+//! denoiser spec (`atrous:demodulate=on`) run per frame. Errors are one line naming the
+//! denoiser and the option.
 
 use crate::svgf::supersample::ExtraSample;
 use crate::svgf::{Svgf, SvgfInput, SvgfParams};
 use crate::{PerFrame, TemporalDenoiser, TemporalError, TemporalFrame};
+use rt_core::options::SEPARATORS;
 use rt_core::RgbImage;
 use rt_denoise::{DenoiseError, DenoiserSpec, Options};
 use rt_film::Channel;
@@ -15,7 +17,7 @@ use std::str::FromStr;
 #[derive(Clone, Debug, PartialEq)]
 pub enum TemporalSpec {
     /// SVGF with `key=value` options.
-    Svgf(Vec<(String, String)>),
+    Svgf(Options),
     /// A single-frame denoiser run on every frame.
     PerFrame(DenoiserSpec),
 }
@@ -27,8 +29,8 @@ impl TemporalSpec {
     }
 
     /// The SVGF parameters of an `svgf` spec.
-    pub fn svgf_params(options: &[(String, String)]) -> Result<SvgfParams, DenoiseError> {
-        let mut o = Options::new("svgf", options);
+    pub fn svgf_params(options: &Options) -> Result<SvgfParams, DenoiseError> {
+        let mut o = options.clone();
         let p = SvgfParams::from_options(&mut o)?;
         o.finish()?;
         Ok(p)
@@ -50,27 +52,13 @@ impl FromStr for TemporalSpec {
     type Err = DenoiseError;
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let mut parts = s.trim().split(':');
-        let kind = parts.next().unwrap_or_default();
-        if !kind.eq_ignore_ascii_case("svgf") {
+        let given = Options::parse(s)?;
+        if !given.kind().eq_ignore_ascii_case("svgf") {
             return Ok(TemporalSpec::PerFrame(s.parse()?));
         }
-        let mut options: Vec<(String, String)> = Vec::new();
-        for p in parts {
-            let Some((k, v)) = p.split_once('=') else {
-                return Err(DenoiseError::Spec(format!(
-                    "svgf: option '{p}' is not key=value"
-                )));
-            };
-            let k = k.trim().to_string();
-            if options.iter().any(|(o, _)| *o == k) {
-                return Err(DenoiseError::Spec(format!(
-                    "svgf: option '{k}' given twice"
-                )));
-            }
-            options.push((k, v.trim().to_string()));
-        }
-        Ok(TemporalSpec::Svgf(options))
+        let rest = s.trim();
+        let rest = &rest[rest.find(SEPARATORS).map_or(rest.len(), |i| i + 1)..];
+        Ok(TemporalSpec::Svgf(Options::of("svgf", rest)?))
     }
 }
 
@@ -79,10 +67,7 @@ impl fmt::Display for TemporalSpec {
         match self {
             TemporalSpec::Svgf(options) => {
                 f.write_str("svgf")?;
-                for (k, v) in options {
-                    write!(f, ":{k}={v}")?;
-                }
-                Ok(())
+                rt_denoise::spec::write_options(f, options)
             }
             TemporalSpec::PerFrame(s) => s.fmt(f),
         }
@@ -145,5 +130,42 @@ impl TemporalDenoiser for NamedSvgf {
 
     fn reset(&mut self) {
         self.svgf.reset();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn specs_display_what_parses_back_and_refuse_bad_options_naming_them() {
+        for text in [
+            "svgf",
+            "svgf:alpha=0.1:iterations=3",
+            "atrous:iterations=2",
+            "box",
+        ] {
+            let s: TemporalSpec = text.parse().unwrap();
+            assert_eq!(s.to_string(), text);
+            assert_eq!(s.to_string().parse::<TemporalSpec>().unwrap(), s);
+            s.build().unwrap();
+        }
+        assert_eq!(
+            "SVGF:alpha=0.1,clip=off"
+                .parse::<TemporalSpec>()
+                .unwrap()
+                .to_string(),
+            "svgf:alpha=0.1:clip=off"
+        );
+        let err = |t: &str| match t.parse::<TemporalSpec>() {
+            Err(e) => e.to_string(),
+            Ok(s) => s.build().err().map(|e| e.to_string()).unwrap_or_default(),
+        };
+        assert_eq!(
+            err("svgf:alpha=0.1:alpha=0.2"),
+            "svgf: option `alpha` given twice"
+        );
+        assert_eq!(err("svgf:sigma-q=1"), "svgf: unknown option `sigma-q`");
+        assert_eq!(err("svgf:alpha=3"), "svgf: alpha: must be in (0, 1], got 3");
     }
 }

@@ -224,13 +224,13 @@ fn bad_options_and_missing_guides_give_one_clear_line() {
         Ok(s) => s.build().err().map(|e| e.to_string()).unwrap_or_default(),
     };
     assert_eq!(err("svgf:alpha=2"), "svgf: alpha: must be in (0, 1], got 2");
-    assert_eq!(err("svgf:colour=on"), "svgf: unknown option 'colour'");
+    assert_eq!(err("svgf:colour=on"), "svgf: unknown option `colour`");
     assert_eq!(
         err("svgf:reflections=maybe"),
-        "svgf: reflections: 'maybe' is not one of reproject, primary, drop"
+        "svgf: reflections: `maybe` is not one of reproject, primary, drop"
     );
     assert!(err("svgf:feedback=7:iterations=3").contains("feedback: must be at most iterations"));
-    assert!(err("svgf:alpha").contains("not key=value"));
+    assert!(err("svgf:alpha").contains("option `alpha` needs a value"));
     // A frame without guides, or without the lighting split.
     let mut d = "svgf".parse::<TemporalSpec>().unwrap().build().unwrap();
     let mut frame = NoisyFrame::new(Image::filled(4, 3, Rgb::ONE));

@@ -1,7 +1,9 @@
 //! Naming a cache and its options in one string, the single dispatch point between the point
 //! sets: `worldspace[:key=value,...]` (implicit points) or `grid[:key=value,...]` (the fixed
-//! grid). Options are separated by `,` or `:`. Every bad option is one [`CacheError`] naming
-//! the cache kind and the option.
+//! grid), in the one option grammar of every spec ([`rt_core::options`]: options separated by
+//! `:` or `,`). Every bad option is one [`CacheError`] naming the cache kind and the option; a
+//! spec displays itself canonically (the options that differ from the defaults), and that
+//! text parses back to the same spec.
 //!
 //! | option        | meaning                                                  | default |
 //! |---------------|----------------------------------------------------------|---------|
@@ -21,6 +23,7 @@ use crate::cache::{AnyPoints, CacheParams, WorldCache};
 use crate::discretisation::Connectivity;
 use crate::select::Selection;
 use crate::{FixedGrid, ImplicitPoints};
+use rt_core::options::Options;
 use std::fmt;
 use std::str::FromStr;
 use thiserror::Error;
@@ -28,6 +31,9 @@ use thiserror::Error;
 /// A cache name or option that cannot be used.
 #[derive(Clone, Debug, Error, PartialEq)]
 pub enum CacheError {
+    /// An option that breaks the option grammar, is out of range, or that nothing reads.
+    #[error(transparent)]
+    Options(#[from] rt_core::options::OptionsError),
     /// Not `worldspace` or `grid`.
     #[error("unknown cache `{0}` (known: worldspace, grid)")]
     UnknownKind(String),
@@ -98,7 +104,6 @@ pub struct CacheSpec {
     pub capacity: usize,
     /// Accumulator slots.
     pub pass_capacity: usize,
-    text: String,
 }
 
 impl CacheSpec {
@@ -130,25 +135,13 @@ impl CacheSpec {
     }
 }
 
-impl fmt::Display for CacheSpec {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.text)
-    }
-}
+/// Entries of either table when nothing says (2^18: 6 MiB persistent, 10 MiB per pass).
+const DEFAULT_CAPACITY: usize = 1 << 18;
 
-impl FromStr for CacheSpec {
-    type Err = CacheError;
-
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let s = s.trim();
-        let (name, rest) = s.split_once(':').unwrap_or((s, ""));
-        let kind = match name {
-            "worldspace" => CacheKind::Worldspace,
-            "grid" => CacheKind::Grid,
-            other => return Err(CacheError::UnknownKind(other.to_string())),
-        };
-        let k = kind.name();
-        let mut spec = CacheSpec {
+impl CacheSpec {
+    /// The default spec of `kind`: level 5 (`worldspace`) or 6 (`grid`, the matched density).
+    pub fn new(kind: CacheKind) -> Self {
+        Self {
             kind,
             lod: match kind {
                 CacheKind::Worldspace => 5,
@@ -156,113 +149,108 @@ impl FromStr for CacheSpec {
             },
             s0: None,
             params: CacheParams::default(),
-            capacity: 1 << 18,
-            pass_capacity: 1 << 18,
-            text: s.to_string(),
-        };
-        for opt in rest
-            .split([',', ':'])
-            .map(str::trim)
-            .filter(|o| !o.is_empty())
-        {
-            let Some((key, value)) = opt.split_once('=') else {
-                return Err(CacheError::MissingValue {
-                    kind: k,
-                    key: opt.to_string(),
-                });
-            };
-            let (key, value) = (key.trim(), value.trim());
-            let bad = |expected: &'static str| CacheError::BadValue {
-                kind: k,
-                key: key.to_string(),
-                value: value.to_string(),
-                expected,
-            };
-            let p = &mut spec.params;
-            match key {
-                "lod" => {
-                    spec.lod = value
-                        .parse()
-                        .ok()
-                        .filter(|l| *l <= 20)
-                        .ok_or_else(|| bad("an integer in 0..=20"))?
-                }
-                "s0" => {
-                    spec.s0 = Some(
-                        value
-                            .parse::<f32>()
-                            .ok()
-                            .filter(|v| v.is_finite() && *v > 0.0)
-                            .ok_or_else(|| bad("a positive number"))?,
-                    )
-                }
-                "kappa" => {
-                    p.kappa = value
-                        .parse::<f32>()
-                        .ok()
-                        .filter(|v| *v > 0.0 && *v <= 1.0)
-                        .ok_or_else(|| bad("a number in (0, 1]"))?
-                }
-                "connectivity" => {
-                    p.connectivity = value
-                        .parse()
-                        .ok()
-                        .and_then(Connectivity::from_neighbours)
-                        .ok_or_else(|| bad("one of 0, 6, 18, 26"))?
-                }
-                "select" => {
-                    p.selection = match value {
-                        "barycentric" => Selection::Barycentric,
-                        "nearest" => Selection::Nearest,
-                        "jitter" => Selection::Jitter { radius: 1.0 },
-                        _ => return Err(bad("one of barycentric, nearest, jitter")),
-                    }
-                }
-                "jitter" => {
-                    let radius = value
-                        .parse::<f32>()
-                        .ok()
-                        .filter(|v| v.is_finite() && *v >= 0.0)
-                        .ok_or_else(|| bad("a non-negative number"))?;
-                    p.selection = Selection::Jitter { radius };
-                }
-                "radius" => {
-                    p.radius = value
-                        .parse::<f32>()
-                        .ok()
-                        .filter(|v| *v > 0.0 && *v <= 4.0)
-                        .ok_or_else(|| bad("a number in (0, 4]"))?
-                }
-                "normals" => {
-                    p.normals = value.parse().map_err(|_| bad("true or false"))?;
-                }
-                "min-samples" => {
-                    p.min_samples = value
-                        .parse::<f32>()
-                        .ok()
-                        .filter(|v| v.is_finite() && *v >= 0.0)
-                        .ok_or_else(|| bad("a non-negative number"))?
-                }
-                "capacity" | "pass-capacity" => {
-                    let c = value
-                        .parse::<usize>()
-                        .ok()
-                        .filter(|c| c.is_power_of_two() && (2..=1 << 28).contains(c))
-                        .ok_or_else(|| bad("a power of two in 2..=2^28"))?;
-                    if key == "capacity" {
-                        spec.capacity = c;
-                    } else {
-                        spec.pass_capacity = c;
-                    }
-                }
-                _ => {
-                    return Err(CacheError::UnknownOption {
-                        kind: k,
-                        key: key.to_string(),
-                    })
-                }
-            }
+            capacity: DEFAULT_CAPACITY,
+            pass_capacity: DEFAULT_CAPACITY,
         }
+    }
+}
+
+impl fmt::Display for CacheSpec {
+    /// The kind, then every option that differs from the kind's default.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let d = CacheSpec::new(self.kind);
+        let (p, dp) = (&self.params, &d.params);
+        f.write_str(self.kind.name())?;
+        if self.lod != d.lod {
+            write!(f, ":lod={}", self.lod)?;
+        }
+        if let Some(s0) = self.s0 {
+            write!(f, ":s0={s0}")?;
+        }
+        if p.kappa != dp.kappa {
+            write!(f, ":kappa={}", p.kappa)?;
+        }
+        if p.connectivity != dp.connectivity {
+            write!(f, ":connectivity={}", p.connectivity.neighbours())?;
+        }
+        match p.selection {
+            Selection::Barycentric => {}
+            Selection::Nearest => f.write_str(":select=nearest")?,
+            Selection::Jitter { radius } => write!(f, ":jitter={radius}")?,
+        }
+        if p.radius != dp.radius {
+            write!(f, ":radius={}", p.radius)?;
+        }
+        if p.normals != dp.normals {
+            write!(f, ":normals={}", p.normals)?;
+        }
+        if p.min_samples != dp.min_samples {
+            write!(f, ":min-samples={}", p.min_samples)?;
+        }
+        if self.capacity != d.capacity {
+            write!(f, ":capacity={}", self.capacity)?;
+        }
+        if self.pass_capacity != d.pass_capacity {
+            write!(f, ":pass-capacity={}", self.pass_capacity)?;
+        }
+        Ok(())
+    }
+}
+
+impl FromStr for CacheSpec {
+    type Err = CacheError;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let mut o = Options::parse(s)?;
+        let kind = match o.kind() {
+            "worldspace" => CacheKind::Worldspace,
+            "grid" => CacheKind::Grid,
+            other => return Err(CacheError::UnknownKind(other.to_string())),
+        };
+        let mut spec = CacheSpec::new(kind);
+        let positive = |v: &f32| v.is_finite() && *v > 0.0;
+        let capacity = |c: &usize| c.is_power_of_two() && (2..=1 << 28).contains(c);
+        let p = &mut spec.params;
+        spec.lod = o
+            .value_in("lod", "an integer in 0..=20", |l: &u32| *l <= 20)?
+            .unwrap_or(spec.lod);
+        spec.s0 = o.value_in("s0", "a positive number", positive)?;
+        p.kappa = o
+            .value_in("kappa", "a number in (0, 1]", |v: &f32| {
+                *v > 0.0 && *v <= 1.0
+            })?
+            .unwrap_or(p.kappa);
+        if let Some(n) = o.value_in("connectivity", "one of 0, 6, 18, 26", |n: &u32| {
+            Connectivity::from_neighbours(*n).is_some()
+        })? {
+            p.connectivity = Connectivity::from_neighbours(n).expect("checked");
+        }
+        p.selection = match o.choice("select", &["barycentric", "nearest", "jitter"])? {
+            Some("nearest") => Selection::Nearest,
+            Some("jitter") => Selection::Jitter { radius: 1.0 },
+            _ => p.selection,
+        };
+        let jitter = |v: &f32| v.is_finite() && *v >= 0.0;
+        if let Some(radius) = o.value_in("jitter", "a non-negative number", jitter)? {
+            p.selection = Selection::Jitter { radius };
+        }
+        p.radius = o
+            .value_in("radius", "a number in (0, 4]", |v: &f32| {
+                *v > 0.0 && *v <= 4.0
+            })?
+            .unwrap_or(p.radius);
+        p.normals = o.switch("normals")?.unwrap_or(p.normals);
+        p.min_samples = o
+            .value_in("min-samples", "a non-negative number", jitter)?
+            .unwrap_or(p.min_samples);
+        let pow2 = "a power of two in 2..=2^28";
+        spec.capacity = o
+            .value_in("capacity", pow2, capacity)?
+            .unwrap_or(spec.capacity);
+        spec.pass_capacity = o
+            .value_in("pass-capacity", pow2, capacity)?
+            .unwrap_or(spec.pass_capacity);
+        o.finish()?;
         Ok(spec)
     }
 }
@@ -286,18 +274,42 @@ mod tests {
     }
 
     #[test]
+    fn every_spec_displays_a_text_that_parses_back_to_it() {
+        for text in [
+            "worldspace",
+            "grid",
+            "worldspace:lod=7:kappa=0.5:connectivity=6",
+            "grid:s0=2.5:select=nearest:radius=1.5:normals=false:min-samples=4",
+            "worldspace:jitter=3:capacity=1024:pass-capacity=2048",
+        ] {
+            let s: CacheSpec = text.parse().unwrap();
+            assert_eq!(s.to_string(), text);
+            assert_eq!(s.to_string().parse::<CacheSpec>(), Ok(s));
+        }
+        let s: CacheSpec = "worldspace:kappa=0.5,lod=7,select=jitter".parse().unwrap();
+        assert_eq!(s.to_string(), "worldspace:lod=7:kappa=0.5:jitter=1");
+    }
+
+    #[test]
     fn bad_options_name_the_option() {
         let e = |s: &str| s.parse::<CacheSpec>().unwrap_err().to_string();
         assert_eq!(
             e("octree"),
             "unknown cache `octree` (known: worldspace, grid)"
         );
-        assert!(e("worldspace:lod=x").contains("option `lod`: `x` is not an integer"));
-        assert!(e("grid:capacity=1000").contains("`capacity`: `1000` is not a power of two"));
-        assert!(e("worldspace:kappa=0").contains("`kappa`"));
+        assert_eq!(
+            e("worldspace:lod=x"),
+            "worldspace: lod: `x` is not an integer in 0..=20"
+        );
+        assert!(e("grid:capacity=1000").contains("capacity: `1000` is not a power of two"));
+        assert!(e("worldspace:kappa=0").contains("kappa"));
         assert!(e("worldspace:connectivity=5").contains("one of 0, 6, 18, 26"));
-        assert!(e("worldspace:foo=1").starts_with("worldspace: unknown option `foo`"));
+        assert_eq!(e("worldspace:foo=1"), "worldspace: unknown option `foo`");
         assert!(e("worldspace:lod").contains("option `lod` needs a value"));
+        assert_eq!(
+            e("worldspace:lod=3,lod=4"),
+            "worldspace: option `lod` given twice"
+        );
         for msg in [e("worldspace:radius=9"), e("grid:s0=-1")] {
             assert!(!msg.contains('\n'));
         }

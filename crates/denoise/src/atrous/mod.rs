@@ -68,7 +68,7 @@ mod pass;
 mod planes;
 mod simd;
 
-use crate::{Channel, DenoiseError, Denoiser, NoisyFrame, Options};
+use crate::{Channel, DenoiseError, Denoiser, DenoiserOptions, NoisyFrame, Options};
 use parts::{colour_scale, position_scale, Part};
 use pass::{Inputs, Level, Weights};
 use planes::Planes;
@@ -156,34 +156,34 @@ impl Atrous {
     pub fn from_options(o: &mut Options) -> Result<Self, DenoiseError> {
         let iterations = o.usize("iterations", 5)?;
         if !(1..=MAX_ITERATIONS).contains(&iterations) {
-            return Err(o.error(
+            return Err(o.param_error(
                 "iterations",
                 format!("must be 1 to {MAX_ITERATIONS}, got {iterations}"),
             ));
         }
         let weights = Weights {
-            colour: o.flag("colour", true)?,
-            normal: o.flag("normal", true)?,
-            position: o.flag("position", true)?,
+            colour: o.on_off("colour", true)?,
+            normal: o.on_off("normal", true)?,
+            position: o.on_off("position", true)?,
         };
         let phi = |o: &mut Options, key: &'static str, default: f32| {
             let v = o.f32(key, default)?;
             if v > 0.0 {
                 Ok(v)
             } else {
-                Err(o.error(key, format!("must be positive, got {v}")))
+                Err(o.param_error(key, format!("must be positive, got {v}")))
             }
         };
         let c_phi = phi(o, "c_phi", 4.0)?;
         let n_phi = phi(o, "n_phi", 0.01)?;
         let p_phi = phi(o, "p_phi", 0.001)?;
-        let relative = o.choice("scale", &["relative", "absolute"], "relative")? == "relative";
-        let halve = match o.choice("halve", &["phi", "sigma", "none"], "phi")? {
+        let relative = o.pick("scale", &["relative", "absolute"], "relative")? == "relative";
+        let halve = match o.pick("halve", &["phi", "sigma", "none"], "phi")? {
             "sigma" => Halve::Sigma,
             "none" => Halve::None,
             _ => Halve::Phi,
         };
-        let demodulate = match o.choice("demodulate", &["auto", "on", "off"], "auto")? {
+        let demodulate = match o.pick("demodulate", &["auto", "on", "off"], "auto")? {
             "on" => Demodulate::On,
             "off" => Demodulate::Off,
             _ => Demodulate::Auto,
@@ -191,11 +191,11 @@ impl Atrous {
         let part_iterations = |o: &mut Options, key: &'static str, default: usize| {
             let v = o.usize(key, default)?;
             if v > MAX_ITERATIONS {
-                return Err(o.error(key, format!("must be 0 to {MAX_ITERATIONS}, got {v}")));
+                return Err(o.param_error(key, format!("must be 0 to {MAX_ITERATIONS}, got {v}")));
             }
             Ok(v)
         };
-        let split = match o.choice(
+        let split = match o.pick(
             "split",
             &["none", "direct-indirect", "diffuse-glossy"],
             "none",
@@ -210,7 +210,7 @@ impl Atrous {
             },
             _ => Split::None,
         };
-        let simd = o.choice("simd", &["auto", "off"], "auto")? == "auto";
+        let simd = o.pick("simd", &["auto", "off"], "auto")? == "auto";
         Ok(Self::assemble(
             iterations, weights, c_phi, n_phi, p_phi, relative, halve, demodulate, split, simd,
         ))

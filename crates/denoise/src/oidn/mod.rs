@@ -18,7 +18,7 @@
 #[allow(unsafe_code)] // the FFI: every unsafe block there has its SAFETY comment
 mod ffi;
 
-use crate::{DenoiseError, Denoiser, NoisyFrame, Options};
+use crate::{DenoiseError, Denoiser, DenoiserOptions, NoisyFrame, Options};
 use ffi::{Device, Quality, RtFilter, RtParams, RtShape};
 use rt_core::{Image, Rgb, RgbImage};
 use std::sync::{Mutex, PoisonError};
@@ -157,16 +157,16 @@ impl Oidn {
     /// (on), `clean-aux=on|off` (off).
     pub fn from_options(o: &mut Options) -> Result<Self, DenoiseError> {
         let d = OidnParams::default();
-        let quality = match o.choice("quality", &["fast", "balanced", "high"], "high")? {
+        let quality = match o.pick("quality", &["fast", "balanced", "high"], "high")? {
             "fast" => OidnQuality::Fast,
             "balanced" => OidnQuality::Balanced,
             _ => OidnQuality::High,
         };
         Self::new(OidnParams {
             quality,
-            aux: o.flag("aux", d.aux)?,
-            hdr: o.flag("hdr", d.hdr)?,
-            clean_aux: o.flag("clean-aux", d.clean_aux)?,
+            aux: o.on_off("aux", d.aux)?,
+            hdr: o.on_off("hdr", d.hdr)?,
+            clean_aux: o.on_off("clean-aux", d.clean_aux)?,
         })
     }
 

@@ -119,7 +119,7 @@ fn specs_build_with_defaults_and_refuse_bad_options() {
         "oidn: quality: 'ultra' is not one of fast, balanced, high"
     );
     assert_eq!(err("oidn:aux=maybe"), "oidn: aux: 'maybe' is not on or off");
-    assert_eq!(err("oidn:strength=2"), "oidn: unknown option 'strength'");
+    assert_eq!(err("oidn:strength=2"), "oidn: unknown option `strength`");
 }
 
 /// Largest relative difference from `c` over pixels at least `margin` from the border, and

@@ -33,7 +33,7 @@ mod tests;
 
 pub use sweep::SweepStats;
 
-use crate::{DenoiseError, Options};
+use crate::{DenoiseError, DenoiserOptions, Options};
 use layers::Layers;
 use rt_core::{Rgb, RgbImage};
 use rt_film::SampleRecords;

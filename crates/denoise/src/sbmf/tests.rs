@@ -383,11 +383,7 @@ fn parameters_are_validated_and_inputs_checked() {
         })
         .is_ok());
     }
-    let given = [
-        ("manifolds".to_string(), "7".to_string()),
-        ("layers".to_string(), "3".to_string()),
-    ];
-    let mut o = Options::new("sbmf", &given);
+    let mut o = Options::of("sbmf", "manifolds=7:layers=3").unwrap();
     let s = Sbmf::from_options(&mut o).unwrap();
     o.finish().unwrap();
     assert_eq!((s.params().manifolds, s.params().layers), (7, 3));

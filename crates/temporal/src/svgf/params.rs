@@ -6,7 +6,7 @@
 //! them. The defaults are Voorhuis' (seed 001 §1.5, §2.1): σ_z = 1, σ_n = 64, σ_l = 5,
 //! α = 0.2 on diffuse and 0.1 on specular pixels, 5 iterations, feedback after the first.
 
-use rt_denoise::{DenoiseError, Options};
+use rt_denoise::{DenoiseError, DenoiserOptions, Options};
 
 /// How pixels whose primary hit is specular (roughness below `specular_limit`) find their
 /// history.
@@ -113,27 +113,26 @@ impl SvgfParams {
 
     /// Reads the options of an `svgf` spec; `preset=voorhuis|schied` picks the defaults the
     /// other options change.
-    pub fn from_options(o: &mut Options<'_>) -> Result<Self, DenoiseError> {
-        let base = match o.choice("preset", &["voorhuis", "schied"], "voorhuis")? {
+    pub fn from_options(o: &mut Options) -> Result<Self, DenoiseError> {
+        let base = match o.pick("preset", &["voorhuis", "schied"], "voorhuis")? {
             "schied" => Self::schied(),
             _ => Self::default(),
         };
-        let unit = |o: &mut Options<'_>, key: &'static str, d: f32| -> Result<f32, DenoiseError> {
+        let unit = |o: &mut Options, key: &'static str, d: f32| -> Result<f32, DenoiseError> {
             let v = o.f32(key, d)?;
             if !(v > 0.0 && v <= 1.0) {
-                return Err(o.error(key, format!("must be in (0, 1], got {v}")));
+                return Err(o.param_error(key, format!("must be in (0, 1], got {v}")));
             }
             Ok(v)
         };
-        let positive =
-            |o: &mut Options<'_>, key: &'static str, d: f32| -> Result<f32, DenoiseError> {
-                let v = o.f32(key, d)?;
-                if v <= 0.0 {
-                    return Err(o.error(key, format!("must be positive, got {v}")));
-                }
-                Ok(v)
-            };
-        let reflections = match o.choice(
+        let positive = |o: &mut Options, key: &'static str, d: f32| -> Result<f32, DenoiseError> {
+            let v = o.f32(key, d)?;
+            if v <= 0.0 {
+                return Err(o.param_error(key, format!("must be positive, got {v}")));
+            }
+            Ok(v)
+        };
+        let reflections = match o.pick(
             "reflections",
             &["reproject", "primary", "drop"],
             match base.reflections {
@@ -153,14 +152,16 @@ impl SvgfParams {
             max_history: {
                 let v = positive(o, "max-history", base.max_history)?;
                 if v < 1.0 {
-                    return Err(o.error("max-history", format!("must be at least 1, got {v}")));
+                    return Err(
+                        o.param_error("max-history", format!("must be at least 1, got {v}"))
+                    );
                 }
                 v
             },
             iterations: {
                 let v = o.usize("iterations", base.iterations as usize)?;
                 if v > 10 {
-                    return Err(o.error("iterations", format!("must be at most 10, got {v}")));
+                    return Err(o.param_error("iterations", format!("must be at most 10, got {v}")));
                 }
                 v as u32
             },
@@ -169,31 +170,33 @@ impl SvgfParams {
             sigma_n: {
                 let v = o.f32("sigma-n", base.sigma_n)?;
                 if v < 0.0 {
-                    return Err(o.error("sigma-n", format!("must be >= 0, got {v}")));
+                    return Err(o.param_error("sigma-n", format!("must be >= 0, got {v}")));
                 }
                 v
             },
             sigma_l: positive(o, "sigma-l", base.sigma_l)?,
             reflections,
-            clip: o.flag("clip", base.clip)?,
-            median: o.flag("median", base.median)?,
-            wide_start: o.flag("wide-start", base.wide_start)?,
+            clip: o.on_off("clip", base.clip)?,
+            median: o.on_off("median", base.median)?,
+            wide_start: o.on_off("wide-start", base.wide_start)?,
             hold_indirect_variance: o
-                .flag("hold-indirect-variance", base.hold_indirect_variance)?,
+                .on_off("hold-indirect-variance", base.hold_indirect_variance)?,
             specular_limit: unit(o, "specular-limit", base.specular_limit)?,
             glossy_limit: unit(o, "glossy-limit", base.glossy_limit)?,
             omega: positive(o, "omega", base.omega)?,
             diamond_step: {
                 let v = o.usize("diamond-step", base.diamond_step as usize)?;
                 if !(1..=64).contains(&v) {
-                    return Err(o.error("diamond-step", format!("must be in 1..=64, got {v}")));
+                    return Err(
+                        o.param_error("diamond-step", format!("must be in 1..=64, got {v}"))
+                    );
                 }
                 v as u32
             },
-            subpixel: o.flag("subpixel", base.subpixel)?,
+            subpixel: o.on_off("subpixel", base.subpixel)?,
         };
         if p.feedback > p.iterations {
-            return Err(o.error(
+            return Err(o.param_error(
                 "feedback",
                 format!(
                     "must be at most iterations ({}), got {}",
@@ -202,7 +205,7 @@ impl SvgfParams {
             ));
         }
         if p.glossy_limit > p.specular_limit {
-            return Err(o.error(
+            return Err(o.param_error(
                 "glossy-limit",
                 format!(
                     "must not exceed specular-limit ({}), got {}",

@@ -1,8 +1,9 @@
-//! `render --cache worldspace[:options]` / `grid[:options]`: the world-space cache of
-//! `rt-worldcache` behind the integrators' [`RadianceCache`] seam. One cache lives for the
-//! whole job, so it carries over from pass to pass and from frame to frame of a sequence.
+//! A job's world-space cache ([`crate::RenderJob::cache`], `render --cache
+//! worldspace[:options]` / `grid[:options]`): the cache of `rt-worldcache` behind the
+//! integrators' [`RadianceCache`] seam. One cache lives for the whole job, so it carries over
+//! from pass to pass and from frame to frame of a sequence.
 
-use anyhow::{anyhow, bail, Result};
+use crate::job::JobError;
 use rt_core::{Rgb, Scene};
 use rt_integrators::{IntegratorSpec, RadianceCache, Technique};
 use rt_worldcache::{AnyPoints, CacheSpec, WorldCache};
@@ -19,10 +20,9 @@ pub struct SharedCache {
     spec: String,
 }
 
-/// Parses `text` and builds the cache for `scene`; the level-0 edge defaults to the largest
-/// extent of the scene's triangles.
-pub fn build(text: &str, scene: &Scene) -> Result<Arc<SharedCache>> {
-    let spec: CacheSpec = text.parse().map_err(|e| anyhow!("--cache {text}: {e}"))?;
+/// Builds the cache `spec` for `scene`; the level-0 edge defaults to the largest extent of
+/// the scene's triangles.
+pub fn build(spec: &CacheSpec, scene: &Scene) -> Result<Arc<SharedCache>, JobError> {
     let mut bounds = rt_core::Aabb::EMPTY;
     for t in &scene.triangles {
         for &v in t {
@@ -37,7 +37,7 @@ pub fn build(text: &str, scene: &Scene) -> Result<Arc<SharedCache>> {
     };
     let cache = spec
         .build(extent)
-        .map_err(|e| anyhow!("--cache {text}: {e}"))?;
+        .map_err(|e| JobError::Refused(format!("--cache {spec}: {e}")))?;
     Ok(Arc::new(SharedCache {
         min_samples: spec.params.min_samples,
         cache: RwLock::new(cache),
@@ -47,19 +47,21 @@ pub fn build(text: &str, scene: &Scene) -> Result<Arc<SharedCache>> {
     }))
 }
 
-/// The job's cache for `--cache TEXT` (`None` without the flag), refused with one line when
-/// `integrator` cannot use one.
+/// The job's cache (`None` without one), refused with one line when `integrator` cannot use
+/// one.
 pub fn for_job(
-    text: Option<&str>,
+    spec: Option<&CacheSpec>,
     integrator: &IntegratorSpec,
     scene: &Scene,
-) -> Result<Option<Arc<dyn RadianceCache>>> {
-    let Some(text) = text else {
+) -> Result<Option<Arc<dyn RadianceCache>>, JobError> {
+    let Some(spec) = spec else {
         return Ok(None);
     };
-    let c: Arc<dyn RadianceCache> = build(text, scene)?;
+    let c: Arc<dyn RadianceCache> = build(spec, scene)?;
     if integrator.build_cached(c.clone()).is_none() {
-        bail!("--cache {text}: the {integrator} technique cannot use a cache (path, path-bsdf or ao can)");
+        return Err(JobError::Refused(format!(
+            "--cache {spec}: the {integrator} technique cannot use a cache (path, path-bsdf or ao can)"
+        )));
     }
     Ok(Some(c))
 }
@@ -68,11 +70,13 @@ pub fn for_job(
 pub fn technique(
     integrator: &IntegratorSpec,
     cache: Option<Arc<dyn RadianceCache>>,
-) -> Result<Box<dyn Technique>> {
+) -> Result<Box<dyn Technique>, JobError> {
     match cache {
-        Some(c) => integrator
-            .build_cached(c)
-            .ok_or_else(|| anyhow!("--cache: the {integrator} technique cannot use a cache")),
+        Some(c) => integrator.build_cached(c).ok_or_else(|| {
+            JobError::Refused(format!(
+                "--cache: the {integrator} technique cannot use a cache"
+            ))
+        }),
         None => Ok(integrator.build()),
     }
 }

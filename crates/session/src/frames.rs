@@ -1,5 +1,5 @@
-//! File names of numbered frames: `{frame}` and `{frame:0N}` in a path, as `render --frames`
-//! writes them and `render compare --frames` reads them.
+//! File names of numbered frames: `{frame}` and `{frame:0N}` in a path, as a job with several
+//! frames writes them ([`crate::RenderJob::output`]) and `render compare --frames` reads them.
 
 use std::path::{Path, PathBuf};
 

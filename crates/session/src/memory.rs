@@ -1,13 +1,24 @@
-//! `--max-memory`: before the structure and the film are allocated, the render's memory is
-//! estimated (film buffers and per-sample records exactly, `rt_film::FilmMemory::estimate`;
-//! the structure by `rt_accel::AccelKind::memory_bound`), and a render that would not fit is
-//! refused with one line instead of being killed half-way. The limit is `--max-memory`, else
-//! the memory the system reports available now (Linux `MemAvailable`); the scene is already
-//! loaded, so it is not counted again.
+//! The memory check of a job ([`crate::RenderJob::max_memory`], `render --max-memory`):
+//! before the structure and the film are allocated, the render's memory is estimated (film
+//! buffers and per-sample records exactly, `rt_film::FilmMemory::estimate`; the structure by
+//! `rt_accel::AccelKind::memory_bound`), and a render that would not fit is refused with one
+//! line instead of being killed half-way. The limit is the job's, else the memory the system
+//! reports available now (Linux `MemAvailable`); the scene is already loaded, so it is not
+//! counted again.
 
-use anyhow::{anyhow, bail, Result};
 use rt_accel::AccelSpec;
 use rt_film::{FilmBuffers, FilmMemory};
+
+/// A size that does not parse, or a render that would not fit.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{0}")]
+pub struct MemoryError(pub String);
+
+type Result<T> = std::result::Result<T, MemoryError>;
+
+macro_rules! bail {
+    ($($t:tt)*) => { return Err(MemoryError(format!($($t)*))) };
+}
 
 /// `text` as bytes: a number with an optional binary suffix `K`, `M`, `G` or `T` (powers of
 /// 1024; `KiB`, `MB` and the like read the same), e.g. `512M`, `1.5G`, `1000000`.
@@ -19,7 +30,7 @@ pub fn parse_size(text: &str) -> Result<u64> {
     let (number, unit) = t.split_at(digits);
     let value: f64 = number
         .parse()
-        .map_err(|_| anyhow!("--max-memory {text}: not a size (e.g. 512M, 8G)"))?;
+        .map_err(|_| MemoryError(format!("--max-memory {text}: not a size (e.g. 512M, 8G)")))?;
     let shift = match unit
         .trim()
         .to_ascii_uppercase()

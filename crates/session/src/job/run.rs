@@ -1,0 +1,711 @@
+//! Running a job: the frame loop, one image per frame (fixed, adaptive or checkpointed), and
+//! its outputs (image, denoised image, part file, GREE composite); temporally denoised
+//! sequences through [`SequenceRenderer`].
+
+use super::parts::{write_denoised, Checkpointer, Cut};
+use super::report::{AdaptiveSummary, FrameReport, GreeSummary, JobReport, JobSink, Rendered};
+use super::{load_scene, refuse, Frames, JobError, JobScene, RenderJob};
+use crate::frames::frame_path;
+use crate::memory::Estimate;
+use crate::{
+    frame_seed, pick_camera, render_adaptive, Adaptive, RenderReport, ReportInputs,
+    SequenceRenderer,
+};
+use rt_core::{Accel, Camera, Scene};
+use rt_film::{AovSet, Film, FilmBuffers, OutputOptions};
+use rt_integrators::{Ctx, RadianceCache, RenderStats, SamplePass, Technique};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// A rayon pool of `threads` workers (all cores by default), the one every render and
+/// benchmark uses.
+pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, JobError> {
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(t) = threads {
+        let max = rt_core::limits::MAX_THREADS;
+        if t == 0 || t > max {
+            return refuse(format!("--threads must be between 1 and {max}, got {t}"));
+        }
+        pool = pool.num_threads(t);
+    }
+    pool.build()
+        .map_err(|e| JobError::Failed(format!("cannot start worker threads: {e}")))
+}
+
+/// One frame's scene, structure and timings, as the image render needs them.
+struct FrameEnv<'a> {
+    scene: &'a Scene,
+    accel: &'a dyn Accel,
+    frame: Option<u32>,
+    output: PathBuf,
+    seed: u32,
+    load: Duration,
+    build: Duration,
+    threads: usize,
+    scene_hash: Option<&'a str>,
+}
+
+impl RenderJob {
+    /// Loads the scene and runs the job: every frame rendered and written, each reported to
+    /// `sink`. A checkpointed render stops at the next pass after `stop` is set, writes its
+    /// checkpoint and its image so far, and returns [`JobError::Interrupted`].
+    pub fn run(&self, sink: &dyn JobSink, stop: &AtomicBool) -> Result<JobReport, JobError> {
+        self.check()?;
+        let t = Instant::now();
+        let scene = load_scene(&self.scene, self.confine.as_deref())?;
+        for w in &scene.loaded.warnings {
+            sink.warning(w);
+        }
+        self.run_loaded(scene, t.elapsed(), sink, stop)
+    }
+
+    /// [`RenderJob::run`] with the scene already loaded ([`load_scene`]; its warnings are
+    /// the caller's to show), `load` long.
+    pub fn run_loaded(
+        &self,
+        scene: JobScene,
+        load: Duration,
+        sink: &dyn JobSink,
+        stop: &AtomicBool,
+    ) -> Result<JobReport, JobError> {
+        self.check()?;
+        // A part or a checkpoint names the scene's content; nothing else reads the files twice.
+        let scene_hash = (self.writes_part() || self.checkpoint.is_some()).then(|| {
+            rt_parts::content_hash(&scene.access.files_used(), &self.scene.to_string_lossy())
+        });
+        let mut scene = scene.loaded.scene;
+        self.set_shutter(&mut scene)?;
+        self.check_memory(&scene)?;
+        if let Some(spec) = self.temporal() {
+            if self.writes_part() {
+                return refuse(format!(
+                    "{}: a part file cannot hold a temporally denoised sequence: its history carries from frame to frame; render the frames' parts without it",
+                    self.output.display()
+                ));
+            }
+            return self.run_sequence(spec, &mut scene, sink);
+        }
+        let pool = thread_pool(self.settings.threads)?;
+        // One cache for the whole job: it persists across passes and frames.
+        let cache =
+            crate::worldcache::for_job(self.cache.as_ref(), &self.settings.integrator, &scene)?;
+        let started = Instant::now();
+        let frames = self.frame_list();
+        let mut accel: Option<Box<dyn Accel>> = None;
+        for frame in &frames {
+            let frame = *frame;
+            let (output, seed) = match frame {
+                Some(f) => {
+                    scene.set_time((f64::from(f) / self.fps) as f32);
+                    (
+                        frame_path(&self.output, f),
+                        frame_seed(self.settings.seed, f),
+                    )
+                }
+                None => (self.output.clone(), self.settings.seed),
+            };
+            if let Some(e) = scene.motion_blur_error() {
+                return refuse(format!("{}: --shutter: {e}", self.scene.display()));
+            }
+            // Two-level structures follow rigid motion in place; flat ones are rebuilt.
+            let t_build = Instant::now();
+            let updated = accel
+                .as_mut()
+                .is_some_and(|a| pool.install(|| a.update(&scene)));
+            if !updated {
+                // IOSP reorders the scene's triangles to store nothing beyond them.
+                let built = pool.install(|| self.settings.accel.try_build_scene_mut(&mut scene));
+                accel = Some(built.map_err(|e| {
+                    JobError::Refused(format!(
+                        "{}: --accel {}: {e}",
+                        self.scene.display(),
+                        self.settings.accel
+                    ))
+                })?);
+            }
+            let env = FrameEnv {
+                scene: &scene,
+                accel: accel.as_deref().expect("built above"),
+                frame,
+                output,
+                seed,
+                load,
+                build: t_build.elapsed(),
+                threads: pool.current_num_threads(),
+                scene_hash: scene_hash.as_deref(),
+            };
+            pool.install(|| self.render_frame(&env, cache.clone(), sink, stop))?;
+        }
+        Ok(JobReport {
+            frames: frames.len(),
+            elapsed: started.elapsed(),
+            temporal: false,
+        })
+    }
+
+    /// The frames to render: `None` for a still (the scene at time 0).
+    fn frame_list(&self) -> Vec<Option<u32>> {
+        match &self.frames {
+            Frames::Still => vec![None],
+            Frames::One(f) => vec![Some(*f)],
+            Frames::Range(r) => r.clone().map(Some).collect(),
+        }
+    }
+
+    /// The camera of the job (resized), in `scene` as it is now.
+    fn camera_in(&self, scene: &Scene) -> Result<Camera, JobError> {
+        let c = pick_camera(scene, &self.scene, self.camera.as_deref())?;
+        Ok(self.size.apply(c))
+    }
+
+    /// The single-frame denoiser, built (`None` without one, or with a temporal one).
+    fn frame_denoiser(&self) -> Result<Option<Box<dyn rt_denoise::Denoiser>>, JobError> {
+        match &self.settings.denoiser {
+            Some(rt_temporal::TemporalSpec::PerFrame(spec)) => spec
+                .build()
+                .map(Some)
+                .map_err(|e| JobError::Refused(format!("--denoiser {spec}: {e}"))),
+            _ => Ok(None),
+        }
+    }
+
+    /// The film buffers a render keeps: only what its outputs and its denoiser read, no
+    /// variance or half-buffers unless asked for; the stopping criterion reads the even
+    /// samples' half.
+    pub fn film_buffers(&self, denoiser: Option<&dyn rt_denoise::Denoiser>) -> FilmBuffers {
+        let denoise_aovs = denoiser.map_or(AovSet::default(), |d| AovSet::for_channels(d.needs()));
+        let buffers = FilmBuffers::for_outputs(self.settings.aovs.union(denoise_aovs));
+        if self.stop.is_some_and(|s| s.error.is_some()) {
+            buffers.with_halves()
+        } else {
+            buffers
+        }
+    }
+
+    /// Refuses, before the structure and the film are allocated, a render whose estimate
+    /// exceeds the job's limit, else the memory available ([`crate::memory`]).
+    fn check_memory(&self, scene: &Scene) -> Result<(), JobError> {
+        let camera = self.camera_in(scene)?;
+        // A temporal denoiser's needs are its own; the plain film is still the floor.
+        let denoiser = self.frame_denoiser()?;
+        let splats = self.settings.integrator.build().splats();
+        Estimate::new(
+            camera.width,
+            camera.height,
+            self.film_buffers(denoiser.as_deref()),
+            self.settings.spp,
+            splats,
+            &self.settings.accel,
+            scene.triangle_count(),
+        )
+        .check(&self.scene.display().to_string(), self.max_memory)
+        .map_err(|e| JobError::Refused(e.to_string()))
+    }
+
+    /// Opens the scene's shutter for the job's fraction of a frame and checks that the
+    /// render can blur what moves: a camera-ray technique, and a structure that places
+    /// instances per ray.
+    fn set_shutter(&self, scene: &mut Scene) -> Result<(), JobError> {
+        if self.shutter == 0.0 {
+            return Ok(());
+        }
+        scene.shutter = (self.shutter / self.fps) as f32;
+        let path = self.scene.display();
+        let moving_instances = scene.instances.iter().any(|i| i.is_animated());
+        if !moving_instances && scene.camera_motions.is_empty() {
+            return Ok(());
+        }
+        let s = &self.settings;
+        if !s.integrator.build().motion_blur() {
+            return refuse(format!(
+                "{path}: --shutter: the {} integrator cannot motion blur (wavefront, path, path-bsdf, direct and ao can)",
+                s.integrator
+            ));
+        }
+        if moving_instances && !s.accel.kind.is_two_level() {
+            return refuse(format!(
+                "{path}: --shutter: --accel {} holds the scene at one time; motion blur needs two-level or clusters",
+                s.accel
+            ));
+        }
+        Ok(())
+    }
+
+    /// Renders this job's samples (or its slice's) of one image of `ctx` with `technique`
+    /// into a new film and returns it: no file is written. For callers that hold their own
+    /// scene, structure and camera (an experiment's references). Fixed and adaptive jobs
+    /// only.
+    pub fn render_film(
+        &self,
+        ctx: &Ctx<'_>,
+        technique: &dyn Technique,
+        sink: &dyn JobSink,
+    ) -> Result<(Film, RenderStats), JobError> {
+        let camera = ctx.camera;
+        let denoiser = self.frame_denoiser()?;
+        let mut film = Film::new(
+            camera.width,
+            camera.height,
+            self.film_buffers(denoiser.as_deref()),
+        );
+        let stats = match &self.stop {
+            Some(rule) => {
+                render_adaptive(ctx, technique, &mut film, self.settings.seed, rule, &|f| {
+                    sink.progress(f)
+                })
+                .map_err(|e| JobError::Refused(format!("--error {}", e.0)))?
+                .stats
+            }
+            None => {
+                let cut = Cut {
+                    samples: self.slice.samples.clone().unwrap_or(0..self.settings.spp),
+                    region: self
+                        .slice
+                        .rect()
+                        .unwrap_or(rt_film::Rect::full(camera.width, camera.height)),
+                };
+                self.fixed_pass(ctx, technique, &mut film, self.settings.seed, &cut, sink)
+            }
+        };
+        Ok((film, stats))
+    }
+
+    fn fixed_pass(
+        &self,
+        ctx: &Ctx<'_>,
+        technique: &dyn Technique,
+        film: &mut Film,
+        seed: u32,
+        cut: &Cut,
+        sink: &dyn JobSink,
+    ) -> RenderStats {
+        let (w, h) = (ctx.camera.width, ctx.camera.height);
+        let pass = SamplePass {
+            indices: cut.samples.clone(),
+            stream: self.stream.sample_stream(),
+            pixels: cut.mask(w, h),
+            centre_first: false,
+        };
+        let rows = f64::from(h.max(1));
+        technique.render_pass(ctx, film, seed, &pass, &|r| {
+            sink.progress(f64::from(r) / rows)
+        })
+    }
+
+    /// Renders one image of the frame `env` and writes it (or its part, or its GREE
+    /// composite).
+    fn render_frame(
+        &self,
+        env: &FrameEnv<'_>,
+        cache: Option<Arc<dyn RadianceCache>>,
+        sink: &dyn JobSink,
+        stop: &AtomicBool,
+    ) -> Result<(), JobError> {
+        let camera = self.camera_in(env.scene)?;
+        let technique = crate::worldcache::technique(&self.settings.integrator, cache)?;
+        let ctx = Ctx {
+            scene: env.scene,
+            accel: env.accel,
+            camera: &camera,
+        };
+        let report = |stats: RenderStats, output: PathBuf, rendered: Rendered| FrameReport {
+            scene: self.scene.clone(),
+            frame: env.frame,
+            output,
+            width: camera.width,
+            height: camera.height,
+            spp: self.settings.spp,
+            technique: technique.name().to_string(),
+            accel: self.settings.accel.to_string(),
+            accel_name: env.accel.name().to_string(),
+            triangles: env.scene.triangle_count(),
+            threads: env.threads,
+            load: env.load,
+            build: env.build,
+            stats,
+            rendered,
+            stages: None,
+        };
+        if self.gree.is_some() {
+            let (stats, rendered) = self.render_gree(&ctx, technique.as_ref(), env, sink)?;
+            sink.frame(&report(stats, env.output.clone(), rendered));
+            return Ok(());
+        }
+        let denoiser = self.frame_denoiser()?;
+        if let Some(d) = &denoiser {
+            if AovSet::for_channels(d.needs()).any_split() && !technique.writes_split() {
+                return refuse(format!(
+                    "{}: --denoiser {} reads the lighting split, which the {} technique does not write",
+                    self.scene.display(),
+                    d.name(),
+                    self.settings.integrator
+                ));
+            }
+        }
+        let mut film = Film::new(
+            camera.width,
+            camera.height,
+            self.film_buffers(denoiser.as_deref()),
+        );
+        let cut = self.cut(camera.width, camera.height, &film)?;
+        let mut adaptive: Option<Adaptive> = None;
+        let mut interrupted = None;
+        let stats = match (&self.stop, &self.checkpoint, env.scene_hash) {
+            (None, Some(_), Some(scene_hash)) => {
+                let ck = Checkpointer {
+                    job: self,
+                    camera: &camera.name,
+                    scene_hash,
+                    frame: env.frame,
+                };
+                let (stats, stopped) = self.render_checkpointed(
+                    &ck,
+                    &ctx,
+                    technique.as_ref(),
+                    &mut film,
+                    env,
+                    sink,
+                    stop,
+                )?;
+                interrupted = stopped;
+                stats
+            }
+            (None, _, _) => {
+                let whole = Cut {
+                    samples: 0..self.settings.spp,
+                    region: rt_film::Rect::full(camera.width, camera.height),
+                };
+                let cut = cut.as_ref().unwrap_or(&whole);
+                self.fixed_pass(&ctx, technique.as_ref(), &mut film, env.seed, cut, sink)
+            }
+            (Some(rule), _, _) => {
+                let a =
+                    render_adaptive(&ctx, technique.as_ref(), &mut film, env.seed, rule, &|f| {
+                        sink.progress(f)
+                    })
+                    .map_err(|e| JobError::Refused(format!("--error {}", e.0)))?;
+                let stats = a.stats;
+                adaptive = Some(a);
+                stats
+            }
+        };
+
+        if let (Some(cut), Some(hash)) = (&cut, env.scene_hash) {
+            let mut header = self.header(
+                &film,
+                cut,
+                &camera.name,
+                hash,
+                env.frame,
+                rt_parts::PartKind::Part,
+            );
+            header.seconds = stats.elapsed.as_secs_f64();
+            rt_parts::Part {
+                header,
+                sums: film.encode_sums(cut.region),
+            }
+            .write(&env.output)
+            .map_err(|e| JobError::Failed(format!("{}: {e}", env.output.display())))?;
+            let rendered = Rendered::Part {
+                samples: cut.samples.clone(),
+                region: cut.region,
+            };
+            sink.frame(&report(stats, env.output.clone(), rendered));
+            return Ok(());
+        }
+        let stages = |film: &Film, write_time| {
+            RenderReport::collect(&ReportInputs {
+                scene: env.scene,
+                camera: &camera,
+                accel: env.accel,
+                accel_spec: self.settings.accel.to_string(),
+                film,
+                render: &stats,
+                technique: &technique.stages(),
+                load_time: env.load,
+                accel_time: env.build,
+                write_time,
+                output: &env.output,
+            })
+        };
+        let (rendered, write_time) = if let Some(d) = &denoiser {
+            let t = Instant::now();
+            write_denoised(
+                &mut film,
+                d.as_ref(),
+                &env.output,
+                self.exposure,
+                &self.scene,
+            )?;
+            let time = t.elapsed();
+            let rendered = Rendered::Denoised {
+                denoiser: d.name().to_string(),
+                time,
+            };
+            // The denoiser's time stands where the plain image's write would.
+            (rendered, time)
+        } else {
+            let t = Instant::now();
+            let extra = match adaptive.as_ref() {
+                Some(a) if self.settings.aovs.blocks => block_channels(a, &film),
+                _ => Vec::new(),
+            };
+            rt_film::write_image_with(
+                &env.output,
+                &film,
+                &OutputOptions {
+                    exposure: self.exposure,
+                },
+                &extra,
+            )
+            .map_err(|e| JobError::Failed(e.to_string()))?;
+            let rendered = Rendered::Image {
+                adaptive: adaptive.as_ref().map(AdaptiveSummary::from),
+            };
+            (rendered, t.elapsed())
+        };
+        let mut r = report(stats, env.output.clone(), rendered);
+        r.stages = Some(stages(&film, write_time));
+        sink.frame(&r);
+        self.end_checkpoint(&env.output, interrupted)
+    }
+
+    /// Renders the job's samples into `film` pass by pass, one sample per pixel each,
+    /// writing checkpoints; stops early at a pass boundary when `stop` is set (the checkpoint
+    /// then holds every finished pass). Returns the samples per pixel taken when stopped.
+    #[allow(clippy::too_many_arguments)]
+    fn render_checkpointed(
+        &self,
+        ck: &Checkpointer<'_>,
+        ctx: &Ctx<'_>,
+        technique: &dyn Technique,
+        film: &mut Film,
+        env: &FrameEnv<'_>,
+        sink: &dyn JobSink,
+        stop: &AtomicBool,
+    ) -> Result<(RenderStats, Option<u32>), JobError> {
+        let spp = self.settings.spp;
+        let (start, before) = match &self.resume {
+            Some(path) => ck.restore(path, film)?,
+            None => (0, 0.0),
+        };
+        let every = Duration::from_secs_f64(self.checkpoint.as_ref().map_or(0.0, |c| c.every));
+        let mut last = Instant::now();
+        let mut stats = RenderStats::default();
+        sink.progress(f64::from(start) / f64::from(spp));
+        for i in start..spp {
+            let pass = SamplePass {
+                indices: i..i + 1,
+                stream: self.stream.sample_stream(),
+                pixels: None,
+                centre_first: false,
+            };
+            stats += technique.render_pass(ctx, film, env.seed, &pass, &|_| {});
+            sink.progress(f64::from(i + 1) / f64::from(spp));
+            if stop.load(Ordering::Relaxed) {
+                ck.write(film, i + 1, before + stats.elapsed.as_secs_f64())?;
+                return Ok((stats, Some(i + 1)));
+            }
+            if i + 1 < spp && last.elapsed() >= every {
+                ck.write(film, i + 1, before + stats.elapsed.as_secs_f64())?;
+                last = Instant::now();
+            }
+        }
+        Ok((stats, None))
+    }
+
+    /// After the image is written: an interrupted render says so and fails; a finished one
+    /// removes its checkpoint (everything in it is in the image).
+    fn end_checkpoint(
+        &self,
+        output: &std::path::Path,
+        interrupted: Option<u32>,
+    ) -> Result<(), JobError> {
+        let Some(ck) = &self.checkpoint else {
+            return Ok(());
+        };
+        if let Some(samples) = interrupted {
+            return Err(JobError::Interrupted {
+                samples,
+                spp: self.settings.spp,
+                output: output.to_path_buf(),
+                checkpoint: ck.path.clone(),
+            });
+        }
+        match std::fs::remove_file(&ck.path) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(JobError::Failed(format!(
+                "--checkpoint {}: cannot remove it: {e}",
+                ck.path.display()
+            ))),
+            _ => Ok(()),
+        }
+    }
+
+    /// One image denoised by GREE (`crate::gree`), with its label map and error maps when
+    /// asked for.
+    fn render_gree(
+        &self,
+        ctx: &Ctx<'_>,
+        technique: &dyn Technique,
+        env: &FrameEnv<'_>,
+        sink: &dyn JobSink,
+    ) -> Result<(RenderStats, Rendered), JobError> {
+        let g = self.gree.as_ref().expect("a GREE job");
+        let scene = self.scene.display();
+        let Some(integrator) = technique.camera_integrator() else {
+            return refuse(format!(
+                "{scene}: --gree renders filter caches pixel by pixel, which the {} technique cannot (use wavefront, path, path-bsdf, direct or ao)",
+                technique.name()
+            ));
+        };
+        if self.stop.is_some() {
+            return refuse("--gree spends a fixed budget (--spp); it cannot be combined with --error or --time-limit".into());
+        }
+        if self.settings.aovs != AovSet::default() {
+            return refuse("--gree writes the composite only; save a noisy frame's AOVs with a render without --gree".into());
+        }
+        let params = g
+            .options
+            .params(self.settings.spp, self.settings.seed)
+            .map_err(|e| JobError::Refused(format!("--gree {}: {e}", g.options)))?;
+        let bank = match &g.bank {
+            Some(p) => rt_denoise::Bank::from_file(p),
+            None => rt_denoise::Bank::default_gree(),
+        }
+        .map_err(|e| JobError::Refused(e.to_string()))?;
+        let rows = f64::from(ctx.camera.height.max(1));
+        let run = crate::render_gree(ctx, integrator, &bank, &params, env.seed, &|r| {
+            sink.progress(f64::from(r) / rows)
+        })
+        .map_err(|e| JobError::Failed(format!("{scene}: {e}")))?;
+        let failed = |e: rt_film::FilmError| JobError::Failed(e.to_string());
+        let opts = OutputOptions {
+            exposure: self.exposure,
+        };
+        rt_film::write_rgb(&env.output, &run.composite.image, &opts).map_err(failed)?;
+        let names: Vec<&str> = bank.members().iter().map(|m| m.name()).collect();
+        if let Some(p) = &g.labels {
+            run.write_labels(p).map_err(failed)?;
+        }
+        if let Some(dir) = &g.error_maps {
+            run.write_error_maps(dir, &names).map_err(failed)?;
+        }
+        let summary = GreeSummary::of(&run, &names, g.labels.is_some());
+        Ok((run.render, Rendered::Gree(Box::new(summary))))
+    }
+
+    /// The frames of a temporally denoised job, rendered in order through
+    /// [`SequenceRenderer`] so that the denoiser carries its history.
+    fn run_sequence(
+        &self,
+        spec: &rt_temporal::TemporalSpec,
+        scene: &mut Scene,
+        sink: &dyn JobSink,
+    ) -> Result<JobReport, JobError> {
+        let path = self.scene.display();
+        if self.stop.is_some() {
+            return refuse(format!("--denoiser {spec}: a sequence renders a fixed number of samples per frame (--spp); --error and --time-limit do not apply"));
+        }
+        if self.shutter != 0.0 {
+            return refuse(format!("--denoiser {spec}: its guide buffers describe one instant; motion blur (--shutter) would not match them"));
+        }
+        if self.size != crate::ImageSize::Native {
+            return refuse(format!(
+                "--denoiser {spec}: a sequence renders at the camera's resolution"
+            ));
+        }
+        let denoiser = spec
+            .build()
+            .map_err(|e| JobError::Refused(format!("--denoiser {spec}: {e}")))?;
+        let pool = thread_pool(self.settings.threads)?;
+        // One cache for the sequence, as for a plain job: it carries over from frame to frame.
+        let cache =
+            crate::worldcache::for_job(self.cache.as_ref(), &self.settings.integrator, scene)?;
+        let mut renderer = SequenceRenderer::new(
+            crate::worldcache::technique(&self.settings.integrator, cache)?,
+            self.settings.accel,
+            Some(denoiser),
+            self.camera.clone(),
+            self.settings.spp,
+            self.settings.seed,
+            self.fps,
+        )
+        .map_err(|e| JobError::Refused(format!("{path}: --denoiser {spec}: {e}")))?;
+        let started = Instant::now();
+        let frames = self.frame_list();
+        for f in &frames {
+            let frame = f.unwrap_or(0);
+            let out = pool
+                .install(|| renderer.render(scene, frame))
+                .map_err(|e| JobError::Failed(format!("{path}: frame {frame}: {e}")))?;
+            let output = match f {
+                Some(f) => frame_path(&self.output, *f),
+                None => self.output.clone(),
+            };
+            rt_film::write_rgb(
+                &output,
+                &out.image,
+                &OutputOptions {
+                    exposure: self.exposure,
+                },
+            )
+            .map_err(|e| JobError::Failed(e.to_string()))?;
+            sink.frame(&FrameReport {
+                scene: self.scene.clone(),
+                frame: Some(frame),
+                output,
+                width: out.image.width() as u32,
+                height: out.image.height() as u32,
+                spp: self.settings.spp,
+                technique: self.settings.integrator.to_string(),
+                accel: self.settings.accel.to_string(),
+                accel_name: String::new(),
+                triangles: scene.triangle_count(),
+                threads: pool.current_num_threads(),
+                load: Duration::ZERO,
+                build: out.times.update,
+                stats: out.stats,
+                rendered: Rendered::Sequence {
+                    denoiser: renderer.denoiser_name().unwrap_or_default().to_string(),
+                    times: out.times,
+                },
+                stages: None,
+            });
+        }
+        Ok(JobReport {
+            frames: frames.len(),
+            elapsed: started.elapsed(),
+            temporal: true,
+        })
+    }
+}
+
+/// The `blocks` AOV: each pixel's final block (`blocks.index`), its sample count
+/// (`blocks.spp`; light-path techniques sample every pixel alike, so it is the passes' samples
+/// per pixel) and whether its block met the threshold (`blocks.converged`, 0 or 1).
+fn block_channels(a: &Adaptive, film: &Film) -> Vec<(&'static str, Vec<f32>)> {
+    let Some(map) = a.block_map(film.width(), film.height()) else {
+        return Vec::new();
+    };
+    let spp: Vec<f32> = if film.light_paths() > 0 {
+        vec![a.spp as f32; map.index.len()]
+    } else {
+        film.pixels().map(|p| p.count() as f32).collect()
+    };
+    vec![
+        (
+            "blocks.index",
+            map.index.iter().map(|&i| i as f32).collect(),
+        ),
+        ("blocks.spp", spp),
+        (
+            "blocks.converged",
+            map.converged
+                .iter()
+                .map(|&c| f32::from(u8::from(c)))
+                .collect(),
+        ),
+    ]
+}
