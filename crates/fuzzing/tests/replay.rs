@@ -148,13 +148,18 @@ fn the_seeds_and_the_corpus_load_without_a_panic() {
 /// or empty folder is an error, not an empty list.
 #[test]
 fn a_panic_a_hang_and_a_missing_folder_fail() {
+    fn message<T>(r: std::thread::Result<T>) -> String {
+        match r {
+            Ok(_) => panic!("no failure"),
+            Err(e) => *e.downcast::<String>().unwrap(),
+        }
+    }
     let d = tempfile::tempdir().unwrap();
     let f = d.path().join("input");
     std::fs::write(&f, b"x").unwrap();
-    let message = |r: std::thread::Result<_>| *r.unwrap_err().downcast::<String>().unwrap();
     let short = Duration::from_millis(100);
     let m = message(std::panic::catch_unwind(|| {
-        replay("t", |_| panic!("boom"), vec![f.clone()], short)
+        replay("t", |_| panic!("boom"), vec![f.clone()], TIMEOUT)
     }));
     assert!(m.ends_with("input panics"), "{m}");
     let m = message(std::panic::catch_unwind(|| {
