@@ -143,12 +143,12 @@ pub fn excess_z(a: &Estimate, b: &Estimate, allowed: &[Rgb]) -> f64 {
     assert_eq!(a.mean.len(), allowed.len());
     let welch = |v: f64, runs: Option<u32>| runs.map_or(0.0, |k| v * v / f64::from(k.max(2) - 1));
     let mut worst = 0.0f64;
-    for i in 0..a.mean.len() {
+    for (i, allowed) in allowed.iter().enumerate() {
         for c in 0..3 {
             let (ma, mb) = (f64::from(a.mean[i][c]), f64::from(b.mean[i][c]));
             let (va, vb) = (f64::from(a.variance[i][c]), f64::from(b.variance[i][c]));
             let v = va + vb;
-            let excess = ((ma - mb).abs() - f64::from(allowed[i][c])).max(0.0);
+            let excess = ((ma - mb).abs() - f64::from(allowed[c])).max(0.0);
             if excess > 0.0 {
                 let nu = v * v / (welch(va, a.runs) + welch(vb, b.runs));
                 let t = excess / v.sqrt().max(f64::MIN_POSITIVE);
