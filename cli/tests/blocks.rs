@@ -140,3 +140,49 @@ fn block_map_needs_the_criterion_and_an_exr() {
         assert_eq!(err.lines().count(), 1, "{err}");
     }
 }
+
+/// The image of `scene.toml` (or `scene`, if given, written first) rendered with `args`, as an
+/// estimate: the pixel means and the variances of those means (the `variance` AOV).
+fn estimate(
+    dir: &tempfile::TempDir,
+    scene: Option<&str>,
+    args: &[&str],
+) -> rt_validate::stress::compare::Estimate {
+    if let Some(text) = scene {
+        std::fs::write(dir.path().join("scene.toml"), text).unwrap();
+    }
+    let o = render(dir, &[args, &["--aov", "variance", "-o", "e.exr"]].concat());
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let img = rt_film::read_exr(&dir.path().join("e.exr")).unwrap();
+    rt_validate::stress::compare::Estimate {
+        mean: img.rgb("").unwrap(),
+        variance: img.rgb("variance.").unwrap(),
+        runs: None,
+    }
+}
+
+/// Adaptive stopping (`--error`) decides from the samples a block has seen when to stop, which
+/// could bias what it stops at; the result must agree with a uniform render within noise (the
+/// block z-test of `render stress`, 8 × 8 blocks and the whole image, α = 10⁻³, variances from
+/// each render's own `variance` AOV). Control: the uniform render with the lamp 2 % brighter
+/// must fail the same test, so a bias of that size would be seen.
+#[test]
+fn adaptive_renders_agree_with_a_uniform_render_within_noise() {
+    use rt_validate::stress::compare::{compare_estimates, ALPHA};
+    let dir = scene_dir();
+    let text = std::fs::read_to_string(dir.path().join("scene.toml")).unwrap();
+    let adaptive = estimate(&dir, None, &["--error", "2e-3", "--spp", "512"]);
+    let uniform = estimate(&dir, None, &["--spp", "256", "--seed", "9"]);
+    let c = compare_estimates(&adaptive, &uniform, 64, 8, ALPHA);
+    eprintln!("adaptive against uniform: {c:?}");
+    assert!(c.same_within_noise(), "adaptive render biased: {c:?}");
+    let brighter = text.replace("emission = [5.0, 5.0, 5.0]", "emission = [5.1, 5.1, 5.1]");
+    assert_ne!(brighter, text);
+    let control = estimate(&dir, Some(&brighter), &["--spp", "256", "--seed", "9"]);
+    let c = compare_estimates(&adaptive, &control, 64, 8, ALPHA);
+    eprintln!("control, lamp 2 % brighter: {c:?}");
+    assert!(
+        !c.same_within_noise(),
+        "control: a 2 % brighter lamp passes: {c:?}"
+    );
+}

@@ -1,6 +1,9 @@
 //! Checkpoints: a render stopped by SIGINT or SIGTERM writes its image so far and a checkpoint
 //! and fails with one line; one killed by SIGKILL keeps its last checkpoint; `render --resume`
-//! finishes either to the very bytes of a render never stopped.
+//! finishes either to the very bytes of a render never stopped, and traces only the samples
+//! the checkpoint does not hold (a resume that rendered everything again would give the same
+//! bytes too: a checkpoint whose sums were zeroed shows which samples the resumed process
+//! traced).
 
 mod common;
 use common::{one_error_line, render, FLOOR_AND_LAMP};
@@ -114,9 +117,14 @@ fn interrupted_and_killed_renders_resume_to_the_same_bytes() {
         "a second signal ends the render at once: {}",
         String::from_utf8_lossy(&out.stderr)
     );
+    // Whether the image was written depends on where the second signal fell; if it was, it
+    // is whole. The checkpoint is there in any case (written before the signals, replaced
+    // atomically) and whole.
     if dir.join("twice.exr").exists() {
         assert!(rt_film::read_exr(&dir.join("twice.exr")).is_ok());
     }
+    let ck = rt_parts::Part::read(&dir.join("ck.rpart")).expect("a whole checkpoint");
+    assert!(ck.header.samples[1] > 0, "an empty checkpoint");
     resume_and_compare(dir, "twice.exr");
 
     // SIGKILL: no image, but the last checkpoint is whole (written atomically).
@@ -126,6 +134,68 @@ fn interrupted_and_killed_renders_resume_to_the_same_bytes() {
     child.wait().unwrap();
     assert!(!dir.join("killed.exr").exists());
     resume_and_compare(dir, "killed.exr");
+}
+
+/// Mean of the R, G and B channels of an EXR.
+fn exr_mean(path: &Path) -> f64 {
+    let img = rt_film::read_exr(path).unwrap();
+    let rgb: Vec<f64> = ["R", "G", "B"]
+        .iter()
+        .flat_map(|c| img.channel(c).unwrap().iter().map(|&v| f64::from(v)))
+        .collect();
+    rgb.iter().sum::<f64>() / rgb.len() as f64
+}
+
+/// The resumed process traces the samples after the checkpoint's range and only those: with
+/// the checkpoint's colour sums set to zero (its counts kept), the resumed image is the
+/// uninterrupted one times the share of samples after the checkpoint, `1 − k / spp`, within
+/// the noise of a 16 × 12 image at 6000 samples per pixel (the bound is 2 %). Rendering
+/// everything again instead gives the factor 1, and a resume that also skipped the remaining
+/// samples gives 0.
+#[test]
+fn a_resumed_render_traces_only_the_samples_after_the_checkpoint() {
+    let d = tempfile::tempdir().unwrap();
+    let dir = d.path();
+    scene(dir);
+    let whole = render(dir, &["s.toml", "--spp", SPP, "-q", "-o", "whole.exr"]);
+    assert!(whole.status.success());
+    let spp: u32 = SPP.parse().unwrap();
+    let path = dir.join("ck.rpart");
+    // Interrupted once the checkpoint (rewritten every pass) holds a tenth of the samples: a
+    // resume that traced everything again would then be 10 % off, five times the bound.
+    let child = start(dir, "int.exr");
+    let t = Instant::now();
+    while rt_parts::Part::read(&path).map_or(true, |p| p.header.samples[1] < spp / 10) {
+        assert!(t.elapsed() < Duration::from_secs(120), "no progress");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    signal(&child, "-INT");
+    child.wait_with_output().unwrap();
+    let mut ck = rt_parts::Part::read(&path).unwrap();
+    let range = ck.header.sample_range();
+    assert!(
+        range.start == 0 && range.end >= spp / 10 && range.end < spp,
+        "checkpoint of samples {range:?}"
+    );
+    // Layout (rt_film::raw): flags byte, discarded count (u64), a u32 count per pixel, then
+    // the colour sums (three i128 per pixel).
+    assert_eq!(
+        ck.sums[0], 0,
+        "no light-path splats in a path-traced checkpoint"
+    );
+    let area = (ck.header.width * ck.header.height) as usize;
+    let sums = 1 + 8 + 4 * area;
+    ck.sums[sums..sums + 48 * area].fill(0);
+    ck.write(&path).unwrap();
+    let r = render(dir, &["--resume", "ck.rpart"]);
+    assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+    let ratio = exr_mean(&dir.join("int.exr")) / exr_mean(&dir.join("whole.exr"));
+    let expected = 1.0 - f64::from(range.end) / f64::from(spp);
+    assert!(
+        (ratio - expected).abs() < 0.02,
+        "resumed / uninterrupted = {ratio:.4}, but the samples after the checkpoint's \
+         {range:?} are {expected:.4} of {spp}"
+    );
 }
 
 #[test]

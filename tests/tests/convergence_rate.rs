@@ -6,9 +6,10 @@
 //!
 //! What would break it: samples that do not advance with the sample index, passes that repeat
 //! samples, a film that mis-weights its samples, anything that leaves error behind that more
-//! samples do not remove.
+//! samples do not remove. Control, in the test: films whose samples repeat the first four
+//! indices must fail.
 
-use rt_core::{SampleStream, Scene};
+use rt_core::{Rgb, SampleStream, Scene};
 use rt_film::{AovSet, Film};
 use rt_integrators::{PathIntegrator, SamplePass};
 use rt_testkit::{shipped_scene, Renderer, SceneExt};
@@ -39,43 +40,32 @@ fn mean_sd(v: &[f64]) -> (f64, f64) {
     (mean, var.sqrt())
 }
 
-#[test]
-fn path_tracer_mse_falls_at_least_as_fast_as_one_over_spp() {
-    let scene = shipped_scene("cornell-box.toml").with_resolution(SIDE, SIDE);
-    // The reference is the average of two independent halves (two seeds of the reference
-    // stream), so its own error can be measured rather than bounded: E[(r1 − r2)²] = 2 F_half
-    // per value, and the average's error is F = F_half / 2 = E[(r1 − r2)²] / 4. (The film's
-    // variance of the mean would overestimate it badly: stratified samples converge faster
-    // than variance / N.)
-    let r1 = render(&scene, 0, REFERENCE_SPP / 2, SampleStream::Reference).mean_image();
-    let r2 = render(&scene, 1, REFERENCE_SPP / 2, SampleStream::Reference).mean_image();
-    let r: Vec<_> = r1.iter().zip(&r2).map(|(a, b)| (*a + *b) * 0.5).collect();
-    let f_terms: Vec<f64> = r1
-        .iter()
-        .zip(&r2)
-        .map(|(a, b)| {
-            let d = *a - *b;
-            (d.x * d.x + d.y * d.y + d.z * d.z) as f64 / 12.0
-        })
-        .collect();
-    let (f_mean, f_sd) = mean_sd(&f_terms);
-    // An upper bound on F at four standard errors of its estimate.
-    let floor_bound = f_mean + 4.0 * f_sd / (f_terms.len() as f64).sqrt();
+/// The least-squares slope of log MSE against log spp over [`TEST_SPP`], and its tolerance.
+struct Slope {
+    slope: f64,
+    se: f64,
+    bias: f64,
+    tolerance: f64,
+    mse: Vec<f64>,
+}
 
+/// [`Slope`] of the films `film_at(seed, spp)` against the reference `r`, whose own error is
+/// at most `floor_bound`.
+fn measure(r: &[Rgb], floor_bound: f64, film_at: &dyn Fn(u32, u32) -> Film) -> Slope {
     // One point per sample count, each from its own seed, so the points are independent.
     let mut x = Vec::new();
     let mut y = Vec::new();
     let mut rel_se = Vec::new();
     let mut mse = Vec::new();
     for (k, &spp) in TEST_SPP.iter().enumerate() {
-        let film = render(&scene, 1 + k as u32, spp, SampleStream::Render);
+        let film = film_at(1 + k as u32, spp);
         // Per-pixel squared error summed over channels; pixels are independent, so MSE is a
         // mean of P independent terms and its relative standard error is
         // sd(e) / (sqrt(P) mean(e)), measured from the terms themselves (heavy tails included).
         let e: Vec<f64> = film
             .mean_image()
             .iter()
-            .zip(&r)
+            .zip(r)
             .map(|(a, b)| {
                 let d = *a - *b;
                 (d.x * d.x + d.y * d.y + d.z * d.z) as f64
@@ -114,6 +104,47 @@ fn path_tracer_mse_falls_at_least_as_fast_as_one_over_spp() {
         .sum();
     // Four standard errors: a correct estimator fails with probability about 3e-5.
     let tolerance = 4.0 * se + bias;
+    Slope {
+        slope,
+        se,
+        bias,
+        tolerance,
+        mse,
+    }
+}
+
+#[test]
+fn path_tracer_mse_falls_at_least_as_fast_as_one_over_spp() {
+    let scene = shipped_scene("cornell-box.toml").with_resolution(SIDE, SIDE);
+    // The reference is the average of two independent halves (two seeds of the reference
+    // stream), so its own error can be measured rather than bounded: E[(r1 − r2)²] = 2 F_half
+    // per value, and the average's error is F = F_half / 2 = E[(r1 − r2)²] / 4. (The film's
+    // variance of the mean would overestimate it badly: stratified samples converge faster
+    // than variance / N.)
+    let r1 = render(&scene, 0, REFERENCE_SPP / 2, SampleStream::Reference).mean_image();
+    let r2 = render(&scene, 1, REFERENCE_SPP / 2, SampleStream::Reference).mean_image();
+    let r: Vec<_> = r1.iter().zip(&r2).map(|(a, b)| (*a + *b) * 0.5).collect();
+    let f_terms: Vec<f64> = r1
+        .iter()
+        .zip(&r2)
+        .map(|(a, b)| {
+            let d = *a - *b;
+            (d.x * d.x + d.y * d.y + d.z * d.z) as f64 / 12.0
+        })
+        .collect();
+    let (f_mean, f_sd) = mean_sd(&f_terms);
+    // An upper bound on F at four standard errors of its estimate.
+    let floor_bound = f_mean + 4.0 * f_sd / (f_terms.len() as f64).sqrt();
+
+    let Slope {
+        slope,
+        se,
+        bias,
+        tolerance,
+        mse,
+    } = measure(&r, floor_bound, &|seed, spp| {
+        render(&scene, seed, spp, SampleStream::Render)
+    });
     let points: Vec<String> = mse.iter().map(|m| format!("{m:.3e}")).collect();
     eprintln!(
         "MSE slope {slope:.3} (standard error {se:.3}, reference-noise bias at most {bias:.3}), \
@@ -132,5 +163,28 @@ fn path_tracer_mse_falls_at_least_as_fast_as_one_over_spp() {
     assert!(
         tolerance < 0.5,
         "tolerance {tolerance:.3} too loose to mean anything"
+    );
+    // Control: samples that do not advance past the fourth (every film the first four sample
+    // indices, repeated spp/4 times) leave their error behind, and must fail.
+    let stuck = measure(&r, floor_bound, &|seed, spp| {
+        let renderer = Renderer::new(&scene);
+        let mut film = renderer.film(AovSet::default());
+        for _ in 0..spp / 4 {
+            let pass = SamplePass {
+                indices: 0..4,
+                stream: SampleStream::Render,
+                pixels: None,
+                centre_first: false,
+            };
+            renderer.render_pass(&PathIntegrator::new(4), &mut film, seed, &pass);
+        }
+        film
+    });
+    eprintln!("control (samples stuck at 4): MSE slope {:.3}", stuck.slope);
+    assert!(
+        stuck.slope > -1.0 + stuck.tolerance,
+        "control: samples repeating the first four pass with slope {:.3} (tolerance {:.3})",
+        stuck.slope,
+        stuck.tolerance
     );
 }

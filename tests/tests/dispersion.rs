@@ -127,13 +127,13 @@ material = "flint"
 fn white_light_through_dispersive_slabs_keeps_its_mean_colour() {
     let scene = slabs();
     let n = (SIZE * SIZE) as usize;
-    let render = |spectral: bool, spp| {
+    let render_scene = |scene: &rt_core::Scene, spectral: bool, spp| {
         let mut p = PathIntegrator::new(64);
         p.spectral = spectral;
         // No Russian roulette: inside glass the throughput is 1/n², which roulette would turn
         // into rare samples of weight n² (unbiased, but no longer L in every sample).
         p.rr_depth = u32::MAX;
-        let film = Renderer::new(&scene)
+        let film = Renderer::new(scene)
             .threads(2)
             .render(
                 &p,
@@ -145,8 +145,10 @@ fn white_light_through_dispersive_slabs_keeps_its_mean_colour() {
         Estimate {
             mean: film.mean_image(),
             variance: film.variance_image().expect("kept"),
+            runs: None,
         }
     };
+    let render = |spectral: bool, spp| render_scene(&scene, spectral, spp);
     // Without the spectral code every path leaves lossless glass into the environment with
     // weight 1 (the 1/n² of entering cancels the n² of leaving): L up to rounding.
     let rgb = render(false, 8);
@@ -174,11 +176,22 @@ fn white_light_through_dispersive_slabs_keeps_its_mean_colour() {
     let exact = Estimate {
         mean: vec![rt_core::Rgb::splat(L); n],
         variance: vec![rt_core::Rgb::ZERO; n],
+        runs: None,
     };
     let c = compare_estimates(&spectral, &exact, SIZE, 4, ALPHA);
     let mean = spectral.mean.iter().copied().sum::<rt_core::Rgb>() / n as f32;
     eprintln!("spectral mean {mean} (L = {L}): {c:?}");
     assert!(c.same_within_noise(), "white is not white: {c:?}");
+    // Control: glass that keeps 1 % less blue at each interface (what a wavelength weight
+    // 1 % low in blue does to the paths that cross it) must fail the same test.
+    let mut tinted = slabs();
+    for l in &mut tinted.materials[0].layers {
+        l.color = rt_core::Rgb::new(1.0, 1.0, 0.99);
+        l.color90 = l.color;
+    }
+    let c = compare_estimates(&render_scene(&tinted, true, 512), &exact, SIZE, 4, ALPHA);
+    eprintln!("control, 1 % less blue per interface: {c:?}");
+    assert!(!c.same_within_noise(), "control: a blue tint passes: {c:?}");
 }
 
 #[test]

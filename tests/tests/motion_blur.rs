@@ -64,6 +64,7 @@ fn estimate(film: &rt_film::Film) -> Estimate {
     Estimate {
         mean: film.mean_image(),
         variance: film.variance_image().expect("variance kept"),
+        runs: None,
     }
 }
 

@@ -74,6 +74,7 @@ fn plane_sampled_light_paths_give_albedo_times_radiance() {
     let exact = Estimate {
         mean: vec![rt_core::Rgb::splat(ALBEDO * L); n],
         variance: vec![rt_core::Rgb::ZERO; n],
+        runs: None,
     };
     let honest = compare_estimates(&light_estimate(&scene, 1.0), &exact, SIZE, 4, ALPHA);
     let shrunk = compare_estimates(&light_estimate(&scene, 0.5), &exact, SIZE, 4, ALPHA);

@@ -214,8 +214,9 @@ pub const MAX_CONDITIONING: f32 = 1e4;
 ///    from measurement rather than proof: the worst case (PBRT's `δt` turned into a distance) is
 ///    about 50 times larger and would lift rays visibly off large floors. With `γ(2)` no ray
 ///    re-hit a well-shaped triangle 10³–10⁵ across in 10⁶ trials per shape, and `γ(8)` still
-///    left none on 1:1000 slivers, where `γ(4)` did. The self-hit tests in
-///    `tests/tests/self_hits.rs` and the property tests in `crates/core/tests/properties.rs`
+///    left none on 1:1000 slivers, where `γ(4)` did. The stress suite's self-hit
+///    cases (`self-hit/` in `crates/validate/src/stress/mod.rs`, run by `tests/tests/stress.rs`
+///    and `render stress`) and the property tests in `crates/core/tests/properties.rs`
 ///    check it.
 ///
 /// Part 2 dominates on large triangles: an axis-aligned floor at `y = 0` has an exact `p.y` and

@@ -31,6 +31,44 @@ fn wo_at(cos: f32, side: f32) -> Vec3 {
     Vec3::new((1.0 - cos * cos).sqrt(), 0.0, cos * side)
 }
 
+/// The control's sampler: `m` with every glossy exponent `k = 1024κ + 1` made 10 % larger and
+/// every Lambertian layer made a Blinn–Phong lobe of exponent 2 (κ = 0.001). Its samples,
+/// histogrammed against `m`'s pdf, must fail: the χ² test sees a sampler that disagrees with
+/// its pdf by that much.
+fn perturbed(m: &Material) -> Material {
+    let mut m = m.clone();
+    for l in &mut m.layers {
+        if l.hardness <= 0.0 {
+            l.hardness = 0.001;
+        } else if l.hardness < 1.0 {
+            l.hardness = ((1024.0 * l.hardness + 1.0) * 1.1 - 1.0) / 1024.0;
+        }
+    }
+    m
+}
+
+/// χ² of `n` directions sampled from `sampler` for `wo` against `model`'s pdf.
+fn chi_square(
+    model: &Material,
+    sampler: &Material,
+    wo: Vec3,
+    n: usize,
+    rng: &mut Rng,
+) -> chi2::ChiSquare {
+    let bsdf = Bsdf::new(model, Rgb::ONE, Vec3::Z, Vec3::Z, wo);
+    let exp = chi2::expected(|d| bsdf.pdf(d) as f64, 16);
+    let source = Bsdf::new(sampler, Rgb::ONE, Vec3::Z, Vec3::Z, wo);
+    let mut obs = vec![0.0f64; exp.len()];
+    for _ in 0..n {
+        if let Some(s) = source.sample(rng.f32(), rng.vec2()) {
+            if !s.delta {
+                obs[chi2::bin_of(s.wi)] += 1.0;
+            }
+        }
+    }
+    chi2::test(&obs, &exp, n)
+}
+
 #[test]
 fn sampling_matches_the_pdf_chi_square() {
     let n = 200_000usize;
@@ -50,19 +88,17 @@ fn sampling_matches_the_pdf_chi_square() {
     let mut failures = Vec::new();
     for (m, cos, side) in &cases {
         let wo = wo_at(*cos, *side);
-        let bsdf = Bsdf::new(m, Rgb::ONE, Vec3::Z, Vec3::Z, wo);
-        let exp = chi2::expected(|d| bsdf.pdf(d) as f64, 16);
-        let mut obs = vec![0.0f64; exp.len()];
-        for _ in 0..n {
-            if let Some(s) = bsdf.sample(rng.f32(), rng.vec2()) {
-                if !s.delta {
-                    obs[chi2::bin_of(s.wi)] += 1.0;
-                }
-            }
-        }
-        let r = chi2::test(&obs, &exp, n);
+        let r = chi_square(m, m, wo, n, &mut rng);
         if !r.passes(alpha) {
             failures.push(format!("{} cos={cos} side={side}: {r:?}", m.name));
+        }
+        // Control: the perturbed sampler against the same pdf must fail at the same level.
+        let c = chi_square(m, &perturbed(m), wo, n, &mut rng);
+        if c.passes(alpha) {
+            failures.push(format!(
+                "control: {} cos={cos} side={side} with exponents x1.1 passes: {c:?}",
+                m.name
+            ));
         }
     }
     assert!(

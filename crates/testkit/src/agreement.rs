@@ -5,7 +5,7 @@
 //! determinism tests.
 
 use crate::mutants::DroppedShadowRays;
-use crate::stats::Estimate;
+use crate::stats::{normal_equivalent, Estimate};
 use crate::Renderer;
 use rt_core::{Rgb, SampleStream, Scene};
 use rt_film::{AovSet, Film, FilmBuffers};
@@ -22,6 +22,7 @@ pub fn path_reference(scene: &Scene, max_depth: u32, spp: u32) -> Estimate {
     Estimate {
         mean: film.mean_image(),
         variance: film.variance_image().expect("kept"),
+        runs: None,
     }
 }
 
@@ -74,6 +75,7 @@ pub fn reference_blocks(pixels: &Estimate, width: u32, block: u32) -> Estimate {
             .into_iter()
             .map(|v| v / n)
             .collect(),
+        runs: pixels.runs,
     }
 }
 
@@ -129,22 +131,28 @@ pub fn render_in_passes(
     film
 }
 
-/// How far two block estimates are apart beyond a known relative bias: the largest
-/// `(|a − b| − relative · |b|)⁺ / σ` over blocks and channels, against the same family-wise
-/// critical value as `compare_estimates` (`crit`). For a consistent but biased technique
-/// whose bias has a derived bound (the caustic histogram darkens a surface's edge by at most
-/// a few per cent of a block): a z-test alone fails on it once the noise is small enough,
-/// whatever else is right.
-pub fn excess_z(a: &Estimate, b: &Estimate, relative: f64) -> f64 {
+/// How far two block estimates are apart beyond a known bias: the largest
+/// `(|a − b| − allowed)⁺ / σ` over blocks and channels, `allowed` per block (absolute), on
+/// the normal scale of `compare_estimates`' critical value (`crit`). For a consistent but
+/// biased technique whose bias has a derived bound (the caustic histogram darkens the caustic
+/// light near a surface's edge by at most a few per cent of a block): a z-test alone fails on
+/// it once the noise is small enough, whatever else is right. Variances from runs count with
+/// their Welch–Satterthwaite degrees of freedom, as in `compare_estimates`.
+pub fn excess_z(a: &Estimate, b: &Estimate, allowed: &[Rgb]) -> f64 {
     assert_eq!(a.mean.len(), b.mean.len());
+    assert_eq!(a.mean.len(), allowed.len());
+    let welch = |v: f64, runs: Option<u32>| runs.map_or(0.0, |k| v * v / f64::from(k.max(2) - 1));
     let mut worst = 0.0f64;
-    for i in 0..a.mean.len() {
+    for (i, allowed) in allowed.iter().enumerate() {
         for c in 0..3 {
             let (ma, mb) = (f64::from(a.mean[i][c]), f64::from(b.mean[i][c]));
-            let v = f64::from(a.variance[i][c]) + f64::from(b.variance[i][c]);
-            let excess = ((ma - mb).abs() - relative * mb.abs()).max(0.0);
+            let (va, vb) = (f64::from(a.variance[i][c]), f64::from(b.variance[i][c]));
+            let v = va + vb;
+            let excess = ((ma - mb).abs() - f64::from(allowed[c])).max(0.0);
             if excess > 0.0 {
-                worst = worst.max(excess / v.sqrt().max(f64::MIN_POSITIVE));
+                let nu = v * v / (welch(va, a.runs) + welch(vb, b.runs));
+                let t = excess / v.sqrt().max(f64::MIN_POSITIVE);
+                worst = worst.max(normal_equivalent(t, nu));
             }
         }
     }

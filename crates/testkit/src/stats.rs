@@ -4,7 +4,8 @@
 //! re-exported here.
 
 pub use rt_validate::stress::compare::{
-    compare, compare_estimates, image_mean, normal_quantile_upper, Comparison, Estimate, ALPHA,
+    compare, compare_estimates, image_mean, normal_equivalent, normal_quantile_upper,
+    student_t_upper, Comparison, Estimate, ALPHA,
 };
 pub use rt_validate::stress::invalid_values;
 

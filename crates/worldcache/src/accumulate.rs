@@ -95,9 +95,12 @@ impl PassAccumulator {
                 };
             }
             if k == key.0 {
-                slot.rgb[0].fetch_add(r, Relaxed);
-                slot.rgb[1].fetch_add(g, Relaxed);
-                slot.rgb[2].fetch_add(b, Relaxed);
+                for (sum, v) in slot.rgb.iter().zip([r, g, b]) {
+                    let before = sum.fetch_add(v, Relaxed);
+                    // Atomics wrap whatever the overflow checks say: this is what
+                    // `[profile.ci]` (debug assertions on) sees of a wrapped sum.
+                    debug_assert!(before.checked_add(v).is_some(), "fixed-point sum wrapped");
+                }
                 slot.count.fetch_add(1, Relaxed);
                 return true;
             }

@@ -11,6 +11,15 @@
 //! estimator's variance and `α` alone. Blocks localise leaks and missing shadows; the whole
 //! image catches faint acne spread everywhere.
 //!
+//! Variances estimated from a few independent runs ([`Estimate::from_runs`], e.g. 16) are
+//! themselves uncertain: the difference over their square root follows Student's t with the
+//! Welch–Satterthwaite degrees of freedom (15 for a block whose variance is all from 16 runs,
+//! more where a film's sample variance or many pixels' run variances add up), whose tails are
+//! far heavier than the normal's at the quantiles used here (two-sided 10⁻⁵: t₁₅ 6.9 against
+//! 4.4). Each `z` is therefore reported as the normal quantile of the same tail probability
+//! ([`normal_equivalent`]), and judged against the normal critical values, so that `α` is the
+//! false-alarm rate it claims either way.
+//!
 //! Two guards: a pixel whose samples were all equal has zero estimated variance, and there the
 //! means may still differ by the rounding of the running mean, so each pixel's variance is at
 //! least `(ε · mean)²` (ε the f32 machine epsilon); and our variance estimate treats the
@@ -66,6 +75,7 @@ pub fn compare(a: &Film, b: &Film, block: u32, alpha: f64) -> Comparison {
         variance: f
             .variance_image()
             .expect("compared films keep the variance buffer"),
+        runs: None,
     };
     compare_estimates(&estimate(a), &estimate(b), a.width(), block, alpha)
 }
@@ -79,6 +89,11 @@ pub struct Estimate {
     pub mean: Vec<rt_core::Rgb>,
     /// Variance of each pixel estimate.
     pub variance: Vec<rt_core::Rgb>,
+    /// `Some(k)`: the variances are the spread of `k` independent runs ([`Estimate::from_runs`]),
+    /// estimates with `k − 1` degrees of freedom, so a difference over their square root
+    /// follows Student's t, not the normal. `None`: estimated from many samples per pixel (a
+    /// film's variance buffer), where the normal is right.
+    pub runs: Option<u32>,
 }
 
 impl Estimate {
@@ -101,7 +116,11 @@ impl Estimate {
                 ss / ((k - 1.0) * k)
             })
             .collect();
-        Self { mean, variance }
+        Self {
+            mean,
+            variance,
+            runs: Some(runs.len() as u32),
+        }
     }
 }
 
@@ -121,9 +140,14 @@ pub fn compare_estimates(
     let h = a.mean.len() as u32 / w;
     let block = block.max(1);
     let (bw, bh) = (w.div_ceil(block), h.div_ceil(block));
-    // Per block and channel: sum of differences and sum of variances.
-    let mut sums = vec![[(0.0f64, 0.0f64); 3]; (bw * bh) as usize];
-    let mut image = [(0.0f64, 0.0f64); 3];
+    // Per block and channel: sum of differences, sum of variances, and the Welch–Satterthwaite
+    // denominator `Σ v²/(k − 1)` of the variances estimated from runs.
+    let mut sums = vec![[(0.0f64, 0.0f64, 0.0f64); 3]; (bw * bh) as usize];
+    let mut image = [(0.0f64, 0.0f64, 0.0f64); 3];
+    let welch = |v: f64, runs: Option<u32>| match runs {
+        Some(k) => v * v / f64::from(k.max(2) - 1),
+        None => 0.0,
+    };
     for y in 0..h {
         for x in 0..w {
             let i = (y * w + x) as usize;
@@ -133,19 +157,24 @@ pub fn compare_estimates(
             for c in 0..3 {
                 let floor = |m: f32| (f32::EPSILON as f64 * m as f64).powi(2);
                 let d = ma[c] as f64 - mb[c] as f64;
-                let v = (va[c] as f64).max(floor(ma[c])) + (vb[c] as f64).max(floor(mb[c]));
-                sums[k][c].0 += d;
-                sums[k][c].1 += v;
-                image[c].0 += d;
-                image[c].1 += v;
+                let (va, vb) = (
+                    (va[c] as f64).max(floor(ma[c])),
+                    (vb[c] as f64).max(floor(mb[c])),
+                );
+                let q = welch(va, a.runs) + welch(vb, b.runs);
+                for s in [&mut sums[k][c], &mut image[c]] {
+                    s.0 += d;
+                    s.1 += va + vb;
+                    s.2 += q;
+                }
             }
         }
     }
-    let z = |(d, v): (f64, f64)| {
+    let z = |(d, v, q): (f64, f64, f64)| {
         if d == 0.0 {
             0.0
         } else {
-            d / v.sqrt()
+            normal_equivalent(d / v.sqrt(), v * v / q)
         }
     };
     let max_block_z = sums
@@ -208,6 +237,104 @@ pub fn erfc(x: f64) -> f64 {
     }
 }
 
+/// The standard normal value with the tail probability of `t` under Student's t with `nu`
+/// degrees of freedom (sign kept; `nu` infinite or beyond 10⁶: `t` itself). What a t
+/// statistic is worth on the normal scale of [`Comparison`]'s critical values.
+pub fn normal_equivalent(t: f64, nu: f64) -> f64 {
+    if !nu.is_finite() || nu > 1e6 || t == 0.0 {
+        return t;
+    }
+    let p = student_t_upper(t.abs(), nu);
+    let z = if p <= 0.0 {
+        40.0
+    } else {
+        normal_quantile_upper(p.min(0.5))
+    };
+    z.copysign(t)
+}
+
+/// `P(T > t)` for Student's t with `nu` degrees of freedom and `t ≥ 0`:
+/// `I_{ν/(ν+t²)}(ν/2, 1/2) / 2`.
+pub fn student_t_upper(t: f64, nu: f64) -> f64 {
+    0.5 * incomplete_beta(0.5 * nu, 0.5, nu / (nu + t * t))
+}
+
+/// The regularised incomplete beta function `I_x(a, b)` by its continued fraction (Numerical
+/// Recipes §6.4: modified Lentz, relative accuracy about 10⁻¹⁴).
+fn incomplete_beta(a: f64, b: f64, x: f64) -> f64 {
+    if x <= 0.0 {
+        return 0.0;
+    }
+    if x >= 1.0 {
+        return 1.0;
+    }
+    let front =
+        (ln_gamma(a + b) - ln_gamma(a) - ln_gamma(b) + a * x.ln() + b * (1.0 - x).ln()).exp();
+    if x < (a + 1.0) / (a + b + 2.0) {
+        front * beta_fraction(a, b, x) / a
+    } else {
+        1.0 - front * beta_fraction(b, a, 1.0 - x) / b
+    }
+}
+
+fn beta_fraction(a: f64, b: f64, x: f64) -> f64 {
+    let tiny = 1e-300;
+    let (qab, qap, qam) = (a + b, a + 1.0, a - 1.0);
+    let mut c = 1.0;
+    let mut d = 1.0 - qab * x / qap;
+    if d.abs() < tiny {
+        d = tiny;
+    }
+    d = 1.0 / d;
+    let mut h = d;
+    for m in 1..300 {
+        let m = f64::from(m);
+        let m2 = 2.0 * m;
+        for aa in [
+            m * (b - m) * x / ((qam + m2) * (a + m2)),
+            -(a + m) * (qab + m) * x / ((a + m2) * (qap + m2)),
+        ] {
+            d = 1.0 + aa * d;
+            if d.abs() < tiny {
+                d = tiny;
+            }
+            c = 1.0 + aa / c;
+            if c.abs() < tiny {
+                c = tiny;
+            }
+            d = 1.0 / d;
+            h *= d * c;
+        }
+        if (d * c - 1.0).abs() < 1e-15 {
+            break;
+        }
+    }
+    h
+}
+
+/// `ln Γ(x)` for `x > 0` (Lanczos, g = 7, nine terms: relative error below 10⁻¹⁴).
+fn ln_gamma(x: f64) -> f64 {
+    const C: [f64; 9] = [
+        0.999_999_999_999_809_9,
+        676.520_368_121_885_1,
+        -1_259.139_216_722_402_8,
+        771.323_428_777_653_1,
+        -176.615_029_162_140_6,
+        12.507_343_278_686_905,
+        -0.138_571_095_265_720_12,
+        9.984_369_578_019_572e-6,
+        1.505_632_735_149_311_6e-7,
+    ];
+    if x < 0.5 {
+        let pi = std::f64::consts::PI;
+        return (pi / (pi * x).sin()).ln() - ln_gamma(1.0 - x);
+    }
+    let x = x - 1.0;
+    let t = x + 7.5;
+    let sum = C[0] + (1..9).map(|i| C[i] / (x + i as f64)).sum::<f64>();
+    0.5 * (2.0 * std::f64::consts::PI).ln() + (x + 0.5) * t.ln() - t + sum.ln()
+}
+
 /// The `z` with `P(Z > z) = p` for a standard normal `Z` (`0 < p < 0.5`), by bisection on
 /// [`erfc`]: a few dozen evaluations, once per comparison.
 pub fn normal_quantile_upper(p: f64) -> f64 {
@@ -229,6 +356,43 @@ mod tests {
     use super::*;
     use rt_core::Rgb;
     use rt_film::{AovSet, FilmBuffers};
+
+    #[test]
+    fn student_t_tails_match_tables() {
+        // Two-sided 5 % and 0.1 % points of t with 15 degrees of freedom, and of t with 1
+        // (Cauchy: P(T > 1) = 1/4 exactly).
+        assert!((student_t_upper(2.131_449_5, 15.0) - 0.025).abs() < 1e-7);
+        assert!((student_t_upper(4.072_765_2, 15.0) - 0.0005).abs() < 1e-8);
+        assert!((student_t_upper(1.0, 1.0) - 0.25).abs() < 1e-12);
+        // The normal limit, and the normal scale of a t₁₅ value.
+        assert!((student_t_upper(3.090_232, 1e7) - 0.001).abs() < 1e-6);
+        assert!((normal_equivalent(4.072_765_2, 15.0) - 3.290_527).abs() < 1e-4);
+        assert!((normal_equivalent(-2.131_449_5, 15.0) + 1.959_964).abs() < 1e-4);
+        assert_eq!(normal_equivalent(2.5, f64::INFINITY), 2.5);
+    }
+
+    /// One pixel, three channel tests (critical value 3.76, each at a one-sided 1.7·10⁻⁴):
+    /// a t of 4.5 from a variance of 16 runs would be "detected" on the normal scale, though
+    /// t₁₅ exceeds 4.5 with probability 2·10⁻⁴, as often as the level allows.
+    #[test]
+    fn variances_from_runs_are_judged_by_student_t() {
+        let est = |mean: f32, var: f32, runs| Estimate {
+            mean: vec![Rgb::splat(mean)],
+            variance: vec![Rgb::splat(var)],
+            runs,
+        };
+        let exact = est(1.0, 0.0, None);
+        let c = compare_estimates(&est(1.45, 0.01, None), &exact, 1, 1, ALPHA);
+        assert!(
+            (c.max_block_z - 4.5).abs() < 1e-3 && !c.same_within_noise(),
+            "{c:?}"
+        );
+        let c = compare_estimates(&est(1.45, 0.01, Some(16)), &exact, 1, 1, ALPHA);
+        assert!(c.max_block_z < 3.7 && c.same_within_noise(), "{c:?}");
+        // A real difference is still one.
+        let c = compare_estimates(&est(2.0, 0.01, Some(16)), &exact, 1, 1, ALPHA);
+        assert!(!c.same_within_noise(), "{c:?}");
+    }
 
     #[test]
     fn quantiles_match_tables() {
