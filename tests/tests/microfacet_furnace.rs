@@ -1,5 +1,5 @@
 //! The microfacet materials (`type = "conductor"`, `"roughconductor"`, `"dielectric"`,
-//! `"roughdielectric"`, `"smoothplastic"`) end to end, through the TOML loader, `Bsdf` and both path tracers, in
+//! `"roughdielectric"`, `"thindielectric"`, `"smoothplastic"`) end to end, through the TOML loader, `Bsdf` and both path tracers, in
 //! the white furnace (`rt_testkit::furnace`): smooth ones are lossless, so the image is the
 //! environment within 4 standard errors; rough ones and plastic lose energy to single scattering but never
 //! gain it. Control: a conductor reflecting 97 % is told apart from a lossless one.
@@ -37,6 +37,7 @@ fn smooth_microfacet_materials_are_lossless_in_the_furnace() {
     for m in [
         "type = \"conductor\"",
         "type = \"dielectric\"",
+        "type = \"thindielectric\"",
         // Index 1.33 is left out: the layered model's smooth glass at 1.33 renders this
         // furnace 0.4 % dark too, bit for bit the same image (a question for the scene's
         // touching boxes, not for this BSDF).

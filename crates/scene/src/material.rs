@@ -708,6 +708,11 @@ mod tests {
             (Rgb::splat(0.5), Rgb::ONE, false)
         );
         assert!((p.eta - 1.49 / 1.000277).abs() < 1e-6);
+        let Some(Microfacet::ThinDielectric(t)) = ok("type = \"thindielectric\"").microfacet else {
+            panic!()
+        };
+        assert!((t.eta - 1.5046 / 1.000277).abs() < 1e-6);
+        assert!(bad("type = \"thindielectric\"\nalpha = 0.1").contains("`alpha` does not apply"));
     }
 
     #[test]

@@ -10,18 +10,19 @@ use crate::load::{finite3, Ctx};
 use rt_core::microfacet::named::{CONDUCTORS, DIELECTRICS};
 use rt_core::microfacet::{
     named_conductor, named_ior, Distribution, DistributionKind, Microfacet, Plastic,
-    RoughConductor, RoughDielectric,
+    RoughConductor, RoughDielectric, ThinDielectric,
 };
 use rt_core::{Material, Rgb};
 use std::ops::Range;
 
 /// The material types of the family. `smoothplastic` is Mitsuba's `plastic`: our `plastic`
 /// names the thesis' layered preset.
-pub(crate) const TYPES: [&str; 5] = [
+pub(crate) const TYPES: [&str; 6] = [
     "conductor",
     "roughconductor",
     "dielectric",
     "roughdielectric",
+    "thindielectric",
     "smoothplastic",
 ];
 
@@ -202,6 +203,18 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
             k,
             specular_reflectance: rgb(&d.specular_reflectance, "specular_reflectance", Rgb::ONE)?,
             two_sided: d.two_sided.unwrap_or(false),
+        })
+    } else if kind == "thindielectric" {
+        let int = ior(&d.int_ior, "int_ior", BK7_IOR).map_err(|(s, e)| err(s, e))?;
+        let ext = ior(&d.ext_ior, "ext_ior", AIR_IOR).map_err(|(s, e)| err(s, e))?;
+        Microfacet::ThinDielectric(ThinDielectric {
+            eta: int / ext,
+            reflectance: rgb(&d.specular_reflectance, "specular_reflectance", Rgb::ONE)?,
+            transmittance: rgb(
+                &d.specular_transmittance,
+                "specular_transmittance",
+                Rgb::ONE,
+            )?,
         })
     } else if plastic {
         let int = ior(&d.int_ior, "int_ior", POLYPROPYLENE_IOR).map_err(|(s, e)| err(s, e))?;

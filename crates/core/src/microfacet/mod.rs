@@ -18,12 +18,14 @@ mod distribution;
 mod fresnel;
 pub mod named;
 mod plastic;
+mod thin;
 
 pub use conductor::RoughConductor;
 pub use dielectric::RoughDielectric;
 pub use distribution::{Distribution, DistributionKind, MIN_ALPHA};
 pub use fresnel::fresnel_conductor;
 pub use plastic::{fresnel_diffuse_reflectance, Plastic};
+pub use thin::ThinDielectric;
 
 use crate::Rgb;
 use glam::{Vec2, Vec3};
@@ -83,6 +85,8 @@ pub enum Microfacet {
     Dielectric(RoughDielectric),
     /// `plastic`.
     Plastic(Plastic),
+    /// `thindielectric`.
+    ThinDielectric(ThinDielectric),
 }
 
 impl Microfacet {
@@ -91,7 +95,7 @@ impl Microfacet {
         match self {
             Microfacet::Conductor(c) => c.distribution,
             Microfacet::Dielectric(d) => d.distribution,
-            Microfacet::Plastic(_) => None,
+            Microfacet::Plastic(_) | Microfacet::ThinDielectric(_) => None,
         }
     }
 
@@ -106,6 +110,7 @@ impl Microfacet {
             Microfacet::Conductor(c) => fresnel_conductor(1.0, c.eta, c.k) * c.specular_reflectance,
             Microfacet::Dielectric(d) => d.transmittance,
             Microfacet::Plastic(p) => p.diffuse,
+            Microfacet::ThinDielectric(t) => t.transmittance,
         }
     }
 
@@ -157,6 +162,16 @@ impl Microfacet {
                 colour(p.diffuse, "diffuse_reflectance")?;
                 colour(p.specular, "specular_reflectance")
             }
+            Microfacet::ThinDielectric(t) => {
+                if !(t.eta.is_finite() && t.eta > 0.0) {
+                    return Err(format!(
+                        "int_ior / ext_ior must be a positive number, got {}",
+                        t.eta
+                    ));
+                }
+                colour(t.reflectance, "specular_reflectance")?;
+                colour(t.transmittance, "specular_transmittance")
+            }
         }
     }
 }
@@ -167,6 +182,7 @@ impl LocalBsdf for Microfacet {
             Microfacet::Conductor(c) => c.eval_pdf(wo, wi),
             Microfacet::Dielectric(d) => d.eval_pdf(wo, wi),
             Microfacet::Plastic(p) => p.eval_pdf(wo, wi),
+            Microfacet::ThinDielectric(t) => t.eval_pdf(wo, wi),
         }
     }
 
@@ -175,6 +191,7 @@ impl LocalBsdf for Microfacet {
             Microfacet::Conductor(c) => c.sample(wo, u_lobe, u),
             Microfacet::Dielectric(d) => d.sample(wo, u_lobe, u),
             Microfacet::Plastic(p) => p.sample(wo, u_lobe, u),
+            Microfacet::ThinDielectric(t) => t.sample(wo, u_lobe, u),
         }
     }
 }
