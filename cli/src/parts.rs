@@ -240,6 +240,7 @@ fn experiment_requests(p: &PlanArgs) -> Result<Vec<PlanRequest>> {
         else {
             continue;
         };
+        let req = scene.reference_request(*estimator, *spp, *seed);
         if scene.sequence.is_some() {
             bail!(
                 "{}: scene {}: the per-frame references of a sequence are not plannable yet",
@@ -247,14 +248,6 @@ fn experiment_requests(p: &PlanArgs) -> Result<Vec<PlanRequest>> {
                 scene.name
             );
         }
-        let req = rt_experiment::ReferenceRequest {
-            scene_path: &scene.path,
-            scene: &scene.loaded.scene,
-            camera: &scene.camera,
-            estimator: *estimator,
-            spp: *spp,
-            seed: *seed,
-        };
         let mut job = rt_experiment::reference::job(&req, *accel, &req.key()?, &p.cache);
         job.confine = p.confine.clone();
         requests.push(PlanRequest {
@@ -262,7 +255,7 @@ fn experiment_requests(p: &PlanArgs) -> Result<Vec<PlanRequest>> {
                 job: job.to_json(),
                 width: scene.camera.width,
                 height: scene.camera.height,
-                spp: *spp,
+                spp: req.spp,
             },
             into_cache: true,
             frames: vec![(None, p.cache.display().to_string())],

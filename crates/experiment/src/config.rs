@@ -201,6 +201,26 @@ pub struct ScenePlan {
     pub sequence: Option<SequencePlan>,
 }
 
+impl ScenePlan {
+    /// The request for a reference of this scene rendered by `estimator` at `spp` samples
+    /// per pixel from stream `seed` (a [`ReferencePlan::Render`]'s fields).
+    pub fn reference_request(
+        &self,
+        estimator: IntegratorSpec,
+        spp: u32,
+        seed: u32,
+    ) -> crate::ReferenceRequest<'_> {
+        crate::ReferenceRequest {
+            scene_path: &self.path,
+            scene: &self.loaded.scene,
+            camera: &self.camera,
+            estimator,
+            spp,
+            seed,
+        }
+    }
+}
+
 /// The frames of a sequence scene.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SequencePlan {

@@ -9,7 +9,7 @@
 //! apart from the render) and is measured by the denoised image; the noisy image's error is
 //! kept beside it.
 
-use crate::cache::{Cache, ReferenceRequest};
+use crate::cache::Cache;
 use crate::config::{Plan, ReferencePlan, Runs};
 use crate::error::{io, ExperimentError, Result};
 use crate::Progress;
@@ -184,14 +184,7 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
                 seed,
                 accel,
             } => {
-                let req = ReferenceRequest {
-                    scene_path: &scene.path,
-                    scene: &scene.loaded.scene,
-                    camera: &scene.camera,
-                    estimator: *estimator,
-                    spp: *spp,
-                    seed: *seed,
-                };
+                let req = scene.reference_request(*estimator, *spp, *seed);
                 let base = done_runs * UNITS;
                 let built = accel.build_scene(&scene.loaded.scene);
                 let got = crate::reference::obtain(

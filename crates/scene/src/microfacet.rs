@@ -174,6 +174,19 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
         Some(v) => finite3(ctx, v, what),
         None => Ok(default),
     };
+    // Keys a type does not take were refused above, so reading them gives their defaults.
+    let reflectance = rgb(&d.specular_reflectance, "specular_reflectance", Rgb::ONE)?;
+    let transmittance = rgb(
+        &d.specular_transmittance,
+        "specular_transmittance",
+        Rgb::ONE,
+    )?;
+    // Interior over exterior index, with the interior's default.
+    let eta = |default_int: f32| -> Result<f32> {
+        let int = ior(&d.int_ior, "int_ior", default_int).map_err(|(s, e)| err(s, e))?;
+        let ext = ior(&d.ext_ior, "ext_ior", AIR_IOR).map_err(|(s, e)| err(s, e))?;
+        Ok(int / ext)
+    };
     let bsdf = if conductor {
         let (eta, k) = match &d.material {
             Some(named) => {
@@ -201,46 +214,32 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
             distribution,
             eta,
             k,
-            specular_reflectance: rgb(&d.specular_reflectance, "specular_reflectance", Rgb::ONE)?,
+            specular_reflectance: reflectance,
             two_sided: d.two_sided.unwrap_or(false),
         })
     } else if kind == "thindielectric" {
-        let int = ior(&d.int_ior, "int_ior", BK7_IOR).map_err(|(s, e)| err(s, e))?;
-        let ext = ior(&d.ext_ior, "ext_ior", AIR_IOR).map_err(|(s, e)| err(s, e))?;
         Microfacet::ThinDielectric(ThinDielectric {
-            eta: int / ext,
-            reflectance: rgb(&d.specular_reflectance, "specular_reflectance", Rgb::ONE)?,
-            transmittance: rgb(
-                &d.specular_transmittance,
-                "specular_transmittance",
-                Rgb::ONE,
-            )?,
+            eta: eta(BK7_IOR)?,
+            reflectance,
+            transmittance,
         })
     } else if plastic {
-        let int = ior(&d.int_ior, "int_ior", POLYPROPYLENE_IOR).map_err(|(s, e)| err(s, e))?;
-        let ext = ior(&d.ext_ior, "ext_ior", AIR_IOR).map_err(|(s, e)| err(s, e))?;
         Microfacet::Plastic(Plastic {
             diffuse: rgb(
                 &d.diffuse_reflectance,
                 "diffuse_reflectance",
                 Rgb::splat(0.5),
             )?,
-            specular: rgb(&d.specular_reflectance, "specular_reflectance", Rgb::ONE)?,
-            eta: int / ext,
+            specular: reflectance,
+            eta: eta(POLYPROPYLENE_IOR)?,
             nonlinear: d.nonlinear.as_ref().is_some_and(|v| *v.get_ref()),
         })
     } else {
-        let int = ior(&d.int_ior, "int_ior", BK7_IOR).map_err(|(s, e)| err(s, e))?;
-        let ext = ior(&d.ext_ior, "ext_ior", AIR_IOR).map_err(|(s, e)| err(s, e))?;
         Microfacet::Dielectric(RoughDielectric {
             distribution,
-            eta: int / ext,
-            reflectance: rgb(&d.specular_reflectance, "specular_reflectance", Rgb::ONE)?,
-            transmittance: rgb(
-                &d.specular_transmittance,
-                "specular_transmittance",
-                Rgb::ONE,
-            )?,
+            eta: eta(BK7_IOR)?,
+            reflectance,
+            transmittance,
         })
     };
     let mut m = Material::microfacet(name, bsdf);

@@ -89,15 +89,6 @@ impl LocalBsdf for RoughConductor {
         if wi.z <= 0.0 {
             return None;
         }
-        let (f, pdf) = self.eval_pdf(wo, wi);
-        if !(pdf > 0.0 && pdf.is_finite()) {
-            return None;
-        }
-        Some(LocalSample {
-            wi,
-            weight: f * (wi.z / pdf),
-            pdf,
-            delta: false,
-        })
+        self.sample_toward(wo, wi)
     }
 }

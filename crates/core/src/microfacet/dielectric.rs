@@ -111,16 +111,7 @@ impl LocalBsdf for RoughDielectric {
         if (wo.z * wi.z > 0.0) != reflected {
             return None;
         }
-        let (f, pdf) = self.eval_pdf(wo, wi);
-        if !(pdf > 0.0 && pdf.is_finite()) {
-            return None;
-        }
-        Some(LocalSample {
-            wi,
-            weight: f * (wi.z.abs() / pdf),
-            pdf,
-            delta: false,
-        })
+        self.sample_toward(wo, wi)
     }
 }
 

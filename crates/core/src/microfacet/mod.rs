@@ -52,6 +52,22 @@ pub trait LocalBsdf {
     /// Samples `wi` for `wo`; `u_lobe` chooses between lobes (reflection or refraction), `u`
     /// the microfacet normal. `None` where the sample carries nothing.
     fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<LocalSample>;
+
+    /// The non-delta sample of direction `wi` for `wo`: its value and pdf from
+    /// [`LocalBsdf::eval_pdf`] and the weight `f·|cos θi| / pdf`; `None` where the pdf is not
+    /// a positive finite number. What every `sample` ends with once it has chosen `wi`.
+    fn sample_toward(&self, wo: Vec3, wi: Vec3) -> Option<LocalSample> {
+        let (f, pdf) = self.eval_pdf(wo, wi);
+        if !(pdf > 0.0 && pdf.is_finite()) {
+            return None;
+        }
+        Some(LocalSample {
+            wi,
+            weight: f * (wi.z.abs() / pdf),
+            pdf,
+            delta: false,
+        })
+    }
 }
 
 /// The complex index `(η, κ)` of Mitsuba's named conductor `name` ([`named::CONDUCTORS`]).

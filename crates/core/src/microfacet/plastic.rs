@@ -90,15 +90,6 @@ impl LocalBsdf for Plastic {
             });
         }
         let wi = cosine_hemisphere(u);
-        let (f, pdf) = self.eval_pdf(wo, wi);
-        if !(pdf > 0.0 && pdf.is_finite()) {
-            return None;
-        }
-        Some(LocalSample {
-            wi,
-            weight: f * (wi.z / pdf),
-            pdf,
-            delta: false,
-        })
+        self.sample_toward(wo, wi)
     }
 }
