@@ -116,9 +116,9 @@ fn specs_build_with_defaults_and_refuse_bad_options() {
     };
     assert_eq!(
         err("oidn:quality=ultra"),
-        "oidn: quality: 'ultra' is not one of fast, balanced, high"
+        "oidn: quality: `ultra` is not one of fast, balanced, high"
     );
-    assert_eq!(err("oidn:aux=maybe"), "oidn: aux: 'maybe' is not on or off");
+    assert_eq!(err("oidn:aux=maybe"), "oidn: aux: `maybe` is not on or off");
     assert_eq!(err("oidn:strength=2"), "oidn: unknown option `strength`");
 }
 
