@@ -25,10 +25,15 @@ pub struct Args {
     #[command(subcommand)]
     pub command: Option<Command>,
 
-    /// Scene file (TOML), or gen:NAME for a procedural scene (worst-case, rotated, mixed,
-    /// million).
+    /// Scene file (TOML, or Mitsuba XML: `.xml`), or gen:NAME for a procedural scene
+    /// (worst-case, rotated, mixed, million).
     #[arg(required_unless_present = "resume")]
     pub scene: Option<PathBuf>,
+
+    /// A Mitsuba scene's parameter: replaces `$NAME` in the file, winning over its
+    /// `<default name="NAME" .../>`. Repeatable.
+    #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_define)]
+    pub define: Vec<(String, String)>,
 
     /// Output image; the extension picks the format: .exr (linear float, AOVs as extra
     /// channels) or .png (sRGB, exposure then clamp). [default: `[render] output`, else
@@ -287,6 +292,20 @@ pub fn parse_integrator(s: &str) -> Result<IntegratorSpec, String> {
         .map_err(|e: rt_integrators::IntegratorSpecError| e.to_string())
 }
 
+/// `NAME=VALUE` of `-D`.
+pub fn parse_define(s: &str) -> Result<(String, String), String> {
+    match s.split_once('=') {
+        Some((k, v))
+            if !k.is_empty() && k.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') =>
+        {
+            Ok((k.to_string(), v.to_string()))
+        }
+        _ => Err(format!(
+            "`{s}` is not NAME=VALUE (NAME of letters, digits and _)"
+        )),
+    }
+}
+
 /// Subcommands.
 #[derive(Subcommand, Debug)]
 pub enum Command {
@@ -329,6 +348,9 @@ pub enum Command {
     Plan(crate::parts::PlanArgs),
     /// Render part I of a plan into a directory: what a scheduler's task runs.
     Part(crate::parts::PartArgs),
+    /// Translate a Mitsuba scene file (.xml) into our TOML format: the TOML renders the same
+    /// image as the XML (docs/scene-format.md, "Mitsuba scene files").
+    Convert(crate::convert::ConvertArgs),
     /// Write a procedural scene's triangles to a Wavefront OBJ file (one `o` per part), e.g.
     /// to benchmark other ray tracers on the same geometry.
     GenScene {

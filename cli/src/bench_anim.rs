@@ -157,7 +157,7 @@ pub fn run(args: &BenchAnimArgs) -> Result<()> {
         }
     };
     let t = Instant::now();
-    let loaded = rt_session::load_scene(std::path::Path::new(&args.input), None)?.loaded;
+    let loaded = rt_session::load_scene(std::path::Path::new(&args.input), None, &[])?.loaded;
     for w in &loaded.warnings {
         info(&format!("warning: {w}"));
     }

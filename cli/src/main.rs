@@ -16,6 +16,7 @@ mod bench_accel;
 mod bench_anim;
 mod compare;
 mod compare_frames;
+mod convert;
 mod denoise;
 mod experiment;
 mod parts;
@@ -62,6 +63,7 @@ pub(crate) fn run(args: &args::Args) -> anyhow::Result<()> {
         Some(args::Command::Merge(m)) => parts::merge(m),
         Some(args::Command::Plan(p)) => parts::plan(p),
         Some(args::Command::Part(p)) => parts::part(p),
+        Some(args::Command::Convert(c)) => convert::run(c),
         Some(args::Command::GenScene { name, output }) => {
             bench_accel::input::write_obj(name, output)
         }

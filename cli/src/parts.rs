@@ -187,7 +187,7 @@ fn render_request(p: &PlanArgs) -> Result<PlanRequest> {
         }
     }
     let confine = p.confine.as_deref().or(args.confine.as_deref());
-    let scene = rt_session::load_scene(&p.scene, confine)?;
+    let scene = rt_session::load_scene(&p.scene, confine, &args.define)?;
     let mut job = crate::render::job(&args, &scene.loaded)?;
     job.confine = confine.map(Path::to_path_buf);
     let camera = rt_session::pick_camera(&scene.loaded.scene, &job.scene, job.camera.as_deref())?;

@@ -127,7 +127,7 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         None => None,
     };
     let t = std::time::Instant::now();
-    let scene = rt_session::load_scene(&args.scene, args.confine.as_deref())?;
+    let scene = rt_session::load_scene(&args.scene, args.confine.as_deref(), &[])?;
     let load = t.elapsed();
     let loaded = &scene.loaded;
     let overrides = Overrides {

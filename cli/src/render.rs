@@ -43,6 +43,7 @@ pub fn job(args: &Args, loaded: &rt_scene::LoadedScene) -> Result<RenderJob> {
     .resolve(loaded, scene)?;
     let mut job = RenderJob::new(scene, settings);
     job.confine = args.confine.clone();
+    job.defines = args.define.clone();
     job.camera = args.camera.clone();
     job.frames = match (&args.frames, args.frame) {
         (Some(r), _) => Frames::Range(r.clone()),
@@ -94,7 +95,7 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let scene = args.scene.as_deref().expect("clap requires SCENE");
     let t = Instant::now();
-    let loaded = rt_session::load_scene(scene, args.confine.as_deref())?;
+    let loaded = rt_session::load_scene(scene, args.confine.as_deref(), &args.define)?;
     let load = t.elapsed();
     if !args.quiet {
         for w in &loaded.loaded.warnings {

@@ -48,7 +48,7 @@ pub fn load(input: &str, camera: Option<&str>) -> Result<Input> {
         .map(str::to_ascii_lowercase)
         .unwrap_or_default();
     let (loaded, is_mesh) = if input.starts_with("gen:") || ext == "toml" {
-        (rt_session::load_scene(path, None)?.loaded, false)
+        (rt_session::load_scene(path, None, &[])?.loaded, false)
     } else if MESH_EXTENSIONS.contains(&ext.as_str()) {
         (
             rt_scene::load_mesh(path).map_err(|e| anyhow::anyhow!("{e}"))?,

@@ -73,7 +73,7 @@ pub struct View {
 impl View {
     fn load(args: &ViewArgs, spp: u32, fps: f64, size: Option<(u32, u32)>) -> Result<View> {
         let path = args.scene.clone();
-        let loaded = rt_session::load_scene(&path, None)?.loaded;
+        let loaded = rt_session::load_scene(&path, None, &[])?.loaded;
         if !args.quiet {
             for w in &loaded.warnings {
                 eprintln!("warning: {w}");

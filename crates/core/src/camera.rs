@@ -1,6 +1,6 @@
 //! Pinhole and thin-lens cameras.
 
-use crate::{animation::CameraKey, sampling::concentric_disk, Ray};
+use crate::{animation::CameraKey, pixel_filter::PixelFilter, sampling::concentric_disk, Ray};
 use glam::{Vec2, Vec3};
 
 /// A perspective camera. Image right is `forward × up` (right-handed: looking down -z with +y
@@ -27,6 +27,8 @@ pub struct Camera {
     pub aperture: f32,
     /// Distance along `forward` of the plane in focus.
     pub focus_distance: f32,
+    /// Where in its pixel a sample lands ([`PixelFilter::film_position`]); box by default.
+    pub filter: PixelFilter,
     tan_half: f32,
 }
 
@@ -59,6 +61,7 @@ impl Camera {
             height,
             aperture,
             focus_distance,
+            filter: PixelFilter::Box,
             tan_half: (fov_y_deg.to_radians() * 0.5).tan(),
         }
     }
@@ -69,6 +72,7 @@ impl Camera {
             width,
             height,
             name: self.name.clone(),
+            filter: self.filter.clone(),
             ..*self
         }
     }
@@ -285,6 +289,7 @@ impl crate::content_hash::ContentHash for Camera {
             height,
             aperture,
             focus_distance,
+            filter,
             tan_half: _,
         } = self;
         name.content_hash(out);
@@ -297,6 +302,11 @@ impl crate::content_hash::ContentHash for Camera {
         height.content_hash(out);
         aperture.content_hash(out);
         focus_distance.content_hash(out);
+        // Only a non-box filter adds to the hash, so that hashes from before filters existed
+        // (reference caches) still match.
+        if *filter != PixelFilter::Box {
+            filter.to_string().content_hash(out);
+        }
     }
 }
 

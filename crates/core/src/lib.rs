@@ -38,6 +38,7 @@ pub mod limits;
 pub mod material;
 pub mod microfacet;
 pub mod options;
+pub mod pixel_filter;
 pub mod ray;
 pub mod rng;
 pub mod sampler;

@@ -265,7 +265,7 @@ impl<'a> CameraSampling<'a> {
         } else {
             jitter
         };
-        let film_pos = Vec2::new(x as f32, y as f32) + jitter;
+        let film_pos = self.camera.filter.film_position(x, y, jitter);
         let lens = if self.thin_lens {
             sampler.next_2d()
         } else {

@@ -153,6 +153,8 @@ pub(crate) struct CameraDesc {
     pub aperture: Option<Spanned<f32>>,
     /// Default: distance from `position` to `look_at`.
     pub focus_distance: Option<Spanned<f32>>,
+    /// `box` (default), `tent[:radius=R]`, `gaussian[:stddev=S]`.
+    pub pixel_filter: Option<Spanned<String>>,
 }
 
 /// `[[material]]`.
@@ -241,6 +243,8 @@ pub(crate) struct TransformDesc {
     /// Degrees about x, then y, then z.
     pub rotate: Option<V3>,
     pub scale: Option<ScaleDesc>,
+    /// A general affine map as 4 rows of 4 (the last `[0, 0, 0, 1]`), instead of the above.
+    pub matrix: Option<[[f32; 4]; 4]>,
 }
 
 /// `scale = 2.0` or `scale = [1, 2, 1]`.

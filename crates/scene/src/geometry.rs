@@ -322,6 +322,9 @@ fn check_keys(ctx: &Ctx, d: &GeometryDesc, kind: &Kind) -> Result<()> {
 /// `transform = { translate, rotate, scale }`; `None` for the identity.
 pub(crate) fn transform(ctx: &Ctx, t: &Spanned<TransformDesc>) -> Result<Option<Transform>> {
     let d = t.get_ref();
+    if let Some(rows) = d.matrix {
+        return matrix(ctx, t, rows).map(Some);
+    }
     let translate = d.translate.map_or(Vec3::ZERO, Vec3::from);
     let rotate = d.rotate.map_or(Vec3::ZERO, Vec3::from);
     let scale = Vec3::from(d.scale.map_or([1.0; 3], |s| s.0));
@@ -340,6 +343,28 @@ pub(crate) fn transform(ctx: &Ctx, t: &Spanned<TransformDesc>) -> Result<Option<
         return Ok(None);
     }
     Ok(Some(Transform::from_trs(translate, rotate, scale)))
+}
+
+/// `transform = { matrix = [[...], [...], [...], [0, 0, 0, 1]] }`: affine, invertible,
+/// finite, and alone (not with translate, rotate or scale).
+fn matrix(ctx: &Ctx, t: &Spanned<TransformDesc>, rows: [[f32; 4]; 4]) -> Result<Transform> {
+    let d = t.get_ref();
+    let fail = |why: &str| Err(ctx.src.error_at(t.span(), format!("transform: {why}")));
+    if d.translate.is_some() || d.rotate.is_some() || d.scale.is_some() {
+        return fail("matrix cannot be combined with translate, rotate or scale");
+    }
+    if rows.iter().flatten().any(|v| !v.is_finite()) {
+        return fail("matrix entries must be finite");
+    }
+    if rows[3] != [0.0, 0.0, 0.0, 1.0] {
+        return fail("the matrix's last row must be [0, 0, 0, 1] (affine)");
+    }
+    let m = glam::Mat4::from_cols_array_2d(&rows).transpose();
+    let det = glam::Mat3::from_mat4(m).determinant();
+    if !det.is_normal() {
+        return fail("the matrix is singular");
+    }
+    Ok(Transform::from_mat4(m))
 }
 
 fn load_file(

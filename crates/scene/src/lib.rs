@@ -62,6 +62,7 @@ mod instances;
 mod load;
 mod material;
 mod microfacet;
+pub mod mitsuba;
 mod obj;
 pub mod procedural;
 pub mod raw;
@@ -122,6 +123,15 @@ pub fn load_any(path: &Path) -> Result<LoadedScene, SceneError> {
 
 /// [`load_any`] reading files only as `access` allows (`render --confine DIR`).
 pub fn load_any_with(path: &Path, access: &FileAccess) -> Result<LoadedScene, SceneError> {
+    load_any_defined(path, access, &[])
+}
+
+/// [`load_any_with`] with a Mitsuba scene's `$name` parameters ([`load_defined`]).
+pub fn load_any_defined(
+    path: &Path,
+    access: &FileAccess,
+    defines: &[(String, String)],
+) -> Result<LoadedScene, SceneError> {
     if let Some(name) = path.to_str().and_then(|p| p.strip_prefix("gen:")) {
         let scene = procedural::generate(name).map_err(|e| SceneError::File {
             file: path.to_path_buf(),
@@ -133,7 +143,7 @@ pub fn load_any_with(path: &Path, access: &FileAccess) -> Result<LoadedScene, Sc
             warnings: Vec::new(),
         });
     }
-    load_with(path, access)
+    load_defined(path, access, defines)
 }
 
 /// Loads a bare mesh file (OBJ, glTF, .ra2) as a scene through the scene format: one grey
@@ -169,6 +179,26 @@ pub fn load(path: &Path) -> Result<LoadedScene, SceneError> {
 
 /// [`load`] reading files (the scene file too) only as `access` allows.
 pub fn load_with(path: &Path, access: &FileAccess) -> Result<LoadedScene, SceneError> {
+    load_defined(path, access, &[])
+}
+
+/// [`load_with`] with `$name` parameters of a Mitsuba scene file (`render -D name=value`):
+/// a `.xml` file is read as a Mitsuba scene ([`mitsuba`]), anything else as TOML (where
+/// parameters are refused: the format has none).
+pub fn load_defined(
+    path: &Path,
+    access: &FileAccess,
+    defines: &[(String, String)],
+) -> Result<LoadedScene, SceneError> {
+    if is_mitsuba(path) {
+        return mitsuba::load(path, access, defines);
+    }
+    if let Some((name, _)) = defines.first() {
+        return Err(SceneError::file(
+            path,
+            format!("-D {name}=...: only Mitsuba scene files (.xml) take parameters"),
+        ));
+    }
     access.check(path)?;
     let text = std::fs::read_to_string(path).map_err(|e| {
         let why = if e.kind() == std::io::ErrorKind::InvalidData {
@@ -180,6 +210,13 @@ pub fn load_with(path: &Path, access: &FileAccess) -> Result<LoadedScene, SceneE
     })?;
     let base = path.parent().unwrap_or(Path::new(""));
     load::load(&text, base, path, access)
+}
+
+/// Whether `path` names a Mitsuba scene file (`.xml`, any case).
+pub fn is_mitsuba(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("xml"))
 }
 
 /// Loads a scene from TOML text. Relative paths inside it are resolved against `base_dir`;

@@ -16,6 +16,7 @@ use glam::Vec3;
 use rt_core::environment::sky::{Sky, SkyError, DEFAULT_RESOLUTION};
 use rt_core::environment::sun::{SolarTime, TimeOfDay};
 use rt_core::environment::{EnvMap, Environment};
+use rt_core::pixel_filter::PixelFilter;
 use rt_core::{material::MAX_RADIANCE, Camera, Rgb, Scene};
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
@@ -481,7 +482,7 @@ fn camera(ctx: &Ctx, d: &CameraDesc) -> Result<Camera> {
             );
         }
     }
-    Ok(Camera::look_at(
+    let mut camera = Camera::look_at(
         name.clone(),
         position,
         look_at,
@@ -491,7 +492,14 @@ fn camera(ctx: &Ctx, d: &CameraDesc) -> Result<Camera> {
         h,
         aperture,
         focus,
-    ))
+    );
+    if let Some(f) = &d.pixel_filter {
+        camera.filter = PixelFilter::parse(f.get_ref()).map_err(|e| {
+            ctx.src
+                .error_at(f.span(), format!("camera \"{name}\": pixel_filter: {e}"))
+        })?;
+    }
+    Ok(camera)
 }
 
 /// `[[assign]]`: sets the material of a half-open triangle range of one geometry.

@@ -8,7 +8,7 @@ use std::sync::atomic::AtomicBool;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (dir, scene) = (std::env::temp_dir(), "scenes/animated.toml".as_ref());
-    let loaded = rt_session::load_scene(scene, None)?.loaded;
+    let loaded = rt_session::load_scene(scene, None, &[])?.loaded;
     let mut job = RenderJob::new(scene, Overrides::default().resolve(&loaded, scene)?);
     job.frames = Frames::Range(0..2);
     let (go, stop) = (AtomicBool::new(false), AtomicBool::new(true));

@@ -10,7 +10,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
     let scene = PathBuf::from(args.next().unwrap_or("scenes/cornell-box.toml".into()));
     let out = PathBuf::from(args.next().unwrap_or("cornell.exr".into()));
-    let loaded = load_scene(&scene, None)?;
+    let loaded = load_scene(&scene, None, &[])?;
     let settings = Overrides {
         spp: Some(16),
         output: Some(out.clone()),

@@ -31,7 +31,7 @@
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! use rt_session::{load_scene, ImageSize, Overrides, RenderJob};
 //! let path = std::path::Path::new("gen:worst-case");
-//! let scene = load_scene(path, None)?;
+//! let scene = load_scene(path, None, &[])?;
 //! let overrides = Overrides { spp: Some(4), ..Overrides::default() };
 //! let mut job = RenderJob::new(path, overrides.resolve(&scene.loaded, path)?);
 //! job.size = ImageSize::Pixels(16, 12);

@@ -198,7 +198,7 @@ impl Bdpt {
         let camera = ctx.camera;
         let thin_lens = !camera.is_pinhole();
         // The camera-ray driver's first dimensions: film position, then the lens.
-        let film_pos = Vec2::new(x as f32, y as f32) + cam_sampler.next_2d();
+        let film_pos = camera.filter.film_position(x, y, cam_sampler.next_2d());
         let lens = if thin_lens {
             cam_sampler.next_2d()
         } else {

@@ -95,7 +95,7 @@ impl Partitioned {
         want_first_hit: bool,
     ) -> EyeSample {
         let (scene, cam) = (ctx.scene, ctx.camera);
-        let film_pos = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+        let film_pos = cam.filter.film_position(x, y, sampler.next_2d());
         let lens = if cam.is_pinhole() {
             Vec2::ZERO
         } else {

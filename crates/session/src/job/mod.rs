@@ -156,6 +156,9 @@ pub struct RenderJob {
     pub scene: PathBuf,
     /// Refuse any file the scene refers to outside this directory.
     pub confine: Option<PathBuf>,
+    /// Parameters of a Mitsuba scene file (`render -D name=value`), in order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub defines: Vec<(String, String)>,
     /// Integrator, structure, samples, seed, AOVs, threads and denoiser, resolved.
     pub settings: Settings,
     /// The camera by name (`None`: the scene's first).
@@ -247,14 +250,19 @@ pub struct JobScene {
     pub access: FileAccess,
 }
 
-/// Loads `path` (or `gen:NAME`), reading only files inside `confine` if given.
-pub fn load_scene(path: &Path, confine: Option<&Path>) -> Result<JobScene, JobError> {
+/// Loads `path` (or `gen:NAME`), reading only files inside `confine` if given; `defines`
+/// are a Mitsuba scene's `-D name=value` parameters.
+pub fn load_scene(
+    path: &Path,
+    confine: Option<&Path>,
+    defines: &[(String, String)],
+) -> Result<JobScene, JobError> {
     let access = match confine {
         Some(dir) => FileAccess::confined_to(dir).map_err(|e| JobError::Scene(e.to_string()))?,
         None => FileAccess::open(),
     };
-    let loaded =
-        rt_scene::load_any_with(path, &access).map_err(|e| JobError::Scene(e.to_string()))?;
+    let loaded = rt_scene::load_any_defined(path, &access, defines)
+        .map_err(|e| JobError::Scene(e.to_string()))?;
     Ok(JobScene { loaded, access })
 }
 
@@ -291,6 +299,7 @@ impl RenderJob {
             stream: Stream::Render,
             labels: BTreeMap::new(),
             max_memory: None,
+            defines: Vec::new(),
             resume: None,
         }
     }
@@ -624,6 +633,7 @@ mod run_tests {
         let resumed = RenderJob::resume(&ck).unwrap();
         assert_eq!(
             RenderJob {
+                defines: Vec::new(),
                 resume: None,
                 ..resumed.clone()
             },

@@ -54,7 +54,7 @@ impl RenderJob {
     pub fn run(&self, sink: &dyn JobSink, stop: &AtomicBool) -> Result<JobReport, JobError> {
         self.check()?;
         let t = Instant::now();
-        let scene = load_scene(&self.scene, self.confine.as_deref())?;
+        let scene = load_scene(&self.scene, self.confine.as_deref(), &self.defines)?;
         for w in &scene.loaded.warnings {
             sink.warning(w);
         }
@@ -77,6 +77,7 @@ impl RenderJob {
         });
         let mut scene = scene.loaded.scene;
         self.set_shutter(&mut scene)?;
+        self.check_filter(&scene)?;
         self.check_memory(&scene)?;
         if let Some(spec) = self.temporal() {
             if self.writes_part() {
@@ -182,6 +183,25 @@ impl RenderJob {
         } else {
             buffers
         }
+    }
+
+    /// Refuses a pixel filter wider than the box with a technique that splats: its light
+    /// paths land where they land, so only camera samples can be placed by the filter.
+    fn check_filter(&self, scene: &Scene) -> Result<(), JobError> {
+        let camera = self.camera_in(scene)?;
+        if camera.filter == rt_core::pixel_filter::PixelFilter::Box
+            || !self.settings.integrator.build().splats()
+        {
+            return Ok(());
+        }
+        Err(JobError::Refused(format!(
+            "{}: camera \"{}\" has pixel filter {}, which {} cannot apply (it splats light \
+             paths onto the image); use a box filter or a camera-ray integrator",
+            self.scene.display(),
+            camera.name,
+            camera.filter,
+            self.settings.integrator.kind.name()
+        )))
     }
 
     /// Refuses, before the structure and the film are allocated, a render whose estimate

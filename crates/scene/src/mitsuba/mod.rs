@@ -1,0 +1,105 @@
+//! Mitsuba scene files (`.xml`), read as Mitsuba 3 reads them and turned into our scene
+//! format: the 0.x dialect (camelCase, `lookAt`) and the 2.x/3.x one (snake_case),
+//! `<default>` and `$name` substitution (`-D name=value` wins), `<ref>`, `<include>`,
+//! transforms, `rgb`, `srgb` and `spectrum` values reduced to RGB as Mitsuba's RGB variants
+//! reduce them.
+//!
+//! The translation goes through a TOML document of our format ([`to_toml`]), so
+//! `render convert` writes exactly what `render scene.xml` renders. Every element and
+//! parameter is either translated, refused with one error line naming the file, line and
+//! what is missing, or (when it cannot change the image, or changes only the noise) accepted
+//! with one warning line. docs/scene-format.md ("Mitsuba scene files") lists what is read.
+//!
+//! Modules: `xml` (reading, includes, substitution, the old dialect), `props` (typed
+//! parameters, transforms), `spectrum` and `cie` (Mitsuba's spectrum-to-RGB reduction and
+//! its tables), `bsdf` (materials) and `scene` (sensors, shapes, emitters, integrator).
+
+mod bsdf;
+mod cie;
+mod props;
+mod scene;
+mod spectrum;
+mod xml;
+
+use std::path::{Path, PathBuf};
+
+use crate::error::SceneError;
+use crate::files::FileAccess;
+use crate::LoadedScene;
+
+/// A Mitsuba scene translated to our format.
+#[derive(Debug)]
+pub struct Converted {
+    /// The TOML document.
+    pub toml: String,
+    /// One line per parameter accepted but ignored, or approximated.
+    pub warnings: Vec<String>,
+}
+
+/// Translates the Mitsuba scene at `path` to a TOML document whose file names are relative to
+/// `out_dir` (absolute when the scene's directory is elsewhere). `defines` are `-D name=value`.
+pub fn to_toml(
+    path: &Path,
+    out_dir: Option<&Path>,
+    access: &FileAccess,
+    defines: &[(String, String)],
+) -> Result<Converted, SceneError> {
+    let root = xml::read(path, access, defines)?;
+    let scene_dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
+    let same_dir = match out_dir {
+        None => true,
+        Some(o) => same_directory(o, &scene_dir),
+    };
+    let absolute_dir = std::fs::canonicalize(if scene_dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        &scene_dir
+    })
+    .unwrap_or_else(|_| scene_dir.clone());
+    let file_name = |name: &str| -> String {
+        if same_dir || Path::new(name).is_absolute() {
+            name.to_string()
+        } else {
+            absolute_dir.join(name).to_string_lossy().into_owned()
+        }
+    };
+    let mut warnings = Vec::new();
+    let table = scene::build(&root, &file_name, &mut warnings)?;
+    let body = toml::to_string(&table)
+        .map_err(|e| SceneError::file(path, format!("cannot write TOML: {e}")))?;
+    let toml = format!(
+        "# Converted from {} by `render convert`.\n\n{body}",
+        path.file_name().unwrap_or_default().to_string_lossy()
+    );
+    Ok(Converted { toml, warnings })
+}
+
+fn same_directory(a: &Path, b: &Path) -> bool {
+    let canon = |p: &Path| -> Option<PathBuf> {
+        std::fs::canonicalize(if p.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            p
+        })
+        .ok()
+    };
+    match (canon(a), canon(b)) {
+        (Some(x), Some(y)) => x == y,
+        _ => false,
+    }
+}
+
+/// Loads the Mitsuba scene at `path` (through its TOML translation).
+pub fn load(
+    path: &Path,
+    access: &FileAccess,
+    defines: &[(String, String)],
+) -> Result<LoadedScene, SceneError> {
+    let converted = to_toml(path, None, access, defines)?;
+    let base = path.parent().unwrap_or(Path::new(""));
+    let mut loaded = crate::load::load(&converted.toml, base, path, access)?;
+    let mut warnings = converted.warnings;
+    warnings.append(&mut loaded.warnings);
+    loaded.warnings = warnings;
+    Ok(loaded)
+}

@@ -1,0 +1,567 @@
+//! The scene element tree as a TOML document of our format: sensor → `[[camera]]` and
+//! `[render]`, shapes → `[[geometry]]`, BSDFs → `[[material]]`, environment emitters →
+//! `[environment]`, the integrator → `[render]`.
+
+use std::collections::{HashMap, HashSet};
+
+use glam::{DMat4, DVec3, DVec4};
+use toml::{Table, Value};
+
+use super::bsdf;
+use super::props::{Color, Props};
+use super::spectrum::Role;
+use super::xml::Node;
+use crate::error::SceneError;
+
+/// Unlimited depth: the integrators' largest bounce limit (roulette ends paths long before).
+const UNLIMITED_DEPTH: i64 = 10_000;
+/// Subdivisions of the icosphere standing in for an analytic sphere (20·4⁵ triangles).
+const SPHERE_SUBDIVISIONS: i64 = 5;
+
+/// Builds the TOML table of the scene rooted at `root`. `file_name` maps a file name as
+/// written in the scene to the string the TOML should hold.
+pub(super) fn build(
+    root: &Node,
+    file_name: &dyn Fn(&str) -> String,
+    warnings: &mut Vec<String>,
+) -> Result<Table, SceneError> {
+    let mut ids = HashMap::new();
+    collect_ids(root, &mut ids)?;
+    let mut b = Builder {
+        ids,
+        file_name,
+        materials: Vec::new(),
+        by_node: HashMap::new(),
+        used: HashSet::new(),
+        geometry: Vec::new(),
+        cameras: Vec::new(),
+        environment: None,
+        render: Table::new(),
+        warnings,
+    };
+    // A scene's own children are all objects (`<default>`s were consumed by the reader).
+    for c in &root.children {
+        match c.tag.as_str() {
+            "integrator" => b.integrator(c)?,
+            "sensor" => b.sensor(c)?,
+            "shape" => b.shape(c)?,
+            "emitter" => b.environment(c)?,
+            // Declarations: converted where a shape refers to them.
+            "bsdf" | "texture" if c.attr("id").is_some() => {}
+            other => {
+                return Err(c.at.error(format!(
+                    "<{other}{}> is not supported at the top of a scene",
+                    c.attr("type")
+                        .map(|t| format!(" type=\"{t}\""))
+                        .unwrap_or_default()
+                )))
+            }
+        }
+    }
+    if b.cameras.is_empty() {
+        return Err(root.at.error("the scene has no <sensor>"));
+    }
+    let mut doc = Table::new();
+    if let Some(env) = b.environment.take() {
+        doc.insert("environment".into(), Value::Table(env));
+    }
+    let arrays = [
+        ("camera", std::mem::take(&mut b.cameras)),
+        ("material", std::mem::take(&mut b.materials)),
+        ("geometry", std::mem::take(&mut b.geometry)),
+    ];
+    for (key, tables) in arrays {
+        if !tables.is_empty() {
+            doc.insert(
+                key.into(),
+                Value::Array(tables.into_iter().map(Value::Table).collect()),
+            );
+        }
+    }
+    if !b.render.is_empty() {
+        doc.insert("render".into(), Value::Table(std::mem::take(&mut b.render)));
+    }
+    Ok(doc)
+}
+
+fn collect_ids<'a>(n: &'a Node, ids: &mut HashMap<String, &'a Node>) -> Result<(), SceneError> {
+    for c in &n.children {
+        if c.tag != "ref" {
+            if let Some(id) = c.attr("id") {
+                if ids.insert(id.to_string(), c).is_some() {
+                    return Err(c.at.error(format!("id \"{id}\" is defined twice")));
+                }
+            }
+        }
+        collect_ids(c, ids)?;
+    }
+    Ok(())
+}
+
+struct Builder<'a, 'w> {
+    ids: HashMap<String, &'a Node>,
+    file_name: &'w dyn Fn(&str) -> String,
+    materials: Vec<Table>,
+    /// Name and table of each converted BSDF element, by address.
+    by_node: HashMap<*const Node, (String, Table)>,
+    /// Names of the materials in `materials`.
+    used: HashSet<String>,
+    geometry: Vec<Table>,
+    cameras: Vec<Table>,
+    environment: Option<Table>,
+    render: Table,
+    warnings: &'w mut Vec<String>,
+}
+
+fn arr(v: DVec3) -> Value {
+    Value::Array(v.to_array().iter().map(|&x| Value::Float(x)).collect())
+}
+
+impl<'a> Builder<'a, '_> {
+    fn resolve(&self, r: &'a Node) -> Result<&'a Node, SceneError> {
+        let id = r.attr("id").ok_or_else(|| r.at.error("<ref> has no id"))?;
+        self.ids.get(id).copied().ok_or_else(|| {
+            r.at.error(format!("<ref id=\"{id}\">: no element has this id"))
+        })
+    }
+
+    fn integrator(&mut self, n: &Node) -> Result<(), SceneError> {
+        let p = Props::new(n);
+        match n.plugin()? {
+            "path" => {
+                let depth = p.integer("max_depth")?.unwrap_or(-1);
+                let ours = match depth {
+                    -1 => UNLIMITED_DEPTH,
+                    d if d >= 1 => (d - 1).min(UNLIMITED_DEPTH),
+                    d => return Err(p.error(format!("max_depth {d}: must be -1 or at least 1"))),
+                };
+                self.render.insert("max_depth".into(), ours.into());
+                p.ignore(
+                    "rr_depth",
+                    "Russian roulette starts where ours does (the expectation is the same)",
+                );
+                if p.boolean("hide_emitters")? == Some(true) {
+                    return Err(p.error("hide_emitters = true is not supported"));
+                }
+            }
+            "direct" => {
+                self.render.insert("integrator".into(), "direct".into());
+                p.ignore(
+                    "emitter_samples",
+                    "one light sample per hit (the same expectation)",
+                );
+                p.ignore(
+                    "bsdf_samples",
+                    "one BSDF sample per hit (the same expectation)",
+                );
+                if p.boolean("hide_emitters")? == Some(true) {
+                    return Err(p.error("hide_emitters = true is not supported"));
+                }
+            }
+            other => {
+                return Err(n.at.error(format!(
+                    "integrator \"{other}\" is not supported (path and direct are)"
+                )))
+            }
+        }
+        p.finish(self.warnings)
+    }
+
+    fn sensor(&mut self, n: &Node) -> Result<(), SceneError> {
+        let p = Props::new(n);
+        let ty = n.plugin()?;
+        if ty != "perspective" && ty != "thinlens" {
+            return Err(n.at.error(format!(
+                "sensor \"{ty}\" is not supported (perspective and thinlens are)"
+            )));
+        }
+        let mut cam = Table::new();
+        let name = n
+            .attr("id")
+            .map_or_else(|| format!("sensor{}", self.cameras.len()), str::to_string);
+        cam.insert("name".into(), name.into());
+        let m = p.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
+        let (pos, dir, up) = camera_frame(&p, &m)?;
+        cam.insert("position".into(), arr(pos));
+        cam.insert("look_at".into(), arr(pos + dir));
+        cam.insert("up".into(), arr(up));
+
+        // The film first: the field of view's axis depends on its size.
+        let films = p.objects("film");
+        let (w, h) = match films.as_slice() {
+            [] => (768, 576),
+            [f] => self.film(f, &mut cam)?,
+            _ => return Err(p.error("has more than one <film>")),
+        };
+        cam.insert(
+            "resolution".into(),
+            Value::Array(vec![Value::Integer(w), Value::Integer(h)]),
+        );
+        let fov = match (p.float("fov")?, p.string("focal_length")?) {
+            (Some(f), None) => f,
+            (None, Some(fl)) => focal_length_fov(&p, fl)?,
+            (None, None) => return Err(p.error("needs fov or focal_length")),
+            (Some(_), Some(_)) => return Err(p.error("has both fov and focal_length")),
+        };
+        let axis = p.string("fov_axis")?.unwrap_or("x");
+        cam.insert(
+            "fov".into(),
+            vertical_fov(&p, fov, axis, w as f64, h as f64)?.into(),
+        );
+        p.ignore("near_clip", "no near clipping plane");
+        p.ignore("far_clip", "no far clipping plane");
+        if ty == "thinlens" {
+            let r = p.float("aperture_radius")?.unwrap_or(0.03);
+            cam.insert("aperture".into(), r.into());
+            let f = p.float("focus_distance")?.unwrap_or(0.0);
+            if f > 0.0 {
+                cam.insert("focus_distance".into(), f.into());
+            } else {
+                return Err(p.error("thinlens needs a positive focus_distance"));
+            }
+        } else {
+            // Mitsuba's perspective camera has no lens: its focus distance does nothing.
+            p.accept("focus_distance");
+        }
+        for s in p.objects("sampler") {
+            self.sampler(s)?;
+        }
+        p.finish(self.warnings)?;
+        self.cameras.push(cam);
+        Ok(())
+    }
+
+    fn film(&mut self, f: &Node, cam: &mut Table) -> Result<(i64, i64), SceneError> {
+        let p = Props::new(f);
+        if f.plugin()? != "hdrfilm" {
+            return Err(p.error("only hdrfilm is supported"));
+        }
+        let w = p.integer("width")?.unwrap_or(768);
+        let h = p.integer("height")?.unwrap_or(576);
+        for (key, full) in [
+            ("crop_offset_x", 0),
+            ("crop_offset_y", 0),
+            ("crop_width", w),
+            ("crop_height", h),
+        ] {
+            if let Some(v) = p.integer(key)? {
+                if v != full {
+                    return Err(p.error(format!("{key} = {v}: crop windows are not supported")));
+                }
+            }
+        }
+        let filters = p.objects("rfilter");
+        let filter = match filters.as_slice() {
+            // Mitsuba's default reconstruction filter.
+            [] => "gaussian".to_string(),
+            [r] => pixel_filter(r, self.warnings)?,
+            _ => return Err(p.error("has more than one <rfilter>")),
+        };
+        cam.insert("pixel_filter".into(), filter.into());
+        for key in ["file_format", "pixel_format", "component_format", "banner"] {
+            p.ignore(key, "the output format is chosen by `-o`");
+        }
+        p.ignore(
+            "high_quality_edges",
+            "edge pixels see only samples inside the image",
+        );
+        p.ignore(
+            "sample_border",
+            "edge pixels see only samples inside the image",
+        );
+        p.finish(self.warnings)?;
+        Ok((w, h))
+    }
+
+    fn sampler(&mut self, s: &Node) -> Result<(), SceneError> {
+        let p = Props::new(s);
+        let ty = s.plugin()?;
+        if let Some(n) = p.integer("sample_count")? {
+            if n < 1 {
+                return Err(p.error(format!("sample_count {n}: must be at least 1")));
+            }
+            self.render.insert("spp".into(), n.into());
+        }
+        if let Some(seed) = p.integer("seed")? {
+            self.render.insert("seed".into(), seed.max(0).into());
+        }
+        if ty != "independent" {
+            self.warnings.push(s.at.warning(format!(
+                "sampler \"{ty}\" replaced by ours (the same expectation, different noise)"
+            )));
+            for key in ["jitter", "scramble_seed", "dimension"] {
+                p.accept(key);
+            }
+        }
+        p.finish(self.warnings)
+    }
+
+    fn shape(&mut self, n: &'a Node) -> Result<(), SceneError> {
+        let p = Props::new(n);
+        let ty = n.plugin()?;
+        let mut g = Table::new();
+        let name = n
+            .attr("id")
+            .map_or_else(|| format!("shape{}", self.geometry.len()), str::to_string);
+        g.insert("name".into(), name.clone().into());
+        let mut m = p.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
+        match ty {
+            "obj" => {
+                let file = p
+                    .string("filename")?
+                    .ok_or_else(|| p.error("has no filename"))?;
+                g.insert("file".into(), (self.file_name)(file).into());
+                if p.boolean("face_normals")? == Some(true) {
+                    return Err(p.error("face_normals = true is not supported"));
+                }
+            }
+            "rectangle" => {
+                g.insert("shape".into(), "quad".into());
+                let corners = [[-1, -1], [1, -1], [1, 1], [-1, 1]]
+                    .map(|[x, y]| arr(DVec3::new(x as f64, y as f64, 0.0)));
+                g.insert("vertices".into(), Value::Array(corners.to_vec()));
+            }
+            "cube" => {
+                g.insert("shape".into(), "box".into());
+                g.insert("min".into(), arr(DVec3::splat(-1.0)));
+                g.insert("max".into(), arr(DVec3::splat(1.0)));
+            }
+            "disk" => {
+                g.insert("shape".into(), "disk".into());
+                g.insert("radius".into(), 1.0.into());
+                g.insert("normal".into(), arr(DVec3::Z));
+            }
+            "sphere" => {
+                let c = p.point("center")?.unwrap_or(DVec3::ZERO);
+                let r = p.float("radius")?.unwrap_or(1.0);
+                if r <= 0.0 {
+                    return Err(p.error(format!("radius {r}: must be positive")));
+                }
+                m = m * DMat4::from_translation(c) * DMat4::from_scale(DVec3::splat(r));
+                g.insert("shape".into(), "sphere".into());
+                g.insert("radius".into(), 1.0.into());
+                g.insert("subdivisions".into(), SPHERE_SUBDIVISIONS.into());
+                self.warnings.push(n.at.warning(format!(
+                    "shape \"sphere\" tessellated into {} triangles",
+                    20 * 4i64.pow(SPHERE_SUBDIVISIONS as u32)
+                )));
+            }
+            other => {
+                return Err(n.at.error(format!(
+                    "shape \"{other}\" is not supported (obj, rectangle, cube, disk and sphere are)"
+                )))
+            }
+        }
+        if p.boolean("flip_normals")? == Some(true) {
+            return Err(p.error("flip_normals = true is not supported"));
+        }
+        if m != DMat4::IDENTITY {
+            let rows: Vec<Value> = (0..4)
+                .map(|r| {
+                    let row = m.row(r);
+                    Value::Array(row.to_array().iter().map(|&x| Value::Float(x)).collect())
+                })
+                .collect();
+            let mut t = Table::new();
+            t.insert("matrix".into(), Value::Array(rows));
+            g.insert("transform".into(), Value::Table(t));
+        }
+        let mut bsdfs: Vec<&'a Node> = p.objects("bsdf");
+        for r in p.refs() {
+            let target = self.resolve(r)?;
+            if target.tag != "bsdf" {
+                return Err(r.at.error(format!(
+                    "<ref id=\"{}\"> names a <{}>, a shape takes a <bsdf>",
+                    r.attr("id").unwrap_or(""),
+                    target.tag
+                )));
+            }
+            bsdfs.push(target);
+        }
+        let (base, table) = match bsdfs.as_slice() {
+            [] => default_material(),
+            [b] => self.material(b)?,
+            _ => return Err(p.error("has more than one BSDF")),
+        };
+        let emitters = p.objects("emitter");
+        let material = match emitters.as_slice() {
+            [] => self.use_material(base, table),
+            [e] => self.emissive(e, table, &name)?,
+            _ => return Err(p.error("has more than one emitter")),
+        };
+        g.insert("material".into(), material.into());
+        p.finish(self.warnings)?;
+        self.geometry.push(g);
+        Ok(())
+    }
+
+    /// An area emitter on a shape: a copy of the shape's material with `emission`.
+    fn emissive(&mut self, e: &Node, mut table: Table, shape: &str) -> Result<String, SceneError> {
+        let p = Props::new(e);
+        if e.plugin()? != "area" {
+            return Err(p.error("only area emitters can sit on a shape"));
+        }
+        let radiance = p
+            .rgb("radiance", Role::Emission)?
+            .ok_or_else(|| p.error("has no radiance"))?;
+        p.finish(self.warnings)?;
+        table.insert(
+            "emission".into(),
+            Value::Array(radiance.iter().map(|&v| Value::Float(v)).collect()),
+        );
+        Ok(self.use_material(format!("{shape}-emitter"), table))
+    }
+
+    /// Adds material `name` to the document the first time a shape uses it.
+    fn use_material(&mut self, name: String, mut table: Table) -> String {
+        if self.used.insert(name.clone()) {
+            table.insert("name".into(), name.clone().into());
+            self.materials.push(table);
+        }
+        name
+    }
+
+    /// The name and table of a BSDF element, converted once.
+    fn material(&mut self, b: &'a Node) -> Result<(String, Table), SceneError> {
+        if let Some(done) = self.by_node.get(&(b as *const Node)) {
+            return Ok(done.clone());
+        }
+        let ids = &self.ids;
+        let resolve = |r: &'a Node| -> Result<&'a Node, SceneError> {
+            let id = r.attr("id").ok_or_else(|| r.at.error("<ref> has no id"))?;
+            ids.get(id).copied().ok_or_else(|| {
+                r.at.error(format!("<ref id=\"{id}\">: no element has this id"))
+            })
+        };
+        let converted = bsdf::convert(b, &resolve, false, self.warnings)?;
+        let name = b
+            .attr("id")
+            .map_or_else(|| format!("bsdf{}", self.by_node.len()), str::to_string);
+        let mut t = converted.table;
+        if let Some(file) = converted.texture {
+            t.insert("texture".into(), (self.file_name)(&file).into());
+        }
+        let done = (name, t);
+        self.by_node.insert(b as *const Node, done.clone());
+        Ok(done)
+    }
+
+    /// `constant` lights the scene from every direction; other emitters outside shapes are
+    /// not supported yet.
+    fn environment(&mut self, e: &Node) -> Result<(), SceneError> {
+        let p = Props::new(e);
+        match e.plugin()? {
+            "constant" => {
+                let c = match p.color("radiance", Role::Emission)? {
+                    Some(Color::Rgb(c)) => c,
+                    None => [1.0; 3],
+                    Some(Color::Texture(t)) => {
+                        return Err(t.at.error("a textured constant emitter is not supported"))
+                    }
+                };
+                if self.environment.is_some() {
+                    return Err(p.error("a second environment emitter"));
+                }
+                let mut t = Table::new();
+                t.insert(
+                    "color".into(),
+                    Value::Array(c.iter().map(|&v| Value::Float(v)).collect()),
+                );
+                self.environment = Some(t);
+            }
+            other => {
+                return Err(e.at.error(format!(
+                "emitter \"{other}\" is not supported (area emitters on shapes and constant are)"
+            )))
+            }
+        }
+        p.finish(self.warnings)
+    }
+}
+
+/// Position, view direction and up vector of a sensor's `to_world`, which must be rigid:
+/// our cameras cannot scale, shear or mirror the image.
+fn camera_frame(p: &Props, m: &DMat4) -> Result<(DVec3, DVec3, DVec3), SceneError> {
+    let left = m.transform_vector3(DVec3::X);
+    let up = m.transform_vector3(DVec3::Y);
+    let dir = m.transform_vector3(DVec3::Z);
+    let pos = m.transform_point3(DVec3::ZERO);
+    let unit = |v: DVec3| (v.length() - 1.0).abs() < 1e-3;
+    let orthogonal =
+        left.dot(up).abs() < 1e-3 && up.dot(dir).abs() < 1e-3 && dir.dot(left).abs() < 1e-3;
+    if !(unit(left) && unit(up) && unit(dir) && orthogonal) || m.row(3) != DVec4::W {
+        return Err(
+            p.error("to_world must be a rotation and translation (no scale, shear or projection)")
+        );
+    }
+    if up.cross(dir).dot(left) < 0.0 {
+        return Err(p.error("to_world mirrors the image, which our cameras cannot"));
+    }
+    Ok((pos, dir.normalize(), up.normalize()))
+}
+
+/// Mitsuba's field of view along `axis` as our vertical one.
+fn vertical_fov(p: &Props, fov: f64, axis: &str, w: f64, h: f64) -> Result<f64, SceneError> {
+    if !(fov > 0.0 && fov < 180.0) {
+        return Err(p.error(format!("fov {fov}: must be in (0, 180)")));
+    }
+    let t = (fov.to_radians() / 2.0).tan();
+    let vertical_tan = match axis {
+        "x" => t * h / w,
+        "y" => t,
+        "smaller" if w < h => t * h / w,
+        "smaller" => t,
+        "larger" if w > h => t * h / w,
+        "larger" => t,
+        "diagonal" => t * h / (w * w + h * h).sqrt(),
+        other => {
+            return Err(p.error(format!(
+                "fov_axis \"{other}\" is not one of x, y, smaller, larger, diagonal"
+            )))
+        }
+    };
+    Ok((2.0 * vertical_tan.atan()).to_degrees())
+}
+
+/// `focal_length = "50mm"`: the horizontal field of view of a 36 mm wide film.
+fn focal_length_fov(p: &Props, text: &str) -> Result<f64, SceneError> {
+    let mm: f64 = text
+        .trim()
+        .trim_end_matches("mm")
+        .parse()
+        .ok()
+        .filter(|v: &f64| *v > 0.0)
+        .ok_or_else(|| p.error(format!("focal_length \"{text}\" is not like \"50mm\"")))?;
+    Ok((2.0 * (18.0 / mm).atan()).to_degrees())
+}
+
+/// An `<rfilter>` as our `pixel_filter` option string.
+fn pixel_filter(r: &Node, warnings: &mut Vec<String>) -> Result<String, SceneError> {
+    let p = Props::new(r);
+    let spec = match r.plugin()? {
+        "box" => "box".to_string(),
+        "tent" => match p.float("radius")? {
+            Some(radius) => format!("tent:radius={radius}"),
+            None => "tent".into(),
+        },
+        "gaussian" => match p.float("stddev")? {
+            Some(s) => format!("gaussian:stddev={s}"),
+            None => "gaussian".into(),
+        },
+        other => {
+            return Err(r.at.error(format!(
+                "rfilter \"{other}\" is not supported (box, tent and gaussian are)"
+            )))
+        }
+    };
+    p.finish(warnings)?;
+    Ok(spec)
+}
+
+/// Mitsuba's BSDF for a shape without one: diffuse, reflectance 0.5.
+fn default_material() -> (String, Table) {
+    let mut t = Table::new();
+    t.insert("type".into(), "diffuse".into());
+    t.insert("color".into(), arr(DVec3::splat(0.5)));
+    ("default-diffuse".into(), t)
+}

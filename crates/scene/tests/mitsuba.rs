@@ -1,0 +1,267 @@
+//! Mitsuba scene files (`rt_scene::mitsuba`): the reader (dialects, parameters, includes,
+//! references, transforms), the translation of each element, the errors, and the peer scenes
+//! in ../shared/data/mitsuba.
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use rt_scene::{mitsuba, FileAccess, LoadedScene, SceneError};
+
+fn data(rel: &str) -> Option<PathBuf> {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/data/mitsuba")
+        .join(rel);
+    if p.exists() {
+        return Some(p);
+    }
+    assert!(
+        std::env::var_os("RT_REQUIRE_DATA").is_none(),
+        "{} is missing (RT_REQUIRE_DATA is set)",
+        p.display()
+    );
+    eprintln!("skipped: {} is missing", p.display());
+    None
+}
+
+/// Writes `files` (name, text) into a fresh directory and loads the first as a scene.
+fn load_files(files: &[(&str, &str)], defines: &[(&str, &str)]) -> Result<LoadedScene, SceneError> {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, text) in files {
+        std::fs::write(dir.path().join(name), text).unwrap();
+    }
+    let defines: Vec<(String, String)> = defines
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+    let path = dir.path().join(files[0].0);
+    let r = rt_scene::load_defined(&path, &FileAccess::open(), &defines);
+    // Error lines name the file: keep only its name so that tests can compare them.
+    r.map_err(|e| match e {
+        SceneError::Scene { file, at, message } => SceneError::Scene {
+            file: PathBuf::from(file.file_name().unwrap()),
+            at,
+            message,
+        },
+        other => other,
+    })
+}
+
+/// A scene around `body`: a camera, and a lit quad unless `body` has shapes of its own.
+fn scene(version: &str, body: &str) -> String {
+    format!(
+        r#"<scene version="{version}">
+    <sensor type="perspective">
+        <float name="fov" value="45"/>
+        <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <film type="hdrfilm"><integer name="width" value="64"/><integer name="height" value="32"/>
+            <rfilter type="box"/></film>
+    </sensor>
+{body}
+</scene>"#
+    )
+}
+
+const LAMP: &str = r#"<shape type="rectangle"><emitter type="area"><rgb name="radiance" value="1, 2, 3"/></emitter></shape>"#;
+
+fn err(r: Result<LoadedScene, SceneError>) -> String {
+    r.expect_err("should fail").to_string()
+}
+
+#[test]
+fn a_lit_rectangle_with_a_camera() {
+    let s = load_files(&[("s.xml", &scene("3.0.0", LAMP))], &[]).unwrap();
+    let sc = &s.scene;
+    assert_eq!(sc.triangle_count(), 2);
+    let cam = &sc.cameras[0];
+    assert_eq!((cam.width, cam.height), (64, 32));
+    // fov_axis x (Mitsuba's default): 45° across the 64 pixels, so tan(v/2) = tan(22.5°)/2.
+    let v = 2.0 * ((22.5f32).to_radians().tan() / 2.0).atan().to_degrees();
+    assert!((cam.fov_y_deg - v).abs() < 1e-4, "{} vs {v}", cam.fov_y_deg);
+    assert!((cam.position - Vec3::new(0.0, 0.0, 5.0)).length() < 1e-6);
+    assert!((cam.forward - Vec3::NEG_Z).length() < 1e-6);
+    // Mitsuba's rectangle: [-1, 1]² in z = 0, facing +z (towards the camera).
+    let t = sc.triangles[0];
+    let n = (t[1] - t[0]).cross(t[2] - t[0]);
+    assert!(n.z > 0.0, "{n}");
+    assert!(t
+        .iter()
+        .all(|p| p.x.abs() == 1.0 && p.y.abs() == 1.0 && p.z == 0.0));
+    let m = sc.material_of(0);
+    assert_eq!(m.emission.to_array(), [1.0, 2.0, 3.0]);
+}
+
+#[test]
+fn defaults_and_defines_fill_parameters() {
+    let body = format!(
+        r#"<default name="spp" value="16"/><default name="depth" value="5"/>
+        <integrator type="path"><integer name="max_depth" value="$depth"/></integrator>
+        <sampler type="independent"><integer name="sample_count" value="$spp"/></sampler>{LAMP}"#
+    );
+    // The sampler belongs in the sensor; put it there.
+    let text = scene("3.0.0", &body).replace(
+        "<rfilter type=\"box\"/></film>",
+        "<rfilter type=\"box\"/></film><sampler type=\"independent\"><integer name=\"sample_count\" value=\"$spp\"/></sampler>",
+    );
+    let text = text.replace(
+        r#"<sampler type="independent"><integer name="sample_count" value="$spp"/></sampler><shape"#,
+        "<shape",
+    );
+    let s = load_files(&[("s.xml", &text)], &[]).unwrap();
+    assert_eq!(s.render.spp, Some(16));
+    // Mitsuba counts path segments, we count bounces.
+    assert_eq!(s.render.max_depth, Some(4));
+    let s = load_files(&[("s.xml", &text)], &[("spp", "4"), ("depth", "-1")]).unwrap();
+    assert_eq!(s.render.spp, Some(4));
+    assert_eq!(s.render.max_depth, Some(10_000));
+    let e = err(load_files(
+        &[(
+            "s.xml",
+            &text.replace("<default name=\"spp\" value=\"16\"/>", ""),
+        )],
+        &[],
+    ));
+    assert!(
+        e.starts_with("s.xml:") && e.contains("$spp has no value"),
+        "{e}"
+    );
+    // A TOML scene takes no parameters.
+    let e = err(load_files(&[("s.toml", "")], &[("spp", "4")]));
+    assert!(
+        e.contains("only Mitsuba scene files (.xml) take parameters"),
+        "{e}"
+    );
+}
+
+#[test]
+fn includes_refs_and_the_old_dialect() {
+    let inc = r#"<scene version="0.6.0"><bsdf type="roughconductor" id="metal">
+        <string name="distribution" value="ggx"/><float name="alphaU" value="0.1"/>
+        <float name="alphaV" value="0.3"/><string name="material" value="Au"/></bsdf></scene>"#;
+    let body = r#"<include filename="materials.xml"/>
+        <shape type="cube"><ref id="metal"/></shape>"#;
+    let text = scene("0.6.0", body)
+        .replace("lookat", "lookAt")
+        .replace("to_world", "toWorld");
+    let s = load_files(&[("s.xml", &text), ("materials.xml", inc)], &[]).unwrap();
+    assert_eq!(s.scene.triangle_count(), 12);
+    let m = s.scene.material_of(0);
+    let micro = m.microfacet.as_ref().expect("a microfacet material");
+    assert!(format!("{micro:?}").contains("Ggx"), "{micro:?}");
+    // A reference to nothing is an error at the reference.
+    let e = err(load_files(
+        &[(
+            "s.xml",
+            &scene("3.0.0", r#"<shape type="cube"><ref id="nope"/></shape>"#),
+        )],
+        &[],
+    ));
+    assert_eq!(e.split(": ").nth(1).unwrap(), "<ref id=\"nope\">");
+    assert!(e.starts_with("s.xml:8:20:"), "{e}");
+}
+
+#[test]
+fn transforms_apply_in_order() {
+    // translate then scale: the scale also moves the translated points.
+    let body = r#"<shape type="rectangle"><transform name="to_world">
+        <translate x="1"/><scale value="2"/><rotate z="1" angle="90"/></transform></shape>"#;
+    let s = load_files(&[("s.xml", &scene("3.0.0", body))], &[]).unwrap();
+    let t = s.scene.triangles[0];
+    // Corner (-1, -1, 0): translate → (0, -1), scale → (0, -2), rotate 90° about z → (2, 0).
+    assert!((t[0] - Vec3::new(2.0, 0.0, 0.0)).length() < 1e-5, "{t:?}");
+}
+
+#[test]
+fn unsupported_elements_and_parameters_are_one_line_at_their_position() {
+    let cases = [
+        (
+            r#"<shape type="cube"><bsdf type="roughplastic"/></shape>"#,
+            "s.xml:8:20: bsdf \"roughplastic\" is not supported",
+        ),
+        (
+            r#"<shape type="cube"><bsdf type="diffuse"><float name="roughness" value="1"/></bsdf></shape>"#,
+            "s.xml:8:41: bsdf \"diffuse\": parameter `roughness` is not supported",
+        ),
+        (
+            r#"<emitter type="point"/>"#,
+            "s.xml:8:1: emitter \"point\" is not supported",
+        ),
+        (
+            r#"<shape type="ply"><string name="filename" value="a.ply"/></shape>"#,
+            "s.xml:8:1: shape \"ply\" is not supported",
+        ),
+        (
+            r#"<shape type="cube"><bsdf type="diffuse"><rgb name="reflectance" value="1, 2"/></bsdf></shape>"#,
+            "s.xml:8:41: <rgb>: `1, 2` is not 3 numbers",
+        ),
+        (r#"<shape type="cube">"#, "s.xml:9:1: malformed XML"),
+    ];
+    for (body, want) in cases {
+        let e = err(load_files(&[("s.xml", &scene("3.0.0", body))], &[]));
+        assert!(e.starts_with(want), "{body}:\n  got  {e}\n  want {want}...");
+        assert!(!e.contains('\n'), "{e}");
+    }
+}
+
+#[test]
+fn ignored_parameters_are_warnings() {
+    let text = scene("3.0.0", LAMP).replace(
+        r#"<float name="fov" value="45"/>"#,
+        r#"<float name="fov" value="45"/><float name="near_clip" value="0.1"/>"#,
+    );
+    let s = load_files(&[("s.xml", &text)], &[]).unwrap();
+    assert!(
+        s.warnings.iter().any(|w| w.contains("`near_clip` ignored")),
+        "{:?}",
+        s.warnings
+    );
+}
+
+#[test]
+fn spectra_become_mitsubas_rgb() {
+    let body = r#"<shape type="cube"><bsdf type="diffuse">
+        <spectrum name="reflectance" value="400:0.04, 500:0.3, 600:0.6, 700:0.642"/></bsdf>
+        <emitter type="area"><spectrum name="radiance" value="400:0, 500:8, 600:15.6, 700:18.4"/></emitter></shape>"#;
+    let s = load_files(&[("s.xml", &scene("3.0.0", body))], &[]).unwrap();
+    let m = s.scene.material_of(0);
+    // What Mitsuba 3.9.1's llvm_ad_rgb gives for these spectra (tools/reference/mitsuba_cie.py).
+    let (refl, emit) = ([0.670764, 0.43135, 0.143637], [20.7108, 10.8546, 2.77115]);
+    let c = m.layers[0].color.to_array();
+    for i in 0..3 {
+        assert!((c[i] - refl[i]).abs() < 1e-4 * refl[i], "{c:?}");
+        assert!(
+            (m.emission.to_array()[i] - emit[i]).abs() < 1e-4 * emit[i],
+            "{:?}",
+            m.emission
+        );
+    }
+}
+
+#[test]
+fn the_cornell_box_from_the_shared_data_loads_and_converts_to_the_same_scene() {
+    let Some(p) = data("cbox/scene.xml") else {
+        return;
+    };
+    let xml = rt_scene::load(&p).unwrap();
+    assert_eq!(xml.scene.triangle_count(), 38);
+    assert_eq!(xml.render.spp, Some(256));
+    assert_eq!(xml.render.max_depth, Some(9));
+    assert_eq!(
+        xml.scene.cameras[0].filter.to_string(),
+        "gaussian:stddev=0.5"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let c = mitsuba::to_toml(&p, Some(dir.path()), &FileAccess::open(), &[]).unwrap();
+    let toml_path = dir.path().join("cbox.toml");
+    std::fs::write(&toml_path, &c.toml).unwrap();
+    let toml = rt_scene::load(&toml_path).unwrap();
+    assert_eq!(xml.scene.triangles, toml.scene.triangles);
+    assert_eq!(xml.scene.material_ids, toml.scene.material_ids);
+    assert_eq!(
+        format!("{:?}", xml.scene.materials),
+        format!("{:?}", toml.scene.materials)
+    );
+    assert_eq!(
+        format!("{:?}", xml.scene.cameras),
+        format!("{:?}", toml.scene.cameras)
+    );
+}
