@@ -10,12 +10,15 @@
 
 use rt_core::glam::Vec3;
 use rt_core::microfacet::{
-    Distribution, DistributionKind, LocalBsdf, Microfacet, Plastic, RoughConductor, RoughDielectric,
+    Distribution, DistributionKind, LocalBsdf, Microfacet, Plastic, RoughConductor,
+    RoughDielectric, RoughPlastic,
 };
 use rt_core::Rgb;
 use std::io::BufRead;
 
 fn main() {
+    // Rough plastic tabulates at construction: build it once per parameter set.
+    let mut cached: Option<(String, Microfacet)> = None;
     for line in std::io::stdin().lock().lines() {
         let line = line.expect("standard input");
         let w: Vec<&str> = line.split_whitespace().collect();
@@ -32,7 +35,22 @@ fn main() {
             "beckmann" => Some(Distribution::new(DistributionKind::Beckmann, x[0], x[1])),
             _ => None,
         };
+        let key = w[..6].join(" ");
         let bsdf = match w[0] {
+            "roughplastic" => match &cached {
+                Some((k, b)) if *k == key => *b,
+                _ => {
+                    let b = Microfacet::RoughPlastic(RoughPlastic::new(
+                        distribution.expect("a distribution"),
+                        Rgb::splat(x[3]),
+                        Rgb::ONE,
+                        x[2],
+                        false,
+                    ));
+                    cached = Some((key, b));
+                    b
+                }
+            },
             "conductor" => Microfacet::Conductor(RoughConductor {
                 distribution,
                 eta: Rgb::splat(x[2]),

@@ -40,7 +40,7 @@
 //! dispersive event too. Dispersion is limited to delta layers: their `eval` is zero, so light
 //! connections never need a wavelength the path does not have yet.
 
-use crate::microfacet::{LocalBsdf, Microfacet};
+use crate::microfacet::Microfacet;
 use crate::{
     frame::Frame,
     sampling::{blinn_phong_half, blinn_phong_half_pdf, cosine_hemisphere},
@@ -398,7 +398,8 @@ pub struct Bsdf<'a> {
     /// [`Bsdf::sample`], need no layer loop. The arithmetic is the general path's, operation
     /// for operation, so both give the same bits.
     lambert: Option<Rgb>,
-    /// The material's microfacet BSDF, which replaces the layers when present.
+    /// The material's microfacet BSDF, which replaces the layers when present (the texture's
+    /// tint applies through [`Microfacet::eval_pdf_tinted`] and [`Microfacet::sample_tinted`]).
     micro: Option<&'a Microfacet>,
     /// The path's wavelength, nm (`None`: an RGB path).
     wavelength: Option<f32>,
@@ -538,7 +539,7 @@ impl<'a> Bsdf<'a> {
     /// Reflectance at normal incidence summed over layers: the albedo AOV.
     pub fn albedo(&self) -> Rgb {
         if let Some(m) = self.micro {
-            return m.albedo();
+            return m.albedo_tinted(self.tint);
         }
         self.layers
             .iter()
@@ -583,7 +584,7 @@ impl<'a> Bsdf<'a> {
             return lambert_eval_pdf(f, wi_local, reflect);
         }
         if let Some(m) = self.micro {
-            return m.eval_pdf(self.wo_local, wi_local);
+            return m.eval_pdf_tinted(self.tint, self.wo_local, wi_local);
         }
         let mut f = Rgb::ZERO;
         let mut pdf = 0.0;
@@ -681,7 +682,7 @@ impl Bsdf<'_> {
     /// [`Bsdf::sample`] for a microfacet material: the local sample in world space, kept only
     /// where it is consistent with the geometric normal too.
     fn sample_microfacet(&self, m: &Microfacet, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
-        let s = m.sample(self.wo_local, u_lobe, u)?;
+        let s = m.sample_tinted(self.tint, self.wo_local, u_lobe, u)?;
         let wi = self.frame.to_world(s.wi).normalize();
         let reflect = self.sides(wi, s.wi)?;
         Some(BsdfSample {

@@ -1,7 +1,8 @@
 //! `rt-scene`: the scene file format and the mesh loaders.
 //!
-//! This is the only crate that knows TOML and mesh file formats. It turns a scene file
-//! (documented key by key in `docs/scene-format.md`) into the plain runtime
+//! This is the only crate that knows scene and mesh file formats. It turns a scene file
+//! (TOML, documented key by key in `docs/scene-format.md`, or Mitsuba's XML, translated into
+//! TOML by [`mitsuba`]) into the plain runtime
 //! [`rt_core::Scene`] that the accelerators and integrators read, plus the optional `[render]`
 //! defaults ([`RenderDesc`]) that the `render` CLI merges with its flags. Nothing downstream
 //! sees a file format, so a new format is a new module here and nothing else.

@@ -713,6 +713,16 @@ mod tests {
         };
         assert!((t.eta - 1.5046 / 1.000277).abs() < 1e-6);
         assert!(bad("type = \"thindielectric\"\nalpha = 0.1").contains("`alpha` does not apply"));
+        let Some(Microfacet::RoughPlastic(r)) =
+            ok("type = \"roughplastic\"\ndistribution = \"ggx\"\nalpha = 0.3\ndiffuse_reflectance = [0.2, 0.3, 0.4]\nnonlinear = true").microfacet
+        else {
+            panic!()
+        };
+        assert_eq!(
+            (r.distribution.alpha_x, r.diffuse, r.nonlinear),
+            (0.3, Rgb::new(0.2, 0.3, 0.4), true)
+        );
+        assert!((r.eta - 1.49 / 1.000277).abs() < 1e-6);
     }
 
     #[test]
@@ -759,6 +769,14 @@ mod tests {
             (
                 "type = \"smoothplastic\"\nalpha = 0.1",
                 "`alpha` does not apply to type \"smoothplastic\"",
+            ),
+            (
+                "type = \"roughplastic\"\nalpha_u = 0.1\nalpha_v = 0.3",
+                "roughplastic is isotropic",
+            ),
+            (
+                "type = \"roughconductor\"\ntexture = \"t.png\"",
+                "a texture multiplies the plastics' diffuse_reflectance only",
             ),
             (
                 "type = \"roughconductor\"\ndiffuse_reflectance = [1, 1, 1]",

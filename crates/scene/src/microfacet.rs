@@ -10,20 +10,21 @@ use crate::load::{finite3, Ctx};
 use rt_core::microfacet::named::{CONDUCTORS, DIELECTRICS};
 use rt_core::microfacet::{
     named_conductor, named_ior, Distribution, DistributionKind, Microfacet, Plastic,
-    RoughConductor, RoughDielectric, ThinDielectric,
+    RoughConductor, RoughDielectric, RoughPlastic, ThinDielectric,
 };
 use rt_core::{Material, Rgb};
 use std::ops::Range;
 
 /// The material types of the family. `smoothplastic` is Mitsuba's `plastic`: our `plastic`
 /// names the thesis' layered preset.
-pub(crate) const TYPES: [&str; 6] = [
+pub(crate) const TYPES: [&str; 7] = [
     "conductor",
     "roughconductor",
     "dielectric",
     "roughdielectric",
     "thindielectric",
     "smoothplastic",
+    "roughplastic",
 ];
 
 const DEFAULT_ALPHA: f32 = 0.1;
@@ -77,7 +78,13 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
         ("ior", d.ior.as_ref().map(|v| v.span())),
         ("dispersion", d.dispersion.as_ref().map(|v| v.span())),
         ("layers", d.layers.as_ref().map(|v| v.span())),
-        ("texture", d.texture.as_ref().map(|v| v.span())),
+        (
+            "texture",
+            d.texture
+                .as_ref()
+                .filter(|_| !kind.ends_with("plastic"))
+                .map(|v| v.span()),
+        ),
     ];
     for (key, span) in layered {
         if let Some(span) = span {
@@ -85,7 +92,7 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
                 "ior" => " (use int_ior and ext_ior)",
                 "color" => " (use specular_reflectance)",
                 "hardness" => " (use alpha)",
-                "texture" => " (textures on microfacet parameters are not supported yet)",
+                "texture" => " (a texture multiplies the plastics' diffuse_reflectance only)",
                 _ => "",
             };
             return Err(err(
@@ -96,7 +103,7 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
     }
     let rough = kind.starts_with("rough");
     let conductor = kind.ends_with("conductor");
-    let plastic = kind == "smoothplastic";
+    let plastic = kind == "smoothplastic" || kind == "roughplastic";
     for (key, span) in keys(d) {
         let applies = match key {
             "distribution" | "alpha" | "alpha_u" | "alpha_v" => rough,
@@ -224,16 +231,38 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
             transmittance,
         })
     } else if plastic {
-        Microfacet::Plastic(Plastic {
-            diffuse: rgb(
-                &d.diffuse_reflectance,
-                "diffuse_reflectance",
-                Rgb::splat(0.5),
-            )?,
-            specular: reflectance,
-            eta: eta(POLYPROPYLENE_IOR)?,
-            nonlinear: d.nonlinear.as_ref().is_some_and(|v| *v.get_ref()),
-        })
+        let diffuse = rgb(
+            &d.diffuse_reflectance,
+            "diffuse_reflectance",
+            Rgb::splat(0.5),
+        )?;
+        let nonlinear = d.nonlinear.as_ref().is_some_and(|v| *v.get_ref());
+        let eta = eta(POLYPROPYLENE_IOR)?;
+        match distribution {
+            Some(dist) => {
+                if dist.alpha_x != dist.alpha_y {
+                    let span = d.alpha_u.as_ref().map_or(d.name.span(), |a| a.span());
+                    return Err(err(
+                        span,
+                        "roughplastic is isotropic: give `alpha`, not `alpha_u` and `alpha_v`"
+                            .into(),
+                    ));
+                }
+                Microfacet::RoughPlastic(RoughPlastic::new(
+                    dist,
+                    diffuse,
+                    reflectance,
+                    eta,
+                    nonlinear,
+                ))
+            }
+            None => Microfacet::Plastic(Plastic {
+                diffuse,
+                specular: reflectance,
+                eta,
+                nonlinear,
+            }),
+        }
     } else {
         Microfacet::Dielectric(RoughDielectric {
             distribution,
@@ -247,6 +276,9 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
         m.emission = finite3(ctx, e, "emission")?;
     }
     m.two_sided = d.two_sided.unwrap_or(false);
+    if let Some(t) = &d.texture {
+        m.texture = Some(ctx.textures.load_file(&ctx.resolve(t.get_ref()))?);
+    }
     if let Err(e) = m.validate() {
         return Err(err(d.name.span(), e.to_string()));
     }

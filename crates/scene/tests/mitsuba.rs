@@ -174,8 +174,8 @@ fn transforms_apply_in_order() {
 fn unsupported_elements_and_parameters_are_one_line_at_their_position() {
     let cases = [
         (
-            r#"<shape type="cube"><bsdf type="roughplastic"/></shape>"#,
-            "s.xml:8:20: bsdf \"roughplastic\" is not supported",
+            r#"<shape type="cube"><bsdf type="blendbsdf"/></shape>"#,
+            "s.xml:8:20: bsdf \"blendbsdf\" is not supported",
         ),
         (
             r#"<shape type="cube"><bsdf type="diffuse"><float name="roughness" value="1"/></bsdf></shape>"#,
@@ -264,4 +264,71 @@ fn the_cornell_box_from_the_shared_data_loads_and_converts_to_the_same_scene() {
         format!("{:?}", xml.scene.cameras),
         format!("{:?}", toml.scene.cameras)
     );
+}
+
+#[test]
+fn rough_plastic_with_a_texture_on_its_base() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbImage::from_pixel(2, 2, image::Rgb([255, 128, 0]))
+        .save(dir.path().join("t.png"))
+        .unwrap();
+    // The texture declared once and referenced by name, as Mitsuba scenes often do.
+    let body = r#"<texture type="bitmap" id="wood"><string name="filename" value="t.png"/></texture>
+        <shape type="cube"><bsdf type="twosided"><bsdf type="roughplastic">
+        <string name="distribution" value="ggx"/><float name="alpha" value="0.2"/>
+        <ref name="diffuse_reflectance" id="wood"/></bsdf></bsdf></shape>"#;
+    std::fs::write(dir.path().join("s.xml"), scene("3.0.0", body)).unwrap();
+    let s = rt_scene::load(&dir.path().join("s.xml")).unwrap();
+    let m = s.scene.material_of(0);
+    assert_eq!(m.texture, Some(0));
+    match m.microfacet {
+        Some(rt_core::microfacet::Microfacet::RoughPlastic(p)) => {
+            assert_eq!(
+                p.diffuse.to_array(),
+                [1.0; 3],
+                "the texture is the base colour"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+/// A textured plastic renders as the untextured one whose base is the texture's colour: the
+/// tint reaches the BSDF (a tint that did not would leave the textured one white).
+#[test]
+fn a_texture_on_a_plastic_base_is_its_colour() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbImage::from_pixel(2, 2, image::Rgb([255, 0, 255]))
+        .save(dir.path().join("t.png"))
+        .unwrap();
+    let render = |base: &str, extra: &str| {
+        let body = format!(
+            r#"<shape type="rectangle"><bsdf type="{base}"><string name="distribution" value="ggx"/>
+            {extra}</bsdf></shape>
+            <emitter type="constant"><rgb name="radiance" value="1, 1, 1"/></emitter>"#
+        );
+        let text = scene("3.0.0", &body);
+        let text = if base == "plastic" {
+            text.replace(r#"<string name="distribution" value="ggx"/>"#, "")
+        } else {
+            text
+        };
+        std::fs::write(dir.path().join("s.xml"), text).unwrap();
+        let s = rt_scene::load(&dir.path().join("s.xml")).unwrap();
+        let film = rt_testkit::render(&s.scene, &rt_integrators::PathIntegrator::new(3), 4, 1);
+        film.mean_image()
+    };
+    for base in ["plastic", "roughplastic"] {
+        let textured = render(
+            base,
+            r#"<texture name="diffuse_reflectance" type="bitmap"><string name="filename" value="t.png"/></texture>"#,
+        );
+        let plain = render(base, r#"<rgb name="diffuse_reflectance" value="1, 0, 1"/>"#);
+        let white = render(base, r#"<rgb name="diffuse_reflectance" value="1, 1, 1"/>"#);
+        assert!(
+            textured == plain,
+            "{base}: the textured plastic differs from its colour"
+        );
+        assert!(textured != white, "{base}: the control must differ");
+    }
 }

@@ -18,6 +18,7 @@ mod distribution;
 mod fresnel;
 pub mod named;
 mod plastic;
+mod rough_plastic;
 mod thin;
 
 pub use conductor::RoughConductor;
@@ -25,6 +26,7 @@ pub use dielectric::RoughDielectric;
 pub use distribution::{Distribution, DistributionKind, MIN_ALPHA};
 pub use fresnel::fresnel_conductor;
 pub use plastic::{fresnel_diffuse_reflectance, Plastic};
+pub use rough_plastic::RoughPlastic;
 pub use thin::ThinDielectric;
 
 use crate::Rgb;
@@ -94,6 +96,9 @@ pub fn reflect(wo: Vec3, m: Vec3) -> Vec3 {
 
 /// One BSDF of the family, as a material holds it.
 #[derive(Clone, Copy, Debug, PartialEq)]
+// Rough plastic carries its 64-entry transmittance table inline: a material holds one, and
+// the BSDF a hit builds copies it (a few hundred bytes, no allocation, no indirection).
+#[allow(clippy::large_enum_variant)]
 pub enum Microfacet {
     /// `conductor`, `roughconductor`.
     Conductor(RoughConductor),
@@ -101,6 +106,8 @@ pub enum Microfacet {
     Dielectric(RoughDielectric),
     /// `plastic`.
     Plastic(Plastic),
+    /// `roughplastic`.
+    RoughPlastic(RoughPlastic),
     /// `thindielectric`.
     ThinDielectric(ThinDielectric),
 }
@@ -111,6 +118,7 @@ impl Microfacet {
         match self {
             Microfacet::Conductor(c) => c.distribution,
             Microfacet::Dielectric(d) => d.distribution,
+            Microfacet::RoughPlastic(p) => Some(p.distribution),
             Microfacet::Plastic(_) | Microfacet::ThinDielectric(_) => None,
         }
     }
@@ -126,8 +134,51 @@ impl Microfacet {
             Microfacet::Conductor(c) => fresnel_conductor(1.0, c.eta, c.k) * c.specular_reflectance,
             Microfacet::Dielectric(d) => d.transmittance,
             Microfacet::Plastic(p) => p.diffuse,
+            Microfacet::RoughPlastic(p) => p.diffuse,
             Microfacet::ThinDielectric(t) => t.transmittance,
         }
+    }
+
+    /// The BSDF with a texture's `tint` multiplying the diffuse base of the plastics (the
+    /// other types take no texture); `None` when the tint changes nothing.
+    fn tinted(&self, tint: Rgb) -> Option<Self> {
+        if tint == Rgb::ONE {
+            return None;
+        }
+        match *self {
+            Microfacet::Plastic(mut p) => {
+                p.diffuse *= tint;
+                Some(Microfacet::Plastic(p))
+            }
+            Microfacet::RoughPlastic(mut p) => {
+                p.diffuse *= tint;
+                Some(Microfacet::RoughPlastic(p))
+            }
+            _ => None,
+        }
+    }
+
+    /// [`LocalBsdf::eval_pdf`] under a texture's `tint` (a copy of the BSDF only for a
+    /// textured plastic).
+    pub fn eval_pdf_tinted(&self, tint: Rgb, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        match self.tinted(tint) {
+            Some(t) => t.eval_pdf(wo, wi),
+            None => self.eval_pdf(wo, wi),
+        }
+    }
+
+    /// [`LocalBsdf::sample`] under a texture's `tint`.
+    pub fn sample_tinted(&self, tint: Rgb, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<LocalSample> {
+        match self.tinted(tint) {
+            Some(t) => t.sample(wo, u_lobe, u),
+            None => self.sample(wo, u_lobe, u),
+        }
+    }
+
+    /// [`Microfacet::albedo`] under a texture's `tint`.
+    pub fn albedo_tinted(&self, tint: Rgb) -> Rgb {
+        self.tinted(tint)
+            .map_or_else(|| self.albedo(), |t| t.albedo())
     }
 
     /// Checks every parameter's range; the message names the parameter.
@@ -178,6 +229,21 @@ impl Microfacet {
                 colour(p.diffuse, "diffuse_reflectance")?;
                 colour(p.specular, "specular_reflectance")
             }
+            Microfacet::RoughPlastic(p) => {
+                if !(p.eta.is_finite() && p.eta > 0.0) || p.eta == 1.0 {
+                    return Err(format!(
+                        "int_ior / ext_ior must be a positive number other than 1, got {}",
+                        p.eta
+                    ));
+                }
+                if p.distribution.alpha_x != p.distribution.alpha_y {
+                    return Err(
+                        "roughplastic is isotropic: give alpha, not alpha_u and alpha_v".into(),
+                    );
+                }
+                colour(p.diffuse, "diffuse_reflectance")?;
+                colour(p.specular, "specular_reflectance")
+            }
             Microfacet::ThinDielectric(t) => {
                 if !(t.eta.is_finite() && t.eta > 0.0) {
                     return Err(format!(
@@ -198,6 +264,7 @@ impl LocalBsdf for Microfacet {
             Microfacet::Conductor(c) => c.eval_pdf(wo, wi),
             Microfacet::Dielectric(d) => d.eval_pdf(wo, wi),
             Microfacet::Plastic(p) => p.eval_pdf(wo, wi),
+            Microfacet::RoughPlastic(p) => p.eval_pdf(wo, wi),
             Microfacet::ThinDielectric(t) => t.eval_pdf(wo, wi),
         }
     }
@@ -207,6 +274,7 @@ impl LocalBsdf for Microfacet {
             Microfacet::Conductor(c) => c.sample(wo, u_lobe, u),
             Microfacet::Dielectric(d) => d.sample(wo, u_lobe, u),
             Microfacet::Plastic(p) => p.sample(wo, u_lobe, u),
+            Microfacet::RoughPlastic(p) => p.sample(wo, u_lobe, u),
             Microfacet::ThinDielectric(t) => t.sample(wo, u_lobe, u),
         }
     }

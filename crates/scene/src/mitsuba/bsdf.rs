@@ -82,11 +82,30 @@ pub(super) fn convert<'a>(
             reflectance(&p, &mut t, "specular_reflectance")?;
             reflectance(&p, &mut t, "specular_transmittance")?;
         }
-        "plastic" => {
-            t.insert("type".into(), "smoothplastic".into());
+        "plastic" | "roughplastic" => {
+            let rough_one = ty == "roughplastic";
+            t.insert(
+                "type".into(),
+                if rough_one {
+                    "roughplastic"
+                } else {
+                    "smoothplastic"
+                }
+                .into(),
+            );
+            rough(&p, &mut t, rough_one)?;
             iors(&p, &mut t)?;
             reflectance(&p, &mut t, "specular_reflectance")?;
-            reflectance(&p, &mut t, "diffuse_reflectance")?;
+            match p.color("diffuse_reflectance", Role::Reflectance)? {
+                None => {}
+                Some(Color::Rgb(c)) => {
+                    t.insert("diffuse_reflectance".into(), rgb(c));
+                }
+                Some(Color::Texture(tex)) => {
+                    texture = Some(bitmap(tex, warnings)?);
+                    t.insert("diffuse_reflectance".into(), rgb([1.0; 3]));
+                }
+            }
             if let Some(b) = p.boolean("nonlinear")? {
                 t.insert("nonlinear".into(), b.into());
             }
@@ -94,7 +113,7 @@ pub(super) fn convert<'a>(
         other => {
             return Err(node.at.error(format!(
             "bsdf \"{other}\" is not supported (supported: diffuse, dielectric, thindielectric, \
-                 roughdielectric, conductor, roughconductor, plastic, twosided)"
+                 roughdielectric, conductor, roughconductor, plastic, roughplastic, twosided)"
         )))
         }
     }

@@ -95,7 +95,34 @@ pub(super) fn read(
     }
     root.children.retain(|c| c.tag != "default");
     substitute(&mut root, &params)?;
+    let textures: HashMap<String, Node> = root
+        .children
+        .iter()
+        .filter(|c| c.tag == "texture")
+        .filter_map(|c| Some((c.attr("id")?.to_string(), c.clone())))
+        .collect();
+    inline_texture_refs(&mut root, &textures);
     Ok(root)
+}
+
+/// `<ref name="reflectance" id="wood"/>` to a declared `<texture id="wood">` becomes a copy of
+/// the texture named `reflectance`, so that parameters read textures in one way.
+fn inline_texture_refs(node: &mut Node, textures: &HashMap<String, Node>) {
+    for c in &mut node.children {
+        let target = (c.tag == "ref")
+            .then(|| c.attr("id").and_then(|id| textures.get(id)))
+            .flatten();
+        match (target, c.attr("name")) {
+            (Some(t), Some(name)) => {
+                let mut copy = t.clone();
+                copy.attrs.retain(|(k, _)| k != "id" && k != "name");
+                copy.attrs.push(("name".into(), name.to_string()));
+                copy.at = c.at.clone();
+                *c = copy;
+            }
+            _ => inline_texture_refs(c, textures),
+        }
+    }
 }
 
 fn parse_file(path: &Path, access: &FileAccess, depth: usize) -> Result<Node, SceneError> {
