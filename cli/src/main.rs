@@ -15,7 +15,6 @@ mod args;
 mod bench_accel;
 mod bench_anim;
 mod compare;
-mod compare_frames;
 mod denoise;
 mod experiment;
 mod parts;
@@ -62,9 +61,7 @@ pub(crate) fn run(args: &args::Args) -> anyhow::Result<()> {
         Some(args::Command::Merge(m)) => parts::merge(m),
         Some(args::Command::Plan(p)) => parts::plan(p),
         Some(args::Command::Part(p)) => parts::part(p),
-        Some(args::Command::GenScene { name, output }) => {
-            bench_accel::input::write_obj(name, output)
-        }
+        Some(args::Command::GenScene { name, output }) => bench_accel::write_obj(name, output),
         None => render::run(args),
     }
 }

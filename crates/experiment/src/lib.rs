@@ -23,7 +23,9 @@
 //!   the temporal metrics of `rt_metrics::temporal`; frames.csv, sequences.csv, plots over
 //!   frames, stills.
 //!
-//! [`run`] does all of it into one output folder.
+//! [`run`] does all of it into one output folder. [`bench`] holds the acceleration-structure
+//! benchmarks (`render bench-accel`, `render bench-anim`); [`compare`] the image and sequence
+//! comparisons of `render compare`.
 //!
 //! Depends on `rt-session` (progressive rendering of one configuration), `rt-metrics`
 //! (errors, error images), `rt-denoise` (denoisers), `rt-film` (image files), `rt-scene`, `rt-accel`, `rt-integrators` and `rt-core`;
@@ -41,8 +43,11 @@
 //! ```
 #![forbid(unsafe_code)]
 
+pub mod bench;
 pub mod cache;
+pub mod compare;
 pub mod config;
+pub mod csv;
 mod error;
 pub mod fit;
 pub mod grid;
