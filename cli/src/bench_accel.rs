@@ -136,24 +136,13 @@ fn parse_sets(args: &BenchArgs) -> Result<RaySets> {
     Ok(w)
 }
 
-/// The structures of `--accel`, each once; with `fixed_order`, none that reorders the scene's
-/// triangles (they cannot be compared frame by frame).
+/// The structures of `--accel` (`rt_accel::bench::contenders`).
 pub(crate) fn parse_specs(list: &[String], fixed_order: bool) -> Result<Vec<AccelSpec>> {
-    let mut specs: Vec<AccelSpec> = Vec::new();
-    for s in list {
-        let spec: AccelSpec = s.parse().map_err(|e| anyhow!("--accel {s}: {e}"))?;
-        if fixed_order && spec.kind.permutes() {
-            bail!("--accel {s}: a structure that reorders the scene's triangles cannot be compared frame by frame");
-        }
-        if specs.contains(&spec) {
-            bail!("--accel: {spec} is listed twice");
-        }
-        specs.push(spec);
-    }
-    if specs.is_empty() {
-        bail!("--accel: no acceleration structure given");
-    }
-    Ok(specs)
+    use rt_accel::bench::ListError;
+    rt_accel::bench::contenders(list, fixed_order).map_err(|e| match e {
+        ListError::Spec { .. } | ListError::Reorders(_) => anyhow!("--accel {e}"),
+        _ => anyhow!("--accel: {e}"),
+    })
 }
 
 /// A benchmark error with the flag it is about.

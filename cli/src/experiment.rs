@@ -79,24 +79,10 @@ pub fn run(args: &ExperimentArgs) -> Result<()> {
     let cache = Cache::new(&args.cache);
     let outcome = pool.install(|| rt_experiment::run(&plan, &out, &cache, &progress))?;
     progress.finish();
-    for e in &outcome.equal_time {
-        if let Some((p, wins)) = e.overall() {
-            progress.message(&format!(
-                "{}: lowest relMSE at equal time: {} ({wins} of {} times)",
-                plan.scenes[e.scene].name,
-                plan.methods[plan.pairs[p].method].name,
-                e.table.len()
-            ));
-        }
+    for line in outcome.winners(&plan) {
+        progress.message(&line);
     }
-    let runs = match &outcome.sequences {
-        Some(s) => format!(
-            "{} frames of {} sequences",
-            s.frames.len(),
-            s.sequences.len()
-        ),
-        None => format!("{} runs", outcome.results.rows.len()),
-    };
+    let runs = outcome.runs();
     progress.message(&format!(
         "{runs} in {:.1} s; to look at them, open {}",
         wall.elapsed().as_secs_f64(),

@@ -7,8 +7,8 @@
 use crate::args::Args;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Parser;
-use rt_parts::{Plan, PlanRequest, PlannedRender};
-use rt_session::{Frames, RenderJob, Slice};
+use rt_parts::{Plan, PlanRequest};
+use rt_session::RenderJob;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
@@ -190,83 +190,21 @@ fn render_request(p: &PlanArgs) -> Result<PlanRequest> {
     let scene = rt_session::load_scene(&p.scene, confine)?;
     let mut job = crate::render::job(&args, &scene.loaded)?;
     job.confine = confine.map(Path::to_path_buf);
-    let camera = rt_session::pick_camera(&scene.loaded.scene, &job.scene, job.camera.as_deref())?;
-    let camera = job.size.apply(camera);
-    let output = job.output.display().to_string();
-    let frames: Vec<(Option<u32>, String)> = match &p.frames {
-        None => vec![(None, output.clone())],
-        Some(r) => {
-            if !rt_session::frames::names_frame(&job.output) {
-                bail!("{output}: --frames needs an output that names the frame, e.g. -o 'out/frame_{{frame:04}}.exr'");
-            }
-            r.clone()
-                .map(|f| {
-                    let path = rt_session::frames::frame_path(&job.output, f);
-                    (Some(f), path.display().to_string())
-                })
-                .collect()
-        }
-    };
-    Ok(PlanRequest {
-        render: PlannedRender {
-            job: job.to_json(),
-            width: camera.width,
-            height: camera.height,
-            spp: job.settings.spp,
-        },
-        into_cache: false,
-        frames,
-        tile: p.tiles,
-        sample_splits: p.sample_splits,
-    })
+    let frames = p.frames.clone();
+    Ok(job.plan_request(&scene.loaded.scene, frames, p.tiles, p.sample_splits)?)
 }
 
-/// The references an experiment renders, each a reference job cut as `p` asks and merged
-/// into the cache. Sequence scenes (one reference per frame) are refused for now.
+/// The references an experiment renders, merged into the cache (`rt_experiment::reference`).
 fn experiment_requests(p: &PlanArgs) -> Result<Vec<PlanRequest>> {
     let access = match &p.confine {
         Some(dir) => rt_scene::FileAccess::confined_to(dir)?,
         None => rt_scene::FileAccess::open(),
     };
     let exp = rt_experiment::config::load_with(&p.scene, &access)?;
-    let mut requests = Vec::new();
-    for scene in &exp.scenes {
-        let rt_experiment::config::ReferencePlan::Render {
-            spp,
-            estimator,
-            seed,
-            accel,
-        } = &scene.reference
-        else {
-            continue;
-        };
-        let req = scene.reference_request(*estimator, *spp, *seed);
-        if scene.sequence.is_some() {
-            bail!(
-                "{}: scene {}: the per-frame references of a sequence are not plannable yet",
-                p.scene.display(),
-                scene.name
-            );
-        }
-        let mut job = rt_experiment::reference::job(&req, *accel, &req.key()?, &p.cache);
-        job.confine = p.confine.clone();
-        requests.push(PlanRequest {
-            render: PlannedRender {
-                job: job.to_json(),
-                width: scene.camera.width,
-                height: scene.camera.height,
-                spp: req.spp,
-            },
-            into_cache: true,
-            frames: vec![(None, p.cache.display().to_string())],
-            tile: p.tiles,
-            sample_splits: p.sample_splits,
-        });
-    }
-    if requests.is_empty() {
-        bail!("{}: the experiment renders no reference", p.scene.display());
-    }
-    Ok(requests)
+    let (confine, tiles, splits) = (p.confine.as_deref(), p.tiles, p.sample_splits);
+    Ok(rt_experiment::reference::plan_requests(
+        &exp, &p.cache, confine, tiles, splits,
+    )?)
 }
 
 fn read_plan(path: &Path) -> Result<Plan> {
@@ -304,14 +242,7 @@ pub fn part(p: &PartArgs) -> Result<()> {
     };
     std::fs::create_dir_all(&p.output)
         .with_context(|| format!("{}: cannot create the parts directory", p.output.display()))?;
-    let mut job = RenderJob::from_json(&plan.renders[part.render].job)
+    let job = RenderJob::for_part(&plan, part, &p.output)
         .map_err(|e| anyhow!("{}: {e}", p.plan.display()))?;
-    let [a, b] = part.samples;
-    job.slice = Slice {
-        samples: Some(a..b),
-        region: Some(part.region),
-    };
-    job.frames = part.frame.map_or(Frames::Still, Frames::One);
-    job.output = p.output.join(&part.file);
     crate::render::run_job(&job, None, p.quiet, false)
 }

@@ -4,9 +4,9 @@
 
 use crate::progress::Progress;
 use anyhow::{anyhow, bail, Result};
-use rt_experiment::{Cache, ReferenceRequest, DEFAULT_CACHE_DIR};
+use rt_experiment::{Cache, DEFAULT_CACHE_DIR};
 use rt_integrators::IntegratorSpec;
-use rt_session::{parse_resolution, pick_camera, ImageSize, Overrides};
+use rt_session::{parse_resolution, ImageSize, Overrides};
 use std::path::PathBuf;
 
 /// `render reference` arguments.
@@ -138,28 +138,19 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         accel,
         ..Overrides::default()
     };
-    let estimator = overrides.integrator_spec(&loaded.render, &args.scene)?;
-    if estimator.build().splats() {
-        anyhow::bail!(
-            "{}: integrator `{}` splats light paths and keeps no per-pixel variance; render references with a camera-ray integrator (wavefront, path, path-bsdf, direct, ao)",
-            args.scene.display(),
-            estimator.kind
-        );
-    }
-    let accel_spec = overrides.accel_spec(loaded, &args.scene)?;
-    let camera = size.apply(pick_camera(
-        &loaded.scene,
+    let order = rt_experiment::reference::Order::new(
         &args.scene,
+        loaded,
+        &overrides,
         args.camera.as_deref(),
-    )?);
-    let req = ReferenceRequest {
-        scene_path: &args.scene,
-        scene: &loaded.scene,
-        camera: &camera,
-        estimator,
-        spp: args.spp,
-        seed: overrides.seed(&loaded.render),
-    };
+        size,
+        args.spp,
+    )?;
+    let (req, accel_spec, camera) = (
+        order.request(&args.scene, &loaded.scene),
+        order.accel,
+        &order.camera,
+    );
     if part {
         // A slice of the reference, as a part file whose header carries the cache key for
         // `render merge --plan` to store the merged parts under.

@@ -6,7 +6,7 @@
 //! it.
 
 use super::{View, ViewArgs};
-use anyhow::{Context, Result};
+use anyhow::{anyhow, Context, Result};
 use rt_film::OutputOptions;
 use rt_session::frames::frame_path;
 
@@ -39,7 +39,8 @@ pub fn run(args: &ViewArgs, mut view: View) -> Result<()> {
             );
         }
         Ok(())
-    })?;
+    });
+    let summary = summary.map_err(|e: anyhow::Error| anyhow!("{path}: {e}"))?;
     println!("{path}: {summary}");
     Ok(())
 }

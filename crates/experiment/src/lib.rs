@@ -155,6 +155,36 @@ pub struct Outcome {
     pub sequences: Option<sequence::SequenceResults>,
 }
 
+impl Outcome {
+    /// Per scene, the method with the lowest relMSE at equal time most often, one line each.
+    pub fn winners(&self, plan: &Plan) -> Vec<String> {
+        let mut lines = Vec::new();
+        for e in &self.equal_time {
+            if let Some((p, wins)) = e.overall() {
+                lines.push(format!(
+                    "{}: lowest relMSE at equal time: {} ({wins} of {} times)",
+                    plan.scenes[e.scene].name,
+                    plan.methods[plan.pairs[p].method].name,
+                    e.table.len()
+                ));
+            }
+        }
+        lines
+    }
+
+    /// What ran: `N runs`, or `N frames of M sequences`.
+    pub fn runs(&self) -> String {
+        match &self.sequences {
+            Some(s) => format!(
+                "{} frames of {} sequences",
+                s.frames.len(),
+                s.sequences.len()
+            ),
+            None => format!("{} runs", self.results.rows.len()),
+        }
+    }
+}
+
 /// Runs `plan` (its file is copied beside the results) into the folder `out`
 /// (see [`prepare_out`]): references, the grid, images, results.csv, slopes.csv, plots, crops,
 /// report.md and report.html with its pictures. Call it inside the thread pool that should do

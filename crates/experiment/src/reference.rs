@@ -24,6 +24,69 @@ pub struct Obtained {
     pub seconds: f64,
 }
 
+/// What a reference of one loaded scene renders, resolved from the scene's `[render]` table
+/// and the caller's overrides (what `render reference` asks for).
+pub struct Order {
+    /// The camera, resized.
+    pub camera: rt_core::Camera,
+    /// The integrator: one that keeps per-pixel variance (camera rays only).
+    pub estimator: rt_integrators::IntegratorSpec,
+    /// The structure (the scene's default unless overridden).
+    pub accel: AccelSpec,
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Seed of the reference stream.
+    pub seed: u32,
+}
+
+impl Order {
+    /// The reference of `loaded` (read from `scene_path`) through `camera` (the first by
+    /// default) at `size`, with `spp` samples. A technique that splats is refused: it keeps no
+    /// per-pixel variance.
+    pub fn new(
+        scene_path: &Path,
+        loaded: &rt_scene::LoadedScene,
+        overrides: &rt_session::Overrides,
+        camera: Option<&str>,
+        size: rt_session::ImageSize,
+        spp: u32,
+    ) -> Result<Self> {
+        let estimator = overrides.integrator_spec(&loaded.render, scene_path)?;
+        if estimator.build().splats() {
+            return Err(ExperimentError::Run(format!(
+                "{}: integrator `{}` splats light paths and keeps no per-pixel variance; render references with a camera-ray integrator (wavefront, path, path-bsdf, direct, ao)",
+                scene_path.display(),
+                estimator.kind
+            )));
+        }
+        let accel = overrides.accel_spec(loaded, scene_path)?;
+        let camera = size.apply(rt_session::pick_camera(&loaded.scene, scene_path, camera)?);
+        Ok(Self {
+            camera,
+            estimator,
+            accel,
+            spp,
+            seed: overrides.seed(&loaded.render),
+        })
+    }
+
+    /// The cache's request for this reference of `scene` (loaded from `scene_path`).
+    pub fn request<'a>(
+        &'a self,
+        scene_path: &'a Path,
+        scene: &'a rt_core::Scene,
+    ) -> ReferenceRequest<'a> {
+        ReferenceRequest {
+            scene_path,
+            scene,
+            camera: &self.camera,
+            estimator: self.estimator,
+            spp: self.spp,
+            seed: self.seed,
+        }
+    }
+}
+
 /// The render job of the reference `req` with `key` (its cache key, which part headers
 /// carry so that the merged parts are stored under it), over `accel`, written to `output`:
 /// the reference stream, the camera at the request's size, the variance AOV kept where the
@@ -51,6 +114,62 @@ pub fn job(req: &ReferenceRequest<'_>, accel: AccelSpec, key: &Key, output: &Pat
     job.labels
         .insert("cache description".into(), key.description.clone());
     job
+}
+
+/// The references `plan` renders, each a reference job (confined to `confine`) cut into
+/// `tile`s and `sample_splits` sample ranges and merged into the cache `cache`, where the
+/// experiment then finds them; what `render plan --experiment` writes. Sequence scenes (one
+/// reference per frame) are refused for now.
+pub fn plan_requests(
+    plan: &crate::Plan,
+    cache: &Path,
+    confine: Option<&Path>,
+    tile: Option<(u32, u32)>,
+    sample_splits: u32,
+) -> Result<Vec<rt_parts::PlanRequest>> {
+    let mut requests = Vec::new();
+    for scene in &plan.scenes {
+        let crate::config::ReferencePlan::Render {
+            spp,
+            estimator,
+            seed,
+            accel,
+        } = &scene.reference
+        else {
+            continue;
+        };
+        let req = scene.reference_request(*estimator, *spp, *seed);
+        if scene.sequence.is_some() {
+            return Err(ExperimentError::Config {
+                file: plan.path.clone(),
+                message: format!(
+                    "scene {}: the per-frame references of a sequence are not plannable yet",
+                    scene.name
+                ),
+            });
+        }
+        let mut job = job(&req, *accel, &req.key()?, cache);
+        job.confine = confine.map(Path::to_path_buf);
+        requests.push(rt_parts::PlanRequest {
+            render: rt_parts::PlannedRender {
+                job: job.to_json(),
+                width: scene.camera.width,
+                height: scene.camera.height,
+                spp: req.spp,
+            },
+            into_cache: true,
+            frames: vec![(None, cache.display().to_string())],
+            tile,
+            sample_splits,
+        });
+    }
+    if requests.is_empty() {
+        return Err(ExperimentError::Config {
+            file: plan.path.clone(),
+            message: "the experiment renders no reference".into(),
+        });
+    }
+    Ok(requests)
 }
 
 /// Finds `req` in `cache` or renders it (with `accel`, built from `accel_spec`) and stores it

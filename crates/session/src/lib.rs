@@ -54,6 +54,7 @@ pub mod report;
 pub mod sequence;
 pub mod settings;
 mod text;
+pub mod viewer;
 pub mod worldcache;
 
 pub use adaptive::{
