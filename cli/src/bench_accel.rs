@@ -1,4 +1,4 @@
-//! `render bench-accel`: measures acceleration structures on one scene, and `render gen-scene`.
+//! `render bench-accel`: measures acceleration structures on one scene.
 //! The arguments are here; the benchmark (`rt_experiment::bench::accel`: rays, checks, timings)
 //! and its table and CSV are in the library. Progress goes to stderr (silenced by `-q`); the
 //! table is the only thing on stdout.
@@ -6,11 +6,10 @@
 use anyhow::{anyhow, bail, Result};
 use rt_accel::bench::{read_set, Query};
 use rt_accel::AccelSpec;
-use rt_core::limits::MAX_THREADS;
-use rt_experiment::bench::accel::{self, AccelBench, RaySets};
+use rt_experiment::bench::accel::{self, AccelBench, RaySetError, RaySets};
 use rt_experiment::bench::input::View;
 use rt_experiment::bench::BenchError;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Arguments of `render bench-accel`.
 #[derive(clap::Args, Debug)]
@@ -108,34 +107,6 @@ pub enum ViewArg {
     Inside,
 }
 
-fn parse_sets(args: &BenchArgs) -> Result<RaySets> {
-    let Some(names) = &args.rays else {
-        return Ok(if args.ray_file.is_some() {
-            RaySets::default()
-        } else {
-            RaySets::ALL
-        });
-    };
-    let mut w = RaySets::default();
-    for n in names {
-        match n.trim() {
-            "primary" => w.primary = true,
-            "incoherent" => w.incoherent = true,
-            "shadow" => w.shadow = true,
-            "uniform" => w.uniform = true,
-            "file" if args.ray_file.is_some() => {}
-            "file" => bail!("--rays file needs --ray-file"),
-            other => bail!(
-                "--rays: unknown ray set \"{other}\" (expected primary, incoherent, shadow, uniform or file)"
-            ),
-        }
-    }
-    if !w.any() && args.ray_file.is_none() {
-        bail!("--rays: no ray set given");
-    }
-    Ok(w)
-}
-
 /// The structures of `--accel` (`rt_accel::bench::contenders`).
 pub(crate) fn parse_specs(list: &[String], fixed_order: bool) -> Result<Vec<AccelSpec>> {
     use rt_accel::bench::ListError;
@@ -158,14 +129,17 @@ pub(crate) fn flagged(e: BenchError, camera: Option<&str>) -> anyhow::Error {
 /// Runs the benchmark.
 pub fn run(args: &BenchArgs) -> Result<()> {
     let specs = parse_specs(&args.accel, false)?;
-    let sets = parse_sets(args)?;
-    let threads = match args.threads {
-        Some(t) if t == 0 || t > MAX_THREADS => {
-            bail!("--threads: thread count must be between 1 and {MAX_THREADS}, got {t}")
-        }
-        Some(t) => t,
-        None => std::thread::available_parallelism().map_or(1, |n| n.get()),
-    };
+    let sets =
+        RaySets::from_names(args.rays.as_deref(), args.ray_file.is_some()).map_err(
+            |e| match e {
+                RaySetError::NoRayFile => anyhow!("--rays file needs --ray-file"),
+                e => anyhow!("--rays: {e}"),
+            },
+        )?;
+    // Checked by the thread pool.
+    let threads = args
+        .threads
+        .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
     if args.repeat == 0 {
         bail!("--repeat must be at least 1");
     }
@@ -213,9 +187,4 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         info(&format!("wrote {}", path.display()));
     }
     Ok(())
-}
-
-/// `render gen-scene NAME -o FILE.obj`: the procedural scene's triangles as OBJ.
-pub fn write_obj(name: &str, output: &Path) -> Result<()> {
-    Ok(rt_experiment::bench::input::write_obj(name, output)?)
 }

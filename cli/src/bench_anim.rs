@@ -6,7 +6,6 @@
 use crate::bench_accel::{flagged, parse_specs};
 use anyhow::{anyhow, bail, Result};
 use rt_accel::bench::anim::{AnimOptions, Workload};
-use rt_core::limits::MAX_THREADS;
 use rt_experiment::bench::anim::{self, AnimBench, DEFAULT_SWEEP};
 use rt_experiment::bench::input::{MAX_PIXELS, MAX_SIDE};
 use std::path::PathBuf;
@@ -93,15 +92,9 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
             "size must be WxH with sides 1 to {MAX_SIDE} and at most {MAX_PIXELS} pixels, e.g. 480x300, got `{s}`"
         )
     };
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
-    let side = |v: &str| {
-        v.trim()
-            .parse::<u32>()
-            .ok()
-            .filter(|n| (1..=MAX_SIDE).contains(n))
-    };
-    let (w, h) = (side(w).ok_or_else(bad)?, side(h).ok_or_else(bad)?);
-    if u64::from(w) * u64::from(h) > MAX_PIXELS {
+    let (w, h) = rt_session::split_size(s).ok_or_else(bad)?;
+    let side = 1..=MAX_SIDE;
+    if !side.contains(&w) || !side.contains(&h) || u64::from(w) * u64::from(h) > MAX_PIXELS {
         return Err(bad());
     }
     Ok((w, h))
@@ -114,12 +107,6 @@ pub fn run(args: &BenchAnimArgs) -> Result<()> {
         None => DEFAULT_SWEEP.split(',').map(str::to_owned).collect(),
     };
     let specs = parse_specs(&list, true)?;
-    if args.threads == 0 || args.threads > MAX_THREADS {
-        bail!(
-            "--threads: thread count must be between 1 and {MAX_THREADS}, got {}",
-            args.threads
-        );
-    }
     rt_session::job::check_fps(args.fps)?;
     if args.repeat == 0 {
         bail!("--repeat must be at least 1");

@@ -7,8 +7,6 @@ use anyhow::{anyhow, bail, Result};
 use rt_experiment::compare::{report, sequence_report, CompareError, Comparison, LagReport};
 use rt_metrics::temporal::{lag, LagOptions};
 use rt_metrics::{CompareOptions, DEFAULT_EPSILON, DEFAULT_PEAK};
-use rt_session::frames::names_frame;
-use std::ops::Range;
 use std::path::PathBuf;
 
 /// `render compare` arguments.
@@ -77,10 +75,9 @@ pub(crate) fn positive(s: &str) -> Result<f64, String> {
 
 /// Runs `render compare`.
 pub fn run(args: &CompareArgs) -> Result<()> {
-    let region = match args.region.as_deref() {
-        None => None,
-        Some(&[x0, y0, x1, y1]) => Some([x0, y0, x1, y1]),
-        Some(_) => bail!("--region takes four numbers: x0,y0,x1,y1"),
+    let region = match args.region.as_deref().map(<[usize; 4]>::try_from) {
+        Some(Err(_)) => bail!("--region takes four numbers: x0,y0,x1,y1"),
+        r => r.and_then(Result::ok),
     };
     let comparison = Comparison {
         test: args.test.clone(),
@@ -97,20 +94,13 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         other => other.into(),
     };
     let Some(frames) = args.frames.clone() else {
-        for path in [&args.test, &args.reference] {
-            if names_frame(path) && !path.exists() {
-                bail!(
-                    "{}: names a frame; add --frames S..E to compare sequences",
-                    path.display()
-                );
-            }
-        }
         let metrics = comparison.images().map_err(flag)?;
         print!("{}", report(&metrics, &comparison.options, args.json));
         return Ok(());
     };
-    check_frames(args, &frames)?;
-    // check_frames made sure of two frames.
+    let event = args.event.map(|e| (e, args.lag_window));
+    comparison.check_sequence(&frames, event)?;
+    // check_sequence made sure of two frames.
     let metrics = comparison.sequences(frames.clone()).map_err(flag)?;
     let lag = match args.event {
         None => None,
@@ -130,50 +120,6 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         "{}",
         sequence_report(frames.start, &metrics, lag.as_ref(), opts, args.json)
     );
-    Ok(())
-}
-
-/// Refuses, before any file is read, what cannot give a result.
-fn check_frames(args: &CompareArgs, frames: &Range<u32>) -> Result<()> {
-    if !names_frame(&args.test) {
-        bail!(
-            "{}: --frames needs an A that names the frame, e.g. 'a_{{frame:04}}.exr'",
-            args.test.display()
-        );
-    }
-    if frames.len() < 2 {
-        bail!(
-            "--frames {}..{} holds one frame; the temporal metrics need at least two",
-            frames.start,
-            frames.end
-        );
-    }
-    if let Some(path) = &args.error_image {
-        if !names_frame(path) {
-            bail!(
-                "{}: with --frames, --error-image must name the frame, e.g. 'err_{{frame:04}}.png'",
-                path.display()
-            );
-        }
-    }
-    if let Some(event) = args.event {
-        if !frames.contains(&event) {
-            bail!(
-                "--event {event} is not one of --frames {}..{}",
-                frames.start,
-                frames.end
-            );
-        }
-        let before = event - frames.start;
-        if before < args.lag_window {
-            bail!(
-                "--event {event}: the lag's steady state needs --lag-window {} frames before it, but --frames {}..{} has {before}",
-                args.lag_window,
-                frames.start,
-                frames.end
-            );
-        }
-    }
     Ok(())
 }
 

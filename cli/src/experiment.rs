@@ -44,11 +44,7 @@ pub struct ExperimentArgs {
 /// Runs `render experiment`.
 pub fn run(args: &ExperimentArgs) -> Result<()> {
     let wall = Instant::now();
-    let access = match &args.confine {
-        Some(dir) => rt_scene::FileAccess::confined_to(dir)?,
-        None => rt_scene::FileAccess::open(),
-    };
-    let plan = rt_experiment::config::load_with(&args.config, &access)?;
+    let plan = rt_experiment::config::load_confined(&args.config, args.confine.as_deref())?;
     if args.check {
         for w in &plan.warnings {
             eprintln!("warning: {w}");

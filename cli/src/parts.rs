@@ -7,6 +7,7 @@
 use crate::args::Args;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Parser;
+use rt_experiment::merge::{merge_files, merge_plan, Merged};
 use rt_parts::{Plan, PlanRequest};
 use rt_session::RenderJob;
 use std::ops::Range;
@@ -38,9 +39,15 @@ pub fn merge(m: &MergeArgs) -> Result<()> {
         Some(s) => Some(rt_session::memory::parse_size(s)?),
         None => rt_session::memory::available(),
     };
+    let mut print = |merged: &Merged| {
+        if !m.quiet {
+            println!("{merged}");
+        }
+    };
     let Some(plan_path) = &m.plan else {
         let output = m.output.as_ref().expect("clap requires -o without --plan");
-        return merge_files(&m.parts, output, false, limit, m.quiet);
+        print(&merge_files(&m.parts, output, false, limit)?);
+        return Ok(());
     };
     let plan = read_plan(plan_path)?;
     let [dir] = &m.parts[..] else {
@@ -49,51 +56,7 @@ pub fn merge(m: &MergeArgs) -> Result<()> {
             m.parts.len()
         );
     };
-    for out in &plan.outputs {
-        let files: Vec<PathBuf> = out
-            .parts
-            .iter()
-            .map(|&i| dir.join(&plan.parts[i].file))
-            .collect();
-        let output = Path::new(&out.output);
-        merge_files(&files, output, out.into_cache, limit, m.quiet)?;
-    }
-    Ok(())
-}
-
-/// Merges `files` into `output` (or, `into_cache`, into the reference cache directory
-/// `output`, where `render reference` and experiments find it).
-fn merge_files(
-    files: &[PathBuf],
-    output: &Path,
-    into_cache: bool,
-    limit: Option<u64>,
-    quiet: bool,
-) -> Result<()> {
-    let parts = rt_session::job::read_parts(files)?;
-    let t = std::time::Instant::now();
-    if into_cache {
-        let (path, s) = rt_experiment::Cache::new(output).store_parts(&parts, limit)?;
-        if !quiet {
-            println!(
-                "merged {} parts of the reference of {} ({}x{}, {} spp, {:.1} s of rendering) -> {}",
-                parts.len(),
-                s.scene,
-                s.width,
-                s.height,
-                s.spp,
-                s.seconds,
-                path.display()
-            );
-        }
-        return Ok(());
-    }
-    let report = rt_session::job::merge(&parts, output, limit)?;
-    if !quiet {
-        let secs = t.elapsed().as_secs_f64();
-        println!("{report} in {secs:.2} s -> {}", output.display());
-    }
-    Ok(())
+    Ok(merge_plan(&plan, dir, limit, &mut print)?)
 }
 
 /// `render plan`.
@@ -133,12 +96,9 @@ pub struct PlanArgs {
 
 fn parse_tile(s: &str) -> Result<(u32, u32), String> {
     let bad = || format!("--tiles must be WxH with positive integers, got `{s}`");
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
-    let (w, h): (u32, u32) = (w.parse().map_err(|_| bad())?, h.parse().map_err(|_| bad())?);
-    if w == 0 || h == 0 {
-        return Err(bad());
-    }
-    Ok((w, h))
+    rt_session::split_size(s)
+        .filter(|&(w, h)| w > 0 && h > 0)
+        .ok_or_else(bad)
 }
 
 /// `args` as `render` parses them (the program name added).
@@ -196,11 +156,7 @@ fn render_request(p: &PlanArgs) -> Result<PlanRequest> {
 
 /// The references an experiment renders, merged into the cache (`rt_experiment::reference`).
 fn experiment_requests(p: &PlanArgs) -> Result<Vec<PlanRequest>> {
-    let access = match &p.confine {
-        Some(dir) => rt_scene::FileAccess::confined_to(dir)?,
-        None => rt_scene::FileAccess::open(),
-    };
-    let exp = rt_experiment::config::load_with(&p.scene, &access)?;
+    let exp = rt_experiment::config::load_confined(&p.scene, p.confine.as_deref())?;
     let (confine, tiles, splits) = (p.confine.as_deref(), p.tiles, p.sample_splits);
     Ok(rt_experiment::reference::plan_requests(
         &exp, &p.cache, confine, tiles, splits,

@@ -146,16 +146,10 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         size,
         args.spp,
     )?;
-    let (req, accel_spec, camera) = (
-        order.request(&args.scene, &loaded.scene),
-        order.accel,
-        &order.camera,
-    );
     if part {
-        // A slice of the reference, as a part file whose header carries the cache key for
-        // `render merge --plan` to store the merged parts under.
+        // A slice of the reference, as a part file.
         let out = args.output.as_ref().expect("a part has an output");
-        let mut job = rt_experiment::reference::job(&req, accel_spec, &req.key()?, out);
+        let mut job = order.part_job(&args.scene, &loaded.scene, out)?;
         job.slice = rt_session::Slice {
             samples: args.sample_range.clone(),
             region: args.region.map(|r| [r.x0, r.y0, r.x1, r.y1]),
@@ -172,32 +166,18 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     );
     let cache = (!args.no_cache).then(|| Cache::new(&args.cache));
     let obtained = pool.install(|| {
-        let accel = accel_spec.build_scene(&loaded.scene);
-        rt_experiment::reference::obtain(
-            &req,
-            (&accel_spec, accel.as_ref()),
+        let progress = |f: f64| progress.bar().set_position((f * 1000.0) as u64);
+        let (path, scene) = (&args.scene, &loaded.scene);
+        order.obtain(
+            path,
+            scene,
             cache.as_ref(),
             args.output.as_deref(),
-            &|f| progress.bar().set_position((f * 1000.0) as u64),
+            &progress,
         )
     })?;
     progress.finish();
-    if obtained.cached {
-        progress.message(&format!(
-            "reference: cached {} ({:.1} s when rendered)",
-            obtained.path.display(),
-            obtained.seconds
-        ));
-    } else {
-        progress.message(&format!(
-            "reference: rendered {}x{} at {} spp in {:.1} s -> {}",
-            camera.width,
-            camera.height,
-            args.spp,
-            obtained.seconds,
-            obtained.path.display()
-        ));
-    }
+    progress.message(&order.describe(&obtained));
     let printed = match &args.output {
         Some(out) if obtained.path != *out => {
             rt_film::copy_atomic(&obtained.path, out)?;

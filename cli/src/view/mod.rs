@@ -52,11 +52,8 @@ pub fn run(args: &ViewArgs) -> Result<()> {
 }
 
 /// The scene, the renderer and what they render: shared by the window and the headless loop.
-/// The library's live view; the window and the headless loop drive it.
-pub type View = LiveView;
-
 /// The view the arguments ask for.
-fn load(args: &ViewArgs, spp: u32, fps: f64, size: Option<(u32, u32)>) -> Result<View> {
+fn load(args: &ViewArgs, spp: u32, fps: f64, size: Option<(u32, u32)>) -> Result<LiveView> {
     let path = args.scene.clone();
     let loaded = rt_session::load_scene(&path, None)?.loaded;
     if !args.quiet {

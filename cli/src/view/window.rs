@@ -10,9 +10,10 @@
 //! which starts from the scene camera as it was at that moment. Left drag turns about the look-at point, the wheel
 //! zooms, `Escape`/`Q` or closing the window quits. The title shows frames per second.
 
-use super::{View, ViewArgs};
+use super::ViewArgs;
 use anyhow::{anyhow, bail, Result};
 use rt_session::viewer::display::blit;
+use rt_session::viewer::LiveView;
 use std::num::NonZeroU32;
 use std::rc::Rc;
 use std::time::{Duration, Instant};
@@ -48,7 +49,7 @@ pub fn check_display() -> Result<()> {
 }
 
 /// Opens the window and runs until it closes.
-pub fn run(args: &ViewArgs, view: View) -> Result<()> {
+pub fn run(args: &ViewArgs, view: LiveView) -> Result<()> {
     let display = std::env::var("DISPLAY").unwrap_or_default();
     let event_loop = EventLoop::new().map_err(|e| {
         anyhow!("render view: cannot open X display {display}: {e}; use --headless to render without a window")
@@ -68,7 +69,7 @@ type Surface = softbuffer::Surface<Rc<Window>, Rc<Window>>;
 
 struct App<'a> {
     args: &'a ViewArgs,
-    view: View,
+    view: LiveView,
     window: Option<(Rc<Window>, Surface)>,
     dragging: bool,
     cursor: Option<PhysicalPosition<f64>>,
@@ -79,7 +80,7 @@ struct App<'a> {
 }
 
 impl<'a> App<'a> {
-    fn new(args: &'a ViewArgs, mut view: View) -> Self {
+    fn new(args: &'a ViewArgs, mut view: LiveView) -> Self {
         view.set_stepping(args.step);
         App {
             args,

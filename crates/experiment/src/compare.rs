@@ -36,6 +36,10 @@ pub enum CompareError {
         /// The image.
         path: PathBuf,
     },
+    /// A sequence comparison that cannot give a result (too few frames, an event outside
+    /// them), refused before any file is read.
+    #[error("{0}")]
+    Refused(String),
     /// The sequence's metrics refused (too few frames, bad options).
     #[error(transparent)]
     Temporal(#[from] TemporalError),
@@ -136,8 +140,62 @@ impl Comparison {
         Ok(())
     }
 
-    /// The metrics of A against B, and the error image if asked for.
+    /// Refuses, before any file is read, a comparison of `frames` (with the lag after `event`
+    /// over a steady state of `window` frames before it) that cannot give a result. The
+    /// messages name `render compare`'s flags, as the user gave them.
+    pub fn check_sequence(
+        &self,
+        frames: &Range<u32>,
+        event: Option<(u32, u32)>,
+    ) -> Result<(), CompareError> {
+        let refuse = |m: String| Err(CompareError::Refused(m));
+        let names = rt_session::frames::names_frame;
+        if !names(&self.test) {
+            return refuse(format!(
+                "{}: --frames needs an A that names the frame, e.g. 'a_{{frame:04}}.exr'",
+                self.test.display()
+            ));
+        }
+        let (start, end) = (frames.start, frames.end);
+        if frames.len() < 2 {
+            return refuse(format!(
+                "--frames {start}..{end} holds one frame; the temporal metrics need at least two"
+            ));
+        }
+        if let Some(path) = self.error_image.as_ref().filter(|p| !names(p)) {
+            return refuse(format!(
+                "{}: with --frames, --error-image must name the frame, e.g. 'err_{{frame:04}}.png'",
+                path.display()
+            ));
+        }
+        let Some((event, window)) = event else {
+            return Ok(());
+        };
+        if !frames.contains(&event) {
+            return refuse(format!(
+                "--event {event} is not one of --frames {start}..{end}"
+            ));
+        }
+        let before = event - start;
+        if before < window {
+            return refuse(format!(
+                "--event {event}: the lag's steady state needs --lag-window {window} frames before it, but --frames {start}..{end} has {before}"
+            ));
+        }
+        Ok(())
+    }
+
+    /// The metrics of A against B, and the error image if asked for. A missing file whose
+    /// name holds a frame placeholder is refused with a hint at sequences.
     pub fn images(&self) -> Result<Metrics, CompareError> {
+        for path in [&self.test, &self.reference] {
+            if rt_session::frames::names_frame(path) && !path.exists() {
+                return Err(CompareError::Refused(format!(
+                    "{}: names a frame; add --frames S..E to compare sequences",
+                    path.display()
+                )));
+            }
+        }
         let test = load(&self.test, self.region)?;
         let reference = load(&self.reference, self.region)?;
         let files = (self.test.as_path(), self.reference.as_path());

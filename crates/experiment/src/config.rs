@@ -420,6 +420,15 @@ pub fn load(path: &Path) -> CrateResult<Plan> {
     load_with(path, &rt_scene::FileAccess::open())
 }
 
+/// [`load_with`] confined to the directory `confine` (`--confine`), or reading anything.
+pub fn load_confined(path: &Path, confine: Option<&Path>) -> CrateResult<Plan> {
+    let access = match confine {
+        Some(dir) => rt_scene::FileAccess::confined_to(dir)?,
+        None => rt_scene::FileAccess::open(),
+    };
+    load_with(path, &access)
+}
+
 /// [`load`], reading only the files `access` allows (`--confine`): the experiment file, its
 /// scenes and everything they refer to, and reference images.
 pub fn load_with(path: &Path, access: &rt_scene::FileAccess) -> CrateResult<Plan> {

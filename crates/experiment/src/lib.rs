@@ -52,6 +52,7 @@ mod error;
 pub mod fit;
 pub mod grid;
 pub mod html;
+pub mod merge;
 pub mod plot;
 pub mod reference;
 pub mod report;

@@ -85,6 +85,51 @@ impl Order {
             seed: self.seed,
         }
     }
+
+    /// The job of a slice of this reference, written as the part file `output` whose header
+    /// carries the cache key (for `render merge --plan` to store the merged parts under).
+    pub fn part_job(
+        &self,
+        scene_path: &Path,
+        scene: &rt_core::Scene,
+        output: &Path,
+    ) -> Result<RenderJob> {
+        let req = self.request(scene_path, scene);
+        Ok(job(&req, self.accel, &req.key()?, output))
+    }
+
+    /// The reference from `cache` or rendered ([`obtain`]); call inside the thread pool to
+    /// use.
+    pub fn obtain(
+        &self,
+        scene_path: &Path,
+        scene: &rt_core::Scene,
+        cache: Option<&Cache>,
+        write_to: Option<&Path>,
+        progress: &(dyn Fn(f64) + Sync),
+    ) -> Result<Obtained> {
+        let accel = self.accel.build_scene(scene);
+        let req = self.request(scene_path, scene);
+        obtain(
+            &req,
+            (&self.accel, accel.as_ref()),
+            cache,
+            write_to,
+            progress,
+        )
+    }
+
+    /// One line on where `obtained` came from.
+    pub fn describe(&self, obtained: &Obtained) -> String {
+        let (path, seconds) = (obtained.path.display(), obtained.seconds);
+        if obtained.cached {
+            format!("reference: cached {path} ({seconds:.1} s when rendered)")
+        } else {
+            let (w, h) = (self.camera.width, self.camera.height);
+            let spp = self.spp;
+            format!("reference: rendered {w}x{h} at {spp} spp in {seconds:.1} s -> {path}")
+        }
+    }
 }
 
 /// The render job of the reference `req` with `key` (its cache key, which part headers

@@ -91,15 +91,19 @@ impl ImageSize {
     }
 }
 
+/// `WxH` (or `WXH`, spaces around the numbers allowed) as two numbers, not yet checked
+/// against any limit; `None` when it is not of that form.
+pub fn split_size(s: &str) -> Option<(u32, u32)> {
+    let (w, h) = s.split_once(['x', 'X'])?;
+    Some((w.trim().parse().ok()?, h.trim().parse().ok()?))
+}
+
 /// Parses `WxH` (`--resolution 128x96`).
 pub fn parse_resolution(s: &str) -> Result<(u32, u32), SessionError> {
-    let err = || SessionError::BadSize {
+    let (w, h) = split_size(s).ok_or_else(|| SessionError::BadSize {
         what: "--resolution".into(),
         reason: format!("expected WIDTHxHEIGHT such as 128x96, got \"{s}\""),
-    };
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(err)?;
-    let w: u32 = w.trim().parse().map_err(|_| err())?;
-    let h: u32 = h.trim().parse().map_err(|_| err())?;
+    })?;
     ImageSize::Pixels(w, h).validate("--resolution")?;
     Ok((w, h))
 }

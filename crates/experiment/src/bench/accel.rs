@@ -48,6 +48,44 @@ impl RaySets {
     pub fn any(&self) -> bool {
         self.primary || self.incoherent || self.shadow || self.uniform
     }
+
+    /// The sets `names` asks for (`file`, the ray file's set, is allowed when `file` is true
+    /// and traced anyway); without names all four, or none when there is a ray file.
+    pub fn from_names(names: Option<&[String]>, file: bool) -> Result<Self, RaySetError> {
+        let Some(names) = names else {
+            return Ok(if file { Self::default() } else { Self::ALL });
+        };
+        let mut w = Self::default();
+        for n in names {
+            match n.trim() {
+                "primary" => w.primary = true,
+                "incoherent" => w.incoherent = true,
+                "shadow" => w.shadow = true,
+                "uniform" => w.uniform = true,
+                "file" if file => {}
+                "file" => return Err(RaySetError::NoRayFile),
+                other => return Err(RaySetError::Unknown(other.to_string())),
+            }
+        }
+        if !w.any() && !file {
+            return Err(RaySetError::None);
+        }
+        Ok(w)
+    }
+}
+
+/// Ray set names that do not make a benchmark.
+#[derive(Debug, thiserror::Error, PartialEq, Eq)]
+pub enum RaySetError {
+    /// A name of no set.
+    #[error("unknown ray set \"{0}\" (expected primary, incoherent, shadow, uniform or file)")]
+    Unknown(String),
+    /// The set `file` without a ray file.
+    #[error("the set file needs a ray file")]
+    NoRayFile,
+    /// No set at all.
+    #[error("no ray set given")]
+    None,
 }
 
 /// What to measure.

@@ -317,9 +317,7 @@ impl RenderJob {
         let frames: Vec<(Option<u32>, String)> = match frames {
             None => vec![(None, output)],
             Some(r) => {
-                if !crate::frames::names_frame(&self.output) {
-                    return refuse(format!("{output}: --frames needs an output that names the frame, e.g. -o 'out/frame_{{frame:04}}.exr'"));
-                }
+                super::check_frame_pattern(&self.output)?;
                 r.map(|f| {
                     let path = crate::frames::frame_path(&self.output, f);
                     (Some(f), path.display().to_string())
