@@ -23,9 +23,10 @@
 //!   the temporal metrics of `rt_metrics::temporal`; frames.csv, sequences.csv, plots over
 //!   frames, stills.
 //!
-//! [`run`] does all of it into one output folder. [`bench`] holds the acceleration-structure
-//! benchmarks (`render bench-accel`, `render bench-anim`); [`compare`] the image and sequence
-//! comparisons of `render compare`.
+//! [`run`] does all of it into one output folder. Beside it: [`bench`](mod@bench), the
+//! acceleration-structure benchmarks (`render bench-accel`, `render bench-anim`); [`compare`],
+//! the image and sequence comparisons of `render compare`; [`merge`], part files merged into
+//! an image or the reference cache; [`csv`], the one CSV cell quoting.
 //!
 //! Depends on `rt-session` (progressive rendering of one configuration), `rt-metrics`
 //! (errors, error images), `rt-denoise` (denoisers), `rt-film` (image files), `rt-scene`, `rt-accel`, `rt-integrators` and `rt-core`;
