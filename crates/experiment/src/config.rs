@@ -251,11 +251,7 @@ impl SequencePlan {
 
     /// The camera of frame `f` (the scene already moved to the frame's time), resized.
     pub fn camera_of(&self, scene: &rt_core::Scene) -> Option<Camera> {
-        let c = match &self.camera {
-            Some(name) => scene.cameras.iter().find(|c| &c.name == name)?,
-            None => scene.cameras.first()?,
-        };
-        Some(self.size.apply(c))
+        Some(self.size.apply(scene.camera(self.camera.as_deref())?))
     }
 }
 

@@ -16,20 +16,16 @@ pub fn pick_camera<'s>(
     scene_path: &Path,
     name: Option<&str>,
 ) -> Result<&'s Camera, SessionError> {
-    match name {
-        Some(name) => scene
-            .cameras
-            .iter()
-            .find(|c| c.name == name)
-            .ok_or_else(|| SessionError::NoSuchCamera {
-                file: scene_path.to_path_buf(),
-                name: name.to_string(),
-                cameras: scene.cameras.iter().map(|c| c.name.clone()).collect(),
-            }),
-        None => scene.cameras.first().ok_or_else(|| SessionError::NoCamera {
+    scene.camera(name).ok_or_else(|| match name {
+        Some(name) => SessionError::NoSuchCamera {
             file: scene_path.to_path_buf(),
-        }),
-    }
+            name: name.to_string(),
+            cameras: scene.cameras.iter().map(|c| c.name.clone()).collect(),
+        },
+        None => SessionError::NoCamera {
+            file: scene_path.to_path_buf(),
+        },
+    })
 }
 
 /// How big to render, relative to the camera's own resolution.
