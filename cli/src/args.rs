@@ -30,9 +30,8 @@ pub struct Args {
     #[arg(required_unless_present = "resume")]
     pub scene: Option<PathBuf>,
 
-    /// A Mitsuba scene's parameter: replaces `$NAME` in the file, winning over its
-    /// `<default name="NAME" .../>`. Repeatable.
-    #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = parse_define)]
+    /// A Mitsuba scene's parameter: replaces `$NAME`, winning over its `<default>`. Repeatable.
+    #[arg(short = 'D', value_name = "NAME=VALUE", value_parser = rt_scene::mitsuba::parse_define)]
     pub define: Vec<(String, String)>,
 
     /// Output image; the extension picks the format: .exr (linear float, AOVs as extra
@@ -290,20 +289,6 @@ fn accel_help() -> String {
 pub fn parse_integrator(s: &str) -> Result<IntegratorSpec, String> {
     s.parse()
         .map_err(|e: rt_integrators::IntegratorSpecError| e.to_string())
-}
-
-/// `NAME=VALUE` of `-D`.
-pub fn parse_define(s: &str) -> Result<(String, String), String> {
-    match s.split_once('=') {
-        Some((k, v))
-            if !k.is_empty() && k.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') =>
-        {
-            Ok((k.to_string(), v.to_string()))
-        }
-        _ => Err(format!(
-            "`{s}` is not NAME=VALUE (NAME of letters, digits and _)"
-        )),
-    }
 }
 
 /// Subcommands.

@@ -1,17 +1,13 @@
-//! `render compare A B`: how far image A is from the reference B (MSE, relMSE, RMSE, PSNR,
-//! SSIM from `rt-metrics`), printed as `name value` lines or one JSON object, plus an optional
-//! false-colour error image. With `--frames`, A and B are numbered sequences and
-//! `compare_frames.rs` adds the temporal metrics. Definitions: docs/experiments.md.
+//! `render compare A B`: how far image A is from the reference B, or with `--frames` sequence
+//! A from sequence B with the temporal metrics. The arguments and the checks that need no file
+//! are here; the comparison and the report are `rt_experiment::compare`. Definitions:
+//! docs/experiments.md.
 
-use anyhow::{anyhow, Result};
-use rt_film::read_rgb as load_rgb;
-use rt_metrics::{
-    compare, error_image, CompareOptions, FalseColourOptions, Metrics, MetricsError, RgbImage,
-    Role, DEFAULT_EPSILON, DEFAULT_PEAK,
-};
-use rt_session::frames::names_frame;
-use serde::Serialize;
-use std::path::{Path, PathBuf};
+use anyhow::{anyhow, bail, Result};
+use rt_experiment::compare::{report, sequence_report, CompareError, Comparison, LagReport};
+use rt_metrics::temporal::{lag, LagOptions};
+use rt_metrics::{CompareOptions, DEFAULT_EPSILON, DEFAULT_PEAK};
+use std::path::PathBuf;
 
 /// `render compare` arguments.
 #[derive(clap::Args, Debug)]
@@ -70,24 +66,6 @@ pub struct CompareArgs {
     pub lag_factor: f64,
 }
 
-/// `image` cut to `region` (x0, y0, x1, y1), or a line saying why it cannot be.
-pub(crate) fn crop(image: RgbImage, region: &[usize], path: &Path) -> Result<RgbImage> {
-    let &[x0, y0, x1, y1] = region else {
-        return Err(anyhow!("--region takes four numbers: x0,y0,x1,y1"));
-    };
-    let (w, h) = (image.width(), image.height());
-    if x0 >= x1 || y0 >= y1 || x1 > w || y1 > h {
-        return Err(anyhow!(
-            "--region {x0},{y0},{x1},{y1} is not a non-empty rectangle inside the {w}x{h} image {}",
-            path.display()
-        ));
-    }
-    let px = image.pixels();
-    Ok(RgbImage::from_fn(x1 - x0, y1 - y0, |x, y| {
-        px[(y0 + y) * w + x0 + x]
-    }))
-}
-
 pub(crate) fn positive(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
@@ -97,175 +75,57 @@ pub(crate) fn positive(s: &str) -> Result<f64, String> {
 
 /// Runs `render compare`.
 pub fn run(args: &CompareArgs) -> Result<()> {
-    if let Some(frames) = &args.frames {
-        return crate::compare_frames::run(args, frames.clone());
-    }
-    for path in [&args.test, &args.reference] {
-        if names_frame(path) && !path.exists() {
-            return Err(anyhow!(
-                "{}: names a frame; add --frames S..E to compare sequences",
-                path.display()
-            ));
-        }
-    }
-    let mut test = load_rgb(&args.test)?;
-    let mut reference = load_rgb(&args.reference)?;
-    if let Some(region) = &args.region {
-        test = crop(test, region, &args.test)?;
-        reference = crop(reference, region, &args.reference)?;
-    }
-    let explain = |e| explain(e, &args.test, &args.reference);
-    let opts = CompareOptions {
-        epsilon: args.epsilon,
-        peak: args.peak,
+    let region = match args.region.as_deref().map(<[usize; 4]>::try_from) {
+        Some(Err(_)) => bail!("--region takes four numbers: x0,y0,x1,y1"),
+        r => r.and_then(Result::ok),
     };
-    let metrics = compare(&test, &reference, &opts).map_err(explain)?;
-    if let Some(path) = &args.error_image {
-        let colours = FalseColourOptions {
+    let comparison = Comparison {
+        test: args.test.clone(),
+        reference: args.reference.clone(),
+        region,
+        options: CompareOptions {
             epsilon: args.epsilon,
-            ..Default::default()
-        };
-        let img = error_image(&test, &reference, &colours).map_err(explain)?;
-        rt_film::write_rgb(path, &img, &rt_film::OutputOptions::default())
-            // The message already holds the cause; `{:#}` would print it twice.
-            .map_err(|e| anyhow!("{e}"))?;
-    }
-    print!("{}", report(&metrics, &opts, args.json));
-    Ok(())
-}
-
-/// Restates a metrics error with the file names the user typed.
-pub(crate) fn explain(e: MetricsError, test: &Path, reference: &Path) -> anyhow::Error {
-    let file = |role| match role {
-        Role::Test => test.display(),
-        Role::Reference => reference.display(),
+            peak: args.peak,
+        },
+        error_image: args.error_image.clone(),
     };
-    match e {
-        MetricsError::SizeMismatch {
-            test: (tw, th),
-            reference: (rw, rh),
-        } => anyhow!(
-            "{} is {tw}x{th} but {} is {rw}x{rh}",
-            test.display(),
-            reference.display()
-        ),
-        MetricsError::NonFinite {
-            role,
-            x,
-            y,
-            channel,
-            value,
-        } => anyhow!(
-            "{} has a non-finite value ({value}) at pixel ({x}, {y}), channel {channel}",
-            file(role)
-        ),
-        MetricsError::Empty {
-            role,
-            width,
-            height,
-        } => anyhow!("{} is empty ({width}x{height})", file(role)),
+    let flag = |e: CompareError| match e {
+        CompareError::Region { .. } => anyhow!("--region {e}"),
         other => other.into(),
-    }
-}
-
-/// The JSON form; fields serialise in this order.
-#[derive(Serialize)]
-struct JsonReport {
-    mse: f64,
-    relmse: f64,
-    rmse: f64,
-    /// `None` (null) when the images are identical: JSON has no infinity.
-    psnr: Option<f64>,
-    ssim: f64,
-    relmse_epsilon: f64,
-    psnr_peak: f64,
-}
-
-/// The output: the five metrics in a fixed order, then the settings they depend on. Numbers
-/// are printed in Rust's shortest round-trip form, so they parse back to the same `f64`.
-fn report(m: &Metrics, opts: &CompareOptions, json: bool) -> String {
-    if json {
-        let r = JsonReport {
-            mse: m.mse,
-            relmse: m.relmse,
-            rmse: m.rmse,
-            psnr: m.psnr.is_finite().then_some(m.psnr),
-            ssim: m.ssim,
-            relmse_epsilon: opts.epsilon,
-            psnr_peak: opts.peak,
-        };
-        // Serialising plain numbers cannot fail.
-        serde_json::to_string(&r).unwrap_or_default() + "\n"
-    } else {
-        format!(
-            "mse {}\nrelmse {}\nrmse {}\npsnr {}\nssim {}\nrelmse_epsilon {}\npsnr_peak {}\n",
-            m.mse, m.relmse, m.rmse, m.psnr, m.ssim, opts.epsilon, opts.peak
-        )
-    }
+    };
+    let Some(frames) = args.frames.clone() else {
+        let metrics = comparison.images().map_err(flag)?;
+        print!("{}", report(&metrics, &comparison.options, args.json));
+        return Ok(());
+    };
+    let event = args.event.map(|e| (e, args.lag_window));
+    comparison.check_sequence(&frames, event)?;
+    // check_sequence made sure of two frames.
+    let metrics = comparison.sequences(frames.clone()).map_err(flag)?;
+    let lag = match args.event {
+        None => None,
+        Some(event) => {
+            let opts = LagOptions {
+                factor: args.lag_factor,
+                window: args.lag_window as usize,
+            };
+            let relmse = metrics.per_frame(|m| m.relmse);
+            let lag = lag(&relmse, (event - frames.start) as usize, &opts)
+                .map_err(|e| anyhow!("--event {event}: {e}"))?;
+            Some(LagReport { event, lag, opts })
+        }
+    };
+    let opts = &comparison.options;
+    print!(
+        "{}",
+        sequence_report(frames.start, &metrics, lag.as_ref(), opts, args.json)
+    );
+    Ok(())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    const M: Metrics = Metrics {
-        mse: 0.25,
-        relmse: 0.5,
-        rmse: 0.5,
-        psnr: f64::INFINITY,
-        ssim: 0.75,
-    };
-
-    #[test]
-    fn text_report() {
-        let text = report(&M, &CompareOptions::default(), false);
-        assert_eq!(
-            text,
-            "mse 0.25\nrelmse 0.5\nrmse 0.5\npsnr inf\nssim 0.75\n\
-             relmse_epsilon 0.01\npsnr_peak 1\n"
-        );
-    }
-
-    #[test]
-    fn json_report() {
-        let text = report(&M, &CompareOptions::default(), true);
-        assert_eq!(
-            text,
-            "{\"mse\":0.25,\"relmse\":0.5,\"rmse\":0.5,\"psnr\":null,\"ssim\":0.75,\
-             \"relmse_epsilon\":0.01,\"psnr_peak\":1.0}\n"
-        );
-        let finite = Metrics { psnr: 6.0, ..M };
-        assert!(report(&finite, &CompareOptions::default(), true).contains("\"psnr\":6.0"));
-    }
-
-    #[test]
-    fn errors_name_the_files() {
-        let (a, b) = (Path::new("A.exr"), Path::new("B.exr"));
-        let e = explain(
-            MetricsError::SizeMismatch {
-                test: (64, 64),
-                reference: (32, 32),
-            },
-            a,
-            b,
-        );
-        assert_eq!(e.to_string(), "A.exr is 64x64 but B.exr is 32x32");
-        let e = explain(
-            MetricsError::NonFinite {
-                role: Role::Reference,
-                x: 3,
-                y: 4,
-                channel: 'G',
-                value: f32::NAN,
-            },
-            a,
-            b,
-        );
-        assert_eq!(
-            e.to_string(),
-            "B.exr has a non-finite value (NaN) at pixel (3, 4), channel G"
-        );
-    }
 
     #[test]
     fn options_must_be_positive() {

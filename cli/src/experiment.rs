@@ -44,11 +44,7 @@ pub struct ExperimentArgs {
 /// Runs `render experiment`.
 pub fn run(args: &ExperimentArgs) -> Result<()> {
     let wall = Instant::now();
-    let access = match &args.confine {
-        Some(dir) => rt_scene::FileAccess::confined_to(dir)?,
-        None => rt_scene::FileAccess::open(),
-    };
-    let plan = rt_experiment::config::load_with(&args.config, &access)?;
+    let plan = rt_experiment::config::load_confined(&args.config, args.confine.as_deref())?;
     if args.check {
         for w in &plan.warnings {
             eprintln!("warning: {w}");
@@ -79,24 +75,10 @@ pub fn run(args: &ExperimentArgs) -> Result<()> {
     let cache = Cache::new(&args.cache);
     let outcome = pool.install(|| rt_experiment::run(&plan, &out, &cache, &progress))?;
     progress.finish();
-    for e in &outcome.equal_time {
-        if let Some((p, wins)) = e.overall() {
-            progress.message(&format!(
-                "{}: lowest relMSE at equal time: {} ({wins} of {} times)",
-                plan.scenes[e.scene].name,
-                plan.methods[plan.pairs[p].method].name,
-                e.table.len()
-            ));
-        }
+    for line in outcome.winners(&plan) {
+        progress.message(&line);
     }
-    let runs = match &outcome.sequences {
-        Some(s) => format!(
-            "{} frames of {} sequences",
-            s.frames.len(),
-            s.sequences.len()
-        ),
-        None => format!("{} runs", outcome.results.rows.len()),
-    };
+    let runs = outcome.runs();
     progress.message(&format!(
         "{runs} in {:.1} s; to look at them, open {}",
         wall.elapsed().as_secs_f64(),

@@ -1,21 +1,15 @@
 //! `render`: the command-line front end. It parses arguments (clap), calls the libraries and
-//! prints: `render SCENE` turns its flags into an `rt_session::RenderJob` and runs it
-//! (`render.rs`); `render plan`, `render part` and `render merge` (`parts.rs`) cut, run and
-//! merge jobs; `render reference` and `render experiment` (`reference.rs`, `experiment.rs`)
-//! call `rt-experiment`; `render bench-accel` (`bench_accel/`) and `render bench-anim`
-//! (`bench_anim.rs`) measure the acceleration structures; `render compare` (`compare.rs`,
-//! `compare_frames.rs`) measures the error of one image against another, or the per-frame and
-//! temporal errors of a sequence; `render denoise` filters a saved frame; `render stress`
-//! (`stress.rs`) runs the numerical stress suite; `render view` (`view/`) is the real-time
-//! mode: a window, or a headless sequence within a per-frame time budget. All error reporting
-//! to the user happens here: libraries return typed errors, this turns them into one line on
-//! stderr and a non-zero exit code (2 for usage errors, 1 for everything else).
+//! prints. `render SCENE` turns its flags into an `rt_session::RenderJob` and runs it
+//! (`render.rs`); `plan`, `part` and `merge` (`parts.rs`) cut, run and merge jobs; `reference`,
+//! `experiment`, `compare`, `bench-accel` and `bench-anim` call `rt-experiment`; `stress` calls
+//! `rt-validate`; `view` (`view/`) drives an `rt_session::viewer::LiveView` from a window or
+//! headless. Libraries return typed errors; this turns them into one line on stderr and a
+//! non-zero exit code (2 for usage errors, 1 for everything else).
 
 mod args;
 mod bench_accel;
 mod bench_anim;
 mod compare;
-mod compare_frames;
 mod convert;
 mod denoise;
 mod experiment;
@@ -65,7 +59,7 @@ pub(crate) fn run(args: &args::Args) -> anyhow::Result<()> {
         Some(args::Command::Part(p)) => parts::part(p),
         Some(args::Command::Convert(c)) => convert::run(c),
         Some(args::Command::GenScene { name, output }) => {
-            bench_accel::input::write_obj(name, output)
+            Ok(rt_experiment::bench::input::write_obj(name, output)?)
         }
         None => render::run(args),
     }

@@ -7,8 +7,9 @@
 use crate::args::Args;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Parser;
-use rt_parts::{Plan, PlanRequest, PlannedRender};
-use rt_session::{Frames, RenderJob, Slice};
+use rt_experiment::merge::{merge_files, merge_plan, Merged};
+use rt_parts::{Plan, PlanRequest};
+use rt_session::RenderJob;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
@@ -38,9 +39,15 @@ pub fn merge(m: &MergeArgs) -> Result<()> {
         Some(s) => Some(rt_session::memory::parse_size(s)?),
         None => rt_session::memory::available(),
     };
+    let mut print = |merged: &Merged| {
+        if !m.quiet {
+            println!("{merged}");
+        }
+    };
     let Some(plan_path) = &m.plan else {
         let output = m.output.as_ref().expect("clap requires -o without --plan");
-        return merge_files(&m.parts, output, false, limit, m.quiet);
+        print(&merge_files(&m.parts, output, false, limit)?);
+        return Ok(());
     };
     let plan = read_plan(plan_path)?;
     let [dir] = &m.parts[..] else {
@@ -49,51 +56,7 @@ pub fn merge(m: &MergeArgs) -> Result<()> {
             m.parts.len()
         );
     };
-    for out in &plan.outputs {
-        let files: Vec<PathBuf> = out
-            .parts
-            .iter()
-            .map(|&i| dir.join(&plan.parts[i].file))
-            .collect();
-        let output = Path::new(&out.output);
-        merge_files(&files, output, out.into_cache, limit, m.quiet)?;
-    }
-    Ok(())
-}
-
-/// Merges `files` into `output` (or, `into_cache`, into the reference cache directory
-/// `output`, where `render reference` and experiments find it).
-fn merge_files(
-    files: &[PathBuf],
-    output: &Path,
-    into_cache: bool,
-    limit: Option<u64>,
-    quiet: bool,
-) -> Result<()> {
-    let parts = rt_session::job::read_parts(files)?;
-    let t = std::time::Instant::now();
-    if into_cache {
-        let (path, s) = rt_experiment::Cache::new(output).store_parts(&parts, limit)?;
-        if !quiet {
-            println!(
-                "merged {} parts of the reference of {} ({}x{}, {} spp, {:.1} s of rendering) -> {}",
-                parts.len(),
-                s.scene,
-                s.width,
-                s.height,
-                s.spp,
-                s.seconds,
-                path.display()
-            );
-        }
-        return Ok(());
-    }
-    let report = rt_session::job::merge(&parts, output, limit)?;
-    if !quiet {
-        let secs = t.elapsed().as_secs_f64();
-        println!("{report} in {secs:.2} s -> {}", output.display());
-    }
-    Ok(())
+    Ok(merge_plan(&plan, dir, limit, &mut print)?)
 }
 
 /// `render plan`.
@@ -103,7 +66,7 @@ pub struct PlanArgs {
     pub scene: PathBuf,
     /// Tiles of W×H pixels (the last column and row take what is left). [default: the whole
     /// image]
-    #[arg(long, value_name = "WxH", value_parser = parse_tile)]
+    #[arg(long, value_name = "WxH", value_parser = rt_session::camera::parse_tiles)]
     pub tiles: Option<(u32, u32)>,
     /// Cut the samples of every pixel into K ranges.
     #[arg(long, value_name = "K", default_value_t = 1)]
@@ -129,16 +92,6 @@ pub struct PlanArgs {
     /// -o out.exr` (its -o is the merged image's path); the plan stores the job they make.
     #[arg(last = true)]
     pub render_args: Vec<String>,
-}
-
-fn parse_tile(s: &str) -> Result<(u32, u32), String> {
-    let bad = || format!("--tiles must be WxH with positive integers, got `{s}`");
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
-    let (w, h): (u32, u32) = (w.parse().map_err(|_| bad())?, h.parse().map_err(|_| bad())?);
-    if w == 0 || h == 0 {
-        return Err(bad());
-    }
-    Ok((w, h))
 }
 
 /// `args` as `render` parses them (the program name added).
@@ -190,83 +143,17 @@ fn render_request(p: &PlanArgs) -> Result<PlanRequest> {
     let scene = rt_session::load_scene(&p.scene, confine, &args.define)?;
     let mut job = crate::render::job(&args, &scene.loaded)?;
     job.confine = confine.map(Path::to_path_buf);
-    let camera = rt_session::pick_camera(&scene.loaded.scene, &job.scene, job.camera.as_deref())?;
-    let camera = job.size.apply(camera);
-    let output = job.output.display().to_string();
-    let frames: Vec<(Option<u32>, String)> = match &p.frames {
-        None => vec![(None, output.clone())],
-        Some(r) => {
-            if !rt_session::frames::names_frame(&job.output) {
-                bail!("{output}: --frames needs an output that names the frame, e.g. -o 'out/frame_{{frame:04}}.exr'");
-            }
-            r.clone()
-                .map(|f| {
-                    let path = rt_session::frames::frame_path(&job.output, f);
-                    (Some(f), path.display().to_string())
-                })
-                .collect()
-        }
-    };
-    Ok(PlanRequest {
-        render: PlannedRender {
-            job: job.to_json(),
-            width: camera.width,
-            height: camera.height,
-            spp: job.settings.spp,
-        },
-        into_cache: false,
-        frames,
-        tile: p.tiles,
-        sample_splits: p.sample_splits,
-    })
+    let frames = p.frames.clone();
+    Ok(job.plan_request(&scene.loaded.scene, frames, p.tiles, p.sample_splits)?)
 }
 
-/// The references an experiment renders, each a reference job cut as `p` asks and merged
-/// into the cache. Sequence scenes (one reference per frame) are refused for now.
+/// The references an experiment renders, merged into the cache (`rt_experiment::reference`).
 fn experiment_requests(p: &PlanArgs) -> Result<Vec<PlanRequest>> {
-    let access = match &p.confine {
-        Some(dir) => rt_scene::FileAccess::confined_to(dir)?,
-        None => rt_scene::FileAccess::open(),
-    };
-    let exp = rt_experiment::config::load_with(&p.scene, &access)?;
-    let mut requests = Vec::new();
-    for scene in &exp.scenes {
-        let rt_experiment::config::ReferencePlan::Render {
-            spp,
-            estimator,
-            seed,
-            accel,
-        } = &scene.reference
-        else {
-            continue;
-        };
-        let req = scene.reference_request(*estimator, *spp, *seed);
-        if scene.sequence.is_some() {
-            bail!(
-                "{}: scene {}: the per-frame references of a sequence are not plannable yet",
-                p.scene.display(),
-                scene.name
-            );
-        }
-        let mut job = rt_experiment::reference::job(&req, *accel, &req.key()?, &p.cache);
-        job.confine = p.confine.clone();
-        requests.push(PlanRequest {
-            render: PlannedRender {
-                job: job.to_json(),
-                width: scene.camera.width,
-                height: scene.camera.height,
-                spp: req.spp,
-            },
-            into_cache: true,
-            frames: vec![(None, p.cache.display().to_string())],
-            tile: p.tiles,
-            sample_splits: p.sample_splits,
-        });
-    }
-    if requests.is_empty() {
-        bail!("{}: the experiment renders no reference", p.scene.display());
-    }
-    Ok(requests)
+    let exp = rt_experiment::config::load_confined(&p.scene, p.confine.as_deref())?;
+    let (confine, tiles, splits) = (p.confine.as_deref(), p.tiles, p.sample_splits);
+    Ok(rt_experiment::reference::plan_requests(
+        &exp, &p.cache, confine, tiles, splits,
+    )?)
 }
 
 fn read_plan(path: &Path) -> Result<Plan> {
@@ -304,14 +191,7 @@ pub fn part(p: &PartArgs) -> Result<()> {
     };
     std::fs::create_dir_all(&p.output)
         .with_context(|| format!("{}: cannot create the parts directory", p.output.display()))?;
-    let mut job = RenderJob::from_json(&plan.renders[part.render].job)
+    let job = RenderJob::for_part(&plan, part, &p.output)
         .map_err(|e| anyhow!("{}: {e}", p.plan.display()))?;
-    let [a, b] = part.samples;
-    job.slice = Slice {
-        samples: Some(a..b),
-        region: Some(part.region),
-    };
-    job.frames = part.frame.map_or(Frames::Still, Frames::One);
-    job.output = p.output.join(&part.file);
     crate::render::run_job(&job, None, p.quiet, false)
 }

@@ -4,9 +4,9 @@
 
 use crate::progress::Progress;
 use anyhow::{anyhow, bail, Result};
-use rt_experiment::{Cache, ReferenceRequest, DEFAULT_CACHE_DIR};
+use rt_experiment::{Cache, DEFAULT_CACHE_DIR};
 use rt_integrators::IntegratorSpec;
-use rt_session::{parse_resolution, pick_camera, ImageSize, Overrides};
+use rt_session::{parse_resolution, ImageSize, Overrides};
 use std::path::PathBuf;
 
 /// `render reference` arguments.
@@ -138,33 +138,18 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
         accel,
         ..Overrides::default()
     };
-    let estimator = overrides.integrator_spec(&loaded.render, &args.scene)?;
-    if estimator.build().splats() {
-        anyhow::bail!(
-            "{}: integrator `{}` splats light paths and keeps no per-pixel variance; render references with a camera-ray integrator (wavefront, path, path-bsdf, direct, ao)",
-            args.scene.display(),
-            estimator.kind
-        );
-    }
-    let accel_spec = overrides.accel_spec(loaded, &args.scene)?;
-    let camera = size.apply(pick_camera(
-        &loaded.scene,
+    let order = rt_experiment::reference::Order::new(
         &args.scene,
+        loaded,
+        &overrides,
         args.camera.as_deref(),
-    )?);
-    let req = ReferenceRequest {
-        scene_path: &args.scene,
-        scene: &loaded.scene,
-        camera: &camera,
-        estimator,
-        spp: args.spp,
-        seed: overrides.seed(&loaded.render),
-    };
+        size,
+        args.spp,
+    )?;
     if part {
-        // A slice of the reference, as a part file whose header carries the cache key for
-        // `render merge --plan` to store the merged parts under.
+        // A slice of the reference, as a part file.
         let out = args.output.as_ref().expect("a part has an output");
-        let mut job = rt_experiment::reference::job(&req, accel_spec, &req.key()?, out);
+        let mut job = order.part_job(&args.scene, &loaded.scene, out)?;
         job.slice = rt_session::Slice {
             samples: args.sample_range.clone(),
             region: args.region.map(|r| [r.x0, r.y0, r.x1, r.y1]),
@@ -181,32 +166,18 @@ pub fn run(args: &ReferenceArgs) -> Result<()> {
     );
     let cache = (!args.no_cache).then(|| Cache::new(&args.cache));
     let obtained = pool.install(|| {
-        let accel = accel_spec.build_scene(&loaded.scene);
-        rt_experiment::reference::obtain(
-            &req,
-            (&accel_spec, accel.as_ref()),
+        let progress = |f: f64| progress.bar().set_position((f * 1000.0) as u64);
+        let (path, scene) = (&args.scene, &loaded.scene);
+        order.obtain(
+            path,
+            scene,
             cache.as_ref(),
             args.output.as_deref(),
-            &|f| progress.bar().set_position((f * 1000.0) as u64),
+            &progress,
         )
     })?;
     progress.finish();
-    if obtained.cached {
-        progress.message(&format!(
-            "reference: cached {} ({:.1} s when rendered)",
-            obtained.path.display(),
-            obtained.seconds
-        ));
-    } else {
-        progress.message(&format!(
-            "reference: rendered {}x{} at {} spp in {:.1} s -> {}",
-            camera.width,
-            camera.height,
-            args.spp,
-            obtained.seconds,
-            obtained.path.display()
-        ));
-    }
+    progress.message(&order.describe(&obtained));
     let printed = match &args.output {
         Some(out) if obtained.path != *out => {
             rt_film::copy_atomic(&obtained.path, out)?;

@@ -10,8 +10,6 @@ use rt_session::{
     Checkpointing, FrameReport, Frames, GreeJob, JobError, JobScene, JobSink, Overrides, RenderJob,
     Rendered, Slice, StopRule, MAX_SPP,
 };
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// The job the flags describe, for the scene `loaded` (read from `args.scene`).
@@ -114,11 +112,12 @@ pub fn run_job(
     quiet: bool,
     stats: bool,
 ) -> Result<()> {
-    let (stop, signal) = if job.checkpoint.is_some() {
-        watch_signals()?
+    let signals = if job.checkpoint.is_some() {
+        rt_session::signals::StopOnSignal::watch()?
     } else {
         Default::default()
     };
+    let stop = &signals.stop;
     let printer = Printer {
         bar: Progress::new(
             quiet,
@@ -129,8 +128,8 @@ pub fn run_job(
         stats,
     };
     let result = match scene {
-        Some((scene, load)) => job.run_loaded(scene, load, &printer, &stop),
-        None => job.run(&printer, &stop),
+        Some((scene, load)) => job.run_loaded(scene, load, &printer, stop),
+        None => job.run(&printer, stop),
     };
     printer.bar.finish();
     match result {
@@ -150,7 +149,7 @@ pub fn run_job(
             let ck = checkpoint.display();
             Err(anyhow!(
                 "interrupted by {} after {samples} of {spp} samples per pixel: wrote {} and the checkpoint {ck} (render --resume {ck} continues)",
-                signal_name(signal.load(Ordering::Relaxed)),
+                signals.signal_name(),
                 output.display()
             ))
         }
@@ -191,29 +190,5 @@ impl JobSink for Printer {
             }
         });
         self.bar.bar().set_position(0);
-    }
-}
-
-/// Watches SIGINT and SIGTERM: the first sets the stop flag, which the render reads at the
-/// next pass; a second ends the process at once (exit status 130). Returns the flag and the
-/// signal that set it.
-fn watch_signals() -> Result<(Arc<AtomicBool>, Arc<AtomicUsize>)> {
-    use signal_hook::consts::{SIGINT, SIGTERM};
-    let which = Arc::new(AtomicUsize::new(0));
-    let stop = Arc::new(AtomicBool::new(false));
-    for sig in [SIGINT, SIGTERM] {
-        // Registered first, so it runs before `stop` is set by this same signal.
-        signal_hook::flag::register_conditional_shutdown(sig, 130, stop.clone())?;
-        signal_hook::flag::register(sig, stop.clone())?;
-        signal_hook::flag::register_usize(sig, which.clone(), sig as usize)?;
-    }
-    Ok((stop, which))
-}
-
-fn signal_name(sig: usize) -> &'static str {
-    match sig as i32 {
-        signal_hook::consts::SIGINT => "SIGINT",
-        signal_hook::consts::SIGTERM => "SIGTERM",
-        _ => "a signal",
     }
 }

@@ -6,7 +6,7 @@
 //! stress tests".
 
 use anyhow::{bail, Result};
-use rt_validate::stress::{cases_named, Budget};
+use rt_validate::stress::{cases_named, run_cases, Budget};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -64,14 +64,7 @@ pub fn run(args: &StressArgs) -> Result<()> {
         args.seed
     );
     let start = Instant::now();
-    let mut failed = Vec::new();
-    for case in &cases {
-        let report = pool.install(|| case.run(&budget, args.seed));
-        println!("{report}");
-        if !report.passed() {
-            failed.push(report.name);
-        }
-    }
+    let failed = run_cases(&cases, &budget, args.seed, &pool, &mut |r| println!("{r}"));
     println!(
         "{} passed, {} failed ({:.1} s)",
         cases.len() - failed.len(),

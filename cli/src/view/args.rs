@@ -121,12 +121,9 @@ impl ViewArgs {
         let Some(s) = &self.size else {
             return Ok(None);
         };
-        let bad = || anyhow::anyhow!("--size must be WIDTHxHEIGHT such as 256x256, got `{s}`");
-        let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
-        let (w, h) = (
-            w.trim().parse().map_err(|_| bad())?,
-            h.trim().parse().map_err(|_| bad())?,
-        );
+        let (w, h) = rt_session::split_size(s).ok_or_else(|| {
+            anyhow::anyhow!("--size must be WIDTHxHEIGHT such as 256x256, got `{s}`")
+        })?;
         rt_session::ImageSize::Pixels(w, h).validate("--size")?;
         Ok(Some((w, h)))
     }
@@ -146,20 +143,15 @@ impl ViewArgs {
             bail!("--spp must be at least 1");
         }
         if let Some(out) = &self.output {
-            if !out.to_string_lossy().contains("{frame") {
+            if !rt_session::frames::names_frame(out) {
                 bail!(
                     "{}: -o must name the frame, e.g. -o 'out/f_{{frame:04}}.png'",
                     out.display()
                 );
             }
-            match out
-                .extension()
-                .and_then(|e| e.to_str())
-                .map(str::to_ascii_lowercase)
-                .as_deref()
-            {
-                Some("png") | Some("exr") => {}
-                _ => bail!("{}: output must end in .png or .exr", out.display()),
+            let ext = out.extension().and_then(|e| e.to_str()).unwrap_or("");
+            if !["png", "exr"].iter().any(|e| ext.eq_ignore_ascii_case(e)) {
+                bail!("{}: output must end in .png or .exr", out.display());
             }
         }
         Ok(())

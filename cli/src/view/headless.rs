@@ -1,17 +1,18 @@
 //! `render view --headless`: the viewer's frames without a window, one animation frame per
 //! rendered frame, through the scene camera, optionally within a per-frame time budget
-//! (`rt_session::SequenceRenderer::run` renders them). Prints a line per frame (unless -q),
+//! (`rt_session::viewer::LiveView::run` renders them). Prints a line per frame (unless -q),
 //! writes `-o` files (not counted in the frame time) and the run's summary: frames per second,
 //! mean and worst frame time, mean spp per frame and, with a budget, how many frames overran
 //! it.
 
-use super::{View, ViewArgs};
-use anyhow::{Context, Result};
+use super::ViewArgs;
+use anyhow::{anyhow, Context, Result};
 use rt_film::OutputOptions;
 use rt_session::frames::frame_path;
+use rt_session::viewer::LiveView;
 
 /// Renders `args.frames`.
-pub fn run(args: &ViewArgs, mut view: View) -> Result<()> {
+pub fn run(args: &ViewArgs, mut view: LiveView) -> Result<()> {
     let path = view.path.display().to_string();
     let denoiser = view.denoiser.clone();
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1000.0;
@@ -39,7 +40,8 @@ pub fn run(args: &ViewArgs, mut view: View) -> Result<()> {
             );
         }
         Ok(())
-    })?;
+    });
+    let summary = summary.map_err(|e: anyhow::Error| anyhow!("{path}: {e}"))?;
     println!("{path}: {summary}");
     Ok(())
 }

@@ -6,14 +6,14 @@
 //! frame has its own sample streams; with `--step` each rendered frame is the next animation
 //! frame at `--fps`. The animation plays once and holds its last pose; `R` restarts it (and the
 //! denoiser's history). Until the mouse first drags or zooms, the view follows the scene's
-//! (possibly animated) camera; from then on it is the orbit (`orbit.rs`), which starts from the
-//! scene camera as it was at that moment. Left drag turns about the look-at point, the wheel
+//! (possibly animated) camera; from then on it is the orbit (`rt_session::viewer::orbit`),
+//! which starts from the scene camera as it was at that moment. Left drag turns about the look-at point, the wheel
 //! zooms, `Escape`/`Q` or closing the window quits. The title shows frames per second.
 
-use super::orbit::Orbit;
-use super::tonemap::blit;
-use super::{View, ViewArgs};
+use super::ViewArgs;
 use anyhow::{anyhow, bail, Result};
+use rt_session::viewer::display::blit;
+use rt_session::viewer::LiveView;
 use std::num::NonZeroU32;
 use std::rc::Rc;
 use std::time::{Duration, Instant};
@@ -49,7 +49,7 @@ pub fn check_display() -> Result<()> {
 }
 
 /// Opens the window and runs until it closes.
-pub fn run(args: &ViewArgs, view: View) -> Result<()> {
+pub fn run(args: &ViewArgs, view: LiveView) -> Result<()> {
     let display = std::env::var("DISPLAY").unwrap_or_default();
     let event_loop = EventLoop::new().map_err(|e| {
         anyhow!("render view: cannot open X display {display}: {e}; use --headless to render without a window")
@@ -69,80 +69,39 @@ type Surface = softbuffer::Surface<Rc<Window>, Rc<Window>>;
 
 struct App<'a> {
     args: &'a ViewArgs,
-    view: View,
+    view: LiveView,
     window: Option<(Rc<Window>, Surface)>,
-    /// `None` while the view follows the scene camera.
-    orbit: Option<Orbit>,
     dragging: bool,
     cursor: Option<PhysicalPosition<f64>>,
-    /// When the animation (re)started.
-    started: Instant,
-    /// The last animation frame rendered.
-    frame: Option<u32>,
     last_frame_at: Option<Instant>,
     /// Frames and time since the title last changed.
     counted: (u32, Instant),
-    last_spp: u32,
     error: Option<anyhow::Error>,
 }
 
 impl<'a> App<'a> {
-    fn new(args: &'a ViewArgs, view: View) -> Self {
-        let now = Instant::now();
+    fn new(args: &'a ViewArgs, mut view: LiveView) -> Self {
+        view.set_stepping(args.step);
         App {
             args,
             view,
             window: None,
-            orbit: None,
             dragging: false,
             cursor: None,
-            started: now,
-            frame: None,
             last_frame_at: None,
-            counted: (0, now),
-            last_spp: 0,
+            counted: (0, Instant::now()),
             error: None,
         }
     }
 
     fn title(&self, fps: Option<f64>) -> String {
-        let name = self
-            .view
-            .path
-            .file_name()
-            .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-        let fps = fps.map_or_else(|| "-".to_string(), |f| format!("{f:.1}"));
-        let time = self.view.time_of(self.frame.unwrap_or(0));
-        format!(
-            "render view: {name}: {fps} fps, {} spp, {}, t = {time:.2} s",
-            self.last_spp.max(self.view.spp),
-            self.view.denoiser
-        )
-    }
-
-    /// The next animation frame number.
-    fn next_frame(&self) -> u32 {
-        let after = self.frame.map_or(0, |f| f.saturating_add(1));
-        if self.args.step {
-            return after;
-        }
-        let ms = self.started.elapsed().as_millis().min(u128::from(u32::MAX)) as u32;
-        ms.max(after)
+        format!("render view: {}", self.view.status(fps))
     }
 
     /// Renders the next frame and shows it.
     fn draw(&mut self) -> Result<()> {
-        let f = self.next_frame();
-        let scene_camera = self.view.scene_camera(f)?;
-        let (w, h) = self.view.size;
-        let camera = match &self.orbit {
-            Some(o) => o.camera(&scene_camera, w, h),
-            None => scene_camera,
-        };
         self.last_frame_at = Some(Instant::now());
-        let out = self.view.render(f, &camera)?;
-        self.frame = Some(f);
-        self.last_spp = out.spp;
+        let out = self.view.render_next()?;
         let Some((window, surface)) = &mut self.window else {
             return Ok(());
         };
@@ -178,16 +137,6 @@ impl<'a> App<'a> {
         Ok(())
     }
 
-    /// The orbit, starting from the scene camera as it is now the first time it is needed.
-    fn orbit(&mut self) -> Result<Orbit> {
-        if let Some(o) = self.orbit {
-            return Ok(o);
-        }
-        let f = self.frame.unwrap_or(0);
-        let c = self.view.scene_camera(f)?;
-        Ok(Orbit::from_camera(&c))
-    }
-
     fn fail(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
         self.error = Some(e);
         event_loop.exit();
@@ -219,7 +168,7 @@ impl ApplicationHandler for App<'_> {
             Ok((window, surface)) => {
                 window.request_redraw();
                 self.window = Some((window, surface));
-                self.started = Instant::now();
+                self.view.restart();
             }
             Err(e) => self.fail(event_loop, e),
         }
@@ -244,9 +193,7 @@ impl ApplicationHandler for App<'_> {
                     Key::Named(NamedKey::Escape) => event_loop.exit(),
                     Key::Character(c) if c.eq_ignore_ascii_case("q") => event_loop.exit(),
                     Key::Character(c) if c.eq_ignore_ascii_case("r") => {
-                        self.view.reset();
-                        self.frame = None;
-                        self.started = Instant::now();
+                        self.view.restart();
                     }
                     _ => {}
                 }
@@ -263,11 +210,10 @@ impl ApplicationHandler for App<'_> {
             WindowEvent::CursorMoved { position, .. } => {
                 let moved = self.cursor.replace(position);
                 match moved {
-                    Some(from) if self.dragging => self.orbit().map(|o| {
-                        self.orbit = Some(
-                            o.dragged((position.x - from.x) as f32, (position.y - from.y) as f32),
-                        );
-                    }),
+                    Some(from) if self.dragging => {
+                        let (dx, dy) = (position.x - from.x, position.y - from.y);
+                        self.view.drag(dx as f32, dy as f32).map_err(Into::into)
+                    }
                     _ => Ok(()),
                 }
             }
@@ -276,7 +222,7 @@ impl ApplicationHandler for App<'_> {
                     MouseScrollDelta::LineDelta(_, y) => y,
                     MouseScrollDelta::PixelDelta(p) => p.y as f32 / PIXELS_PER_LINE,
                 };
-                self.orbit().map(|o| self.orbit = Some(o.zoomed(lines)))
+                self.view.zoom(lines).map_err(Into::into)
             }
             WindowEvent::RedrawRequested => self.draw(),
             _ => Ok(()),

@@ -204,6 +204,15 @@ impl Scene {
             })
     }
 
+    /// The camera named `name`, or the first when `name` is `None`: the one camera-by-name
+    /// lookup (callers add their own error).
+    pub fn camera(&self, name: Option<&str>) -> Option<&Camera> {
+        match name {
+            Some(name) => self.cameras.iter().find(|c| c.name == name),
+            None => self.cameras.first(),
+        }
+    }
+
     /// Number of triangles.
     pub fn triangle_count(&self) -> usize {
         self.triangles.len()

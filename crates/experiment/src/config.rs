@@ -251,11 +251,7 @@ impl SequencePlan {
 
     /// The camera of frame `f` (the scene already moved to the frame's time), resized.
     pub fn camera_of(&self, scene: &rt_core::Scene) -> Option<Camera> {
-        let c = match &self.camera {
-            Some(name) => scene.cameras.iter().find(|c| &c.name == name)?,
-            None => scene.cameras.first()?,
-        };
-        Some(self.size.apply(c))
+        Some(self.size.apply(scene.camera(self.camera.as_deref())?))
     }
 }
 
@@ -418,6 +414,15 @@ fn check_ao(d: Option<f32>) -> Result<Option<f32>, String> {
 /// the file's name.
 pub fn load(path: &Path) -> CrateResult<Plan> {
     load_with(path, &rt_scene::FileAccess::open())
+}
+
+/// [`load_with`] confined to the directory `confine` (`--confine`), or reading anything.
+pub fn load_confined(path: &Path, confine: Option<&Path>) -> CrateResult<Plan> {
+    let access = match confine {
+        Some(dir) => rt_scene::FileAccess::confined_to(dir)?,
+        None => rt_scene::FileAccess::open(),
+    };
+    load_with(path, &access)
 }
 
 /// [`load`], reading only the files `access` allows (`--confine`): the experiment file, its

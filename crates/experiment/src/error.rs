@@ -34,6 +34,9 @@ pub enum ExperimentError {
     /// A setting, camera or image size that cannot be rendered.
     #[error(transparent)]
     Session(#[from] rt_session::SessionError),
+    /// A job (a merge, a reference's render) that failed.
+    #[error(transparent)]
+    Job(#[from] rt_session::JobError),
     /// An image that cannot be read or written.
     #[error(transparent)]
     Image(#[from] rt_film::FilmError),

@@ -23,7 +23,10 @@
 //!   the temporal metrics of `rt_metrics::temporal`; frames.csv, sequences.csv, plots over
 //!   frames, stills.
 //!
-//! [`run`] does all of it into one output folder.
+//! [`run`] does all of it into one output folder. Beside it: [`bench`](mod@bench), the
+//! acceleration-structure benchmarks (`render bench-accel`, `render bench-anim`); [`compare`],
+//! the image and sequence comparisons of `render compare`; [`merge`], part files merged into
+//! an image or the reference cache; [`csv`], the one CSV cell quoting.
 //!
 //! Depends on `rt-session` (progressive rendering of one configuration), `rt-metrics`
 //! (errors, error images), `rt-denoise` (denoisers), `rt-film` (image files), `rt-scene`, `rt-accel`, `rt-integrators` and `rt-core`;
@@ -41,12 +44,16 @@
 //! ```
 #![forbid(unsafe_code)]
 
+pub mod bench;
 pub mod cache;
+pub mod compare;
 pub mod config;
+pub mod csv;
 mod error;
 pub mod fit;
 pub mod grid;
 pub mod html;
+pub mod merge;
 pub mod plot;
 pub mod reference;
 pub mod report;
@@ -148,6 +155,36 @@ pub struct Outcome {
     pub html: PathBuf,
     /// A sequence experiment's measurements (then `results` holds no rows).
     pub sequences: Option<sequence::SequenceResults>,
+}
+
+impl Outcome {
+    /// Per scene, the method with the lowest relMSE at equal time most often, one line each.
+    pub fn winners(&self, plan: &Plan) -> Vec<String> {
+        let mut lines = Vec::new();
+        for e in &self.equal_time {
+            if let Some((p, wins)) = e.overall() {
+                lines.push(format!(
+                    "{}: lowest relMSE at equal time: {} ({wins} of {} times)",
+                    plan.scenes[e.scene].name,
+                    plan.methods[plan.pairs[p].method].name,
+                    e.table.len()
+                ));
+            }
+        }
+        lines
+    }
+
+    /// What ran: `N runs`, or `N frames of M sequences`.
+    pub fn runs(&self) -> String {
+        match &self.sequences {
+            Some(s) => format!(
+                "{} frames of {} sequences",
+                s.frames.len(),
+                s.sequences.len()
+            ),
+            None => format!("{} runs", self.results.rows.len()),
+        }
+    }
 }
 
 /// Runs `plan` (its file is copied beside the results) into the folder `out`

@@ -73,15 +73,6 @@ pub fn floor(reference: &Reference, epsilon: f64) -> Option<Floor> {
     })
 }
 
-/// A CSV cell holding `t`, quoted when it has a comma or a quote (RFC 4180).
-fn csv_text(t: &str) -> String {
-    if t.contains([',', '"', '\n']) {
-        format!("\"{}\"", t.replace('"', "\"\""))
-    } else {
-        t.to_string()
-    }
-}
-
 fn num(v: f64) -> String {
     if v.is_nan() {
         String::new()
@@ -145,7 +136,7 @@ pub fn results_csv(plan: &Plan, results: &Results) -> String {
                 plan.methods[pair.method]
                     .denoiser
                     .as_ref()
-                    .map_or(String::new(), |d| csv_text(&d.to_string())),
+                    .map_or(String::new(), |d| crate::csv::field(&d.to_string())),
                 row.denoise_seconds,
                 row.total_seconds(),
                 cell(|m| m.mse),

@@ -22,13 +22,15 @@ use std::path::{Path, PathBuf};
 pub type Target = fn(&[u8]);
 
 /// The fuzz targets by name, as in `fuzz/fuzz_targets/`, `fuzz/seeds/` and `fuzz/corpus/`.
-pub const TARGETS: [(&str, Target); 10] = [
+pub const TARGETS: [(&str, Target); 12] = [
     ("scene_toml", scene_toml),
+    ("mitsuba_xml", mitsuba_xml),
     ("experiment_toml", experiment_toml),
     ("obj", obj),
     ("gltf", gltf),
     ("glb", glb),
     ("ra2", ra2),
+    ("ply", ply),
     ("exr", exr),
     ("image", image),
     ("part", part),
@@ -55,6 +57,14 @@ fn with_file(name: &str, data: &[u8], load: impl FnOnce(&Path)) {
 /// files it names are missing (their loaders have targets of their own).
 pub fn scene_toml(data: &[u8]) {
     with_file("scene.toml", data, |p| {
+        let _ = rt_scene::load(p);
+    });
+}
+
+/// A Mitsuba scene file (`rt_scene::load` of a `.xml`), alone in its directory like
+/// [`scene_toml`]'s.
+pub fn mitsuba_xml(data: &[u8]) {
+    with_file("scene.xml", data, |p| {
         let _ = rt_scene::load(p);
     });
 }
@@ -90,6 +100,13 @@ pub fn glb(data: &[u8]) {
 /// A `.ra2` triangle file.
 pub fn ra2(data: &[u8]) {
     with_file("mesh.ra2", data, |p| {
+        let _ = rt_scene::load_mesh(p);
+    });
+}
+
+/// A Stanford PLY mesh.
+pub fn ply(data: &[u8]) {
+    with_file("mesh.ply", data, |p| {
         let _ = rt_scene::load_mesh(p);
     });
 }

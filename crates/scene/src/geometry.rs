@@ -6,7 +6,7 @@ use crate::desc::{GeometryDesc, TransformDesc, V3};
 use crate::error::{Result, SceneError};
 use crate::load::{finite3, Ctx};
 use crate::material::MaterialTable;
-use crate::{gltf, obj, raw, shapes};
+use crate::{gltf, obj, ply, raw, shapes};
 use glam::{Vec2, Vec3};
 use rt_core::scene::Object;
 use rt_core::transform::Transform;
@@ -382,10 +382,11 @@ fn load_file(
         "obj" => obj::load(path, want_materials, &mut ctx.textures, &mut ctx.warnings),
         "gltf" | "glb" => gltf::load(path, want_materials, &mut ctx.textures, &mut ctx.warnings),
         "ra2" => raw::load(ctx.textures.access(), path),
+        "ply" => ply::load(ctx.textures.access(), path),
         _ => Err(ctx.src.error_at(
             f.span(),
             format!(
-                "cannot load \"{}\": unknown mesh format (use .obj, .gltf, .glb or .ra2)",
+                "cannot load \"{}\": unknown mesh format (use .obj, .ply, .gltf, .glb or .ra2)",
                 f.get_ref()
             ),
         )),
@@ -973,7 +974,7 @@ mod tests {
             ),
             (
                 "file = \"a.stl\"",
-                "cannot load \"a.stl\": unknown mesh format (use .obj, .gltf, .glb or .ra2)",
+                "cannot load \"a.stl\": unknown mesh format (use .obj, .ply, .gltf, .glb or .ra2)",
             ),
             ("file = \"missing.obj\"", "missing.obj: cannot open"),
             ("file = \"missing.glb\"", "missing.glb: cannot open"),

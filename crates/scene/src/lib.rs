@@ -65,6 +65,7 @@ mod material;
 mod microfacet;
 pub mod mitsuba;
 mod obj;
+mod ply;
 pub mod procedural;
 pub mod raw;
 mod shapes;

@@ -186,8 +186,8 @@ fn unsupported_elements_and_parameters_are_one_line_at_their_position() {
             "s.xml:8:1: emitter \"point\" is not supported",
         ),
         (
-            r#"<shape type="ply"><string name="filename" value="a.ply"/></shape>"#,
-            "s.xml:8:1: shape \"ply\" is not supported",
+            r#"<shape type="serialized"><string name="filename" value="a.serialized"/></shape>"#,
+            "s.xml:8:1: shape \"serialized\" is not supported",
         ),
         (
             r#"<shape type="cube"><bsdf type="diffuse"><rgb name="reflectance" value="1, 2"/></bsdf></shape>"#,
@@ -331,4 +331,23 @@ fn a_texture_on_a_plastic_base_is_its_colour() {
         );
         assert!(textured != white, "{base}: the control must differ");
     }
+}
+
+#[test]
+fn ply_shapes_load() {
+    let dir = tempfile::tempdir().unwrap();
+    let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    std::fs::write(dir.path().join("t.ply"), ply).unwrap();
+    let body = r#"<shape type="ply"><string name="filename" value="t.ply"/>
+        <transform name="to_world"><translate z="-1"/></transform></shape>"#;
+    std::fs::write(dir.path().join("s.xml"), scene("3.0.0", body)).unwrap();
+    let s = rt_scene::load(&dir.path().join("s.xml")).unwrap();
+    assert_eq!(
+        s.scene.triangles,
+        vec![[
+            Vec3::new(0.0, 0.0, -1.0),
+            Vec3::new(1.0, 0.0, -1.0),
+            Vec3::new(0.0, 1.0, -1.0)
+        ]]
+    );
 }

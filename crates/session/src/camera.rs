@@ -16,20 +16,16 @@ pub fn pick_camera<'s>(
     scene_path: &Path,
     name: Option<&str>,
 ) -> Result<&'s Camera, SessionError> {
-    match name {
-        Some(name) => scene
-            .cameras
-            .iter()
-            .find(|c| c.name == name)
-            .ok_or_else(|| SessionError::NoSuchCamera {
-                file: scene_path.to_path_buf(),
-                name: name.to_string(),
-                cameras: scene.cameras.iter().map(|c| c.name.clone()).collect(),
-            }),
-        None => scene.cameras.first().ok_or_else(|| SessionError::NoCamera {
+    scene.camera(name).ok_or_else(|| match name {
+        Some(name) => SessionError::NoSuchCamera {
             file: scene_path.to_path_buf(),
-        }),
-    }
+            name: name.to_string(),
+            cameras: scene.cameras.iter().map(|c| c.name.clone()).collect(),
+        },
+        None => SessionError::NoCamera {
+            file: scene_path.to_path_buf(),
+        },
+    })
 }
 
 /// How big to render, relative to the camera's own resolution.
@@ -91,15 +87,26 @@ impl ImageSize {
     }
 }
 
+/// `WxH` (or `WXH`, spaces around the numbers allowed) as two numbers, not yet checked
+/// against any limit; `None` when it is not of that form.
+pub fn split_size(s: &str) -> Option<(u32, u32)> {
+    let (w, h) = s.split_once(['x', 'X'])?;
+    Some((w.trim().parse().ok()?, h.trim().parse().ok()?))
+}
+
+/// Parses a tile grid `WxH` (`render plan --tiles 4x2`): both positive.
+pub fn parse_tiles(s: &str) -> Result<(u32, u32), String> {
+    split_size(s)
+        .filter(|&(w, h)| w > 0 && h > 0)
+        .ok_or_else(|| format!("--tiles must be WxH with positive integers, got `{s}`"))
+}
+
 /// Parses `WxH` (`--resolution 128x96`).
 pub fn parse_resolution(s: &str) -> Result<(u32, u32), SessionError> {
-    let err = || SessionError::BadSize {
+    let (w, h) = split_size(s).ok_or_else(|| SessionError::BadSize {
         what: "--resolution".into(),
         reason: format!("expected WIDTHxHEIGHT such as 128x96, got \"{s}\""),
-    };
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(err)?;
-    let w: u32 = w.trim().parse().map_err(|_| err())?;
-    let h: u32 = h.trim().parse().map_err(|_| err())?;
+    })?;
     ImageSize::Pixels(w, h).validate("--resolution")?;
     Ok((w, h))
 }

@@ -13,7 +13,9 @@
 //! - [`progressive`]: a list of budgets, samples per pixel or seconds, rendered pass after pass
 //!   into one film ([`Session`], [`Budgets`], [`Checkpoint`]), as experiments measure them.
 //! - [`sequence`]: an animation rendered frame after frame, denoised by a denoiser that may
-//!   remember earlier frames (SVGF), with the guide pass in between ([`SequenceRenderer`]).
+//!   remember earlier frames (SVGF), with the guide pass in between ([`SequenceRenderer`]);
+//!   [`viewer`]: the same frame after frame under a user's hand ([`viewer::LiveView`], the
+//!   orbit camera, window pixels).
 //! - [`gree`]: GREE over the renderer; [`worldcache`]: the world-space cache behind the
 //!   integrators' cache seam; [`memory`]: the memory estimate a job checks; [`frames`]: frame
 //!   file names.
@@ -53,13 +55,15 @@ pub mod progressive;
 pub mod report;
 pub mod sequence;
 pub mod settings;
+pub mod signals;
 mod text;
+pub mod viewer;
 pub mod worldcache;
 
 pub use adaptive::{
     render_adaptive, Adaptive, StopReason, StopRule, StopRuleError, FIRST_DECISION_SPP,
 };
-pub use camera::{parse_resolution, pick_camera, ImageSize, MAX_SIDE};
+pub use camera::{parse_resolution, pick_camera, split_size, ImageSize, MAX_SIDE};
 pub use gree::{gree_aovs, render_gree, GreeRun, GreeRunError, GreeSpec};
 pub use job::{
     load_scene, Checkpointing, FrameReport, Frames, GreeJob, JobError, JobReport, JobScene,

@@ -265,11 +265,8 @@ impl SequenceRenderer {
         for f in frames {
             let t = Instant::now();
             scene.set_time(self.time_of(f));
-            let camera = match &self.camera {
-                Some(name) => scene.cameras.iter().find(|c| &c.name == name),
-                None => scene.cameras.first(),
-            }
-            .ok_or_else(|| SequenceError::NoCamera(self.camera.clone().unwrap_or_default()))?;
+            let camera = (scene.camera(self.camera.as_deref()))
+                .ok_or_else(|| SequenceError::NoCamera(self.camera.clone().unwrap_or_default()))?;
             let (w, h) = size.unwrap_or((camera.width, camera.height));
             let camera = camera.resized(w, h);
             let out = self.render_with(scene, f, Some(&camera))?;
@@ -309,19 +306,12 @@ impl SequenceRenderer {
         times.update = t.elapsed();
         let camera = match camera {
             Some(c) => c.clone(),
-            None => match &self.camera {
-                Some(name) => scene
-                    .cameras
-                    .iter()
-                    .find(|c| &c.name == name)
-                    .cloned()
-                    .ok_or_else(|| SequenceError::NoCamera(name.clone()))?,
-                None => scene
-                    .cameras
-                    .first()
-                    .cloned()
-                    .ok_or_else(|| SequenceError::NoCamera("(none)".into()))?,
-            },
+            None => scene
+                .camera(self.camera.as_deref())
+                .cloned()
+                .ok_or_else(|| {
+                    SequenceError::NoCamera(self.camera.clone().unwrap_or_else(|| "(none)".into()))
+                })?,
         };
         let accel = self.accel.as_deref().expect("built above");
         let ctx = Ctx {

@@ -35,6 +35,7 @@
 
 pub mod anim;
 mod file;
+mod list;
 pub mod measure;
 mod rng;
 mod sets;
@@ -42,5 +43,6 @@ mod sets;
 pub use file::{
     decode, dump, encode, read_rays, read_set, write_rays, FormatError, RayFileError, RAY_BYTES,
 };
+pub use list::{contenders, ListError};
 pub use rng::{ray_rng, RayRng};
 pub use sets::{generate, uniform, Generated, Lights, Query, RaySet, SET_NAMES};

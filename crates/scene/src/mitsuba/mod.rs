@@ -89,6 +89,37 @@ fn same_directory(a: &Path, b: &Path) -> bool {
     }
 }
 
+/// Translates the Mitsuba scene at `path` and writes the TOML to `output` atomically
+/// (`render convert`); returns the warnings.
+pub fn convert_file(
+    path: &Path,
+    output: &Path,
+    defines: &[(String, String)],
+) -> Result<Vec<String>, SceneError> {
+    if !crate::is_mitsuba(path) {
+        return Err(SceneError::file(path, "not a Mitsuba scene file (.xml)"));
+    }
+    let out_dir = output.parent().unwrap_or(Path::new(""));
+    let converted = to_toml(path, Some(out_dir), &FileAccess::open(), defines)?;
+    rt_film::write_bytes_atomic(output, converted.toml.as_bytes())
+        .map_err(|e| SceneError::file(output, format!("cannot write: {e}")))?;
+    Ok(converted.warnings)
+}
+
+/// `NAME=VALUE` of `-D` (NAME of ASCII letters, digits and `_`).
+pub fn parse_define(s: &str) -> Result<(String, String), String> {
+    match s.split_once('=') {
+        Some((k, v))
+            if !k.is_empty() && k.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') =>
+        {
+            Ok((k.to_string(), v.to_string()))
+        }
+        _ => Err(format!(
+            "`{s}` is not NAME=VALUE (NAME of letters, digits and _)"
+        )),
+    }
+}
+
 /// Loads the Mitsuba scene at `path` (through its TOML translation).
 pub fn load(
     path: &Path,

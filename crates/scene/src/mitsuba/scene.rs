@@ -306,7 +306,7 @@ impl<'a> Builder<'a, '_> {
         g.insert("name".into(), name.clone().into());
         let mut m = p.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
         match ty {
-            "obj" => {
+            "obj" | "ply" => {
                 let file = p
                     .string("filename")?
                     .ok_or_else(|| p.error("has no filename"))?;
@@ -348,7 +348,7 @@ impl<'a> Builder<'a, '_> {
             }
             other => {
                 return Err(n.at.error(format!(
-                    "shape \"{other}\" is not supported (obj, rectangle, cube, disk and sphere are)"
+                    "shape \"{other}\" is not supported (obj, ply, rectangle, cube, disk and sphere are)"
                 )))
             }
         }

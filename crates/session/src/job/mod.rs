@@ -408,11 +408,7 @@ impl RenderJob {
             check_fps(self.fps)?;
         }
         if let Frames::Range(r) = &self.frames {
-            if !crate::frames::names_frame(&self.output) {
-                return refuse(format!(
-                    "{out}: --frames needs an output that names the frame, e.g. -o 'out/frame_{{frame:04}}.exr'"
-                ));
-            }
+            check_frame_pattern(&self.output)?;
             if r.is_empty() {
                 return refuse(format!("frames {}..{}: no frame", r.start, r.end));
             }
@@ -468,6 +464,17 @@ impl RenderJob {
         map.extend(self.labels.clone());
         map
     }
+}
+
+/// Refuses, for a sequence, an output that does not name the frame.
+pub(crate) fn check_frame_pattern(output: &Path) -> Result<(), JobError> {
+    if crate::frames::names_frame(output) {
+        return Ok(());
+    }
+    refuse(format!(
+        "{}: --frames needs an output that names the frame, e.g. -o 'out/frame_{{frame:04}}.exr'",
+        output.display()
+    ))
 }
 
 /// Frames per second: a positive finite number.

@@ -299,3 +299,61 @@ pub(crate) fn write_denoised(
     rt_film::write_rgb(output, &image, &OutputOptions { exposure })
         .map_err(|e| JobError::Failed(e.to_string()))
 }
+
+impl RenderJob {
+    /// What a plan needs of this job over `scene` (loaded from the job's scene): the job, its
+    /// image size and samples, and one output per frame of `frames` (the job's output must
+    /// then name the frame), cut into `tile`s and `sample_splits` sample ranges.
+    pub fn plan_request(
+        &self,
+        scene: &rt_core::Scene,
+        frames: Option<Range<u32>>,
+        tile: Option<(u32, u32)>,
+        sample_splits: u32,
+    ) -> Result<rt_parts::PlanRequest, JobError> {
+        let camera = crate::pick_camera(scene, &self.scene, self.camera.as_deref())?;
+        let camera = self.size.apply(camera);
+        let output = self.output.display().to_string();
+        let frames: Vec<(Option<u32>, String)> = match frames {
+            None => vec![(None, output)],
+            Some(r) => {
+                super::check_frame_pattern(&self.output)?;
+                r.map(|f| {
+                    let path = crate::frames::frame_path(&self.output, f);
+                    (Some(f), path.display().to_string())
+                })
+                .collect()
+            }
+        };
+        Ok(rt_parts::PlanRequest {
+            render: rt_parts::PlannedRender {
+                job: self.to_json(),
+                width: camera.width,
+                height: camera.height,
+                spp: self.settings.spp,
+            },
+            into_cache: false,
+            frames,
+            tile,
+            sample_splits,
+        })
+    }
+
+    /// The job that renders `part` of `plan` into the directory `dir`: the plan's job with the
+    /// part's frame, samples, pixels and file.
+    pub fn for_part(
+        plan: &rt_parts::Plan,
+        part: &rt_parts::PlannedPart,
+        dir: &Path,
+    ) -> Result<RenderJob, JobError> {
+        let mut job = RenderJob::from_json(&plan.renders[part.render].job)?;
+        let [a, b] = part.samples;
+        job.slice = super::Slice {
+            samples: Some(a..b),
+            region: Some(part.region),
+        };
+        job.frames = part.frame.map_or(super::Frames::Still, super::Frames::One);
+        job.output = dir.join(&part.file);
+        Ok(job)
+    }
+}

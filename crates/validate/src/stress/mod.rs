@@ -238,6 +238,26 @@ impl Case {
     }
 }
 
+/// Runs `cases` in order on `pool`, handing each report to `each`; returns the names of the
+/// cases that failed.
+pub fn run_cases(
+    cases: &[Case],
+    budget: &Budget,
+    seed: u64,
+    pool: &rayon::ThreadPool,
+    each: &mut dyn FnMut(&CaseReport),
+) -> Vec<String> {
+    let mut failed = Vec::new();
+    for case in cases {
+        let report = pool.install(|| case.run(budget, seed));
+        each(&report);
+        if !report.passed() {
+            failed.push(report.name);
+        }
+    }
+    failed
+}
+
 /// Every case, in report order.
 pub fn cases() -> Vec<Case> {
     let mut v = transform::cases();

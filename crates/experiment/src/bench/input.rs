@@ -1,6 +1,6 @@
 //! The benchmark's geometry: a TOML scene, a bare mesh file, or a procedural scene.
 
-use anyhow::{bail, Context, Result};
+use super::BenchError;
 use rt_core::{glam::Vec3, Aabb, Camera, Scene};
 use std::io::Write;
 use std::path::Path;
@@ -24,7 +24,7 @@ pub struct Input {
 }
 
 /// Where the automatic camera of a mesh stands.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum View {
     /// Outside the bounds, seeing every vertex (scanned objects: bunny, dragon).
     Outside,
@@ -39,59 +39,43 @@ const DEFAULT_WIDTH: u32 = 512;
 /// Largest primary ray grid (the renderer's image limits).
 pub use rt_core::limits::{MAX_IMAGE_PIXELS as MAX_PIXELS, MAX_IMAGE_SIDE as MAX_SIDE};
 
-/// Loads `input`: `gen:NAME`, a `.toml` scene, or a mesh file.
-pub fn load(input: &str, camera: Option<&str>) -> Result<Input> {
+/// Loads `input`: `gen:NAME`, a `.toml` scene, or a mesh file; `camera` picks a scene's camera
+/// by name (the first by default; a mesh has none).
+pub fn load(input: &str, camera: Option<&str>) -> Result<Input, BenchError> {
     let path = Path::new(input);
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
         .unwrap_or_default();
+    let refuse = |message: String| BenchError::Input {
+        input: input.to_string(),
+        message,
+    };
     let (loaded, is_mesh) = if input.starts_with("gen:") || ext == "toml" {
         (rt_session::load_scene(path, None, &[])?.loaded, false)
     } else if MESH_EXTENSIONS.contains(&ext.as_str()) {
-        (
-            rt_scene::load_mesh(path).map_err(|e| anyhow::anyhow!("{e}"))?,
-            true,
-        )
+        (rt_scene::load_mesh(path)?, true)
     } else {
-        bail!(
-            "{input}: unknown input type (expected a .toml scene, a .obj, .gltf, .glb or .ra2 \
-             mesh, or gen:NAME with NAME one of {})",
+        return Err(refuse(format!(
+            "unknown input type (expected a .toml scene, a .obj, .gltf, .glb or .ra2 mesh, or \
+             gen:NAME with NAME one of {})",
             rt_scene::procedural::NAMES.join(", ")
-        );
+        )));
     };
     let scene = loaded.scene;
     let bounds = Aabb::from_points(scene.triangles.iter().flatten());
     if scene.triangles.is_empty() || bounds.is_empty() {
-        bail!("{input}: the scene has no triangles");
+        return Err(refuse("the scene has no triangles".into()));
     }
     let radius = 0.5 * bounds.extent().length();
     let camera = if is_mesh {
-        if let Some(name) = camera {
-            bail!("--camera {name}: a mesh file has no cameras (an automatic one is used)");
+        if camera.is_some() {
+            return Err(BenchError::MeshCamera);
         }
         rt_scene::views::outside_view(&scene.triangles, &bounds)
     } else {
-        match camera {
-            Some(name) => scene
-                .cameras
-                .iter()
-                .find(|c| c.name == name)
-                .cloned()
-                .with_context(|| {
-                    let names: Vec<&str> = scene.cameras.iter().map(|c| c.name.as_str()).collect();
-                    format!(
-                        "{input}: no camera named \"{name}\" (cameras: {})",
-                        names.join(", ")
-                    )
-                })?,
-            None => scene
-                .cameras
-                .first()
-                .cloned()
-                .with_context(|| format!("{input}: the scene has no camera"))?,
-        }
+        rt_session::pick_camera(&scene, path, camera)?.clone()
     };
     Ok(Input {
         name: input.to_string(),
@@ -105,7 +89,11 @@ pub fn load(input: &str, camera: Option<&str>) -> Result<Input> {
 }
 
 /// The primary ray grid: as given, or derived from the camera's aspect ratio.
-pub fn resolution(camera: &Camera, width: Option<u32>, height: Option<u32>) -> Result<(u32, u32)> {
+pub fn resolution(
+    camera: &Camera,
+    width: Option<u32>,
+    height: Option<u32>,
+) -> Result<(u32, u32), BenchError> {
     let aspect = camera.height as f64 / camera.width as f64;
     let from = |v: u32, a: f64| ((v as f64 * a).round() as u32).max(1);
     let (w, h) = match (width, height) {
@@ -115,20 +103,25 @@ pub fn resolution(camera: &Camera, width: Option<u32>, height: Option<u32>) -> R
         (None, None) => (DEFAULT_WIDTH, from(DEFAULT_WIDTH, aspect)),
     };
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE || w as u64 * h as u64 > MAX_PIXELS {
-        bail!(
-            "--width/--height: {w}x{h} primary rays: each side must be in [1, {MAX_SIDE}] and \
-             width*height at most {MAX_PIXELS}"
-        );
+        return Err(BenchError::Resolution {
+            width: w,
+            height: h,
+        });
     }
     Ok((w, h))
 }
 
-/// `render gen-scene NAME -o FILE.obj`: the procedural scene's triangles as OBJ, one `o` per
-/// part, vertices not shared, coordinates printed exactly (shortest round-trip decimal).
-pub fn write_obj(name: &str, output: &Path) -> Result<()> {
-    let scene =
-        rt_scene::procedural::generate(name).map_err(|e| anyhow::anyhow!("gen:{name}: {e}"))?;
-    let fail = |e: std::io::Error| anyhow::anyhow!("{}: cannot write: {e}", output.display());
+/// The procedural scene `name`'s triangles as OBJ, one `o` per part, vertices not shared,
+/// coordinates printed exactly (shortest round-trip decimal).
+pub fn write_obj(name: &str, output: &Path) -> Result<(), BenchError> {
+    let scene = rt_scene::procedural::generate(name).map_err(|e| BenchError::Input {
+        input: format!("gen:{name}"),
+        message: e.to_string(),
+    })?;
+    let fail = |source| BenchError::Io {
+        path: output.to_path_buf(),
+        source,
+    };
     let file = std::fs::File::create(output).map_err(fail)?;
     let mut w = std::io::BufWriter::new(file);
     writeln!(
