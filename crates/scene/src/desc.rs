@@ -110,6 +110,8 @@ pub(crate) struct EnvironmentDesc {
     pub strength: Option<Spanned<f32>>,
     /// The Preetham daylight sky with a sun.
     pub sky: Option<Spanned<SkyDesc>>,
+    /// A rotation of `map` (3 rows): world directions into the map's frame.
+    pub rotation: Option<Spanned<[[f32; 3]; 3]>>,
 }
 
 /// `[environment] sky = { ... }`: the sun by direction, or by date, time and place.

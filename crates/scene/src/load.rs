@@ -169,6 +169,11 @@ fn environment(ctx: &Ctx, env: &Spanned<EnvironmentDesc>) -> Result<Environment>
         )
     };
     if let Some(sky_desc) = &e.sky {
+        if let Some(r) = &e.rotation {
+            return Err(ctx
+                .src
+                .error_at(r.span(), "environment rotation turns a `map`, not a `sky`"));
+        }
         if color != Rgb::ZERO {
             return Err(ctx.src.error_at(
                 e.color.as_ref().map_or(sky_desc.span(), |c| c.span()),
@@ -205,6 +210,12 @@ fn environment(ctx: &Ctx, env: &Spanned<EnvironmentDesc>) -> Result<Environment>
         }
         return Ok(Environment::Map(map));
     }
+    if let (Some(r), None) = (&e.rotation, &e.map) {
+        return Err(ctx.src.error_at(
+            r.span(),
+            "environment rotation turns a `map`; there is none",
+        ));
+    }
     let Some(map) = &e.map else {
         let radiance = color * strength;
         if radiance.max_element() > MAX_RADIANCE {
@@ -231,7 +242,28 @@ fn environment(ctx: &Ctx, env: &Spanned<EnvironmentDesc>) -> Result<Environment>
             return Err(too_bright(*t, span));
         }
     }
-    Ok(Environment::Map(EnvMap::new(w, h, texels)))
+    let mut env_map = EnvMap::new(w, h, texels);
+    if let Some(r) = &e.rotation {
+        env_map = env_map.rotated(rotation(ctx, r)?);
+    }
+    Ok(Environment::Map(env_map))
+}
+
+/// `[environment] rotation`: three rows of a proper rotation (orthonormal within 1e-4,
+/// determinant +1).
+fn rotation(ctx: &Ctx, r: &Spanned<[[f32; 3]; 3]>) -> Result<glam::Mat3> {
+    let m = glam::Mat3::from_cols_array_2d(r.get_ref()).transpose();
+    let ortho = (m * m.transpose() - glam::Mat3::IDENTITY)
+        .to_cols_array()
+        .iter()
+        .all(|v| v.abs() < 1e-4);
+    if !ortho || m.determinant() < 0.0 {
+        return Err(ctx.src.error_at(
+            r.span(),
+            "environment rotation must be a rotation (orthonormal rows, no mirror)",
+        ));
+    }
+    Ok(m)
 }
 
 /// `[environment] sky`: the sun from `sun_direction` or from a date, time and place; every

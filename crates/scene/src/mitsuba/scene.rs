@@ -446,8 +446,8 @@ impl<'a> Builder<'a, '_> {
         Ok(done)
     }
 
-    /// `constant` lights the scene from every direction; other emitters outside shapes are
-    /// not supported yet.
+    /// `constant` and `envmap` light the scene from every direction; other emitters outside
+    /// shapes are not supported yet.
     fn environment(&mut self, e: &Node) -> Result<(), SceneError> {
         let p = Props::new(e);
         match e.plugin()? {
@@ -469,10 +469,48 @@ impl<'a> Builder<'a, '_> {
                 );
                 self.environment = Some(t);
             }
+            "envmap" => {
+                let file = p
+                    .string("filename")?
+                    .ok_or_else(|| p.error("has no filename"))?;
+                if !file.to_ascii_lowercase().ends_with(".exr") {
+                    return Err(p.error(format!("\"{file}\": only OpenEXR maps are supported")));
+                }
+                if self.environment.is_some() {
+                    return Err(p.error("a second environment emitter"));
+                }
+                let mut t = Table::new();
+                t.insert("map".into(), (self.file_name)(file).into());
+                if let Some(scale) = p.float("scale")? {
+                    t.insert("strength".into(), scale.into());
+                }
+                let m = p.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
+                let r = glam::DMat3::from_mat4(m);
+                let orthonormal = (r * r.transpose() - glam::DMat3::IDENTITY)
+                    .to_cols_array()
+                    .iter()
+                    .all(|v| v.abs() < 1e-4);
+                if !orthonormal || r.determinant() < 0.0 {
+                    return Err(p.error("to_world must be a rotation"));
+                }
+                // Our map is Mitsuba's turned half a turn about +y (docs/scene-format.md,
+                // `tools/reference/toml_to_mitsuba.py`): world → our map frame is S·M⁻¹.
+                let s = glam::DMat3::from_diagonal(DVec3::new(-1.0, 1.0, -1.0));
+                let to_map = s * r.transpose();
+                let identity = (to_map - glam::DMat3::IDENTITY)
+                    .to_cols_array()
+                    .iter()
+                    .all(|v| v.abs() < 1e-9);
+                if !identity {
+                    let rows: Vec<Value> = (0..3).map(|i| arr(to_map.row(i))).collect();
+                    t.insert("rotation".into(), Value::Array(rows));
+                }
+                self.environment = Some(t);
+            }
             other => {
                 return Err(e.at.error(format!(
-                "emitter \"{other}\" is not supported (area emitters on shapes and constant are)"
-            )))
+                    "emitter \"{other}\" is not supported (area emitters on shapes, constant and envmap are)"
+                )))
             }
         }
         p.finish(self.warnings)
