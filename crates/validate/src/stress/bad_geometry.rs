@@ -1,7 +1,7 @@
 //! Scenes of bad geometry and bad values, rendered by every integrator: no NaN or infinity in
 //! any output, no discarded sample, no panic. Finite is not enough (an all-black image is
 //! finite): the closed boxes must be exactly black, every lit scene must have a positive image
-//! mean no brighter than its sources allow and (all but two, [`Light::Unreferenced`]) the
+//! mean no brighter than its sources allow and (all but two, `Light::Unreferenced`) the
 //! image mean of bidirectional path tracing within noise, and the open box, lit by the sky
 //! through its missing face, must match `albedo · AO` under direct lighting and lie between
 //! that and the sky under path tracing. A half-energy path tracer fails every case but those
