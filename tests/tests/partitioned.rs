@@ -7,7 +7,7 @@
 use rt_film::AovSet;
 use rt_integrators::{PartitionOptions, Partitioned};
 use rt_testkit::agreement::{path_reference, reference_blocks, technique_blocks};
-use rt_testkit::stats::{compare_estimates, Comparison, ALPHA};
+use rt_testkit::stats::{compare_estimates, Comparison, Estimate, ALPHA};
 use rt_testkit::{shipped_scene, Renderer, SceneExt};
 
 const SIZE: u32 = 24;
@@ -24,11 +24,26 @@ fn unclamped() -> PartitionOptions {
 /// The block z-test at block scale: the partitioned renderer's pixels are correlated (one VPL
 /// lights many), so its block variances come from the spread of block means over 16 runs.
 fn compare(scene: &rt_core::Scene, spp: u32, dropped: f64, o: PartitionOptions) -> Comparison {
-    let reference = reference_blocks(&path_reference(scene, DEPTH, 2048), SIZE, BLOCK);
+    compare_with(&reference(scene), scene, spp, dropped, o)
+}
+
+/// The path tracer's block means and variances (2048 spp).
+fn reference(scene: &rt_core::Scene) -> Estimate {
+    reference_blocks(&path_reference(scene, DEPTH, 2048), SIZE, BLOCK)
+}
+
+/// [`compare`] against a reference already rendered.
+fn compare_with(
+    reference: &Estimate,
+    scene: &rt_core::Scene,
+    spp: u32,
+    dropped: f64,
+    o: PartitionOptions,
+) -> Comparison {
     let t = Partitioned::new(DEPTH, o);
     let c = compare_estimates(
         &technique_blocks(scene, &t, 16, spp, dropped, BLOCK),
-        &reference,
+        reference,
         SIZE / BLOCK,
         1,
         ALPHA,
@@ -88,12 +103,13 @@ fn partitioned_is_deterministic_across_threads() {
 fn the_default_clamp_agrees_with_path_tracing() {
     let scene = shipped_scene("cornell-box.toml").with_resolution(SIZE, SIZE);
     let default = PartitionOptions::default();
-    let shipped = compare(&scene, 32, 0.0, default);
+    let reference = reference(&scene);
+    let shipped = compare_with(&reference, &scene, 32, 0.0, default);
     let coarse = PartitionOptions {
         clamp: 0.15,
         ..PartitionOptions::default()
     };
-    let control = compare(&scene, 32, 0.0, coarse);
+    let control = compare_with(&reference, &scene, 32, 0.0, coarse);
     let total = |o: PartitionOptions| -> f64 {
         let t = Partitioned::new(DEPTH, o);
         let (film, _) =
