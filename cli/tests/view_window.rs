@@ -98,8 +98,9 @@ fn mean_and_sd(pixels: &[[u8; 3]]) -> (f64, f64) {
     (mean, var.sqrt())
 }
 
-#[test]
-fn the_window_shows_a_rendered_image_and_closes_cleanly() {
+/// A virtual X server on a free display: its process (killed on drop) and the display name;
+/// `None` (after printing why) where Xvfb is missing and `RT_SKIP_XVFB=1`.
+fn xvfb() -> Option<(Kill, String)> {
     let Some(xvfb) = find_in_path("Xvfb") else {
         if std::env::var("RT_SKIP_XVFB").as_deref() == Ok("1") {
             // The real standard error: libtest captures the print! family.
@@ -107,7 +108,7 @@ fn the_window_shows_a_rendered_image_and_closes_cleanly() {
                 std::io::stderr(),
                 "skipping: Xvfb is not installed (RT_SKIP_XVFB=1)"
             );
-            return;
+            return None;
         }
         panic!("Xvfb is not installed: run .ci/setup (Debian package xvfb), or set RT_SKIP_XVFB=1 to skip");
     };
@@ -128,11 +129,18 @@ fn the_window_shows_a_rendered_image_and_closes_cleanly() {
         .spawn()
         .unwrap();
     let stdout = server.stdout.take().unwrap();
-    let mut procs = Kill(vec![server]);
+    let procs = Kill(vec![server]);
     let mut line = String::new();
     BufReader::new(stdout).read_line(&mut line).unwrap();
-    let display = format!(":{}", line.trim());
     assert!(line.trim().parse::<u32>().is_ok(), "Xvfb printed {line:?}");
+    Some((procs, format!(":{}", line.trim())))
+}
+
+#[test]
+fn the_window_shows_a_rendered_image_and_closes_cleanly() {
+    let Some((mut procs, display)) = xvfb() else {
+        return;
+    };
 
     let root = workspace_root();
     let viewer = Command::new(env!("CARGO_BIN_EXE_render"))
@@ -263,4 +271,151 @@ fn workspace_root() -> PathBuf {
         .parent()
         .unwrap()
         .to_path_buf()
+}
+
+/// Four emitting quadrants filling the view, black where they do not emit: every pixel inside
+/// a quadrant sees only its emission, whatever the sample, so a frame is the same bits at any
+/// frame number and seed except along the quadrants' edges.
+const QUADRANTS: &str = r#"
+[[camera]]
+name = "c"
+position = [0.0, 0.0, 2.0]
+look_at = [0.0, 0.0, 0.0]
+fov = 60.0
+resolution = [256, 256]
+
+[[material]]
+name = "a"
+color = [0.0, 0.0, 0.0]
+emission = [0.8, 0.2, 0.1]
+two_sided = true
+
+[[material]]
+name = "b"
+color = [0.0, 0.0, 0.0]
+emission = [0.1, 0.6, 0.2]
+two_sided = true
+
+[[material]]
+name = "c"
+color = [0.0, 0.0, 0.0]
+emission = [0.2, 0.3, 0.9]
+two_sided = true
+
+[[material]]
+name = "d"
+color = [0.0, 0.0, 0.0]
+emission = [0.5, 0.45, 0.4]
+two_sided = true
+
+[[geometry]]
+name = "qa"
+shape = "quad"
+vertices = [[-2, 0, 0], [0, 0, 0], [0, 2, 0], [-2, 2, 0]]
+material = "a"
+
+[[geometry]]
+name = "qb"
+shape = "quad"
+vertices = [[0, 0, 0], [2, 0, 0], [2, 2, 0], [0, 2, 0]]
+material = "b"
+
+[[geometry]]
+name = "qc"
+shape = "quad"
+vertices = [[-2, -2, 0], [0, -2, 0], [0, 0, 0], [-2, 0, 0]]
+material = "c"
+
+[[geometry]]
+name = "qd"
+shape = "quad"
+vertices = [[0, -2, 0], [2, -2, 0], [2, 0, 0], [0, 0, 0]]
+material = "d"
+"#;
+
+/// The window shows what `render view --headless` writes: on the quadrants scene, every pixel
+/// whose 3 × 3 neighbourhood in the headless PNG is one colour (all its samples see one
+/// emitter, in any frame) has the same 8-bit value in the screenshot, and those are most of the
+/// image. A window that tone-maps, orders channels or places the image differently fails.
+#[test]
+fn the_window_shows_the_headless_frame() {
+    let Some((mut procs, display)) = xvfb() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("q.toml"), QUADRANTS).unwrap();
+    let common = [
+        "q.toml",
+        "--size",
+        "256x256",
+        "--spp",
+        "4",
+        "--denoiser",
+        "none",
+    ];
+    let out = Command::new(env!("CARGO_BIN_EXE_render"))
+        .current_dir(d)
+        .args([
+            "view",
+            "--headless",
+            "--frames",
+            "0..1",
+            "-q",
+            "-o",
+            "h_{frame}.png",
+        ])
+        .args(common)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let headless = image::open(d.join("h_0.png")).unwrap().to_rgb8();
+    let viewer = Command::new(env!("CARGO_BIN_EXE_render"))
+        .current_dir(d)
+        .arg("view")
+        .args(common)
+        .env("DISPLAY", &display)
+        .env_remove("WAYLAND_DISPLAY")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    procs.0.push(viewer);
+    let (conn, screen) = x11rb::connect(Some(&display)).unwrap();
+    let root_window = conn.setup().roots[screen].root;
+    let n = SIZE as usize;
+    // The pixels whose neighbourhood is one colour in the headless frame.
+    let flat: Vec<usize> = (1..n - 1)
+        .flat_map(|y| (1..n - 1).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let c = headless.get_pixel(x as u32, y as u32);
+            (0..9).all(|k| headless.get_pixel((x + k % 3 - 1) as u32, (y + k / 3 - 1) as u32) == c)
+        })
+        .map(|(x, y)| y * n + x)
+        .collect();
+    assert!(flat.len() * 10 > n * n * 9, "{} flat pixels", flat.len());
+    let started = Instant::now();
+    let mismatched = loop {
+        let shown =
+            viewer_window(&conn, root_window).map(|(_, x, y)| screenshot(&conn, root_window, x, y));
+        let bad = shown.map(|s| {
+            flat.iter()
+                .filter(|&&i| s[i] != headless.get_pixel((i % n) as u32, (i / n) as u32).0)
+                .count()
+        });
+        if bad == Some(0) || started.elapsed() > PATIENCE {
+            break bad;
+        }
+        std::thread::sleep(Duration::from_millis(250));
+    };
+    assert_eq!(
+        mismatched,
+        Some(0),
+        "pixels of the window that differ from the headless frame (of {} compared)",
+        flat.len()
+    );
 }
