@@ -196,6 +196,10 @@ fn parse(data: &[u8]) -> Result<Mesh, String> {
             index(&["v", "t", "texture_v", "texture_t"]),
         ];
         let list = index(&["vertex_indices", "vertex_index"]);
+        if e.props.is_empty() {
+            // Nothing to read: a huge count must not spin.
+            continue;
+        }
         let mut row = vec![0.0f64; e.props.len()];
         for _ in 0..e.count {
             let mut face = Vec::new();
@@ -327,5 +331,11 @@ mod tests {
         assert!(parse(b"ply\nformat ascii 1.0\n")
             .unwrap_err()
             .contains("no end_header"));
+        // An element of no properties and an absurd count is skipped, not looped over.
+        let empty = ASCII.replace(
+            "element face 1",
+            "element junk 18446744073709551615\nelement face 1",
+        );
+        assert_eq!(parse(empty.as_bytes()).unwrap().tris.len(), 2);
     }
 }

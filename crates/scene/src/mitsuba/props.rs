@@ -171,19 +171,14 @@ impl<'a> Props<'a> {
         transform(c).map(Some)
     }
 
-    /// The nested plugin elements with tag `tag` (references resolved by the caller).
+    /// The nested plugin elements with tag `tag`, each marked read (references: [`Props::refs`]).
     pub fn objects(&self, tag: &str) -> Vec<&'a Node> {
         let node = self.node;
         let mut out = Vec::new();
         for (i, c) in node.children.iter().enumerate() {
-            let is_ref = c.tag == "ref";
-            if c.tag == tag || is_ref {
-                if !is_ref {
-                    self.read.borrow_mut()[i] = true;
-                }
-                if c.tag == tag {
-                    out.push(c);
-                }
+            if c.tag == tag {
+                self.read.borrow_mut()[i] = true;
+                out.push(c);
             }
         }
         out

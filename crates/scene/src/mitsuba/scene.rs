@@ -117,14 +117,15 @@ fn arr(v: DVec3) -> Value {
     Value::Array(v.to_array().iter().map(|&x| Value::Float(x)).collect())
 }
 
-impl<'a> Builder<'a, '_> {
-    fn resolve(&self, r: &'a Node) -> Result<&'a Node, SceneError> {
-        let id = r.attr("id").ok_or_else(|| r.at.error("<ref> has no id"))?;
-        self.ids.get(id).copied().ok_or_else(|| {
-            r.at.error(format!("<ref id=\"{id}\">: no element has this id"))
-        })
-    }
+/// The element a `<ref id>` names.
+fn resolve<'a>(ids: &HashMap<String, &'a Node>, r: &Node) -> Result<&'a Node, SceneError> {
+    let id = r.attr("id").ok_or_else(|| r.at.error("<ref> has no id"))?;
+    ids.get(id).copied().ok_or_else(|| {
+        r.at.error(format!("<ref id=\"{id}\">: no element has this id"))
+    })
+}
 
+impl<'a> Builder<'a, '_> {
     fn integrator(&mut self, n: &Node) -> Result<(), SceneError> {
         let p = Props::new(n);
         match n.plugin()? {
@@ -368,7 +369,7 @@ impl<'a> Builder<'a, '_> {
         }
         let mut bsdfs: Vec<&'a Node> = p.objects("bsdf");
         for r in p.refs() {
-            let target = self.resolve(r)?;
+            let target = resolve(&self.ids, r)?;
             if target.tag != "bsdf" {
                 return Err(r.at.error(format!(
                     "<ref id=\"{}\"> names a <{}>, a shape takes a <bsdf>",
@@ -427,13 +428,7 @@ impl<'a> Builder<'a, '_> {
             return Ok(done.clone());
         }
         let ids = &self.ids;
-        let resolve = |r: &'a Node| -> Result<&'a Node, SceneError> {
-            let id = r.attr("id").ok_or_else(|| r.at.error("<ref> has no id"))?;
-            ids.get(id).copied().ok_or_else(|| {
-                r.at.error(format!("<ref id=\"{id}\">: no element has this id"))
-            })
-        };
-        let converted = bsdf::convert(b, &resolve, false, self.warnings)?;
+        let converted = bsdf::convert(b, &|r| resolve(ids, r), false, self.warnings)?;
         let name = b
             .attr("id")
             .map_or_else(|| format!("bsdf{}", self.by_node.len()), str::to_string);
