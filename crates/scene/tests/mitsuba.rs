@@ -357,10 +357,15 @@ fn ply_shapes_load() {
 #[test]
 fn envmaps_become_rotated_environment_maps() {
     let dir = tempfile::tempdir().unwrap();
-    let exr = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/sky.exr");
+    // A map whose every texel differs, so that any wrong turn reads another texel.
+    let exr = dir.path().join("m.exr");
+    exr::prelude::write_rgb_file(&exr, 16, 8, |x, y| {
+        (1.0 + x as f32, 1.0 + y as f32, 1.0 + (x * 8 + y) as f32)
+    })
+    .unwrap();
     let body = format!(
         r#"<emitter type="envmap"><string name="filename" value="{}"/><float name="scale" value="2"/>
-        <transform name="to_world"><rotate y="1" angle="90"/></transform></emitter>"#,
+        <transform name="to_world"><rotate y="1" angle="90"/><rotate x="1" angle="30"/></transform></emitter>"#,
         exr.display()
     );
     let xml = dir.path().join("s.xml");
@@ -378,18 +383,26 @@ fn envmaps_become_rotated_environment_maps() {
         Path::new("p.toml"),
     )
     .unwrap();
-    // World direction d looks up the plain map at S·R_y(90°)⁻¹·d.
-    for (d, seen_as) in [
-        (Vec3::X, Vec3::new(0.0, 0.0, 1.0)),
-        (Vec3::Z, Vec3::new(-1.0, 0.0, 0.0)),
-        (Vec3::Y, Vec3::Y),
-    ] {
-        assert_eq!(
-            s.scene.environment.radiance(d),
-            plain.scene.environment.radiance(seen_as),
-            "{d}"
-        );
+    // World direction d looks up the plain map at S·M⁻¹·d, M = R_x(30°)·R_y(90°).
+    let m = glam::Mat3::from_rotation_x(30f32.to_radians())
+        * glam::Mat3::from_rotation_y(90f32.to_radians());
+    let to_map = glam::Mat3::from_diagonal(Vec3::new(-1.0, 1.0, -1.0)) * m.transpose();
+    let mut differs = 0;
+    for i in 0..64 {
+        let d = Vec3::new(
+            (i as f32 * 0.37).sin(),
+            (i as f32 * 0.23).cos(),
+            (i as f32 * 0.61).sin(),
+        )
+        .normalize();
+        let want = plain.scene.environment.radiance(to_map * d);
+        assert_eq!(s.scene.environment.radiance(d), want, "{d}");
+        differs += usize::from(plain.scene.environment.radiance(d) != want);
     }
+    assert!(
+        differs > 32,
+        "the rotation must matter for this test to see it ({differs})"
+    );
     let e = err(load_files(
         &[(
             "s.xml",
