@@ -214,6 +214,9 @@ pub fn load_defined(
     load::load(&text, base, path, access)
 }
 
+/// The mesh file extensions `[[geometry]] file` and [`load_mesh`] read (lower case).
+pub const MESH_EXTENSIONS: [&str; 5] = ["obj", "ply", "gltf", "glb", "ra2"];
+
 /// Whether `path` names a Mitsuba scene file (`.xml`, any case).
 pub fn is_mitsuba(path: &Path) -> bool {
     path.extension()

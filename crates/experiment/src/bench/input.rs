@@ -32,8 +32,6 @@ pub enum View {
     Inside,
 }
 
-/// Mesh extensions the scene crate reads.
-const MESH_EXTENSIONS: [&str; 4] = ["obj", "gltf", "glb", "ra2"];
 /// Longest side of the primary ray grid by default.
 const DEFAULT_WIDTH: u32 = 512;
 /// Largest primary ray grid (the renderer's image limits).
@@ -52,14 +50,15 @@ pub fn load(input: &str, camera: Option<&str>) -> Result<Input, BenchError> {
         input: input.to_string(),
         message,
     };
-    let (loaded, is_mesh) = if input.starts_with("gen:") || ext == "toml" {
+    let (loaded, is_mesh) = if input.starts_with("gen:") || ext == "toml" || ext == "xml" {
         (rt_session::load_scene(path, None, &[])?.loaded, false)
-    } else if MESH_EXTENSIONS.contains(&ext.as_str()) {
+    } else if rt_scene::MESH_EXTENSIONS.contains(&ext.as_str()) {
         (rt_scene::load_mesh(path)?, true)
     } else {
         return Err(refuse(format!(
-            "unknown input type (expected a .toml scene, a .obj, .gltf, .glb or .ra2 mesh, or \
-             gen:NAME with NAME one of {})",
+            "unknown input type (expected a .toml or .xml scene, a .{} mesh, or gen:NAME with \
+             NAME one of {})",
+            rt_scene::MESH_EXTENSIONS.join(", ."),
             rt_scene::procedural::NAMES.join(", ")
         )));
     };
