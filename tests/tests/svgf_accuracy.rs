@@ -77,49 +77,54 @@ material = "lamp"
     ))
 }
 
-/// The denoiser keeps returning its first output: a history that never updates.
-struct Frozen(Box<dyn TemporalDenoiser>, Option<RgbImage>);
+/// How a control spoils the real denoiser's output.
+#[derive(Clone, Copy)]
+enum Spoil {
+    /// It keeps returning its first output: a history that never updates.
+    Frozen,
+    /// Its frames are replaced by black.
+    Black,
+}
 
-/// The denoiser's frames replaced by black.
-struct Black(Box<dyn TemporalDenoiser>);
+/// The real denoiser with its output spoiled.
+struct Spoiled {
+    inner: Box<dyn TemporalDenoiser>,
+    spoil: Spoil,
+    first: Option<RgbImage>,
+}
 
-impl TemporalDenoiser for Frozen {
+impl TemporalDenoiser for Spoiled {
     fn name(&self) -> &str {
-        "frozen svgf"
+        match self.spoil {
+            Spoil::Frozen => "frozen svgf",
+            Spoil::Black => "black svgf",
+        }
     }
     fn needs(&self) -> &[Channel] {
-        self.0.needs()
+        self.inner.needs()
     }
     fn needs_guides(&self) -> bool {
-        self.0.needs_guides()
+        self.inner.needs_guides()
     }
     fn filter(&mut self, frame: &TemporalFrame<'_>) -> Result<RgbImage, TemporalError> {
-        let out = self.0.filter(frame)?;
-        Ok(self.1.get_or_insert(out).clone())
+        let out = self.inner.filter(frame)?;
+        Ok(match self.spoil {
+            Spoil::Frozen => self.first.get_or_insert(out).clone(),
+            Spoil::Black => RgbImage::filled(out.width(), out.height(), Rgb::ZERO),
+        })
     }
     fn reset(&mut self) {
-        self.0.reset();
-        self.1 = None;
+        self.inner.reset();
+        self.first = None;
     }
 }
 
-impl TemporalDenoiser for Black {
-    fn name(&self) -> &str {
-        "black svgf"
-    }
-    fn needs(&self) -> &[Channel] {
-        self.0.needs()
-    }
-    fn needs_guides(&self) -> bool {
-        self.0.needs_guides()
-    }
-    fn filter(&mut self, frame: &TemporalFrame<'_>) -> Result<RgbImage, TemporalError> {
-        let out = self.0.filter(frame)?;
-        Ok(RgbImage::filled(out.width(), out.height(), Rgb::ZERO))
-    }
-    fn reset(&mut self) {
-        self.0.reset();
-    }
+fn spoiled(spoil: Spoil) -> Box<dyn TemporalDenoiser> {
+    Box::new(Spoiled {
+        inner: svgf(),
+        spoil,
+        first: None,
+    })
 }
 
 fn svgf() -> Box<dyn TemporalDenoiser> {
@@ -256,8 +261,8 @@ fn svgf_frames_match_a_path_traced_reference_within_the_filters_lag() {
     let t = std::time::Instant::now();
     let r = reference();
     let honest = judge(&runs(&svgf), &r);
-    let frozen = judge(&runs(&|| Box::new(Frozen(svgf(), None))), &r);
-    let black = judge(&runs(&|| Box::new(Black(svgf()))), &r);
+    let frozen = judge(&runs(&|| spoiled(Spoil::Frozen)), &r);
+    let black = judge(&runs(&|| spoiled(Spoil::Black)), &r);
     let mean = |v: &[Rgb]| v.iter().map(|c| c.x as f64).sum::<f64>() / v.len() as f64;
     eprintln!(
         "reference mean {:.4}, lag factor {:.4}, spatial bound mean {:.5}; svgf {honest:?}; frozen {frozen:?}; black {black:?}; {:.2?}",
