@@ -219,6 +219,8 @@ pub(crate) struct GeometryDesc {
     pub transform: Option<Spanned<TransformDesc>>,
     // Mesh file.
     pub file: Option<Spanned<String>>,
+    /// Which mesh of a Mitsuba `.serialized` file (default 0).
+    pub shape_index: Option<Spanned<u32>>,
     // Inline shape.
     pub shape: Option<Spanned<String>>,
     pub vertices: Option<Spanned<Vec<V3>>>,
@@ -230,6 +232,10 @@ pub(crate) struct GeometryDesc {
     pub smooth: Option<Spanned<bool>>,
     pub normal: Option<Spanned<V3>>,
     pub segments: Option<Spanned<u32>>,
+    pub p0: Option<Spanned<V3>>,
+    pub p1: Option<Spanned<V3>>,
+    /// Any kind: reverse every triangle's winding and negate its vertex normals.
+    pub flip_normals: Option<Spanned<bool>>,
     // Inline triangle mesh.
     pub positions: Option<Spanned<Vec<V3>>>,
     pub indices: Option<Spanned<Vec<Arr<u32, 3>>>>,

@@ -6,7 +6,7 @@ use crate::desc::{GeometryDesc, TransformDesc, V3};
 use crate::error::{Result, SceneError};
 use crate::load::{finite3, Ctx};
 use crate::material::MaterialTable;
-use crate::{gltf, obj, ply, raw, shapes};
+use crate::{gltf, obj, ply, raw, serialized, shapes};
 use glam::{Vec2, Vec3};
 use rt_core::scene::Object;
 use rt_core::transform::Transform;
@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use toml::Spanned;
 
 /// The values of a geometry's `shape` key.
-pub(crate) const SHAPES: [&str; 4] = ["quad", "box", "sphere", "disk"];
+pub(crate) const SHAPES: [&str; 5] = ["quad", "box", "sphere", "disk", "cylinder"];
 
 /// Most subdivisions of an icosphere (20·4^7 = 327,680 triangles).
 pub(crate) const MAX_SUBDIVISIONS: u32 = 7;
@@ -56,6 +56,21 @@ impl Mesh {
         self.normals.push(n);
         self.uvs.push(uv);
         self.mat.push(mat);
+    }
+
+    /// Turns every triangle around: reverses its winding (so its geometric normal points the
+    /// other way) and negates its vertex normals.
+    pub fn flip(&mut self) {
+        for i in 0..self.tris.len() {
+            self.tris[i].swap(1, 2);
+            if let Some(n) = &mut self.normals[i] {
+                n.swap(1, 2);
+                *n = n.map(|d| -d);
+            }
+            if let Some(uv) = &mut self.uvs[i] {
+                uv.swap(1, 2);
+            }
+        }
     }
 
     /// Makes the file materials' names unique by appending `#<index>` to repeated ones.
@@ -178,12 +193,20 @@ fn build(
     let (mut mesh, origin) = match kind {
         Kind::File(f) => {
             let path = ctx.resolve(f.get_ref());
-            let mesh = load_file(ctx, f, &path, want_materials)?;
+            let mesh = load_file(ctx, d, f, &path, want_materials)?;
             (mesh, Origin::File(path))
         }
         Kind::Shape(shape, _) => (shape_mesh(ctx, d, shape)?, Origin::Toml(d.name.span())),
         Kind::Inline => (inline_mesh(ctx, d)?, Origin::Toml(d.name.span())),
     };
+    if d.smooth.as_ref().is_some_and(|b| !*b.get_ref()) {
+        // Flat facets: shading normal = geometric normal, which keeps mirror and glass
+        // spheres exactly energy conserving (interpolated normals cannot be).
+        mesh.normals.iter_mut().for_each(|n| *n = None);
+    }
+    if d.flip_normals.as_ref().is_some_and(|b| *b.get_ref()) {
+        mesh.flip();
+    }
     check_and_place(ctx, name, &origin, &mut mesh, transform.as_ref())?;
 
     let ids = match material {
@@ -242,7 +265,7 @@ fn kind<'a>(ctx: &Ctx, d: &'a GeometryDesc) -> Result<Kind<'a>> {
                     s.span(),
                     format!(
                         "geometry \"{name}\": unknown shape \"{shape}\"; valid shapes are quad, \
-                         box, sphere, disk"
+                         box, sphere, disk, cylinder"
                     ),
                 ));
             }
@@ -260,7 +283,7 @@ fn kind<'a>(ctx: &Ctx, d: &'a GeometryDesc) -> Result<Kind<'a>> {
 /// Rejects keys that the geometry's kind does not use, and requires the ones it needs.
 fn check_keys(ctx: &Ctx, d: &GeometryDesc, kind: &Kind) -> Result<()> {
     let name = d.name.get_ref();
-    let keys: [(&str, Option<Range<usize>>); 13] = [
+    let keys: [(&str, Option<Range<usize>>); 15] = [
         ("vertices", d.vertices.as_ref().map(|s| s.span())),
         ("min", d.min.as_ref().map(|s| s.span())),
         ("max", d.max.as_ref().map(|s| s.span())),
@@ -270,13 +293,15 @@ fn check_keys(ctx: &Ctx, d: &GeometryDesc, kind: &Kind) -> Result<()> {
         ("smooth", d.smooth.as_ref().map(|s| s.span())),
         ("normal", d.normal.as_ref().map(|s| s.span())),
         ("segments", d.segments.as_ref().map(|s| s.span())),
+        ("p0", d.p0.as_ref().map(|s| s.span())),
+        ("p1", d.p1.as_ref().map(|s| s.span())),
         ("positions", d.positions.as_ref().map(|s| s.span())),
         ("indices", d.indices.as_ref().map(|s| s.span())),
         ("normals", d.normals.as_ref().map(|s| s.span())),
         ("uvs", d.uvs.as_ref().map(|s| s.span())),
     ];
     let (allowed, required, what): (&[&str], &[&str], String) = match kind {
-        Kind::File(_) => (&[], &[], "a mesh file".into()),
+        Kind::File(_) => (&["smooth"], &[], "a mesh file".into()),
         Kind::Shape("quad", _) => (&["vertices"], &["vertices"], "shape \"quad\"".into()),
         Kind::Shape("box", _) => (&["min", "max"], &["min", "max"], "shape \"box\"".into()),
         Kind::Shape("sphere", _) => (
@@ -284,13 +309,18 @@ fn check_keys(ctx: &Ctx, d: &GeometryDesc, kind: &Kind) -> Result<()> {
             &["radius"],
             "shape \"sphere\"".into(),
         ),
+        Kind::Shape("cylinder", _) => (
+            &["p0", "p1", "radius", "segments", "smooth"],
+            &["radius"],
+            "shape \"cylinder\"".into(),
+        ),
         Kind::Shape(_, _) => (
             &["center", "normal", "radius", "segments"],
             &["radius"],
             "shape \"disk\"".into(),
         ),
         Kind::Inline => (
-            &["positions", "indices", "normals", "uvs"],
+            &["positions", "indices", "normals", "uvs", "smooth"],
             &["positions", "indices"],
             "an inline mesh".into(),
         ),
@@ -369,6 +399,7 @@ fn matrix(ctx: &Ctx, t: &Spanned<TransformDesc>, rows: [[f32; 4]; 4]) -> Result<
 
 fn load_file(
     ctx: &mut Ctx,
+    d: &GeometryDesc,
     f: &Spanned<String>,
     path: &Path,
     want_materials: bool,
@@ -378,15 +409,27 @@ fn load_file(
         .and_then(|e| e.to_str())
         .map(|e| e.to_ascii_lowercase())
         .unwrap_or_default();
+    if let Some(i) = d.shape_index.as_ref().filter(|_| ext != "serialized") {
+        return Err(ctx.src.error_at(
+            i.span(),
+            "`shape_index` applies to Mitsuba .serialized files only",
+        ));
+    }
     match ext.as_str() {
         "obj" => obj::load(path, want_materials, &mut ctx.textures, &mut ctx.warnings),
         "gltf" | "glb" => gltf::load(path, want_materials, &mut ctx.textures, &mut ctx.warnings),
         "ra2" => raw::load(ctx.textures.access(), path),
         "ply" => ply::load(ctx.textures.access(), path),
+        "serialized" => serialized::load(
+            ctx.textures.access(),
+            path,
+            d.shape_index.as_ref().map_or(0, |i| *i.get_ref()),
+        ),
         _ => Err(ctx.src.error_at(
             f.span(),
             format!(
-                "cannot load \"{}\": unknown mesh format (use .obj, .ply, .gltf, .glb or .ra2)",
+                "cannot load \"{}\": unknown mesh format (use .obj, .ply, .serialized, .gltf, \
+                 .glb or .ra2)",
                 f.get_ref()
             ),
         )),
@@ -458,13 +501,27 @@ fn shape_mesh(ctx: &Ctx, d: &GeometryDesc, shape: &str) -> Result<Mesh> {
                     ));
                 }
             }
-            let mut mesh = shapes::sphere(center, r, s);
-            if d.smooth.as_ref().is_some_and(|b| !*b.get_ref()) {
-                // Flat facets: shading normal = geometric normal, which keeps mirror and glass
-                // spheres exactly energy conserving (interpolated normals cannot be).
-                mesh.normals.iter_mut().for_each(|n| *n = None);
+            shapes::sphere(center, r, s)
+        }
+        "cylinder" => {
+            let r = positive(ctx, d.radius.as_ref().expect("checked"), "radius")?;
+            let p0 =
+                d.p0.as_ref()
+                    .map_or(Ok(Vec3::ZERO), |p| finite3(ctx, p, "p0"))?;
+            let p1 =
+                d.p1.as_ref()
+                    .map_or(Ok(Vec3::Z), |p| finite3(ctx, p, "p1"))?;
+            if p0 == p1 {
+                let at =
+                    d.p1.as_ref()
+                        .or(d.p0.as_ref())
+                        .map_or(d.name.span(), |p| p.span());
+                return Err(ctx.src.error_at(
+                    at,
+                    format!("geometry \"{name}\": cylinder `p0` and `p1` must differ"),
+                ));
             }
-            mesh
+            shapes::cylinder(p0, p1, r, segments(ctx, d)?)
         }
         _ => {
             let r = positive(ctx, d.radius.as_ref().expect("checked"), "radius")?;
@@ -476,19 +533,24 @@ fn shape_mesh(ctx: &Ctx, d: &GeometryDesc, shape: &str) -> Result<Mesh> {
                 }
                 n = n.normalize();
             }
-            let mut segments = DEFAULT_SEGMENTS;
-            if let Some(s) = &d.segments {
-                segments = *s.get_ref();
-                if !(3..=MAX_SEGMENTS).contains(&segments) {
-                    return Err(ctx.src.error_at(
-                        s.span(),
-                        format!("segments must be in [3, {MAX_SEGMENTS}], got {segments}"),
-                    ));
-                }
-            }
-            shapes::disk(center, n, r, segments)
+            shapes::disk(center, n, r, segments(ctx, d)?)
         }
     })
+}
+
+/// A disk's or cylinder's `segments`.
+fn segments(ctx: &Ctx, d: &GeometryDesc) -> Result<u32> {
+    let Some(s) = &d.segments else {
+        return Ok(DEFAULT_SEGMENTS);
+    };
+    let n = *s.get_ref();
+    if !(3..=MAX_SEGMENTS).contains(&n) {
+        return Err(ctx.src.error_at(
+            s.span(),
+            format!("segments must be in [3, {MAX_SEGMENTS}], got {n}"),
+        ));
+    }
+    Ok(n)
 }
 
 /// `positions` + `indices` (+ optional per-vertex `normals` and `uvs`).
@@ -958,7 +1020,7 @@ mod tests {
             ),
             (
                 "shape = \"cone\"",
-                "unknown shape \"cone\"; valid shapes are quad, box, sphere, disk",
+                "unknown shape \"cone\"; valid shapes are quad, box, sphere, disk, cylinder",
             ),
             (
                 "shape = \"box\"\nmin = [0, 0, 0]\nmax = [1, 1, 1]\nradius = 1",
@@ -974,7 +1036,19 @@ mod tests {
             ),
             (
                 "file = \"a.stl\"",
-                "cannot load \"a.stl\": unknown mesh format (use .obj, .ply, .gltf, .glb or .ra2)",
+                "cannot load \"a.stl\": unknown mesh format (use .obj, .ply, .serialized, .gltf",
+            ),
+            (
+                "file = \"a.obj\"\nshape_index = 1",
+                "`shape_index` applies to Mitsuba .serialized files only",
+            ),
+            (
+                "shape = \"cylinder\"\nradius = 1\np0 = [0, 1, 0]\np1 = [0, 1, 0]",
+                "cylinder `p0` and `p1` must differ",
+            ),
+            (
+                "shape = \"disk\"\nradius = 1\nsmooth = false",
+                "`smooth` does not apply to shape \"disk\"",
             ),
             ("file = \"missing.obj\"", "missing.obj: cannot open"),
             ("file = \"missing.glb\"", "missing.glb: cannot open"),

@@ -68,6 +68,7 @@ mod obj;
 mod ply;
 pub mod procedural;
 pub mod raw;
+mod serialized;
 mod shapes;
 pub mod views;
 
@@ -215,7 +216,7 @@ pub fn load_defined(
 }
 
 /// The mesh file extensions `[[geometry]] file` and [`load_mesh`] read (lower case).
-pub const MESH_EXTENSIONS: [&str; 5] = ["obj", "ply", "gltf", "glb", "ra2"];
+pub const MESH_EXTENSIONS: [&str; 6] = ["obj", "ply", "serialized", "gltf", "glb", "ra2"];
 
 /// Whether `path` names a Mitsuba scene file (`.xml`, any case).
 pub fn is_mitsuba(path: &Path) -> bool {

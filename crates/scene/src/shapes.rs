@@ -1,4 +1,4 @@
-//! Inline shapes, tessellated on load: quad, box, icosphere, disk.
+//! Inline shapes, tessellated on load: quad, box, icosphere, disk, cylinder.
 //!
 //! The functions here take already-validated parameters (finite, positive radius, ordered box
 //! corners; `geometry.rs` checks them against the TOML) and produce triangles whose front
@@ -111,12 +111,80 @@ pub(crate) fn disk(center: Vec3, normal: Vec3, radius: f32, segments: u32) -> Me
     m
 }
 
+/// An open tube (no caps) of `segments` quads from `p0` to `p1` (distinct), outward, with
+/// smooth normals and uvs `(angle / 2π, distance along the axis / its length)`: Mitsuba's
+/// `cylinder` parameterisation.
+pub(crate) fn cylinder(p0: Vec3, p1: Vec3, radius: f32, segments: u32) -> Mesh {
+    let axis = p1 - p0;
+    let dir = axis.normalize();
+    // Mitsuba's local frame: x, y around the axis with x × y = axis, so the angle runs
+    // counter-clockwise seen from `p1`.
+    let (t, b) = dir.any_orthonormal_pair();
+    let (t, b) = if t.cross(b).dot(dir) > 0.0 {
+        (t, b)
+    } else {
+        (b, t)
+    };
+    let around = |i: u32| {
+        let a = std::f32::consts::TAU * (i % segments) as f32 / segments as f32;
+        let (s, c) = a.sin_cos();
+        (t * c + b * s, i as f32 / segments as f32)
+    };
+    let mut m = Mesh::default();
+    for i in 0..segments {
+        let (n0, u0) = around(i);
+        let (n1, u1) = around(i + 1);
+        let [a, b_, c, d] = [
+            p0 + n0 * radius,
+            p0 + n1 * radius,
+            p1 + n1 * radius,
+            p1 + n0 * radius,
+        ];
+        let uv = [
+            Vec2::new(u0, 0.0),
+            Vec2::new(u1, 0.0),
+            Vec2::new(u1, 1.0),
+            Vec2::new(u0, 1.0),
+        ];
+        m.push(
+            [a, b_, c],
+            Some([n0, n1, n1]),
+            Some([uv[0], uv[1], uv[2]]),
+            None,
+        );
+        m.push(
+            [a, c, d],
+            Some([n0, n1, n0]),
+            Some([uv[0], uv[2], uv[3]]),
+            None,
+        );
+    }
+    m
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn normal(v: &[Vec3; 3]) -> Vec3 {
         (v[1] - v[0]).cross(v[2] - v[0])
+    }
+
+    #[test]
+    fn cylinder_faces_outward_and_spans_its_axis() {
+        let (p0, p1) = (Vec3::new(1.0, 2.0, 3.0), Vec3::new(1.0, 2.0, 5.0));
+        let m = cylinder(p0, p1, 0.5, 16);
+        assert_eq!(m.tris.len(), 32);
+        for (v, n) in m.tris.iter().zip(&m.normals) {
+            let c = (v[0] + v[1] + v[2]) / 3.0;
+            let radial = c - Vec3::new(1.0, 2.0, c.z);
+            assert!(normal(v).dot(radial) > 0.0, "inward triangle {v:?}");
+            for (p, n) in v.iter().zip(n.unwrap()) {
+                assert!((Vec3::new(p.x - 1.0, p.y - 2.0, 0.0).length() - 0.5).abs() < 1e-6);
+                assert!((n - Vec3::new(p.x - 1.0, p.y - 2.0, 0.0) / 0.5).length() < 1e-5);
+                assert!((3.0..=5.0).contains(&p.z));
+            }
+        }
     }
 
     #[test]

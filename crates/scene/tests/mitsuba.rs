@@ -186,8 +186,8 @@ fn unsupported_elements_and_parameters_are_one_line_at_their_position() {
             "s.xml:8:1: emitter \"point\" is not supported",
         ),
         (
-            r#"<shape type="serialized"><string name="filename" value="a.serialized"/></shape>"#,
-            "s.xml:8:1: shape \"serialized\" is not supported",
+            r#"<shape type="bsplinecurve"><string name="filename" value="a.txt"/></shape>"#,
+            "s.xml:8:1: shape \"bsplinecurve\" is not supported",
         ),
         (
             r#"<shape type="cube"><bsdf type="diffuse"><rgb name="reflectance" value="1, 2"/></bsdf></shape>"#,
@@ -414,4 +414,77 @@ fn envmaps_become_rotated_environment_maps() {
         &[],
     ));
     assert!(e.contains("only OpenEXR maps are supported"), "{e}");
+}
+
+#[test]
+fn cylinders_flipped_normals_and_instanced_shape_groups() {
+    let body = r#"
+    <shape type="shapegroup" id="pair">
+        <shape type="rectangle" id="a"/>
+        <shape type="cylinder"><float name="radius" value="0.5"/></shape>
+    </shape>
+    <shape type="shapegroup" id="never-placed"><shape type="cube"/></shape>
+    <shape type="instance" id="left"><ref id="pair"/>
+        <transform name="to_world"><translate x="-3"/></transform></shape>
+    <shape type="instance"><ref id="pair"/></shape>
+    <shape type="rectangle" id="back"><boolean name="flip_normals" value="true"/>
+        <emitter type="area"><rgb name="radiance" value="1"/></emitter></shape>"#;
+    let s = load_files(&[("s.xml", &scene("3.0.0", body))], &[]).unwrap();
+    let sc = &s.scene;
+    let names: Vec<&str> = sc.objects.iter().map(|o| o.name.as_str()).collect();
+    // The static rectangle first, then each instance's copy of each group member; the group
+    // nothing places is not rendered.
+    assert_eq!(
+        names,
+        [
+            "back",
+            "left/pair/a",
+            "left/pair/shape1",
+            "instance1/pair/a",
+            "instance1/pair/shape1"
+        ]
+    );
+    let range = |name: &str| {
+        let o = sc.objects.iter().find(|o| o.name == name).unwrap();
+        o.first as usize..(o.first + o.count) as usize
+    };
+    // flip_normals: the rectangle faces -z (Mitsuba's rectangle faces +z).
+    for t in range("back") {
+        let v = sc.triangles[t];
+        assert!((v[1] - v[0]).cross(v[2] - v[0]).z < 0.0);
+    }
+    // The instanced cylinder: radius 0.5 around the z axis moved by -3 in x, from z=0 to 1.
+    for t in range("left/pair/shape1") {
+        for p in sc.triangles[t] {
+            let r = (p.x + 3.0).hypot(p.y);
+            assert!(
+                (r - 0.5).abs() < 1e-5 && (-1e-6..=1.0 + 1e-6).contains(&p.z),
+                "{p}"
+            );
+        }
+    }
+    let e = err(load_files(
+        &[(
+            "s.xml",
+            &scene(
+                "3.0.0",
+                r#"<shape type="instance"><ref id="x"/></shape><bsdf type="diffuse" id="x"/>"#,
+            ),
+        )],
+        &[],
+    ));
+    assert!(e.contains("must name a shapegroup"), "{e}");
+    let e = err(load_files(
+        &[(
+            "s.xml",
+            &scene(
+                "3.0.0",
+                &format!(
+                    r#"<shape type="shapegroup" id="g">{LAMP}</shape><shape type="instance"><ref id="g"/></shape>"#
+                ),
+            ),
+        )],
+        &[],
+    ));
+    assert!(e.contains("emitter inside a shapegroup"), "{e}");
 }

@@ -17,6 +17,8 @@ use crate::error::SceneError;
 const UNLIMITED_DEPTH: i64 = 10_000;
 /// Subdivisions of the icosphere standing in for an analytic sphere (20·4⁵ triangles).
 const SPHERE_SUBDIVISIONS: i64 = 5;
+/// Quads around the tube standing in for an analytic cylinder.
+const CYLINDER_SEGMENTS: i64 = 512;
 
 /// Builds the TOML table of the scene rooted at `root`. `file_name` maps a file name as
 /// written in the scene to the string the TOML should hold.
@@ -34,6 +36,9 @@ pub(super) fn build(
         by_node: HashMap::new(),
         used: HashSet::new(),
         geometry: Vec::new(),
+        groups: HashMap::new(),
+        instances: Vec::new(),
+        placed: 0,
         cameras: Vec::new(),
         environment: None,
         render: Table::new(),
@@ -69,6 +74,7 @@ pub(super) fn build(
         ("camera", std::mem::take(&mut b.cameras)),
         ("material", std::mem::take(&mut b.materials)),
         ("geometry", std::mem::take(&mut b.geometry)),
+        ("instance", std::mem::take(&mut b.instances)),
     ];
     for (key, tables) in arrays {
         if !tables.is_empty() {
@@ -107,10 +113,35 @@ struct Builder<'a, 'w> {
     /// Names of the materials in `materials`.
     used: HashSet<String>,
     geometry: Vec<Table>,
+    /// The geometry names of each shape group that an instance placed, by address: a group
+    /// is converted when first placed (one that nothing places is not rendered, as in
+    /// Mitsuba).
+    groups: HashMap<*const Node, Vec<String>>,
+    instances: Vec<Table>,
+    /// `instance` elements seen (each gives one `[[instance]]` per group member).
+    placed: usize,
     cameras: Vec<Table>,
     environment: Option<Table>,
     render: Table,
     warnings: &'w mut Vec<String>,
+}
+
+/// `transform = { matrix = [...] }` of an affine `m`.
+fn matrix_table(m: &DMat4) -> Value {
+    let rows: Vec<Value> = (0..4)
+        .map(|r| {
+            Value::Array(
+                m.row(r)
+                    .to_array()
+                    .iter()
+                    .map(|&x| Value::Float(x))
+                    .collect(),
+            )
+        })
+        .collect();
+    let mut t = Table::new();
+    t.insert("matrix".into(), Value::Array(rows));
+    Value::Table(t)
 }
 
 fn arr(v: DVec3) -> Value {
@@ -201,7 +232,8 @@ impl<'a> Builder<'a, '_> {
         let fov = match (p.float("fov")?, p.string("focal_length")?) {
             (Some(f), None) => f,
             (None, Some(fl)) => focal_length_fov(&p, fl)?,
-            (None, None) => return Err(p.error("needs fov or focal_length")),
+            // Mitsuba's default lens.
+            (None, None) => focal_length_fov(&p, "50mm")?,
             (Some(_), Some(_)) => return Err(p.error("has both fov and focal_length")),
         };
         let axis = p.string("fov_axis")?.unwrap_or("x");
@@ -298,23 +330,128 @@ impl<'a> Builder<'a, '_> {
     }
 
     fn shape(&mut self, n: &'a Node) -> Result<(), SceneError> {
+        match n.plugin()? {
+            // Converted when an instance places it.
+            "shapegroup" => Ok(()),
+            "instance" => self.instance(n),
+            _ => {
+                let name = n
+                    .attr("id")
+                    .map_or_else(|| format!("shape{}", self.geometry.len()), str::to_string);
+                let g = self.geometry_table(n, name, true)?;
+                self.geometry.push(g);
+                Ok(())
+            }
+        }
+    }
+
+    /// An `instance`: one `[[instance]]` per shape of the group it names.
+    fn instance(&mut self, n: &'a Node) -> Result<(), SceneError> {
+        let p = Props::new(n);
+        let group = match p.refs().as_slice() {
+            [r] => resolve(&self.ids, r)?,
+            _ => return Err(p.error("an instance names exactly one shapegroup by <ref id>")),
+        };
+        if group.tag != "shape" || group.attr("type") != Some("shapegroup") {
+            return Err(p.error("an instance's <ref> must name a shapegroup"));
+        }
+        let m = p.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
+        p.finish(self.warnings)?;
+        let members = self.shape_group(group)?;
+        self.placed += 1;
+        let name = n
+            .attr("id")
+            .map_or_else(|| format!("instance{}", self.placed - 1), str::to_string);
+        for g in members {
+            let mut t = Table::new();
+            t.insert("name".into(), format!("{name}/{g}").into());
+            t.insert("geometry".into(), g.into());
+            if m != DMat4::IDENTITY {
+                t.insert("transform".into(), matrix_table(&m));
+            }
+            self.instances.push(t);
+        }
+        Ok(())
+    }
+
+    /// The geometry names of a shape group's shapes, converting them the first time.
+    fn shape_group(&mut self, group: &'a Node) -> Result<Vec<String>, SceneError> {
+        if let Some(done) = self.groups.get(&(group as *const Node)) {
+            return Ok(done.clone());
+        }
+        let p = Props::new(group);
+        let id = group.attr("id").unwrap_or("shapegroup");
+        let mut names = Vec::new();
+        for (i, c) in p.objects("shape").into_iter().enumerate() {
+            if matches!(c.plugin()?, "shapegroup" | "instance") {
+                return Err(c.at.error("shape groups do not nest"));
+            }
+            let own = c
+                .attr("id")
+                .map_or_else(|| format!("shape{i}"), str::to_string);
+            let name = format!("{id}/{own}");
+            let g = self.geometry_table(c, name.clone(), false)?;
+            self.geometry.push(g);
+            names.push(name);
+        }
+        if names.is_empty() {
+            return Err(p.error("the shapegroup holds no shape"));
+        }
+        p.finish(self.warnings)?;
+        self.groups.insert(group as *const Node, names.clone());
+        Ok(names)
+    }
+
+    /// The `[[geometry]]` table of a shape; `emitters` says whether it may carry an area
+    /// emitter (not inside a shape group).
+    fn geometry_table(
+        &mut self,
+        n: &'a Node,
+        name: String,
+        emitters: bool,
+    ) -> Result<Table, SceneError> {
         let p = Props::new(n);
         let ty = n.plugin()?;
         let mut g = Table::new();
-        let name = n
-            .attr("id")
-            .map_or_else(|| format!("shape{}", self.geometry.len()), str::to_string);
         g.insert("name".into(), name.clone().into());
         let mut m = p.transform("to_world")?.unwrap_or(DMat4::IDENTITY);
         match ty {
-            "obj" | "ply" => {
+            "obj" | "ply" | "serialized" => {
                 let file = p
                     .string("filename")?
                     .ok_or_else(|| p.error("has no filename"))?;
                 g.insert("file".into(), (self.file_name)(file).into());
-                if p.boolean("face_normals")? == Some(true) {
-                    return Err(p.error("face_normals = true is not supported"));
+                if ty == "serialized" {
+                    if let Some(i) = p.integer("shape_index")? {
+                        let i = u32::try_from(i).map_err(|_| {
+                            p.error(format!("shape_index {i}: must be at least 0"))
+                        })?;
+                        g.insert("shape_index".into(), i64::from(i).into());
+                    }
                 }
+                if p.boolean("face_normals")? == Some(true) {
+                    g.insert("smooth".into(), false.into());
+                }
+            }
+            "cylinder" => {
+                let r = p.float("radius")?.unwrap_or(1.0);
+                if r <= 0.0 {
+                    return Err(p.error(format!("radius {r}: must be positive")));
+                }
+                let p0 = p.point("p0")?.unwrap_or(DVec3::ZERO);
+                let p1 = p.point("p1")?.unwrap_or(DVec3::Z);
+                if p0 == p1 {
+                    return Err(p.error("p0 and p1 must differ"));
+                }
+                g.insert("shape".into(), "cylinder".into());
+                g.insert("p0".into(), arr(p0));
+                g.insert("p1".into(), arr(p1));
+                g.insert("radius".into(), r.into());
+                g.insert("segments".into(), CYLINDER_SEGMENTS.into());
+                self.warnings.push(n.at.warning(format!(
+                    "shape \"cylinder\" tessellated into {} triangles",
+                    2 * CYLINDER_SEGMENTS
+                )));
             }
             "rectangle" => {
                 g.insert("shape".into(), "quad".into());
@@ -349,23 +486,15 @@ impl<'a> Builder<'a, '_> {
             }
             other => {
                 return Err(n.at.error(format!(
-                    "shape \"{other}\" is not supported (obj, ply, rectangle, cube, disk and sphere are)"
+                    "shape \"{other}\" is not supported (obj, ply, serialized, rectangle, cube, disk, sphere and cylinder are)"
                 )))
             }
         }
         if p.boolean("flip_normals")? == Some(true) {
-            return Err(p.error("flip_normals = true is not supported"));
+            g.insert("flip_normals".into(), true.into());
         }
         if m != DMat4::IDENTITY {
-            let rows: Vec<Value> = (0..4)
-                .map(|r| {
-                    let row = m.row(r);
-                    Value::Array(row.to_array().iter().map(|&x| Value::Float(x)).collect())
-                })
-                .collect();
-            let mut t = Table::new();
-            t.insert("matrix".into(), Value::Array(rows));
-            g.insert("transform".into(), Value::Table(t));
+            g.insert("transform".into(), matrix_table(&m));
         }
         let mut bsdfs: Vec<&'a Node> = p.objects("bsdf");
         for r in p.refs() {
@@ -384,16 +513,19 @@ impl<'a> Builder<'a, '_> {
             [b] => self.material(b)?,
             _ => return Err(p.error("has more than one BSDF")),
         };
-        let emitters = p.objects("emitter");
-        let material = match emitters.as_slice() {
+        let material = match p.objects("emitter").as_slice() {
             [] => self.use_material(base, table),
-            [e] => self.emissive(e, table, &name)?,
+            [e] if emitters => self.emissive(e, table, &name)?,
+            [e] => {
+                return Err(e
+                    .at
+                    .error("an emitter inside a shapegroup is not supported"))
+            }
             _ => return Err(p.error("has more than one emitter")),
         };
         g.insert("material".into(), material.into());
         p.finish(self.warnings)?;
-        self.geometry.push(g);
-        Ok(())
+        Ok(g)
     }
 
     /// An area emitter on a shape: a copy of the shape's material with `emission`.
