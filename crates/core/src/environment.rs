@@ -162,18 +162,44 @@ impl Importance {
     fn build(width: u32, height: u32, texels: &[Rgb], sun: Option<&SunDisc>) -> Self {
         let start = Instant::now();
         let (w, h) = (width as usize, height as usize);
-        // Weight by sinθ: rows near the poles cover less solid angle.
+        // Each texel's weight is the largest luminance of it and its eight neighbours: the
+        // bilinear radiance over a texel's area mixes in its neighbours, so a dark texel next
+        // to a bright one still emits near their border and must be sampled there (its pdf
+        // must not be 0 where the radiance is not). Weight by sinθ: rows near the poles cover
+        // less solid angle.
+        let lum: Vec<f32> = texels.iter().map(|&t| luminance(t).max(0.0)).collect();
+        let at = |x: isize, y: isize| {
+            let y = y.clamp(0, h as isize - 1) as usize;
+            lum[y * w + x.rem_euclid(w as isize) as usize]
+        };
         let weights: Vec<f32> = (0..h)
             .flat_map(|y| {
                 let sin_t = (PI * (y as f32 + 0.5) / h as f32).sin();
-                (0..w).map(move |x| luminance(texels[y * w + x]).max(0.0) * sin_t)
+                let at = &at;
+                (0..w).map(move |x| {
+                    let (x, y) = (x as isize, y as isize);
+                    let mut m = 0.0f32;
+                    for dy in -1..=1 {
+                        for dx in -1..=1 {
+                            m = m.max(at(x + dx, y + dy));
+                        }
+                    }
+                    m * sin_t
+                })
             })
             .collect();
         let dist = Distribution2D::new(&weights, w, h);
-        // The distribution's integral is the mean of luminance × sinθ over [0,1)²; dω = 2π² sinθ
-        // du dv turns it into the texels' power. Splitting samples by power makes the mixture's
-        // pdf proportional to luminance everywhere, as it is for a map alone.
-        let map_power = dist.integral() * 2.0 * PI * PI;
+        // The mean of luminance × sinθ over [0,1)² (the texels', not the widened weights');
+        // dω = 2π² sinθ du dv turns it into the texels' power. Splitting samples by power
+        // makes the mixture's pdf follow luminance as a map's alone does.
+        let mean: f64 = (0..h)
+            .map(|y| {
+                let sin_t = (PI * (y as f32 + 0.5) / h as f32).sin() as f64;
+                lum[y * w..(y + 1) * w].iter().map(|&l| l as f64).sum::<f64>() * sin_t
+            })
+            .sum::<f64>()
+            / (w * h) as f64;
+        let map_power = (mean * 2.0 * std::f64::consts::PI.powi(2)) as f32;
         let sun_prob = match sun {
             Some(s) if s.power() > 0.0 => s.power() / (s.power() + map_power),
             _ => 0.0,
@@ -288,10 +314,21 @@ impl EnvMap {
         std::mem::size_of_val(self.texels.as_slice())
     }
 
+    /// The map's radiance at `uv`, interpolated bilinearly between texel centres (as
+    /// Mitsuba's `envmap` does): wrapping around in `u`, held at the first and last rows'
+    /// centres in `v`.
+    #[inline]
     fn texel(&self, uv: Vec2) -> Rgb {
-        let x = ((uv.x * self.width as f32) as u32).min(self.width - 1);
-        let y = ((uv.y * self.height as f32) as u32).min(self.height - 1);
-        self.texels[(y * self.width + x) as usize]
+        let (w, h) = (self.width as i64, self.height as i64);
+        let x = uv.x * self.width as f32 - 0.5;
+        let y = (uv.y * self.height as f32 - 0.5).clamp(0.0, (h - 1) as f32);
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (i0, j0) = (x0 as i64, y0 as i64);
+        let at = |i: i64, j: i64| self.texels[(j.min(h - 1) * w + i.rem_euclid(w)) as usize];
+        let top = at(i0, j0) * (1.0 - fx) + at(i0 + 1, j0) * fx;
+        let bottom = at(i0, j0 + 1) * (1.0 - fx) + at(i0 + 1, j0 + 1) * fx;
+        top * (1.0 - fy) + bottom * fy
     }
 
     /// The sun's radiance along direction `d` (zero outside the disc or without a sun).
@@ -412,9 +449,13 @@ impl Environment {
                     if pdf_uv <= 0.0 || sin_t <= 0.0 {
                         return None;
                     }
+                    let dir = m.in_world(uv_to_dir(uv));
                     return Some(EnvSample {
-                        dir: m.in_world(uv_to_dir(uv)),
-                        radiance: m.texel(uv),
+                        dir,
+                        // At the direction, as `radiance` computes it: the interpolated
+                        // radiance is continuous, so `uv` and the direction's own uv (which
+                        // differ by rounding) would give different bits.
+                        radiance: m.texel(m.uv(dir)),
                         pdf: pdf_uv / (2.0 * PI * PI * sin_t),
                     });
                 };
@@ -555,6 +596,86 @@ mod tests {
         }
         let mean = sum / (n * n) as f32;
         assert!((mean - 1.0).abs() < 0.02, "{mean}");
+    }
+
+    /// One bright texel among black ones.
+    fn one_bright_texel() -> Environment {
+        let (w, h) = (8u32, 4u32);
+        let mut texels = vec![Rgb::ZERO; (w * h) as usize];
+        texels[(w + 3) as usize] = Rgb::splat(4.0);
+        Environment::Map(EnvMap::new(w, h, texels))
+    }
+
+    #[test]
+    fn radiance_is_interpolated_between_texel_centres() {
+        let env = one_bright_texel();
+        let centre = Vec2::new(3.5 / 8.0, 1.5 / 4.0);
+        let at = |uv: Vec2| env.radiance(uv_to_dir(uv)).x;
+        assert!((at(centre) - 4.0).abs() < 1e-4, "{}", at(centre));
+        // Halfway to the next centre in u, a quarter of the way in v: bilinear weights.
+        let half = at(centre + Vec2::new(0.5 / 8.0, 0.0));
+        let quarter = at(centre + Vec2::new(0.0, 0.25 / 4.0));
+        assert!((half - 2.0).abs() < 1e-3 && (quarter - 3.0).abs() < 1e-3, "{half} {quarter}");
+        // Wraps around in u: a bright texel in column 0 lights the seam from column 7's side.
+        let mut texels = vec![Rgb::ZERO; 32];
+        texels[8] = Rgb::ONE;
+        let seam = Environment::Map(EnvMap::new(8, 4, texels));
+        let l = seam.radiance(uv_to_dir(Vec2::new(0.999, 1.5 / 4.0))).x;
+        assert!((l - 0.492).abs() < 1e-3, "{l}");
+    }
+
+    /// Light sampling alone estimates the map's integral ∫ L dω, which needs a pdf that is
+    /// positive wherever the interpolated radiance is: around a bright texel that is also the
+    /// edges of its black neighbours.
+    #[test]
+    fn sampling_alone_integrates_the_interpolated_map() {
+        let env = one_bright_texel();
+        // The integral by a fine midpoint rule over (u, v): dω = 2π² sinθ du dv.
+        let n = 1024;
+        let mut exact = 0.0f64;
+        for j in 0..n / 2 {
+            for i in 0..n {
+                let uv = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / (n / 2) as f32);
+                let sin_t = (PI * uv.y).sin() as f64;
+                exact += env.radiance(uv_to_dir(uv)).x as f64 * sin_t;
+            }
+        }
+        exact *= 2.0 * std::f64::consts::PI.powi(2) / (n * n / 2) as f64;
+        let estimate = |env: &Environment| {
+            let mut rng = crate::rng::SplitMix64::new(7);
+            let m = 200_000;
+            let (mut sum, mut sum2) = (0.0f64, 0.0f64);
+            for _ in 0..m {
+                let x = env
+                    .sample(rng.vec2())
+                    .map_or(0.0, |s| (s.radiance.x / s.pdf) as f64);
+                sum += x;
+                sum2 += x * x;
+            }
+            let mean = sum / m as f64;
+            (mean, ((sum2 / m as f64 - mean * mean) / m as f64).sqrt())
+        };
+        let (mean, se) = estimate(&env);
+        assert!((mean - exact).abs() < 4.0 * se + 1e-3 * exact, "{mean} ± {se} vs {exact}");
+        // Control: sampling only the bright texel itself (its neighbours' pdf 0) misses the
+        // radiance that spills onto them.
+        let Environment::Map(m) = &env else { unreachable!() };
+        let narrow = {
+            let (w, h) = (m.width as usize, m.height as usize);
+            let weights: Vec<f32> = (0..w * h)
+                .map(|i| luminance(m.texels[i]) * (PI * ((i / w) as f32 + 0.5) / h as f32).sin())
+                .collect();
+            let mut narrow = m.clone();
+            let imp = Importance {
+                dist: Distribution2D::new(&weights, w, h),
+                sun_prob: 0.0,
+                build_time: StageTime::default(),
+            };
+            narrow.importance = OnceLock::from(imp);
+            Environment::Map(narrow)
+        };
+        let (biased, se) = estimate(&narrow);
+        assert!(exact - biased > 10.0 * se, "{biased} ± {se} vs {exact}");
     }
 
     #[test]

@@ -70,34 +70,40 @@ pub(crate) fn texture_from_bytes(bytes: &[u8]) -> std::result::Result<Texture, S
     })
 }
 
-/// Reads the first RGB(A) layer of an EXR file as row-major linear radiance (row 0 at the
-/// top). Rejects empty images and NaN, infinite or negative texels, naming the first bad one.
+/// Reads an environment map as row-major linear radiance (row 0 at the top): the first
+/// RGB(A) layer of an OpenEXR file, or a Radiance RGBE (`.hdr`) file. Rejects empty images
+/// and NaN, infinite or negative texels, naming the first bad one.
 pub(crate) fn read_env_map(access: &FileAccess, path: &Path) -> Result<(u32, u32, Vec<Rgb>)> {
     access.check(path)?;
-    if !path
+    let ext = path
         .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
-    {
-        return Err(SceneError::file(
-            path,
-            "an environment map must be an .exr file",
-        ));
-    }
-    let img = rt_film::read_rgb(path).map_err(|e| {
-        let why = match e {
-            rt_film::FilmError::Io { source, .. } => format!("cannot open: {source}"),
-            rt_film::FilmError::Codec { message, .. } => {
-                format!("cannot read as an RGB EXR image: {message}")
-            }
-            other => format!("cannot read as an RGB EXR image: {other}"),
-        };
-        SceneError::file(path, why)
-    })?;
-    let (w, h) = (img.width(), img.height());
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let (w, h, texels) = match ext.as_deref() {
+        Some("exr") => {
+            let img = rt_film::read_rgb(path).map_err(|e| {
+                let why = match e {
+                    rt_film::FilmError::Io { source, .. } => format!("cannot open: {source}"),
+                    rt_film::FilmError::Codec { message, .. } => {
+                        format!("cannot read as an RGB EXR image: {message}")
+                    }
+                    other => format!("cannot read as an RGB EXR image: {other}"),
+                };
+                SceneError::file(path, why)
+            })?;
+            (img.width(), img.height(), img.into_pixels())
+        }
+        Some("hdr") => read_rgbe(&access.read(path, "")?).map_err(|e| SceneError::file(path, e))?,
+        _ => {
+            return Err(SceneError::file(
+                path,
+                "an environment map must be an .exr or .hdr file",
+            ))
+        }
+    };
     if w == 0 || h == 0 {
         return Err(SceneError::file(path, "the image is empty"));
     }
-    let texels = img.into_pixels();
     if let Some(i) = texels
         .iter()
         .position(|t| !t.is_finite() || t.min_element() < 0.0)
@@ -113,6 +119,16 @@ pub(crate) fn read_env_map(access: &FileAccess, path: &Path) -> Result<(u32, u32
         ));
     }
     Ok((w as u32, h as u32, texels))
+}
+
+/// Decodes a Radiance RGBE image.
+fn read_rgbe(bytes: &[u8]) -> std::result::Result<(usize, usize, Vec<Rgb>), String> {
+    let img = image::load_from_memory_with_format(bytes, image::ImageFormat::Hdr)
+        .map_err(|e| format!("cannot read as a Radiance .hdr image: {e}"))?
+        .into_rgb32f();
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let texels = img.pixels().map(|p| Rgb::new(p[0], p[1], p[2])).collect();
+    Ok((w, h, texels))
 }
 
 #[cfg(test)]
@@ -186,5 +202,41 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("env.exr: cannot read"), "{e}");
+    }
+
+    #[test]
+    fn radiance_hdr_maps_are_read_linear_with_row_zero_at_the_top() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("env.hdr");
+        // Powers of two are exact in RGBE's shared-exponent encoding.
+        let pixels: Vec<image::Rgb<f32>> = (0..8)
+            .map(|i| image::Rgb([i as f32, 0.5, 2.0f32.powi(i - 2)]))
+            .collect();
+        let mut bytes = Vec::new();
+        image::codecs::hdr::HdrEncoder::new(&mut bytes)
+            .encode(&pixels, 4, 2)
+            .unwrap();
+        std::fs::write(&p, &bytes).unwrap();
+        let (w, h, t) = read_env_map(&FileAccess::open(), &p).unwrap();
+        assert_eq!((w, h), (4, 2));
+        for (i, px) in pixels.iter().enumerate() {
+            let want = Rgb::new(px[0], px[1], px[2]);
+            assert!(
+                (t[i] - want).abs().max_element() <= 0.01 * want.max_element(),
+                "{i}"
+            );
+        }
+        std::fs::write(&p, b"#?RADIANCE\ngarbage").unwrap();
+        let e = read_env_map(&FileAccess::open(), &p)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("env.hdr: cannot read as a Radiance .hdr image"),
+            "{e}"
+        );
+        let e = read_env_map(&FileAccess::open(), &dir.path().join("env.png"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("must be an .exr or .hdr file"), "{e}");
     }
 }

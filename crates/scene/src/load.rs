@@ -698,9 +698,10 @@ material = "light"
         let Environment::Map(_) = &s.scene.environment else {
             panic!("expected a map")
         };
-        // Column x = 7 is the last; u = 0.5 + atan2(dx, -dz)/2π: +x is u = 0.75, column 6.
+        // Column x = 7 is the last; u = 0.5 + atan2(dx, -dz)/2π: +x is u = 0.75, between the
+        // centres of columns 5 and 6, where the map is interpolated.
         let r = s.scene.environment.radiance(Vec3::X);
-        assert_eq!(r, Rgb::new(3.0, 0.5, 0.0));
+        assert_eq!(r, Rgb::new(2.75, 0.5, 0.0));
         // A black colour next to a map is fine; a non-black one is not.
         load_in(
             dir.path(),

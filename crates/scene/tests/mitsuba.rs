@@ -395,9 +395,13 @@ fn envmaps_become_rotated_environment_maps() {
             (i as f32 * 0.61).sin(),
         )
         .normalize();
+        // The map is interpolated: rounding in the two rotations moves the bits, not the value.
+        let near = |a: rt_core::Rgb, b: rt_core::Rgb| {
+            (a - b).abs().max_element() <= 1e-3 * b.max_element()
+        };
         let want = plain.scene.environment.radiance(to_map * d);
-        assert_eq!(s.scene.environment.radiance(d), want, "{d}");
-        differs += usize::from(plain.scene.environment.radiance(d) != want);
+        assert!(near(s.scene.environment.radiance(d), want), "{d}");
+        differs += usize::from(!near(plain.scene.environment.radiance(d), want));
     }
     assert!(
         differs > 32,
@@ -408,12 +412,15 @@ fn envmaps_become_rotated_environment_maps() {
             "s.xml",
             &scene(
                 "3.0.0",
-                r#"<emitter type="envmap"><string name="filename" value="a.hdr"/></emitter>"#,
+                r#"<emitter type="envmap"><string name="filename" value="a.png"/></emitter>"#,
             ),
         )],
         &[],
     ));
-    assert!(e.contains("only OpenEXR maps are supported"), "{e}");
+    assert!(
+        e.contains("only OpenEXR and Radiance .hdr maps are supported"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -600,8 +600,11 @@ impl<'a> Builder<'a, '_> {
                 let file = p
                     .string("filename")?
                     .ok_or_else(|| p.error("has no filename"))?;
-                if !file.to_ascii_lowercase().ends_with(".exr") {
-                    return Err(p.error(format!("\"{file}\": only OpenEXR maps are supported")));
+                let lower = file.to_ascii_lowercase();
+                if !lower.ends_with(".exr") && !lower.ends_with(".hdr") {
+                    return Err(p.error(format!(
+                        "\"{file}\": only OpenEXR and Radiance .hdr maps are supported"
+                    )));
                 }
                 if self.environment.is_some() {
                     return Err(p.error("a second environment emitter"));
