@@ -11,8 +11,7 @@ pub struct ConvertArgs {
     #[arg(value_name = "SCENE.xml")]
     pub input: PathBuf,
 
-    /// The TOML file to write; file names in it are relative to its directory when it sits
-    /// beside the scene, else absolute.
+    /// The TOML file to write; file names in it are relative to its directory.
     #[arg(short, long, value_name = "OUT.toml")]
     pub output: PathBuf,
 

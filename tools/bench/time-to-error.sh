@@ -14,7 +14,9 @@
 # the variable is unset.
 #
 # Environment (defaults in brackets):
-#   SCENES       scenes to run                         ["cbox dragon"]
+#   SCENES       scenes to run: cbox, dragon, or paths to ["cbox dragon"]
+#                Mitsuba .xml files (rendered at 256x256 from one patched copy, both at the
+#                file's own depth; tools/reference/mitsuba_copy.py)
 #   SPP          our spp ladder                        ["64 128 256 512 1024"]
 #   THREADS      threads of both renderers             [2]
 #   RENDER       our binary                            [target/release/render]

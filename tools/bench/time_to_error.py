@@ -118,12 +118,16 @@ def worker(argv: list[str]) -> int:
     mi.set_variant(a.variant)
     default_threads = dr.thread_count()
     dr.set_thread_count(a.threads)
-    d = m2t.mitsuba_dict(a.scene, a.dragon or m2t.DEFAULT_DRAGON)
+    if a.scene.endswith(".xml"):
+        load = lambda: mi.load_file(a.scene)  # noqa: E731
+    else:
+        d = m2t.mitsuba_dict(a.scene, a.dragon or m2t.DEFAULT_DRAGON)
+        load = lambda: mi.load_dict(d)  # noqa: E731
     res = {"variant": a.variant, "threads": a.threads, "spp": a.spp, "seed": a.seed}
     cpu_load = 0.0
     if a.warmup:
         c0, t0 = cpu_self(), time.perf_counter()
-        s = mi.load_dict(d)
+        s = load()
         res["load_s"] = time.perf_counter() - t0
         cpu_load = cpu_self() - c0
         t1 = time.perf_counter()
@@ -134,7 +138,7 @@ def worker(argv: list[str]) -> int:
         t1 = t0
     else:
         c0, t0 = cpu_self(), time.perf_counter()
-        s = mi.load_dict(d)
+        s = load()
         t1 = time.perf_counter()
         res["load_s"] = t1 - t0
     mean, var, n, per = m2t.render_passes(
@@ -201,11 +205,12 @@ SUMMARY = re.compile(r"([0-9.]+) s render \(([0-9.]+) s load, ([0-9.]+) s (\S+) 
 
 def run_ours(render: str, toml: str, spp: int, threads: int, out: str) -> dict:
     la = loadavg()
+    # A Mitsuba scene file keeps its own depth (its integrator's max_depth).
+    depth = [] if toml.endswith(".xml") else ["--max-depth", "10000"]
     c0, t0 = cpu_children(), time.perf_counter()
-    p = subprocess.run([render, toml, "--spp", str(spp), "--threads", str(threads),
-                        "--max-depth", "10000", "--integrator", env("INTEGRATOR", "wavefront"),
-                        "-o", out], stdout=subprocess.PIPE,
-                       stderr=subprocess.PIPE, text=True)
+    p = subprocess.run([render, toml, "--spp", str(spp), "--threads", str(threads)] + depth +
+                       ["--integrator", env("INTEGRATOR", "wavefront"), "-o", out],
+                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     wall = time.perf_counter() - t0
     cpu = cpu_children() - c0
     if p.returncode != 0:
@@ -216,6 +221,19 @@ def run_ours(render: str, toml: str, spp: int, threads: int, out: str) -> dict:
         r.update({"render_s": float(m.group(1)), "load_s": float(m.group(2)),
                   "build_s": float(m.group(3)), "accel": m.group(4)})
     return r
+
+
+def scene_dir(scene: str) -> str:
+    """Folder (and cache) name of a scene: a built-in name, or `folder-stem` of an XML file."""
+    if not scene.endswith(".xml"):
+        return scene
+    p = os.path.abspath(scene)
+    return f"{os.path.basename(os.path.dirname(p))}-{os.path.splitext(os.path.basename(p))[0]}"
+
+
+def mi_scene(scene: str, ours: str) -> str:
+    """What the Mitsuba worker loads: a built-in name, or the patched copy of an XML file."""
+    return ours if scene.endswith(".xml") else scene
 
 
 def time_to_error(ladder: list[tuple[float, float]], target: float):
@@ -297,14 +315,20 @@ def main() -> int:
     # Phase 1: every reference (untimed, cached), so that the timed runs of phase 2 follow
     # each other closely.
     refs = {}
+    import mitsuba_copy
     for scene in scenes:
-        sd = os.path.join(out, scene)
+        sd = os.path.join(out, scene_dir(scene))
         os.makedirs(sd, exist_ok=True)
-        toml = os.path.join(sd, f"{scene}.toml")
-        text_sha = m2t.write_toml(scene, toml, dragon)
-        key_src = text_sha + (sha256_file(dragon) if scene == "dragon" else "")
+        if scene.endswith(".xml"):
+            # Both renderers read one copy of the file, at 256x256 (mitsuba_copy.py).
+            toml = str(mitsuba_copy.write_copy(scene, 256, os.path.join(sd, "scene.xml")))
+            key_src = sha256_file(toml)
+        else:
+            toml = os.path.join(sd, f"{scene}.toml")
+            text_sha = m2t.write_toml(scene, toml, dragon)
+            key_src = text_sha + (sha256_file(dragon) if scene == "dragon" else "")
         key = hashlib.sha256(key_src.encode()).hexdigest()[:12]
-        stem = f"{scene}-{versions}-{variant}-{ref_spp}spp-seed{ref_seed}-{key}"
+        stem = f"{scene_dir(scene)}-{versions}-{variant}-{ref_spp}spp-seed{ref_seed}-{key}"
         ref = os.path.join(cache, stem + ".exr")
         ref_var = os.path.join(cache, stem + "-var.exr")
         ref_json = os.path.join(cache, stem + ".json")
@@ -318,7 +342,7 @@ def main() -> int:
                 f"threads (load {loadavg()}) -> {ref}")
             tmp = ref + f".{os.getpid()}.tmp.exr"
             tmpv = ref_var + f".{os.getpid()}.tmp.exr"
-            ref_info = run_worker(["--scene", scene, "--spp", str(ref_spp), "--seed",
+            ref_info = run_worker(["--scene", mi_scene(scene, toml), "--spp", str(ref_spp), "--seed",
                                    str(ref_seed), "--threads", str(ref_threads), "--out", tmp,
                                    "--var-out", tmpv, "--variant", variant, "--dragon", dragon])
             ref_info["loadavg_before"] = loadavg()
@@ -333,7 +357,7 @@ def main() -> int:
     meta["date"] = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     meta["uptime_start"] = sh("uptime")
     for scene in scenes:
-        sd = os.path.join(out, scene)
+        sd = os.path.join(out, scene_dir(scene))
         toml, ref, ref_var, ref_info = refs[scene]
         floor = reference_floor(ref, ref_var)
 
@@ -343,7 +367,7 @@ def main() -> int:
             img = os.path.join(sd, f"mitsuba-{mi_spp}-{mode}.exr")
             la = loadavg()
             log(f"{scene}: Mitsuba {mode}, {mi_spp} spp, {threads} threads (load {la})")
-            args = ["--scene", scene, "--spp", str(mi_spp), "--seed", str(mi_seed),
+            args = ["--scene", mi_scene(scene, toml), "--spp", str(mi_spp), "--seed", str(mi_seed),
                     "--threads", str(threads), "--out", img, "--variant", variant,
                     "--dragon", dragon]
             if mode == "cold":

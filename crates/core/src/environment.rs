@@ -195,7 +195,11 @@ impl Importance {
         let mean: f64 = (0..h)
             .map(|y| {
                 let sin_t = (PI * (y as f32 + 0.5) / h as f32).sin() as f64;
-                lum[y * w..(y + 1) * w].iter().map(|&l| l as f64).sum::<f64>() * sin_t
+                lum[y * w..(y + 1) * w]
+                    .iter()
+                    .map(|&l| l as f64)
+                    .sum::<f64>()
+                    * sin_t
             })
             .sum::<f64>()
             / (w * h) as f64;
@@ -615,7 +619,10 @@ mod tests {
         // Halfway to the next centre in u, a quarter of the way in v: bilinear weights.
         let half = at(centre + Vec2::new(0.5 / 8.0, 0.0));
         let quarter = at(centre + Vec2::new(0.0, 0.25 / 4.0));
-        assert!((half - 2.0).abs() < 1e-3 && (quarter - 3.0).abs() < 1e-3, "{half} {quarter}");
+        assert!(
+            (half - 2.0).abs() < 1e-3 && (quarter - 3.0).abs() < 1e-3,
+            "{half} {quarter}"
+        );
         // Wraps around in u: a bright texel in column 0 lights the seam from column 7's side.
         let mut texels = vec![Rgb::ZERO; 32];
         texels[8] = Rgb::ONE;
@@ -635,7 +642,10 @@ mod tests {
         let mut exact = 0.0f64;
         for j in 0..n / 2 {
             for i in 0..n {
-                let uv = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / (n / 2) as f32);
+                let uv = Vec2::new(
+                    (i as f32 + 0.5) / n as f32,
+                    (j as f32 + 0.5) / (n / 2) as f32,
+                );
                 let sin_t = (PI * uv.y).sin() as f64;
                 exact += env.radiance(uv_to_dir(uv)).x as f64 * sin_t;
             }
@@ -656,10 +666,15 @@ mod tests {
             (mean, ((sum2 / m as f64 - mean * mean) / m as f64).sqrt())
         };
         let (mean, se) = estimate(&env);
-        assert!((mean - exact).abs() < 4.0 * se + 1e-3 * exact, "{mean} ± {se} vs {exact}");
+        assert!(
+            (mean - exact).abs() < 4.0 * se + 1e-3 * exact,
+            "{mean} ± {se} vs {exact}"
+        );
         // Control: sampling only the bright texel itself (its neighbours' pdf 0) misses the
         // radiance that spills onto them.
-        let Environment::Map(m) = &env else { unreachable!() };
+        let Environment::Map(m) = &env else {
+            unreachable!()
+        };
         let narrow = {
             let (w, h) = (m.width as usize, m.height as usize);
             let weights: Vec<f32> = (0..w * h)

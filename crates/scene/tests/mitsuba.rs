@@ -251,6 +251,9 @@ fn the_cornell_box_from_the_shared_data_loads_and_converts_to_the_same_scene() {
     );
     let dir = tempfile::tempdir().unwrap();
     let c = mitsuba::to_toml(&p, Some(dir.path()), &FileAccess::open(), &[]).unwrap();
+    // Mesh files are named relative to where the TOML goes, so a converted scene can be
+    // shipped beside the data it names.
+    assert!(c.toml.contains("file = \"../"), "{}", c.toml);
     let toml_path = dir.path().join("cbox.toml");
     std::fs::write(&toml_path, &c.toml).unwrap();
     let toml = rt_scene::load(&toml_path).unwrap();

@@ -478,3 +478,41 @@ fn the_sponza_scenes_load_from_the_shared_data_with_their_floor_overridden() {
         assert_eq!(s.camera_motions.len(), 1, "{scene}: the fly-through");
     }
 }
+
+/// scenes/shared-data/mitsuba-*.toml are `render convert` of ../shared/data/mitsuba's scenes
+/// (tools/scenes/convert-mitsuba.sh): each must still be what the reader makes of its XML
+/// today, so a change to the translation cannot leave a stale shipped scene behind.
+#[test]
+fn shipped_mitsuba_conversions_equal_a_fresh_conversion() {
+    let shipped = rt_testkit::workspace_root().join("scenes/shared-data");
+    let mut seen = 0;
+    for entry in std::fs::read_dir(&shipped).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        let Some(folder) = name
+            .strip_prefix("mitsuba-")
+            .and_then(|n| n.strip_suffix(".toml"))
+        else {
+            continue;
+        };
+        seen += 1;
+        let Some(xml) = rt_testkit::data::file(&format!("mitsuba/{folder}/scene.xml")) else {
+            return;
+        };
+        let fresh =
+            rt_scene::mitsuba::to_toml(&xml, Some(&shipped), &rt_scene::FileAccess::open(), &[])
+                .unwrap_or_else(|e| panic!("{e}"));
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(
+            text.ends_with(&fresh.toml),
+            "{name} is stale: run tools/scenes/convert-mitsuba.sh"
+        );
+        // Its header names where the scene comes from.
+        assert!(
+            text.starts_with("# ") && text.contains("../shared/data/mitsuba"),
+            "{name}"
+        );
+        rt_scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+    }
+    assert!(seen >= 1, "no shipped conversion in {}", shipped.display());
+}

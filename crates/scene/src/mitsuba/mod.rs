@@ -37,7 +37,8 @@ pub struct Converted {
 }
 
 /// Translates the Mitsuba scene at `path` to a TOML document whose file names are relative to
-/// `out_dir` (absolute when the scene's directory is elsewhere). `defines` are `-D name=value`.
+/// `out_dir` (absolute when either directory cannot be resolved). `defines` are
+/// `-D name=value`.
 pub fn to_toml(
     path: &Path,
     out_dir: Option<&Path>,
@@ -46,22 +47,24 @@ pub fn to_toml(
 ) -> Result<Converted, SceneError> {
     let root = xml::read(path, access, defines)?;
     let scene_dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
-    let same_dir = match out_dir {
-        None => true,
-        Some(o) => same_directory(o, &scene_dir),
+    // The way from the TOML's directory to the scene's: empty beside it.
+    let prefix = match out_dir {
+        None => Some(PathBuf::new()),
+        Some(o) => match (canonical_dir(o), canonical_dir(&scene_dir)) {
+            (Some(from), Some(to)) => Some(relative_path(&from, &to)),
+            _ => None,
+        },
     };
-    let absolute_dir = std::fs::canonicalize(if scene_dir.as_os_str().is_empty() {
-        Path::new(".")
-    } else {
-        &scene_dir
-    })
-    .unwrap_or_else(|_| scene_dir.clone());
+    let absolute_dir = canonical_dir(&scene_dir).unwrap_or_else(|| scene_dir.clone());
     let file_name = |name: &str| -> String {
-        if same_dir || Path::new(name).is_absolute() {
-            name.to_string()
-        } else {
-            absolute_dir.join(name).to_string_lossy().into_owned()
-        }
+        let joined = match &prefix {
+            _ if Path::new(name).is_absolute() => return name.to_string(),
+            Some(p) if p.as_os_str().is_empty() => return name.to_string(),
+            Some(p) => p.join(name),
+            None => absolute_dir.join(name),
+        };
+        // Forward slashes: the TOML stays usable on any system.
+        joined.to_string_lossy().replace('\\', "/")
     };
     let mut warnings = Vec::new();
     let table = scene::build(&root, &file_name, &mut warnings)?;
@@ -74,19 +77,27 @@ pub fn to_toml(
     Ok(Converted { toml, warnings })
 }
 
-fn same_directory(a: &Path, b: &Path) -> bool {
-    let canon = |p: &Path| -> Option<PathBuf> {
-        std::fs::canonicalize(if p.as_os_str().is_empty() {
-            Path::new(".")
-        } else {
-            p
-        })
-        .ok()
-    };
-    match (canon(a), canon(b)) {
-        (Some(x), Some(y)) => x == y,
-        _ => false,
+fn canonical_dir(p: &Path) -> Option<PathBuf> {
+    std::fs::canonicalize(if p.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        p
+    })
+    .ok()
+}
+
+/// The relative path leading from directory `from` to directory `to` (both canonical).
+fn relative_path(from: &Path, to: &Path) -> PathBuf {
+    let (f, t): (Vec<_>, Vec<_>) = (from.components().collect(), to.components().collect());
+    let common = f.iter().zip(&t).take_while(|(a, b)| a == b).count();
+    let mut out = PathBuf::new();
+    for _ in common..f.len() {
+        out.push("..");
     }
+    for c in &t[common..] {
+        out.push(c);
+    }
+    out
 }
 
 /// Translates the Mitsuba scene at `path` and writes the TOML to `output` atomically
