@@ -29,7 +29,38 @@ pub struct Camera {
     pub focus_distance: f32,
     /// Where in its pixel a sample lands ([`PixelFilter::film_position`]); box by default.
     pub filter: PixelFilter,
+    /// The part of a larger image this camera renders (a crop window), or `None` for the
+    /// whole image. The field of view is the larger image's; `width × height` is the crop's.
+    pub crop: Option<Crop>,
     tan_half: f32,
+}
+
+/// A crop window: the rectangle `[x0, x1) × [y0, y1)` of the full image, as fractions of its
+/// width and height (row 0 at the top), so that a resized camera keeps its window.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Crop {
+    /// Left edge, fraction of the full width.
+    pub x0: f32,
+    /// Top edge, fraction of the full height.
+    pub y0: f32,
+    /// Right edge (exclusive).
+    pub x1: f32,
+    /// Bottom edge (exclusive).
+    pub y1: f32,
+}
+
+impl Crop {
+    /// The window `[x, x + w) × [y, y + h)` in pixels of a `full_w × full_h` image, or `None`
+    /// if it is empty or does not fit.
+    pub fn from_pixels(x: u32, y: u32, w: u32, h: u32, full_w: u32, full_h: u32) -> Option<Crop> {
+        let fits = w > 0 && h > 0 && x.checked_add(w)? <= full_w && y.checked_add(h)? <= full_h;
+        fits.then(|| Crop {
+            x0: x as f32 / full_w as f32,
+            y0: y as f32 / full_h as f32,
+            x1: (x + w) as f32 / full_w as f32,
+            y1: (y + h) as f32 / full_h as f32,
+        })
+    }
 }
 
 impl Camera {
@@ -62,7 +93,51 @@ impl Camera {
             aperture,
             focus_distance,
             filter: PixelFilter::Box,
+            crop: None,
             tan_half: (fov_y_deg.to_radians() * 0.5).tan(),
+        }
+    }
+
+    /// The window of the full image this camera renders ([0, 1]² without a crop).
+    #[inline]
+    fn window(&self) -> Crop {
+        self.crop.unwrap_or(Crop {
+            x0: 0.0,
+            y0: 0.0,
+            x1: 1.0,
+            y1: 1.0,
+        })
+    }
+
+    /// Width over height of the full image (the crop's own aspect without a crop).
+    #[inline]
+    fn full_aspect(&self) -> f32 {
+        let c = self.window();
+        (self.width as f32 / (c.x1 - c.x0)) / (self.height as f32 / (c.y1 - c.y0))
+    }
+
+    /// The full image's height in pixels (this camera's height without a crop).
+    #[inline]
+    fn full_height(&self) -> f32 {
+        let c = self.window();
+        self.height as f32 / (c.y1 - c.y0)
+    }
+
+    /// The side of one pixel on the image plane at distance 1 (pixels are square).
+    #[inline]
+    pub fn pixel_size(&self) -> f32 {
+        2.0 * self.tan_half / self.full_height()
+    }
+
+    /// Position on the full image in [0, 1]² (x right, y down) of raster position `film`.
+    #[inline]
+    fn full_image_position(&self, film: Vec2) -> Vec2 {
+        match &self.crop {
+            None => film / Vec2::new(self.width as f32, self.height as f32),
+            Some(c) => Vec2::new(
+                c.x0 + film.x / self.width as f32 * (c.x1 - c.x0),
+                c.y0 + film.y / self.height as f32 * (c.y1 - c.y0),
+            ),
         }
     }
 
@@ -124,9 +199,10 @@ impl Camera {
         film: Vec2,
         lens: Vec2,
     ) -> Ray {
-        let aspect = self.width as f32 / self.height as f32;
-        let sx = (2.0 * film.x / self.width as f32 - 1.0) * tan_half * aspect;
-        let sy = (1.0 - 2.0 * film.y / self.height as f32) * tan_half;
+        let aspect = self.full_aspect();
+        let f = self.full_image_position(film);
+        let sx = (2.0 * f.x - 1.0) * tan_half * aspect;
+        let sy = (1.0 - 2.0 * f.y) * tan_half;
         let d = forward + right * sx + up * sy;
         if self.is_pinhole() {
             return Ray::new(position, d.normalize());
@@ -149,8 +225,7 @@ impl Camera {
         if cos.is_nan() || cos <= 0.0 {
             return 0.0;
         }
-        let aspect = self.width as f32 / self.height as f32;
-        let image_area = (2.0 * self.tan_half * aspect) * (2.0 * self.tan_half);
+        let image_area = self.pixel_size().powi(2) * (self.width as f32 * self.height as f32);
         1.0 / (image_area * cos * cos * cos)
     }
 
@@ -182,7 +257,7 @@ impl Camera {
         if self.is_pinhole() {
             return 0.0;
         }
-        self.aperture * self.height as f32 / (2.0 * self.tan_half * self.focus_distance)
+        self.aperture / (self.pixel_size() * self.focus_distance)
     }
 
     /// Raster position (x right, y down) of a world point seen through the pinhole, if it is in
@@ -193,13 +268,17 @@ impl Camera {
         if z <= 0.0 {
             return None;
         }
-        let aspect = self.width as f32 / self.height as f32;
+        let aspect = self.full_aspect();
         let sx = v.dot(self.right) / z / (self.tan_half * aspect);
         let sy = v.dot(self.up) / z / self.tan_half;
-        Some(Vec2::new(
-            (sx + 1.0) * 0.5 * self.width as f32,
-            (1.0 - sy) * 0.5 * self.height as f32,
-        ))
+        let (fx, fy) = ((sx + 1.0) * 0.5, (1.0 - sy) * 0.5);
+        Some(match &self.crop {
+            None => Vec2::new(fx * self.width as f32, fy * self.height as f32),
+            Some(c) => Vec2::new(
+                (fx - c.x0) / (c.x1 - c.x0) * self.width as f32,
+                (fy - c.y0) / (c.y1 - c.y0) * self.height as f32,
+            ),
+        })
     }
 }
 
@@ -261,9 +340,7 @@ impl Camera {
         }
         let dist = dist2.sqrt();
         let cos = z / dist;
-        let aspect = self.width as f32 / self.height as f32;
-        let pixel_area = (2.0 * self.tan_half * aspect / self.width as f32)
-            * (2.0 * self.tan_half / self.height as f32);
+        let pixel_area = self.pixel_size().powi(2);
         let importance = 1.0 / (dist2 * pixel_area * cos * cos * cos);
         Some(CameraConnection {
             raster,
@@ -290,6 +367,7 @@ impl crate::content_hash::ContentHash for Camera {
             aperture,
             focus_distance,
             filter,
+            crop,
             tan_half: _,
         } = self;
         name.content_hash(out);
@@ -306,6 +384,10 @@ impl crate::content_hash::ContentHash for Camera {
         // (reference caches) still match.
         if *filter != PixelFilter::Box {
             filter.to_string().content_hash(out);
+        }
+        // Likewise a crop window.
+        if let Some(c) = crop {
+            [c.x0, c.y0, c.x1, c.y1].content_hash(out);
         }
     }
 }
@@ -326,6 +408,50 @@ mod tests {
             aperture,
             5.0,
         )
+    }
+
+    #[test]
+    fn a_crop_sees_its_part_of_the_full_image() {
+        for aperture in [0.0, 0.2] {
+            let full = cam(aperture);
+            let mut crop = full.resized(60, 40);
+            crop.crop = Crop::from_pixels(50, 20, 60, 40, 200, 100);
+            let offset = Vec2::new(50.0, 20.0);
+            let close = |a: Vec3, b: Vec3| (a - b).length() < 1e-5;
+            for film in [
+                Vec2::new(0.5, 0.5),
+                Vec2::new(59.9, 3.0),
+                Vec2::new(30.0, 39.5),
+            ] {
+                let lens = Vec2::new(0.3, 0.7);
+                let (a, b) = (
+                    crop.generate_ray(film, lens),
+                    full.generate_ray(film + offset, lens),
+                );
+                assert!(close(a.origin, b.origin) && close(a.dir, b.dir), "{film}");
+                // Projection is the inverse, in the crop's pixels.
+                let p = full.position + b.dir * 3.0;
+                let back = crop.project(p).unwrap();
+                assert!((back - full.project(p).unwrap() + offset).length() < 1e-3);
+                // A light path's connection: the same per-pixel importance, raster shifted.
+                let (cc, fc) = (crop.connect(p, lens), full.connect(p, lens).unwrap());
+                if aperture == 0.0 {
+                    let cc = cc.unwrap();
+                    assert!((cc.importance / fc.importance - 1.0).abs() < 1e-4);
+                    assert!((cc.raster + offset - fc.raster).length() < 1e-3);
+                }
+                // The direction pdf is over the crop's smaller image: 200·100 / (60·40) times.
+                let ratio = crop.pdf_direction(b.dir) / full.pdf_direction(b.dir);
+                assert!((ratio - 200.0 * 100.0 / 2400.0).abs() < 1e-3, "{ratio}");
+            }
+            let coc = (crop.coc_at_infinity(), full.coc_at_infinity());
+            assert!((coc.0 - coc.1).abs() <= 1e-5 * coc.1, "{coc:?}");
+            // Outside the window a point does not connect.
+            let outside = full.position + full.generate_ray(Vec2::new(10.0, 10.0), Vec2::ZERO).dir;
+            assert!(crop.connect(outside, Vec2::ZERO).is_none());
+        }
+        assert!(Crop::from_pixels(150, 0, 60, 10, 200, 100).is_none());
+        assert!(Crop::from_pixels(0, 0, 0, 10, 200, 100).is_none());
     }
 
     #[test]

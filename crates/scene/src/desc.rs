@@ -157,6 +157,8 @@ pub(crate) struct CameraDesc {
     pub focus_distance: Option<Spanned<f32>>,
     /// `box` (default), `tent[:radius=R]`, `gaussian[:stddev=S]`.
     pub pixel_filter: Option<Spanned<String>>,
+    /// `[x, y, width, height]`: the part of `resolution` rendered.
+    pub crop: Option<Spanned<Arr<u32, 4>>>,
 }
 
 /// `[[material]]`.

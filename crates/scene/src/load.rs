@@ -514,6 +514,21 @@ fn camera(ctx: &Ctx, d: &CameraDesc) -> Result<Camera> {
             );
         }
     }
+    // A crop window renders part of the `w × h` image, at its own size.
+    let mut crop = None;
+    if let Some(c) = &d.crop {
+        let [x, y, cw, ch] = c.get_ref().0;
+        crop = rt_core::camera::Crop::from_pixels(x, y, cw, ch, w, h);
+        if crop.is_none() {
+            return at(
+                c.span(),
+                format!(
+                    "crop [{x}, {y}, {cw}, {ch}] must be a non-empty part of the {w}x{h} image"
+                ),
+            );
+        }
+        (w, h) = (cw, ch);
+    }
     let mut camera = Camera::look_at(
         name.clone(),
         position,
@@ -525,6 +540,7 @@ fn camera(ctx: &Ctx, d: &CameraDesc) -> Result<Camera> {
         aperture,
         focus,
     );
+    camera.crop = crop;
     if let Some(f) = &d.pixel_filter {
         camera.filter = PixelFilter::parse(f.get_ref()).map_err(|e| {
             ctx.src

@@ -498,3 +498,58 @@ fn cylinders_flipped_normals_and_instanced_shape_groups() {
     ));
     assert!(e.contains("emitter inside a shapegroup"), "{e}");
 }
+
+#[test]
+fn a_film_crop_window_renders_its_part_of_the_film() {
+    let film = |extra: &str| {
+        format!(
+            r#"<scene version="3.0.0">
+    <sensor type="perspective"><float name="fov" value="45"/>
+        <film type="hdrfilm"><integer name="width" value="64"/><integer name="height" value="32"/>{extra}</film>
+    </sensor>
+    {LAMP}
+</scene>"#
+        )
+    };
+    let s = load_files(
+        &[(
+            "s.xml",
+            &film(
+                r#"<integer name="crop_offset_x" value="16"/><integer name="crop_offset_y" value="8"/>
+                <integer name="crop_width" value="32"/><integer name="crop_height" value="16"/>"#,
+            ),
+        )],
+        &[],
+    )
+    .unwrap();
+    let cam = &s.scene.cameras[0];
+    assert_eq!((cam.width, cam.height), (32, 16));
+    assert_eq!(
+        cam.crop,
+        rt_core::camera::Crop::from_pixels(16, 8, 32, 16, 64, 32)
+    );
+    // The field of view is the whole film's: the crop's centre ray is the film's centre ray.
+    let full = load_files(&[("s.xml", &film(""))], &[]).unwrap();
+    assert!(
+        (cam.generate_ray(glam::Vec2::new(16.0, 8.0), glam::Vec2::ZERO)
+            .dir
+            - full.scene.cameras[0]
+                .generate_ray(glam::Vec2::new(32.0, 16.0), glam::Vec2::ZERO)
+                .dir)
+            .length()
+            < 1e-6
+    );
+    let e = err(load_files(
+        &[(
+            "s.xml",
+            &film(
+                r#"<integer name="crop_offset_x" value="40"/><integer name="crop_width" value="32"/>"#,
+            ),
+        )],
+        &[],
+    ));
+    assert!(
+        e.contains("crop window 32x32 at (40, 0) does not fit the 64x32 film"),
+        "{e}"
+    );
+}

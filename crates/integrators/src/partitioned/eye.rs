@@ -68,7 +68,7 @@ impl Partitioned {
         let cam = ctx.camera;
         let pixels = (cam.width * cam.height) as usize;
         // Angle subtended by a pixel at the centre of the image.
-        let pixel_angle = 2.0 * (cam.fov_y_deg.to_radians() * 0.5).tan() / cam.height as f32;
+        let pixel_angle = cam.pixel_size();
         let chunks: Vec<Vec<EyeSample>> = (0..pixels.div_ceil(CHUNK))
             .into_par_iter()
             .map(|c| {

@@ -271,17 +271,25 @@ impl<'a> Builder<'a, '_> {
         }
         let w = p.integer("width")?.unwrap_or(768);
         let h = p.integer("height")?.unwrap_or(576);
-        for (key, full) in [
-            ("crop_offset_x", 0),
-            ("crop_offset_y", 0),
-            ("crop_width", w),
-            ("crop_height", h),
-        ] {
-            if let Some(v) = p.integer(key)? {
-                if v != full {
-                    return Err(p.error(format!("{key} = {v}: crop windows are not supported")));
-                }
+        let crop_x = p.integer("crop_offset_x")?.unwrap_or(0);
+        let crop_y = p.integer("crop_offset_y")?.unwrap_or(0);
+        let crop_w = p.integer("crop_width")?.unwrap_or(w);
+        let crop_h = p.integer("crop_height")?.unwrap_or(h);
+        if (crop_x, crop_y, crop_w, crop_h) != (0, 0, w, h) {
+            let fits = crop_x >= 0
+                && crop_y >= 0
+                && crop_w > 0
+                && crop_h > 0
+                && crop_x + crop_w <= w
+                && crop_y + crop_h <= h;
+            if !fits {
+                return Err(p.error(format!(
+                    "crop window {crop_w}x{crop_h} at ({crop_x}, {crop_y}) does not fit the \
+                     {w}x{h} film"
+                )));
             }
+            let v = [crop_x, crop_y, crop_w, crop_h].map(Value::Integer);
+            cam.insert("crop".into(), Value::Array(v.to_vec()));
         }
         let filters = p.objects("rfilter");
         let filter = match filters.as_slice() {
