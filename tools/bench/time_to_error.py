@@ -441,7 +441,7 @@ def markdown(res: dict) -> str:
          f"`{m.get('uptime_end', '?')}` at its end; "
          "per render in the table (1-, 5-, 15-minute load averages just before it).",
          f"- 256x256, box filter, unlimited depth (Mitsuba `max_depth = -1`, ours "
-         f"`--max-depth 10000`); reference: Mitsuba {m['ref_spp']} spp. Times: ours = whole "
+         f"`--max-depth 10000`; a Mitsuba .xml scene keeps its own filter and depth); reference: Mitsuba {m['ref_spp']} spp. Times: ours = whole "
          "`render` command (load, BVH build, render, EXR write; render-only in brackets); "
          "Mitsuba = `load_dict` + render + EXR write in-process, without Python start-up and "
          "import; warm = JIT excluded (4-spp warm-up first), cold = empty kernel cache. "
