@@ -198,6 +198,13 @@ pub struct RenderJob {
     /// The checkpoint to continue from ([`RenderJob::resume`]); not part of the job's file.
     #[serde(skip)]
     pub resume: Option<PathBuf>,
+    /// Stop a fixed render without a checkpoint at the next pass when the stop flag is set:
+    /// its samples are then rendered in passes of one sample per pixel (which add up to the
+    /// bits of one pass), and a stopped render writes nothing and returns
+    /// [`JobError::Stopped`]. For callers that interrupt renders they do not checkpoint (the
+    /// Python module's Ctrl-C); not part of the job's file.
+    #[serde(skip)]
+    pub interruptible: bool,
 }
 
 /// Why a job could not run, or stopped. Each is one line naming what it is about.
@@ -234,6 +241,15 @@ pub enum JobError {
         output: PathBuf,
         /// The checkpoint written.
         checkpoint: PathBuf,
+    },
+    /// The stop flag stopped an interruptible render ([`RenderJob::interruptible`]): nothing
+    /// was written.
+    #[error("stopped after {samples} of {spp} samples per pixel: nothing written")]
+    Stopped {
+        /// Samples per pixel taken.
+        samples: u32,
+        /// Samples per pixel of the whole render.
+        spp: u32,
     },
 }
 
@@ -301,6 +317,7 @@ impl RenderJob {
             max_memory: None,
             defines: Vec::new(),
             resume: None,
+            interruptible: false,
         }
     }
 

@@ -19,6 +19,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+/// About how long a pass of an interruptible render lasts ([`RenderJob::interruptible`]):
+/// how long stopping it may wait.
+pub const INTERRUPTIBLE_PASS: Duration = Duration::from_millis(250);
+
 /// A rayon pool of `threads` workers (all cores by default), the one every render and
 /// benchmark uses.
 pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool, JobError> {
@@ -380,8 +384,8 @@ impl RenderJob {
                     scene_hash,
                     frame: env.frame,
                 };
-                let (stats, stopped) = self.render_checkpointed(
-                    &ck,
+                let (stats, stopped) = self.render_in_passes(
+                    Some(&ck),
                     &ctx,
                     technique.as_ref(),
                     &mut film,
@@ -390,6 +394,24 @@ impl RenderJob {
                     stop,
                 )?;
                 interrupted = stopped;
+                stats
+            }
+            (None, None, _) if self.interruptible && cut.is_none() => {
+                let (stats, stopped) = self.render_in_passes(
+                    None,
+                    &ctx,
+                    technique.as_ref(),
+                    &mut film,
+                    env,
+                    sink,
+                    stop,
+                )?;
+                if let Some(samples) = stopped {
+                    return Err(JobError::Stopped {
+                        samples,
+                        spp: self.settings.spp,
+                    });
+                }
                 stats
             }
             (None, _, _) => {
@@ -492,13 +514,16 @@ impl RenderJob {
         self.end_checkpoint(&env.output, interrupted)
     }
 
-    /// Renders the job's samples into `film` pass by pass, one sample per pixel each,
-    /// writing checkpoints; stops early at a pass boundary when `stop` is set (the checkpoint
-    /// then holds every finished pass). Returns the samples per pixel taken when stopped.
+    /// Renders the job's samples into `film` pass by pass, writing checkpoints through `ck` if
+    /// given; stops early at a pass boundary when `stop` is set (a checkpoint then holds every
+    /// finished pass). Returns the samples per pixel taken when stopped. A checkpointed render
+    /// takes one sample per pixel a pass (a checkpoint may fall after any); without one a pass
+    /// takes as many as fit in about [`INTERRUPTIBLE_PASS`], so that stopping waits for little
+    /// and the passes cost little. Passes add up to the bits of one pass either way.
     #[allow(clippy::too_many_arguments)]
-    fn render_checkpointed(
+    fn render_in_passes(
         &self,
-        ck: &Checkpointer<'_>,
+        ck: Option<&Checkpointer<'_>>,
         ctx: &Ctx<'_>,
         technique: &dyn Technique,
         film: &mut Film,
@@ -507,29 +532,44 @@ impl RenderJob {
         stop: &AtomicBool,
     ) -> Result<(RenderStats, Option<u32>), JobError> {
         let spp = self.settings.spp;
-        let (start, before) = match &self.resume {
-            Some(path) => ck.restore(path, film)?,
-            None => (0, 0.0),
+        let (start, before) = match (&self.resume, ck) {
+            (Some(path), Some(ck)) => ck.restore(path, film)?,
+            _ => (0, 0.0),
         };
         let every = Duration::from_secs_f64(self.checkpoint.as_ref().map_or(0.0, |c| c.every));
         let mut last = Instant::now();
         let mut stats = RenderStats::default();
         sink.progress(f64::from(start) / f64::from(spp));
-        for i in start..spp {
+        let rows = f64::from(ctx.camera.height.max(1));
+        let (mut i, mut n) = (start, 1);
+        while i < spp {
+            n = n.min(spp - i);
             let pass = SamplePass {
-                indices: i..i + 1,
+                indices: i..i + n,
                 stream: self.stream.sample_stream(),
                 pixels: None,
                 centre_first: false,
             };
-            stats += technique.render_pass(ctx, film, env.seed, &pass, &|_| {});
-            sink.progress(f64::from(i + 1) / f64::from(spp));
-            if stop.load(Ordering::Relaxed) {
-                ck.write(film, i + 1, before + stats.elapsed.as_secs_f64())?;
-                return Ok((stats, Some(i + 1)));
+            let s = technique.render_pass(ctx, film, env.seed, &pass, &|r| {
+                sink.progress((f64::from(i) + f64::from(n) * f64::from(r) / rows) / f64::from(spp))
+            });
+            if ck.is_none() {
+                let per_sample = s.elapsed.as_secs_f64() / f64::from(n);
+                let fit = (INTERRUPTIBLE_PASS.as_secs_f64() / per_sample.max(1e-9)) as u32;
+                n = fit.clamp(1, 2 * n);
             }
-            if i + 1 < spp && last.elapsed() >= every {
-                ck.write(film, i + 1, before + stats.elapsed.as_secs_f64())?;
+            stats += s;
+            i += pass.indices.len() as u32;
+            sink.progress(f64::from(i) / f64::from(spp));
+            let seconds = before + stats.elapsed.as_secs_f64();
+            if stop.load(Ordering::Relaxed) {
+                if let Some(ck) = ck {
+                    ck.write(film, i, seconds)?;
+                }
+                return Ok((stats, Some(i)));
+            }
+            if let Some(ck) = ck.filter(|_| i < spp && last.elapsed() >= every) {
+                ck.write(film, i, seconds)?;
                 last = Instant::now();
             }
         }
