@@ -91,9 +91,11 @@ pub fn dict_to_frame(frame: &Bound<'_, PyDict>, what: &str) -> PyResult<ExrImage
         let shape = array.shape().to_vec();
         let (h, w) = match shape[..] {
             [h, w] | [h, w, 3] => (h, w),
-            _ => return Err(value_err(format!(
+            _ => {
+                return Err(value_err(format!(
                 "{what}[{key:?}]: shape {shape:?}, expected (height, width, 3) or (height, width)"
-            ))),
+            )))
+            }
         };
         match size {
             Some(s) if s != (w, h) => {

@@ -26,8 +26,10 @@ pub struct Scene {
 
 #[pymethods]
 impl Scene {
-    /// Loads a TOML scene, a Mitsuba XML scene (`defines`: its `$name` parameters) or
-    /// `gen:NAME`; `confine` refuses files outside that directory.
+    /// Loads a TOML scene, a Mitsuba XML scene (`defines`: its `$name` parameters),
+    /// `gen:NAME`, or a bare mesh file (`.obj`, `.ply`, ...: its triangles under a grey
+    /// material, as `render bench-accel` reads it); `confine` refuses files outside that
+    /// directory.
     #[staticmethod]
     #[pyo3(signature = (path, defines=None, confine=None))]
     fn load(
@@ -43,6 +45,21 @@ impl Scene {
                 .collect::<PyResult<_>>()?,
             None => Vec::new(),
         };
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .unwrap_or_default();
+        if rt_scene::MESH_EXTENSIONS.contains(&ext.as_str()) && confine.is_none() {
+            // A bare mesh, as `render bench-accel` reads one: one grey material, a white
+            // sky and a placeholder camera.
+            let loaded = py.detach(|| rt_scene::load_mesh(&path)).map_err(rt_err)?;
+            return Ok(Scene {
+                loaded,
+                path,
+                access: FileAccess::open(),
+            });
+        }
         let loaded = py
             .detach(|| rt_session::load_scene(&path, confine.as_deref(), &defines))
             .map_err(rt_err)?;
