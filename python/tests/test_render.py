@@ -121,14 +121,15 @@ def rss_bytes():
 
 def test_rss_stays_bounded_over_100_small_renders(small_cornell):
     scene = rt.Scene.load(small_cornell)
+    kwargs = dict(spp=1, denoiser="none", aovs=["albedo"], size=(128, 128))
     for _ in range(10):
-        scene.render(spp=1, denoiser="none", aovs=["albedo"])
+        scene.render(**kwargs)
     before = rss_bytes()
     for _ in range(100):
-        scene.render(spp=1, denoiser="none", aovs=["albedo"])
+        scene.render(**kwargs)
     grown = rss_bytes() - before
-    # One render holds about 48*40*6*4 bytes of arrays and a film; a leak of the frame per render
-    # would add 100 of them, a leaked thread pool far more.
+    # One frame is 128*128*6*4 bytes = 384 KiB (a film more): leaking one per render would
+    # add 37 MiB (seen failing so), a leaked thread pool or scene copy more.
     assert grown < 8 << 20, f"RSS grew by {grown / 2**20:.1f} MiB over 100 renders"
 
 
