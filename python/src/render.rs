@@ -14,7 +14,6 @@ use crate::arrays::frame_to_dict;
 use crate::scene::Scene;
 use crate::{rt_err, value_err};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
 use rt_session::{JobScene, JobSink, Overrides, RenderJob, StopRule, MAX_SPP};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{mpsc, Mutex};
@@ -37,6 +36,14 @@ pub struct RenderArgs {
     pub camera: Option<String>,
     pub max_depth: Option<u32>,
     pub size: Option<(u32, u32)>,
+    /// Frames `a..b` of the animation (one frame dict each; a temporal denoiser carries its
+    /// history across them).
+    pub frames: Option<std::ops::Range<u32>>,
+    /// One frame of the animation.
+    pub frame: Option<u32>,
+    /// GREE's options (`""`: the defaults) instead of a denoiser, with its bank file.
+    pub gree: Option<String>,
+    pub bank: Option<std::path::PathBuf>,
 }
 
 /// The job `args` describe over `scene`, writing `output`.
@@ -65,12 +72,38 @@ fn job(scene: &Scene, args: &RenderArgs, output: std::path::PathBuf) -> PyResult
         accel,
         aovs: args.aovs.clone(),
         output: Some(output),
-        denoiser: args.denoiser.clone(),
+        // GREE chooses among its own bank, as `render --gree` does.
+        denoiser: if args.gree.is_some() {
+            if args.denoiser.is_some() {
+                return Err(value_err(
+                    "denoiser and gree cannot be combined: GREE is the denoiser",
+                ));
+            }
+            Some("none".into())
+        } else {
+            args.denoiser.clone()
+        },
     }
     .resolve(&scene.loaded, path)
     .map_err(rt_err)?;
     let mut job = RenderJob::new(path, settings);
     job.camera = args.camera.clone();
+    job.frames = match (&args.frames, args.frame) {
+        (Some(_), Some(_)) => return Err(value_err("give frames or frame, not both")),
+        (Some(r), None) => rt_session::Frames::Range(r.clone()),
+        (None, Some(f)) => rt_session::Frames::One(f),
+        (None, None) => rt_session::Frames::Still,
+    };
+    if let Some(text) = &args.gree {
+        job.gree = Some(rt_session::GreeJob {
+            options: text
+                .parse()
+                .map_err(|e| rt_err(format!("gree={text}: {e}")))?,
+            bank: args.bank.clone(),
+            labels: None,
+            error_maps: None,
+        });
+    }
     if let Some((w, h)) = args.size {
         job.size = rt_session::ImageSize::Pixels(w, h);
     }
@@ -105,13 +138,14 @@ impl JobSink for Sink {
     }
 }
 
-/// Renders `scene` as `args` say and returns the frame dict (`arrays.rs`).
+/// Renders `scene` as `args` say and returns the frame dict (`arrays.rs`), or with `frames`
+/// a list of them.
 pub fn render<'py>(
     py: Python<'py>,
     scene: &Scene,
     args: &RenderArgs,
     progress: Option<Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyDict>> {
+) -> PyResult<Bound<'py, PyAny>> {
     if progress.as_ref().is_some_and(|p| !p.is_callable()) {
         return Err(value_err(
             "progress: expected a callable taking the fraction done",
@@ -121,7 +155,7 @@ pub fn render<'py>(
         .prefix("rt-renderer-")
         .tempdir()
         .map_err(|e| rt_err(format!("cannot create a temporary directory: {e}")))?;
-    let output = dir.path().join("render.exr");
+    let output = dir.path().join("render-{frame}.exr");
     let job = job(scene, args, output.clone())?;
     let loaded = JobScene {
         loaded: rt_scene::LoadedScene {
@@ -189,6 +223,19 @@ pub fn render<'py>(
     if let Some(cb) = &progress {
         cb.call1(py, (1.0,))?;
     }
-    let exr = py.detach(|| rt_film::read_exr(&output)).map_err(rt_err)?;
-    frame_to_dict(py, &exr)
+    let read = |path: std::path::PathBuf| {
+        let exr = py.detach(|| rt_film::read_exr(&path)).map_err(rt_err)?;
+        frame_to_dict(py, &exr)
+    };
+    match (&args.frames, args.frame) {
+        (Some(r), _) => {
+            let frames = r
+                .clone()
+                .map(|f| read(rt_session::frames::frame_path(&output, f)))
+                .collect::<PyResult<Vec<_>>>()?;
+            Ok(pyo3::types::PyList::new(py, frames)?.into_any())
+        }
+        (None, Some(f)) => Ok(read(rt_session::frames::frame_path(&output, f))?.into_any()),
+        (None, None) => Ok(read(output)?.into_any()),
+    }
 }

@@ -283,8 +283,11 @@ impl Scene {
     /// `rt_renderer`'s doc): the same bits. Settings not given come from the scene's
     /// `[render]` table, then the defaults. `progress(fraction)` is called on this thread as
     /// the render advances; Ctrl-C stops the render at the next pass and raises
-    /// `KeyboardInterrupt`.
-    #[pyo3(signature = (spp=None, integrator=None, accel=None, seed=None, error=None, time_limit=None, aovs=None, threads=None, denoiser=None, camera=None, max_depth=None, size=None, progress=None))]
+    /// `KeyboardInterrupt`. `frames=range(a, b)` renders frames of the animation and returns
+    /// a list of frame dicts (a temporal `denoiser`, `"svgf"`, carries its history across
+    /// them); `frame=F` renders one; `gree="fraction=0.875"` (`""`: the defaults) denoises by
+    /// GREE with the filter bank file `bank`, as `render --gree` does.
+    #[pyo3(signature = (spp=None, integrator=None, accel=None, seed=None, error=None, time_limit=None, aovs=None, threads=None, denoiser=None, camera=None, max_depth=None, size=None, frames=None, frame=None, gree=None, bank=None, progress=None))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
@@ -301,8 +304,13 @@ impl Scene {
         camera: Option<String>,
         max_depth: Option<u32>,
         size: Option<(u32, u32)>,
+        frames: Option<Bound<'py, PyAny>>,
+        frame: Option<u32>,
+        gree: Option<String>,
+        bank: Option<PathBuf>,
         progress: Option<Bound<'py, PyAny>>,
-    ) -> PyResult<Bound<'py, PyDict>> {
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let frames = frames.map(|f| frame_range(&f)).transpose()?;
         let args = crate::render::RenderArgs {
             spp,
             integrator,
@@ -316,6 +324,10 @@ impl Scene {
             camera,
             max_depth,
             size,
+            frames,
+            frame,
+            gree,
+            bank,
         };
         crate::render::render(py, self, &args, progress)
     }
@@ -327,6 +339,28 @@ impl Scene {
             self.loaded.scene.triangle_count(),
             self.cameras()
         )
+    }
+}
+
+/// `frames=`: a `range` of step 1 or a pair `(a, b)`, as `a..b`.
+fn frame_range(obj: &Bound<'_, PyAny>) -> PyResult<std::ops::Range<u32>> {
+    let bad = || value_err("frames: expected range(a, b) or (a, b) with 0 <= a < b");
+    let (a, b): (i64, i64) = match obj.extract::<(i64, i64)>() {
+        Ok(pair) => pair,
+        Err(_) => {
+            let step: i64 = obj.getattr("step").map_err(|_| bad())?.extract()?;
+            if step != 1 {
+                return Err(value_err("frames: a range of step 1"));
+            }
+            (
+                obj.getattr("start")?.extract()?,
+                obj.getattr("stop")?.extract()?,
+            )
+        }
+    };
+    match (u32::try_from(a), u32::try_from(b)) {
+        (Ok(a), Ok(b)) if a < b => Ok(a..b),
+        _ => Err(bad()),
     }
 }
 

@@ -135,8 +135,9 @@ def test_rss_stays_bounded_over_100_small_renders(small_cornell):
 
 CHILD = textwrap.dedent(
     """
-    import sys, time, rt_renderer as rt
+    import json, sys, time, rt_renderer as rt
     scene = rt.Scene.load(sys.argv[1])
+    kwargs = json.loads(sys.argv[2])
     def progress(done):
         if not progress.told:
             progress.told = True
@@ -144,7 +145,7 @@ CHILD = textwrap.dedent(
     progress.told = False
     t = time.monotonic()
     try:
-        scene.render(spp=1_000_000, denoiser="none", progress=progress)
+        scene.render(denoiser="none", progress=progress, **kwargs)
     except KeyboardInterrupt:
         print(f"interrupted after {time.monotonic() - t:.2f} s", flush=True)
         raise
@@ -153,9 +154,16 @@ CHILD = textwrap.dedent(
 )
 
 
-def test_ctrl_c_stops_a_render_at_the_next_pass(small_cornell):
+@pytest.mark.parametrize(
+    "kwargs",
+    [dict(spp=1_000_000), dict(spp=1_000_000, error=1e-9, time_limit=600.0)],
+    ids=["fixed", "adaptive"],
+)
+def test_ctrl_c_stops_a_render_at_the_next_pass(small_cornell, kwargs):
+    import json
+
     child = subprocess.Popen(
-        [sys.executable, "-c", CHILD, str(small_cornell)],
+        [sys.executable, "-c", CHILD, str(small_cornell), json.dumps(kwargs)],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )
     assert child.stdout.readline().strip() == "rendering"
@@ -172,3 +180,29 @@ def test_ctrl_c_stops_a_render_at_the_next_pass(small_cornell):
     assert child.returncode != 0 and "finished" not in out
     # A pass lasts about 0.25 s; on a loaded machine allow several.
     assert stopped < 5, f"stopped {stopped:.1f} s after SIGINT"
+
+
+def test_gree_equals_render_gree(render_bin, small_cornell, tmp_path):
+    out = tmp_path / "cli.exr"
+    run_cli(render_bin, small_cornell, "-q", "--spp", "8", "--gree", "sparsity=0.9", "-o", out)
+    frame = rt.Scene.load(small_cornell).render(spp=8, gree="sparsity=0.9")
+    assert_same_bits(frame, out)
+    with pytest.raises(ValueError, match="cannot be combined"):
+        rt.Scene.load(small_cornell).render(spp=8, gree="", denoiser="nlm")
+
+
+def test_an_svgf_sequence_equals_render_frames(render_bin, tmp_path):
+    scene = ROOT / "scenes" / "dynamic-small.toml"
+    pattern = tmp_path / "f_{frame}.exr"
+    run_cli(render_bin, scene, "-q", "--frames", "2..5", "--spp", "1", "--denoiser", "svgf",
+            "-o", pattern)
+    frames = rt.Scene.load(scene).render(frames=range(2, 5), spp=1, denoiser="svgf")
+    assert len(frames) == 3
+    for f, frame in zip(range(2, 5), frames):
+        assert_same_bits(frame, tmp_path / f"f_{f}.exr")
+    one = rt.Scene.load(scene).render(frame=3, spp=1, denoiser="none")
+    run_cli(render_bin, scene, "-q", "--frame", "3", "--spp", "1", "--denoiser", "none",
+            "-o", tmp_path / "one.exr")
+    assert_same_bits(one, tmp_path / "one.exr")
+    with pytest.raises(ValueError, match="frames"):
+        rt.Scene.load(scene).render(frames=range(5, 2))

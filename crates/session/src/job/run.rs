@@ -8,8 +8,8 @@ use super::{load_scene, refuse, Frames, JobError, JobScene, RenderJob};
 use crate::frames::frame_path;
 use crate::memory::Estimate;
 use crate::{
-    frame_seed, pick_camera, render_adaptive, Adaptive, RenderReport, ReportInputs,
-    SequenceRenderer,
+    frame_seed, pick_camera, render_adaptive, render_adaptive_until, Adaptive, RenderReport,
+    ReportInputs, SequenceRenderer,
 };
 use rt_core::{Accel, Camera, Scene};
 use rt_film::{AovSet, Film, FilmBuffers, OutputOptions};
@@ -423,11 +423,26 @@ impl RenderJob {
                 self.fixed_pass(&ctx, technique.as_ref(), &mut film, env.seed, cut, sink)
             }
             (Some(rule), _, _) => {
-                let a =
-                    render_adaptive(&ctx, technique.as_ref(), &mut film, env.seed, rule, &|f| {
-                        sink.progress(f)
-                    })
-                    .map_err(|e| JobError::Refused(format!("--error {}", e.0)))?;
+                // Only an interruptible job listens to `stop` here (a checkpointed one cannot
+                // be adaptive).
+                let never = AtomicBool::new(false);
+                let stop = if self.interruptible { stop } else { &never };
+                let a = render_adaptive_until(
+                    &ctx,
+                    technique.as_ref(),
+                    &mut film,
+                    env.seed,
+                    rule,
+                    &|f| sink.progress(f),
+                    stop,
+                )
+                .map_err(|e| JobError::Refused(format!("--error {}", e.0)))?;
+                if a.reason == crate::StopReason::Stopped {
+                    return Err(JobError::Stopped {
+                        samples: a.spp,
+                        spp: rule.max_spp,
+                    });
+                }
                 let stats = a.stats;
                 adaptive = Some(a);
                 stats
