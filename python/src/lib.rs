@@ -2,12 +2,12 @@
 //! over NumPy arrays. The Python package `rt_renderer` (python/rt_renderer) re-exports it and
 //! adds what is plain Python (experiment rows as a pandas DataFrame).
 //!
-//! - [`scene`]: [`scene::Scene`], loaded from a TOML or Mitsuba XML file or TOML text, its
+//! - `scene`: `Scene`, loaded from a TOML or Mitsuba XML file or TOML text, its
 //!   cameras and objects changed in place; `Scene.render` runs an `rt_session::RenderJob` over
-//!   it ([`render`]) with the GIL released, a progress callback and Ctrl-C at the next pass.
-//! - [`rays`]: [`rays::Accel`], any `rt_accel::AccelSpec` built over NumPy triangles, tracing
+//!   it (`render`) with the GIL released, a progress callback and Ctrl-C at the next pass.
+//! - `rays`: `Accel`, any `rt_accel::AccelSpec` built over NumPy triangles, tracing
 //!   NumPy rays on all cores; the `render bench-accel` uniform rays.
-//! - [`images`]: denoising NumPy frames with any `rt_denoise::DenoiserSpec`, the CLI's metrics
+//! - `images`: denoising NumPy frames with any `rt_denoise::DenoiserSpec`, the CLI's metrics
 //!   (`rt_metrics::compare`), EXR reading and experiments.
 //!
 //! Errors raise `rt_renderer.RtError` with the library's one-line message; arguments of the
