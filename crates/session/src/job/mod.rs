@@ -596,6 +596,40 @@ mod run_tests {
     }
 
     #[test]
+    fn an_interruptible_job_gives_the_same_bytes_and_stops_at_a_pass_writing_nothing() {
+        let d = tempfile::tempdir().unwrap();
+        let dir = d.path();
+        let mut j = job(dir, 5);
+        j.output = dir.join("whole.exr");
+        j.run(&(), &AtomicBool::new(false)).unwrap();
+        j.interruptible = true;
+        j.output = dir.join("passes.exr");
+        j.run(&(), &AtomicBool::new(false)).unwrap();
+        assert!(bytes(&dir.join("passes.exr")) == bytes(&dir.join("whole.exr")));
+        // Set before the render: it ends after its first pass.
+        j.output = dir.join("stopped.exr");
+        let e = j.run(&(), &AtomicBool::new(true)).unwrap_err();
+        assert!(matches!(e, JobError::Stopped { samples: 1, spp: 5 }), "{e}");
+        assert!(!j.output.exists());
+        // Adaptive jobs too; a job that is not interruptible ignores the flag.
+        j.stop = Some(crate::StopRule::new(Some(1e-9), None, 64).unwrap());
+        let e = j.run(&(), &AtomicBool::new(true)).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                JobError::Stopped {
+                    samples: 2,
+                    spp: 64
+                }
+            ),
+            "{e}"
+        );
+        j.interruptible = false;
+        j.run(&(), &AtomicBool::new(true)).unwrap();
+        assert!(j.output.exists());
+    }
+
+    #[test]
     fn parts_of_two_frames_merge_to_the_bytes_of_each_whole_frame() {
         let d = tempfile::tempdir().unwrap();
         let dir = d.path();
