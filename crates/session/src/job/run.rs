@@ -20,8 +20,11 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// About how long a pass of an interruptible render lasts ([`RenderJob::interruptible`]):
-/// how long stopping it may wait.
-pub const INTERRUPTIBLE_PASS: Duration = Duration::from_millis(250);
+/// how long stopping it may wait. Every pass costs a little (the wavefront's batches are
+/// filled and drained, threads wait for the last band): passes of one sample per pixel made
+/// the default scene about 5 % slower, passes of a second about 1 % (docs/benchmarks.md,
+/// "The Python module").
+pub const INTERRUPTIBLE_PASS: Duration = Duration::from_secs(1);
 
 /// A rayon pool of `threads` workers (all cores by default), the one every render and
 /// benchmark uses.
@@ -571,7 +574,8 @@ impl RenderJob {
             if ck.is_none() {
                 let per_sample = s.elapsed.as_secs_f64() / f64::from(n);
                 let fit = (INTERRUPTIBLE_PASS.as_secs_f64() / per_sample.max(1e-9)) as u32;
-                n = fit.clamp(1, 2 * n);
+                // A first pass of one sample may mislead (caches are cold): grow at most 4x.
+                n = fit.clamp(1, 4 * n);
             }
             stats += s;
             i += pass.indices.len() as u32;
