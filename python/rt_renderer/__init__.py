@@ -4,7 +4,7 @@ Render a scene (the same bits as ``render SCENE -o OUT.exr``)::
 
     import rt_renderer as rt
     scene = rt.Scene.load("scenes/cornell-box.toml")
-    frame = scene.render(spp=16, aovs=["albedo", "normal"], progress=print)
+    frame = scene.render(spp=16, denoiser="none", aovs=["albedo", "normal"], progress=print)
     frame["image"]          # (height, width, 3) float32: the EXR's R, G, B
     frame["albedo"]         # the AOVs, one entry per channel group of the EXR
 

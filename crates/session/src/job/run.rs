@@ -22,8 +22,9 @@ use std::time::{Duration, Instant};
 /// About how long a pass of an interruptible render lasts ([`RenderJob::interruptible`]):
 /// how long stopping it may wait. Every pass costs a little (the wavefront's batches are
 /// filled and drained, threads wait for the last band): on the default scene at 16 spp on one
-/// thread, passes of one sample per pixel cost 2.7 % more CPU time than one pass, and a render
-/// from Python with passes of about a second 1.3 % (docs/benchmarks.md, "The Python module").
+/// thread, passes of one sample per pixel cost 3–4 % more CPU time than one pass, and
+/// quarter-second passes made a render from Python 5 % dearer than the CLI's
+/// (docs/benchmarks.md, "The Python module").
 pub const INTERRUPTIBLE_PASS: Duration = Duration::from_secs(1);
 
 /// A rayon pool of `threads` workers (all cores by default), the one every render and
