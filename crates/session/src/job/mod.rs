@@ -23,7 +23,7 @@ mod run;
 
 pub use parts::{merge, read_parts, MergeReport};
 pub use report::{AdaptiveSummary, FrameReport, GreeSummary, JobReport, JobSink, Rendered};
-pub use run::thread_pool;
+pub use run::{thread_pool, INTERRUPTIBLE_PASS};
 
 use crate::text;
 use crate::{ImageSize, SessionError, Settings, SettingsError, StopRule};
@@ -198,9 +198,10 @@ pub struct RenderJob {
     /// The checkpoint to continue from ([`RenderJob::resume`]); not part of the job's file.
     #[serde(skip)]
     pub resume: Option<PathBuf>,
-    /// Stop a fixed render without a checkpoint at the next pass when the stop flag is set:
-    /// its samples are then rendered in passes of one sample per pixel (which add up to the
-    /// bits of one pass), and a stopped render writes nothing and returns
+    /// Stop a render without a checkpoint at the next pass when the stop flag is set: a
+    /// fixed render's samples are then rendered in passes of about
+    /// [`INTERRUPTIBLE_PASS`] (which add up to the bits of one pass), an adaptive render
+    /// stops after its current pass, and a stopped render writes nothing and returns
     /// [`JobError::Stopped`]. For callers that interrupt renders they do not checkpoint (the
     /// Python module's Ctrl-C); not part of the job's file.
     #[serde(skip)]
