@@ -507,7 +507,10 @@ impl NoisyFrame {
         })
     }
 
-    fn from_exr_image(exr: &ExrImage) -> Result<Self, String> {
+    /// [`NoisyFrame::from_exr`] of channels already in memory (an EXR's, or arrays named as
+    /// in a file, as the Python module hands them over); the error names the problem, not a
+    /// file.
+    pub fn from_exr_image(exr: &ExrImage) -> Result<Self, String> {
         let (w, h) = (exr.width, exr.height);
         let group = |prefix: &str, names: [&str; 3]| -> Result<Option<Image<Vec3>>, String> {
             let full = |n: &str| {

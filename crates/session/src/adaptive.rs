@@ -14,6 +14,7 @@ use rt_core::SampleStream;
 use rt_film::stopping::{BadThreshold, Block, BlockMap, StoppingCriterion};
 use rt_film::Film;
 use rt_integrators::{Ctx, RenderStats, SamplePass, Technique};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -97,6 +98,8 @@ pub enum StopReason {
     TimeLimit,
     /// The cap on samples per pixel was reached.
     SampleCap,
+    /// The caller's stop flag was set ([`render_adaptive_until`]).
+    Stopped,
 }
 
 impl std::fmt::Display for StopReason {
@@ -105,6 +108,7 @@ impl std::fmt::Display for StopReason {
             StopReason::Converged => "converged",
             StopReason::TimeLimit => "time limit",
             StopReason::SampleCap => "sample cap",
+            StopReason::Stopped => "stopped",
         })
     }
 }
@@ -152,6 +156,21 @@ pub fn render_adaptive(
     rule: &StopRule,
     progress: &(dyn Fn(f64) + Sync),
 ) -> Result<Adaptive, BadThreshold> {
+    let never = AtomicBool::new(false);
+    render_adaptive_until(ctx, technique, film, seed, rule, progress, &never)
+}
+
+/// [`render_adaptive`] that also ends after the pass in which `stop` is set
+/// ([`StopReason::Stopped`]), for callers that interrupt renders (the Python module's Ctrl-C).
+pub fn render_adaptive_until(
+    ctx: &Ctx<'_>,
+    technique: &dyn Technique,
+    film: &mut Film,
+    seed: u32,
+    rule: &StopRule,
+    progress: &(dyn Fn(f64) + Sync),
+    stop: &AtomicBool,
+) -> Result<Adaptive, BadThreshold> {
     let mut criterion = rule
         .error
         .map(|v| StoppingCriterion::new(film.width(), film.height(), v))
@@ -195,6 +214,9 @@ pub fn render_adaptive(
         }
         if rule.time_limit.is_some_and(|t| start.elapsed() >= t) {
             break StopReason::TimeLimit;
+        }
+        if stop.load(Ordering::Relaxed) {
+            break StopReason::Stopped;
         }
     };
     stats.elapsed = start.elapsed();

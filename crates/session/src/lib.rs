@@ -61,7 +61,8 @@ pub mod viewer;
 pub mod worldcache;
 
 pub use adaptive::{
-    render_adaptive, Adaptive, StopReason, StopRule, StopRuleError, FIRST_DECISION_SPP,
+    render_adaptive, render_adaptive_until, Adaptive, StopReason, StopRule, StopRuleError,
+    FIRST_DECISION_SPP,
 };
 pub use camera::{parse_resolution, pick_camera, split_size, ImageSize, MAX_SIDE};
 pub use gree::{gree_aovs, render_gree, GreeRun, GreeRunError, GreeSpec};

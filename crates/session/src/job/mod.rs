@@ -23,7 +23,7 @@ mod run;
 
 pub use parts::{merge, read_parts, MergeReport};
 pub use report::{AdaptiveSummary, FrameReport, GreeSummary, JobReport, JobSink, Rendered};
-pub use run::thread_pool;
+pub use run::{thread_pool, INTERRUPTIBLE_PASS};
 
 use crate::text;
 use crate::{ImageSize, SessionError, Settings, SettingsError, StopRule};
@@ -198,6 +198,14 @@ pub struct RenderJob {
     /// The checkpoint to continue from ([`RenderJob::resume`]); not part of the job's file.
     #[serde(skip)]
     pub resume: Option<PathBuf>,
+    /// Stop a render without a checkpoint at the next pass when the stop flag is set: a
+    /// fixed render's samples are then rendered in passes of about
+    /// [`INTERRUPTIBLE_PASS`] (which add up to the bits of one pass), an adaptive render
+    /// stops after its current pass, and a stopped render writes nothing and returns
+    /// [`JobError::Stopped`]. For callers that interrupt renders they do not checkpoint (the
+    /// Python module's Ctrl-C); not part of the job's file.
+    #[serde(skip)]
+    pub interruptible: bool,
 }
 
 /// Why a job could not run, or stopped. Each is one line naming what it is about.
@@ -234,6 +242,15 @@ pub enum JobError {
         output: PathBuf,
         /// The checkpoint written.
         checkpoint: PathBuf,
+    },
+    /// The stop flag stopped an interruptible render ([`RenderJob::interruptible`]): nothing
+    /// was written.
+    #[error("stopped after {samples} of {spp} samples per pixel: nothing written")]
+    Stopped {
+        /// Samples per pixel taken.
+        samples: u32,
+        /// Samples per pixel of the whole render.
+        spp: u32,
     },
 }
 
@@ -301,6 +318,7 @@ impl RenderJob {
             max_memory: None,
             defines: Vec::new(),
             resume: None,
+            interruptible: false,
         }
     }
 
@@ -576,6 +594,40 @@ mod run_tests {
 
     fn bytes(p: &Path) -> Vec<u8> {
         std::fs::read(p).unwrap()
+    }
+
+    #[test]
+    fn an_interruptible_job_gives_the_same_bytes_and_stops_at_a_pass_writing_nothing() {
+        let d = tempfile::tempdir().unwrap();
+        let dir = d.path();
+        let mut j = job(dir, 5);
+        j.output = dir.join("whole.exr");
+        j.run(&(), &AtomicBool::new(false)).unwrap();
+        j.interruptible = true;
+        j.output = dir.join("passes.exr");
+        j.run(&(), &AtomicBool::new(false)).unwrap();
+        assert!(bytes(&dir.join("passes.exr")) == bytes(&dir.join("whole.exr")));
+        // Set before the render: it ends after its first pass.
+        j.output = dir.join("stopped.exr");
+        let e = j.run(&(), &AtomicBool::new(true)).unwrap_err();
+        assert!(matches!(e, JobError::Stopped { samples: 1, spp: 5 }), "{e}");
+        assert!(!j.output.exists());
+        // Adaptive jobs too; a job that is not interruptible ignores the flag.
+        j.stop = Some(crate::StopRule::new(Some(1e-9), None, 64).unwrap());
+        let e = j.run(&(), &AtomicBool::new(true)).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                JobError::Stopped {
+                    samples: 2,
+                    spp: 64
+                }
+            ),
+            "{e}"
+        );
+        j.interruptible = false;
+        j.run(&(), &AtomicBool::new(true)).unwrap();
+        assert!(j.output.exists());
     }
 
     #[test]

@@ -8,8 +8,8 @@ use super::{load_scene, refuse, Frames, JobError, JobScene, RenderJob};
 use crate::frames::frame_path;
 use crate::memory::Estimate;
 use crate::{
-    frame_seed, pick_camera, render_adaptive, Adaptive, RenderReport, ReportInputs,
-    SequenceRenderer,
+    frame_seed, pick_camera, render_adaptive, render_adaptive_until, Adaptive, RenderReport,
+    ReportInputs, SequenceRenderer,
 };
 use rt_core::{Accel, Camera, Scene};
 use rt_film::{AovSet, Film, FilmBuffers, OutputOptions};
@@ -18,6 +18,14 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
+
+/// About how long a pass of an interruptible render lasts ([`RenderJob::interruptible`]):
+/// how long stopping it may wait. Every pass costs a little (the wavefront's batches are
+/// filled and drained, threads wait for the last band): on the default scene at 16 spp on one
+/// thread, passes of one sample per pixel cost 3–4 % more CPU time than one pass, and
+/// quarter-second passes made a render from Python 5 % dearer than the CLI's
+/// (docs/benchmarks.md, "The Python module").
+pub const INTERRUPTIBLE_PASS: Duration = Duration::from_secs(1);
 
 /// A rayon pool of `threads` workers (all cores by default), the one every render and
 /// benchmark uses.
@@ -380,8 +388,8 @@ impl RenderJob {
                     scene_hash,
                     frame: env.frame,
                 };
-                let (stats, stopped) = self.render_checkpointed(
-                    &ck,
+                let (stats, stopped) = self.render_in_passes(
+                    Some(&ck),
                     &ctx,
                     technique.as_ref(),
                     &mut film,
@@ -390,6 +398,24 @@ impl RenderJob {
                     stop,
                 )?;
                 interrupted = stopped;
+                stats
+            }
+            (None, None, _) if self.interruptible && cut.is_none() => {
+                let (stats, stopped) = self.render_in_passes(
+                    None,
+                    &ctx,
+                    technique.as_ref(),
+                    &mut film,
+                    env,
+                    sink,
+                    stop,
+                )?;
+                if let Some(samples) = stopped {
+                    return Err(JobError::Stopped {
+                        samples,
+                        spp: self.settings.spp,
+                    });
+                }
                 stats
             }
             (None, _, _) => {
@@ -401,11 +427,26 @@ impl RenderJob {
                 self.fixed_pass(&ctx, technique.as_ref(), &mut film, env.seed, cut, sink)
             }
             (Some(rule), _, _) => {
-                let a =
-                    render_adaptive(&ctx, technique.as_ref(), &mut film, env.seed, rule, &|f| {
-                        sink.progress(f)
-                    })
-                    .map_err(|e| JobError::Refused(format!("--error {}", e.0)))?;
+                // Only an interruptible job listens to `stop` here (a checkpointed one cannot
+                // be adaptive).
+                let never = AtomicBool::new(false);
+                let stop = if self.interruptible { stop } else { &never };
+                let a = render_adaptive_until(
+                    &ctx,
+                    technique.as_ref(),
+                    &mut film,
+                    env.seed,
+                    rule,
+                    &|f| sink.progress(f),
+                    stop,
+                )
+                .map_err(|e| JobError::Refused(format!("--error {}", e.0)))?;
+                if a.reason == crate::StopReason::Stopped {
+                    return Err(JobError::Stopped {
+                        samples: a.spp,
+                        spp: rule.max_spp,
+                    });
+                }
                 let stats = a.stats;
                 adaptive = Some(a);
                 stats
@@ -492,13 +533,16 @@ impl RenderJob {
         self.end_checkpoint(&env.output, interrupted)
     }
 
-    /// Renders the job's samples into `film` pass by pass, one sample per pixel each,
-    /// writing checkpoints; stops early at a pass boundary when `stop` is set (the checkpoint
-    /// then holds every finished pass). Returns the samples per pixel taken when stopped.
+    /// Renders the job's samples into `film` pass by pass, writing checkpoints through `ck` if
+    /// given; stops early at a pass boundary when `stop` is set (a checkpoint then holds every
+    /// finished pass). Returns the samples per pixel taken when stopped. A checkpointed render
+    /// takes one sample per pixel a pass (a checkpoint may fall after any); without one a pass
+    /// takes as many as fit in about [`INTERRUPTIBLE_PASS`], so that stopping waits for little
+    /// and the passes cost little. Passes add up to the bits of one pass either way.
     #[allow(clippy::too_many_arguments)]
-    fn render_checkpointed(
+    fn render_in_passes(
         &self,
-        ck: &Checkpointer<'_>,
+        ck: Option<&Checkpointer<'_>>,
         ctx: &Ctx<'_>,
         technique: &dyn Technique,
         film: &mut Film,
@@ -507,29 +551,45 @@ impl RenderJob {
         stop: &AtomicBool,
     ) -> Result<(RenderStats, Option<u32>), JobError> {
         let spp = self.settings.spp;
-        let (start, before) = match &self.resume {
-            Some(path) => ck.restore(path, film)?,
-            None => (0, 0.0),
+        let (start, before) = match (&self.resume, ck) {
+            (Some(path), Some(ck)) => ck.restore(path, film)?,
+            _ => (0, 0.0),
         };
         let every = Duration::from_secs_f64(self.checkpoint.as_ref().map_or(0.0, |c| c.every));
         let mut last = Instant::now();
         let mut stats = RenderStats::default();
         sink.progress(f64::from(start) / f64::from(spp));
-        for i in start..spp {
+        let rows = f64::from(ctx.camera.height.max(1));
+        let (mut i, mut n) = (start, 1);
+        while i < spp {
+            n = n.min(spp - i);
             let pass = SamplePass {
-                indices: i..i + 1,
+                indices: i..i + n,
                 stream: self.stream.sample_stream(),
                 pixels: None,
                 centre_first: false,
             };
-            stats += technique.render_pass(ctx, film, env.seed, &pass, &|_| {});
-            sink.progress(f64::from(i + 1) / f64::from(spp));
-            if stop.load(Ordering::Relaxed) {
-                ck.write(film, i + 1, before + stats.elapsed.as_secs_f64())?;
-                return Ok((stats, Some(i + 1)));
+            let s = technique.render_pass(ctx, film, env.seed, &pass, &|r| {
+                sink.progress((f64::from(i) + f64::from(n) * f64::from(r) / rows) / f64::from(spp))
+            });
+            if ck.is_none() {
+                let per_sample = s.elapsed.as_secs_f64() / f64::from(n);
+                let fit = (INTERRUPTIBLE_PASS.as_secs_f64() / per_sample.max(1e-9)) as u32;
+                // A first pass of one sample may mislead (caches are cold): grow at most 4x.
+                n = fit.clamp(1, 4 * n);
             }
-            if i + 1 < spp && last.elapsed() >= every {
-                ck.write(film, i + 1, before + stats.elapsed.as_secs_f64())?;
+            stats += s;
+            i += pass.indices.len() as u32;
+            sink.progress(f64::from(i) / f64::from(spp));
+            let seconds = before + stats.elapsed.as_secs_f64();
+            if stop.load(Ordering::Relaxed) {
+                if let Some(ck) = ck {
+                    ck.write(film, i, seconds)?;
+                }
+                return Ok((stats, Some(i)));
+            }
+            if let Some(ck) = ck.filter(|_| i < spp && last.elapsed() >= every) {
+                ck.write(film, i, seconds)?;
                 last = Instant::now();
             }
         }
