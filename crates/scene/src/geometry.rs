@@ -178,7 +178,11 @@ fn build(
     let (mut mesh, origin) = match kind {
         Kind::File(f) => {
             let path = ctx.resolve(f.get_ref());
-            let mesh = load_file(ctx, f, &path, want_materials)?;
+            let mut mesh = load_file(ctx, f, &path, want_materials)?;
+            if d.smooth.as_ref().is_some_and(|b| !*b.get_ref()) {
+                // Flat facets (Mitsuba's `face_normals`): the file's normals are dropped.
+                mesh.normals.iter_mut().for_each(|n| *n = None);
+            }
             (mesh, Origin::File(path))
         }
         Kind::Shape(shape, _) => (shape_mesh(ctx, d, shape)?, Origin::Toml(d.name.span())),
@@ -276,7 +280,7 @@ fn check_keys(ctx: &Ctx, d: &GeometryDesc, kind: &Kind) -> Result<()> {
         ("uvs", d.uvs.as_ref().map(|s| s.span())),
     ];
     let (allowed, required, what): (&[&str], &[&str], String) = match kind {
-        Kind::File(_) => (&[], &[], "a mesh file".into()),
+        Kind::File(_) => (&["smooth"], &[], "a mesh file".into()),
         Kind::Shape("quad", _) => (&["vertices"], &["vertices"], "shape \"quad\"".into()),
         Kind::Shape("box", _) => (&["min", "max"], &["min", "max"], "shape \"box\"".into()),
         Kind::Shape("sphere", _) => (
@@ -609,7 +613,10 @@ fn check_and_place(
         }
     }
     let zero = m.tris.iter().filter(|v| double_area(v) == 0.0).count();
-    if zero == n {
+    // A mesh file of nothing but zero-area triangles is invisible, not broken: Mitsuba loads
+    // one (the staircase has some), so it gets the warning below; a shape or inline mesh that
+    // is all degenerate is a mistake in the scene itself.
+    if zero == n && matches!(origin, Origin::Toml(_)) {
         return Err(origin.error(
             ctx,
             name,

@@ -69,6 +69,7 @@ mod ply;
 pub mod procedural;
 pub mod raw;
 mod shapes;
+mod texture_desc;
 pub mod views;
 
 pub use error::{LineCol, SceneError};

@@ -84,7 +84,13 @@ impl MaterialTable {
 
 /// Builds the material of one `[[material]]` table and checks it with `Material::validate`.
 pub(crate) fn build(ctx: &mut Ctx, d: &Spanned<MaterialDesc>) -> Result<Material> {
-    let d = d.get_ref();
+    let mut m = build_bsdf(ctx, d.get_ref())?;
+    m.perturbation = crate::texture_desc::perturbation(ctx, d.get_ref())?;
+    Ok(m)
+}
+
+/// [`build`] without the bump or normal map.
+fn build_bsdf(ctx: &mut Ctx, d: &MaterialDesc) -> Result<Material> {
     let name = d.name.get_ref();
     let err = |span: Range<usize>, msg: String| {
         ctx.src
@@ -234,7 +240,8 @@ pub(crate) fn build(ctx: &mut Ctx, d: &Spanned<MaterialDesc>) -> Result<Material
     }
     m.two_sided = d.two_sided.unwrap_or(false);
     if let Some(t) = &d.texture {
-        m.texture = Some(ctx.textures.load_file(&ctx.resolve(t.get_ref()))?);
+        let (path, options) = crate::texture_desc::read(ctx, name, t, false)?;
+        m.texture = Some(ctx.textures.load(&path, options)?);
     }
     if let Err(e) = m.validate() {
         // Point at the value that is wrong.

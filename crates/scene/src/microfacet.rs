@@ -277,7 +277,8 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
     }
     m.two_sided = d.two_sided.unwrap_or(false);
     if let Some(t) = &d.texture {
-        m.texture = Some(ctx.textures.load_file(&ctx.resolve(t.get_ref()))?);
+        let (path, options) = crate::texture_desc::read(ctx, name, t, false)?;
+        m.texture = Some(ctx.textures.load(&path, options)?);
     }
     if let Err(e) = m.validate() {
         return Err(err(d.name.span(), e.to_string()));
