@@ -220,6 +220,9 @@ fn convert_in<'a>(
             if let Some(b) = p.boolean("nonlinear")? {
                 t.insert("nonlinear".into(), b.into());
             }
+            if two_sided {
+                t.insert("two_sided".into(), true.into());
+            }
         }
         other => {
             return Err(node.at.error(format!(
