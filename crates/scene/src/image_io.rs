@@ -137,6 +137,13 @@ pub(crate) fn read_env_map(access: &FileAccess, path: &Path) -> Result<(u32, u32
 
 #[cfg(test)]
 mod tests {
+
+    /// A texture file read as a scene's texture (bilinear, repeat, sRGB).
+    fn read_texture(access: &FileAccess, path: &Path) -> Result<Texture> {
+        let mut t = Textures::new(access.clone());
+        let i = t.load_file(path)?;
+        Ok(t.into_vec().swap_remove(i as usize))
+    }
     use super::*;
 
     #[test]
