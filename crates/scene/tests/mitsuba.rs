@@ -506,3 +506,29 @@ fn bump_and_normal_maps_wrap_a_bsdf_and_bitmap_options_reach_the_texture() {
         assert!(!e.contains('\n'), "{e}");
     }
 }
+
+/// The Wooden Staircase (0.5 dialect) loads: its unnamed top-level `bumpmap` is reported and
+/// unused, as in Mitsuba 3, whose shapes name the nested `twosided` conductor; the wood is a
+/// two-sided rough plastic (black from behind otherwise).
+#[test]
+fn the_staircase_from_the_shared_data_loads_as_mitsuba_reads_it() {
+    let Some(p) = data("staircase/scene.xml") else {
+        return;
+    };
+    let s = rt_scene::load(&p).unwrap();
+    assert!(s.scene.triangle_count() > 200_000);
+    assert!(
+        s.warnings
+            .iter()
+            .any(|w| w.contains("<bsdf type=\"bumpmap\"> has no id")),
+        "{:?}",
+        s.warnings
+    );
+    let by_name = |n: &str| s.scene.materials.iter().find(|m| m.name == n).unwrap();
+    let aluminium = by_name("BrushedAluminium");
+    assert_eq!(aluminium.perturbation, None);
+    match by_name("WoodStairs").microfacet {
+        Some(rt_core::microfacet::Microfacet::RoughPlastic(p)) => assert!(p.two_sided),
+        other => panic!("{other:?}"),
+    }
+}
