@@ -14,6 +14,8 @@ the second N-spp render, printed as the floor).
 
 Usage: tools/reference/mitsuba_scene_check.py SCENE.xml [--size 256] [--spp 64]
        [--ref-spp 4096] [--our-spp 4096] [--render target/release/render] [--out DIR]
+With --out, Mitsuba's renders are kept there and reused by the next run with the same size and
+spp (unless the scene file is newer).
 Needs `pip install mitsuba numpy` and (for llvm_ad_rgb) Debian's libllvm19.
 """
 import argparse, os, re, shutil, subprocess, sys, tempfile, time
@@ -55,18 +57,27 @@ try:
         img = np.array(mi.render(scene, spp=spp, seed=seed))[:, :, :3].astype(np.float64)
         return img, time.time() - t
 
-    m1, t1 = mitsuba(a.spp, 1)
-    m2, _ = mitsuba(a.spp, 2)
-    # The reference in slices of at most 1024 spp (Dr.Jit's wavefront holds every sample).
-    ref = np.zeros_like(m1)
-    left, seed = a.ref_spp, 100
-    while left > 0:
-        n = min(left, 1024)
-        img, _ = mitsuba(n, seed)
-        ref += img * n
-        left -= n
-        seed += 1
-    ref /= a.ref_spp
+    # Mitsuba's images depend only on the scene and these settings: kept in --out, so a
+    # second run (our renderer changed) renders only ours.
+    cache = out / f"mitsuba-{a.size}-{a.spp}-{a.ref_spp}.npz"
+    if cache.exists() and cache.stat().st_mtime > src.stat().st_mtime:
+        c = np.load(cache)
+        m1, m2, ref, t1 = c["m1"], c["m2"], c["ref"], float(c["t1"])
+        print(f"Mitsuba's renders from {cache}")
+    else:
+        m1, t1 = mitsuba(a.spp, 1)
+        m2, _ = mitsuba(a.spp, 2)
+        # The reference in slices of at most 1024 spp (Dr.Jit's wavefront holds every sample).
+        ref = np.zeros_like(m1)
+        left, seed = a.ref_spp, 100
+        while left > 0:
+            n = min(left, 1024)
+            img, _ = mitsuba(n, seed)
+            ref += img * n
+            left -= n
+            seed += 1
+        ref /= a.ref_spp
+        np.savez(cache, m1=m1, m2=m2, ref=ref, t1=t1)
     ours_path = out / "ours.exr"
     t = time.time()
     subprocess.run([a.render, str(copy), "--spp", str(a.our_spp), "-q", "-o", str(ours_path)], check=True)

@@ -63,6 +63,7 @@ fn main() {
                 specular: Rgb::ONE,
                 eta: x[2],
                 nonlinear: false,
+                two_sided: false,
             }),
             _ => Microfacet::Dielectric(RoughDielectric {
                 distribution,

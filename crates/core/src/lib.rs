@@ -24,6 +24,7 @@
 pub mod aabb;
 pub mod accel;
 pub mod animation;
+pub mod bump;
 pub mod camera;
 pub mod color;
 pub mod content_hash;

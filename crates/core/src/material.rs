@@ -40,6 +40,7 @@
 //! dispersive event too. Dispersion is limited to delta layers: their `eval` is zero, so light
 //! connections never need a wavelength the path does not have yet.
 
+use crate::bump::NormalPerturbation;
 use crate::microfacet::Microfacet;
 use crate::{
     frame::Frame,
@@ -147,6 +148,9 @@ pub struct Material {
     /// A BSDF of Mitsuba's microfacet family in place of the layer stack (`layers` is then
     /// empty): [`crate::microfacet`].
     pub microfacet: Option<Microfacet>,
+    /// A bump or normal map bending the shading normal ([`crate::bump`]), applied where the
+    /// scene builds a hit ([`crate::scene::Scene::surface`]).
+    pub perturbation: Option<NormalPerturbation>,
 }
 
 /// A material parameter outside its valid range.
@@ -199,6 +203,7 @@ impl Material {
             two_sided: false,
             texture: None,
             microfacet: None,
+            perturbation: None,
         }
     }
 
@@ -893,6 +898,7 @@ impl crate::content_hash::ContentHash for Material {
             two_sided,
             texture,
             microfacet,
+            perturbation,
         } = self;
         name.content_hash(out);
         layers.content_hash(out);
@@ -901,6 +907,10 @@ impl crate::content_hash::ContentHash for Material {
         texture.content_hash(out);
         if let Some(m) = microfacet {
             m.content_hash(out);
+        }
+        // Only when present, as the microfacet BSDF: older scenes keep their hashes.
+        if let Some(p) = perturbation {
+            format!("{p:?}").content_hash(out);
         }
     }
 }

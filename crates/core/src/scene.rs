@@ -10,6 +10,7 @@
 
 use crate::{
     animation::{CameraMotion, MaterialMotion, Motion},
+    bump::{self, NormalPerturbation},
     environment::Environment,
     instance::{place_attributes, place_triangle, placement_error, Instance, Prototype},
     lights::LightSampler,
@@ -258,9 +259,15 @@ impl Scene {
             }
             None => ng,
         };
-        let uv = match self.uvs_of(i) {
+        let uvs = self.uvs_of(i);
+        let uv = match uvs {
             Some(t) => t[0] * b0 + t[1] * b1 + t[2] * b2,
             None => Vec2::new(b1, b2),
+        };
+        let material = self.material_ids[i];
+        let ns = match self.materials[material as usize].perturbation {
+            Some(pert) => self.perturbed_normal(pert, v, uvs, ns, ng, uv),
+            None => ns,
         };
         // A two-level structure intersects the prototype with an inverse-transformed ray:
         // the origin offset must also cover the placement's rounding.
@@ -283,10 +290,36 @@ impl Scene {
             ng,
             ns,
             uv,
-            material: self.material_ids[i],
+            material,
             prim: hit.prim,
             instance,
             time,
+        }
+    }
+
+    /// The shading normal `ns` bent by a bump or normal map, at texture coordinates `uv` of
+    /// the triangle with vertices `v` and uvs `uvs` (barycentrics when it has none, whose
+    /// tangents are the edges).
+    fn perturbed_normal(
+        &self,
+        pert: NormalPerturbation,
+        v: &[Vec3; 3],
+        uvs: Option<&[Vec2; 3]>,
+        ns: Vec3,
+        ng: Vec3,
+        uv: Vec2,
+    ) -> Vec3 {
+        const BARYCENTRIC: [Vec2; 3] = [Vec2::ZERO, Vec2::X, Vec2::Y];
+        let (dpdu, dpdv) = bump::triangle_tangents(v, uvs.unwrap_or(&BARYCENTRIC), ng);
+        match pert {
+            NormalPerturbation::Bump { texture, scale } => {
+                let (_, grad) = self.textures[texture as usize].scalar_gradient(uv);
+                bump::bumped_normal(ns, ng, dpdu, dpdv, grad * scale)
+            }
+            NormalPerturbation::NormalMap { texture } => {
+                let rgb = self.textures[texture as usize].lookup(uv);
+                bump::mapped_normal(ns, ng, dpdu, rgb)
+            }
         }
     }
 
@@ -713,11 +746,7 @@ mod memory_tests {
         s.materials.push(Material::diffuse("ab", Rgb::ONE));
         s.push_triangle([Vec3::ZERO, Vec3::X, Vec3::Y], 0);
         s.push_triangle([Vec3::ZERO, Vec3::Y, Vec3::Z], 0);
-        s.textures.push(Texture {
-            width: 2,
-            height: 1,
-            texels: vec![Rgb::ONE; 2],
-        });
+        s.textures.push(Texture::new(2, 1, vec![Rgb::ONE; 2]));
         let m = s.memory();
         let per_tri = 36 + size_of::<Option<[Vec3; 3]>>() + size_of::<Option<[Vec2; 3]>>() + 4;
         assert_eq!(m.geometry, 2 * per_tri);

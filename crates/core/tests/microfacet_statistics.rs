@@ -51,6 +51,7 @@ fn plastic(diffuse: f32, eta: f32) -> Plastic {
         specular: Rgb::ONE,
         eta,
         nonlinear: false,
+        two_sided: false,
     }
 }
 
@@ -433,5 +434,44 @@ fn two_sided_conductors_mirror_the_front() {
             b.map(|s| (s.wi, s.weight, s.pdf))
         );
         assert!(front.sample(mirror(wo), ul, u).is_none());
+    }
+}
+
+/// Two-sided plastics, smooth and rough, are their front mirrored below the surface too (the
+/// staircase's `twosided` wood): value, pdf and samples through `Microfacet`; the one-sided
+/// ones reflect nothing from below (control).
+#[test]
+fn two_sided_plastics_mirror_the_front() {
+    use rt_core::microfacet::Microfacet;
+    let mut smooth = plastic(0.6, 1.5);
+    let mut rough = rough_plastic(Ggx, 0.1, 0.6, 1.5);
+    let one_sided = [Microfacet::Plastic(smooth), Microfacet::RoughPlastic(rough)];
+    smooth.two_sided = true;
+    rough.two_sided = true;
+    let two_sided = [Microfacet::Plastic(smooth), Microfacet::RoughPlastic(rough)];
+    let mirror = |w: Vec3| Vec3::new(w.x, w.y, -w.z);
+    let mut rng = Rng::new(10);
+    for (front, both) in one_sided.iter().zip(&two_sided) {
+        let mut seen = 0;
+        for _ in 0..1000 {
+            let (wo, wi) = (
+                wo_at(0.2 + 0.7 * rng.f32(), 1.0),
+                wo_at(0.2 + 0.7 * rng.f32(), 1.0),
+            );
+            let wi = Vec3::new(-wi.x, wi.y, wi.z);
+            let want = front.eval_pdf(wo, wi);
+            assert_eq!(both.eval_pdf(mirror(wo), mirror(wi)), want);
+            assert_eq!(both.eval_pdf(wo, wi), want);
+            assert_eq!(front.eval_pdf(mirror(wo), mirror(wi)), (Rgb::ZERO, 0.0));
+            seen += (want.1 > 0.0) as usize;
+            let (ul, u) = (rng.f32(), rng.vec2());
+            let (a, b) = (both.sample(mirror(wo), ul, u), front.sample(wo, ul, u));
+            assert_eq!(
+                a.map(|s| (mirror(s.wi), s.weight, s.pdf, s.delta)),
+                b.map(|s| (s.wi, s.weight, s.pdf, s.delta))
+            );
+            assert!(front.sample(mirror(wo), ul, u).is_none());
+        }
+        assert!(seen > 900, "{seen}");
     }
 }

@@ -55,6 +55,17 @@ pub fn read_rgb(path: &Path) -> Result<RgbImage> {
 /// its values to be sRGB-encoded, to linear RGB: the one decoder for image files and for images
 /// inside other files (glTF). Eight-bit values go through an exact table.
 pub fn decode_srgb(bytes: &[u8]) -> std::result::Result<RgbImage, String> {
+    decode(bytes, srgb_to_linear)
+}
+
+/// [`decode_srgb`] for images that hold data rather than colours (normal maps, Mitsuba's `raw`
+/// bitmaps): values are read as they are, scaled to [0, 1].
+pub fn decode_raw(bytes: &[u8]) -> std::result::Result<RgbImage, String> {
+    decode(bytes, |v| v)
+}
+
+/// Decodes a PNG or JPEG, mapping each value in [0, 1] through `transfer`.
+fn decode(bytes: &[u8], transfer: fn(f32) -> f32) -> std::result::Result<RgbImage, String> {
     let img = image::load_from_memory(bytes).map_err(|e| format!("cannot decode image: {e}"))?;
     let (width, height) = (img.width() as usize, img.height() as usize);
     let pixels = match img {
@@ -62,7 +73,7 @@ pub fn decode_srgb(bytes: &[u8]) -> std::result::Result<RgbImage, String> {
         | image::DynamicImage::ImageLumaA8(_)
         | image::DynamicImage::ImageRgb8(_)
         | image::DynamicImage::ImageRgba8(_) => {
-            let lut: Vec<f32> = (0..256).map(|i| srgb_to_linear(i as f32 / 255.0)).collect();
+            let lut: Vec<f32> = (0..256).map(|i| transfer(i as f32 / 255.0)).collect();
             img.to_rgb8()
                 .pixels()
                 .map(|p| Rgb::new(lut[p[0] as usize], lut[p[1] as usize], lut[p[2] as usize]))
@@ -71,7 +82,7 @@ pub fn decode_srgb(bytes: &[u8]) -> std::result::Result<RgbImage, String> {
         _ => img
             .to_rgb32f()
             .pixels()
-            .map(|p| Rgb::from_array(p.0.map(|v| srgb_to_linear(v.clamp(0.0, 1.0)))))
+            .map(|p| Rgb::from_array(p.0.map(|v| transfer(v.clamp(0.0, 1.0)))))
             .collect(),
     };
     RgbImage::new(width, height, pixels).map_err(|e| e.to_string())

@@ -62,7 +62,7 @@ pub use film::{
     AovSet, FeatureVariances, Film, FilmBuffers, FilmMemory, FilmStripe, UnknownAov, AOV_NAMES,
 };
 pub use guides::{GuideBuffers, GuideError, ReflectedGuides, NO_ID};
-pub use input::{decode_srgb, read_rgb};
+pub use input::{decode_raw, decode_srgb, read_rgb};
 pub use noisy_frame::{Channel, FrameError, NoisyFrame};
 pub use output::{
     copy_atomic, read_exr, srgb8, write_bytes_atomic, write_image, write_image_with, write_rgb,

@@ -172,7 +172,11 @@ pub(crate) struct MaterialDesc {
     pub color: Option<Spanned<V3>>,
     pub hardness: Option<Spanned<f32>>,
     pub ior: Option<Spanned<f32>>,
-    pub texture: Option<Spanned<String>>,
+    /// A file name or a table of options (`texture_desc.rs`).
+    pub texture: Option<Spanned<toml::Value>>,
+    pub bump_map: Option<Spanned<toml::Value>>,
+    pub bump_scale: Option<Spanned<f32>>,
+    pub normal_map: Option<Spanned<toml::Value>>,
     pub emission: Option<Spanned<V3>>,
     pub two_sided: Option<bool>,
     pub layers: Option<Spanned<Vec<Spanned<LayerDesc>>>>,

@@ -671,7 +671,10 @@ fn check_and_place(
         }
     }
     let zero = m.tris.iter().filter(|v| double_area(v) == 0.0).count();
-    if zero == n {
+    // A mesh file of nothing but zero-area triangles is invisible, not broken: Mitsuba loads
+    // one (the staircase has some), so it gets the warning below; a shape or inline mesh that
+    // is all degenerate is a mistake in the scene itself.
+    if zero == n && matches!(origin, Origin::Toml(_)) {
         return Err(origin.error(
             ctx,
             name,

@@ -2,7 +2,10 @@
 
 use crate::error::{Result, SceneError};
 use crate::files::FileAccess;
-use rt_core::{texture::Texture, Rgb};
+use rt_core::{
+    texture::{Filter, Texture, Wrap},
+    Rgb,
+};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -11,7 +14,7 @@ use std::path::{Path, PathBuf};
 #[derive(Default)]
 pub(crate) struct Textures {
     list: Vec<Texture>,
-    by_path: HashMap<PathBuf, u32>,
+    by_path: HashMap<(PathBuf, TextureOptions), u32>,
     access: FileAccess,
 }
 
@@ -29,13 +32,28 @@ impl Textures {
         &self.access
     }
 
-    /// Index of the texture in `path`, loading it on first use.
+    /// Index of the texture in `path` (bilinear, repeating, sRGB), loading it on first use.
     pub fn load_file(&mut self, path: &Path) -> Result<u32> {
-        let key = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+        self.load(path, TextureOptions::default())
+    }
+
+    /// Index of the texture in `path` read with `options`, loading it on first use.
+    pub fn load(&mut self, path: &Path, options: TextureOptions) -> Result<u32> {
+        let canonical = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
+        let key = (canonical, options);
         if let Some(&i) = self.by_path.get(&key) {
             return Ok(i);
         }
-        let t = read_texture(&self.access, path)?;
+        let bytes = self.access.read(path, "")?;
+        let decoded = if options.raw {
+            rt_film::decode_raw(&bytes)
+        } else {
+            rt_film::decode_srgb(&bytes)
+        };
+        let img = decoded.map_err(|e| SceneError::file(path, e))?;
+        let mut t = Texture::new(img.width() as u32, img.height() as u32, img.into_pixels());
+        t.filter = options.filter;
+        t.wrap = options.wrap;
         let i = self.add(t);
         self.by_path.insert(key, i);
         Ok(i)
@@ -53,21 +71,23 @@ impl Textures {
     }
 }
 
-/// Reads a PNG or JPEG texture (`rt_film::decode_srgb`: sRGB decoded to linear, alpha
-/// ignored).
-pub(crate) fn read_texture(access: &FileAccess, path: &Path) -> Result<Texture> {
-    let bytes = access.read(path, "")?;
-    texture_from_bytes(&bytes).map_err(|e| SceneError::file(path, e))
+/// How a texture file is read and looked up (Mitsuba's `bitmap` options).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub(crate) struct TextureOptions {
+    pub filter: Filter,
+    pub wrap: Wrap,
+    /// Linear data (normal maps), not sRGB-encoded colours.
+    pub raw: bool,
 }
 
 /// Decodes an encoded PNG or JPEG (a file's bytes, or an image inside a glTF file).
 pub(crate) fn texture_from_bytes(bytes: &[u8]) -> std::result::Result<Texture, String> {
     let img = rt_film::decode_srgb(bytes)?;
-    Ok(Texture {
-        width: img.width() as u32,
-        height: img.height() as u32,
-        texels: img.into_pixels(),
-    })
+    Ok(Texture::new(
+        img.width() as u32,
+        img.height() as u32,
+        img.into_pixels(),
+    ))
 }
 
 /// Reads an environment map as row-major linear radiance (row 0 at the top): the first
@@ -133,6 +153,13 @@ fn read_rgbe(bytes: &[u8]) -> std::result::Result<(usize, usize, Vec<Rgb>), Stri
 
 #[cfg(test)]
 mod tests {
+
+    /// A texture file read as a scene's texture (bilinear, repeat, sRGB).
+    fn read_texture(access: &FileAccess, path: &Path) -> Result<Texture> {
+        let mut t = Textures::new(access.clone());
+        let i = t.load_file(path)?;
+        Ok(t.into_vec().swap_remove(i as usize))
+    }
     use super::*;
 
     #[test]

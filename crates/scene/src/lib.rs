@@ -70,6 +70,7 @@ pub mod procedural;
 pub mod raw;
 mod serialized;
 mod shapes;
+mod texture_desc;
 pub mod views;
 
 pub use error::{LineCol, SceneError};

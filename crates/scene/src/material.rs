@@ -84,7 +84,13 @@ impl MaterialTable {
 
 /// Builds the material of one `[[material]]` table and checks it with `Material::validate`.
 pub(crate) fn build(ctx: &mut Ctx, d: &Spanned<MaterialDesc>) -> Result<Material> {
-    let d = d.get_ref();
+    let mut m = build_bsdf(ctx, d.get_ref())?;
+    m.perturbation = crate::texture_desc::perturbation(ctx, d.get_ref())?;
+    Ok(m)
+}
+
+/// [`build`] without the bump or normal map.
+fn build_bsdf(ctx: &mut Ctx, d: &MaterialDesc) -> Result<Material> {
     let name = d.name.get_ref();
     let err = |span: Range<usize>, msg: String| {
         ctx.src
@@ -234,7 +240,8 @@ pub(crate) fn build(ctx: &mut Ctx, d: &Spanned<MaterialDesc>) -> Result<Material
     }
     m.two_sided = d.two_sided.unwrap_or(false);
     if let Some(t) = &d.texture {
-        m.texture = Some(ctx.textures.load_file(&ctx.resolve(t.get_ref()))?);
+        let (path, options) = crate::texture_desc::read(ctx, name, t, false)?;
+        m.texture = Some(ctx.textures.load(&path, options)?);
     }
     if let Err(e) = m.validate() {
         // Point at the value that is wrong.
@@ -656,6 +663,83 @@ mod tests {
         );
         let e = bad("texture = \"nope.png\"");
         assert!(e.contains("nope.png: cannot open"), "{e}");
+    }
+
+    /// Texture tables carry Mitsuba's bitmap options; `bump_map` and `normal_map` bend the
+    /// normal of any type (a normal map reads raw data unless told otherwise); each mistake is
+    /// one line naming the key.
+    #[test]
+    fn texture_options_and_bump_and_normal_maps() {
+        use rt_core::bump::NormalPerturbation;
+        use rt_core::texture::{Filter, Wrap};
+        let dir = tempfile::tempdir().unwrap();
+        image::RgbImage::from_pixel(2, 2, image::Rgb([128, 128, 255]))
+            .save(dir.path().join("t.png"))
+            .unwrap();
+        let load = |body: &str| {
+            let text = format!("[[material]]\nname = \"m\"\n{body}");
+            let d: SceneDesc = toml::from_str(&text).map_err(|e| e.to_string())?;
+            let mut ctx = Ctx {
+                src: Source {
+                    name: Path::new("m.toml"),
+                    text: &text,
+                },
+                base: dir.path(),
+                textures: Textures::default(),
+                warnings: vec![],
+            };
+            let m = build(&mut ctx, &d.material[0]).map_err(|e| e.to_string())?;
+            Ok::<_, String>((m, ctx.textures.into_vec()))
+        };
+        let (m, t) = load(
+            "texture = { file = \"t.png\", filter = \"nearest\", wrap = \"clamp\" }\n\
+             bump_map = \"t.png\"\nbump_scale = 0.5",
+        )
+        .unwrap();
+        assert_eq!(m.texture, Some(0));
+        assert_eq!((t[0].filter, t[0].wrap), (Filter::Nearest, Wrap::Clamp));
+        // The same file with other options is another texture.
+        assert_eq!(
+            m.perturbation,
+            Some(NormalPerturbation::Bump {
+                texture: 1,
+                scale: 0.5
+            })
+        );
+        let srgb = rt_core::color::srgb_to_linear(128.0 / 255.0);
+        assert_eq!(t[1].texels[0].x, srgb);
+        let (m, t) = load("type = \"roughplastic\"\nnormal_map = \"t.png\"").unwrap();
+        assert_eq!(
+            m.perturbation,
+            Some(NormalPerturbation::NormalMap { texture: 0 })
+        );
+        assert_eq!(t[0].texels[0].x, 128.0 / 255.0, "raw by default");
+        let (_, t) = load("normal_map = { file = \"t.png\", raw = false }").unwrap();
+        assert_eq!(t[0].texels[0].x, srgb);
+        for (body, want) in [
+            (
+                "texture = { file = \"t.png\", wrap = \"border\" }",
+                "material \"m\": texture wrap \"border\" is not repeat, mirror or clamp",
+            ),
+            (
+                "texture = { file = \"t.png\", filtr = \"nearest\" }",
+                "unknown texture key `filtr` (the keys are file, filter, wrap, raw)",
+            ),
+            (
+                "texture = { wrap = \"clamp\" }",
+                "a texture table needs a `file`",
+            ),
+            ("texture = 3", "a texture is a file name or a table"),
+            ("bump_scale = 2.0", "`bump_scale` needs a `bump_map`"),
+            (
+                "bump_map = \"t.png\"\nnormal_map = \"t.png\"",
+                "`bump_map` and `normal_map` exclude each other",
+            ),
+            ("bump_map = \"nope.png\"", "nope.png: cannot open"),
+        ] {
+            let e = load(body).unwrap_err();
+            assert!(e.contains(want), "{body}: got {e}, want {want}");
+        }
     }
 
     #[test]

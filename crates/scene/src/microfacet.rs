@@ -194,6 +194,9 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
         let ext = ior(&d.ext_ior, "ext_ior", AIR_IOR).map_err(|(s, e)| err(s, e))?;
         Ok(int / ext)
     };
+    // Reflection from both faces (Mitsuba's `twosided`) for the reflecting types; for every
+    // type it also makes an emitter emit from both.
+    let two_sided = d.two_sided.unwrap_or(false);
     let bsdf = if conductor {
         let (eta, k) = match &d.material {
             Some(named) => {
@@ -222,7 +225,7 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
             eta,
             k,
             specular_reflectance: reflectance,
-            two_sided: d.two_sided.unwrap_or(false),
+            two_sided,
         })
     } else if kind == "thindielectric" {
         Microfacet::ThinDielectric(ThinDielectric {
@@ -248,19 +251,16 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
                             .into(),
                     ));
                 }
-                Microfacet::RoughPlastic(RoughPlastic::new(
-                    dist,
-                    diffuse,
-                    reflectance,
-                    eta,
-                    nonlinear,
-                ))
+                let mut p = RoughPlastic::new(dist, diffuse, reflectance, eta, nonlinear);
+                p.two_sided = two_sided;
+                Microfacet::RoughPlastic(p)
             }
             None => Microfacet::Plastic(Plastic {
                 diffuse,
                 specular: reflectance,
                 eta,
                 nonlinear,
+                two_sided,
             }),
         }
     } else {
@@ -277,7 +277,8 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
     }
     m.two_sided = d.two_sided.unwrap_or(false);
     if let Some(t) = &d.texture {
-        m.texture = Some(ctx.textures.load_file(&ctx.resolve(t.get_ref()))?);
+        let (path, options) = crate::texture_desc::read(ctx, name, t, false)?;
+        m.texture = Some(ctx.textures.load(&path, options)?);
     }
     if let Err(e) = m.validate() {
         return Err(err(d.name.span(), e.to_string()));

@@ -553,3 +553,120 @@ fn a_film_crop_window_renders_its_part_of_the_film() {
         "{e}"
     );
 }
+
+/// `bumpmap` and `normalmap` wrap any BSDF (here around a `twosided`, as the staircase has
+/// them) and become the wrapped material with its map; the bitmap options reach the texture.
+#[test]
+fn bump_and_normal_maps_wrap_a_bsdf_and_bitmap_options_reach_the_texture() {
+    use rt_core::bump::NormalPerturbation;
+    use rt_core::texture::{Filter, Wrap};
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbImage::from_pixel(2, 2, image::Rgb([128, 128, 255]))
+        .save(dir.path().join("t.png"))
+        .unwrap();
+    let load = |body: &str| {
+        std::fs::write(dir.path().join("s.xml"), scene("3.0.0", body)).unwrap();
+        rt_scene::load(&dir.path().join("s.xml"))
+    };
+    let bump = r#"<shape type="rectangle"><bsdf type="bumpmap"><float name="scale" value="0.25"/>
+        <texture type="bitmap"><string name="filename" value="t.png"/>
+        <string name="filter_type" value="nearest"/><string name="wrap_mode" value="mirror"/></texture>
+        <bsdf type="twosided"><bsdf type="roughconductor"/></bsdf></bsdf></shape>"#;
+    let s = load(bump).unwrap();
+    let m = s.scene.material_of(0);
+    let Some(NormalPerturbation::Bump { texture, scale }) = m.perturbation else {
+        panic!("{:?}", m.perturbation)
+    };
+    assert_eq!(scale, 0.25);
+    let t = &s.scene.textures[texture as usize];
+    assert_eq!((t.filter, t.wrap), (Filter::Nearest, Wrap::Mirror));
+    // sRGB 128 decodes to 0.2158.
+    assert!((t.texels[0].x - 0.2158).abs() < 1e-3, "{:?}", t.texels[0]);
+    match m.microfacet {
+        Some(rt_core::microfacet::Microfacet::Conductor(c)) => assert!(c.two_sided),
+        other => panic!("{other:?}"),
+    }
+    let normal = r#"<shape type="rectangle"><bsdf type="twosided"><bsdf type="normalmap">
+        <texture name="normalmap" type="bitmap"><string name="filename" value="t.png"/>
+        <boolean name="raw" value="true"/></texture>
+        <bsdf type="diffuse"/></bsdf></bsdf></shape>"#;
+    let s = load(normal).unwrap();
+    let m = s.scene.material_of(0);
+    let Some(NormalPerturbation::NormalMap { texture }) = m.perturbation else {
+        panic!("{:?}", m.perturbation)
+    };
+    // Raw: 128 / 255.
+    let t = &s.scene.textures[texture as usize];
+    assert!(
+        (t.texels[0].x - 128.0 / 255.0).abs() < 1e-6,
+        "{:?}",
+        t.texels[0]
+    );
+    // A BSDF no shape can name (the staircase's top-level bumpmap) is checked and reported.
+    let unused = format!(
+        "{}{LAMP}",
+        bump.replace(r#"<shape type="rectangle">"#, "")
+            .replace("</bsdf></shape>", "</bsdf>")
+    );
+    let s = load(&unused).unwrap();
+    assert!(
+        s.warnings.iter().any(|w| w.ends_with(
+            "<bsdf type=\"bumpmap\"> has no id, so no shape uses it (Mitsuba ignores it too)"
+        )),
+        "{:?}",
+        s.warnings
+    );
+    let cases = [
+        (
+            bump.replace("mirror", "border"),
+            "wrap_mode \"border\" is not supported (repeat, mirror and clamp are)",
+        ),
+        (
+            bump.replace("nearest", "bicubic"),
+            "filter_type \"bicubic\" is not supported (bilinear and nearest are)",
+        ),
+        (
+            bump.replace("<bsdf type=\"twosided\">", "<texture type=\"bitmap\"><string name=\"filename\" value=\"t.png\"/></texture><bsdf type=\"twosided\">"),
+            "has 2 textures, expected one height map",
+        ),
+        (
+            normal.replace("name=\"normalmap\" ", ""),
+            "needs a texture named `normalmap`",
+        ),
+        (
+            bump.replace("<bsdf type=\"twosided\"><bsdf type=\"roughconductor\"/></bsdf>", ""),
+            "wraps 0 BSDFs, expected one",
+        ),
+    ];
+    for (body, want) in cases {
+        let e = load(&body).expect_err(want).to_string();
+        assert!(e.contains(want), "got {e}\nwant {want}");
+        assert!(!e.contains('\n'), "{e}");
+    }
+}
+
+/// The Wooden Staircase (0.5 dialect) loads: its unnamed top-level `bumpmap` is reported and
+/// unused, as in Mitsuba 3, whose shapes name the nested `twosided` conductor; the wood is a
+/// two-sided rough plastic (black from behind otherwise).
+#[test]
+fn the_staircase_from_the_shared_data_loads_as_mitsuba_reads_it() {
+    let Some(p) = data("staircase/scene.xml") else {
+        return;
+    };
+    let s = rt_scene::load(&p).unwrap();
+    assert!(s.scene.triangle_count() > 200_000);
+    assert!(
+        s.warnings
+            .iter()
+            .any(|w| w.contains("<bsdf type=\"bumpmap\"> has no id")),
+        "{:?}",
+        s.warnings
+    );
+    let by_name = |n: &str| s.scene.materials.iter().find(|m| m.name == n).unwrap();
+    let aluminium = by_name("BrushedAluminium");
+    assert_eq!(aluminium.perturbation, None);
+    match by_name("WoodStairs").microfacet {
+        Some(rt_core::microfacet::Microfacet::RoughPlastic(p)) => assert!(p.two_sided),
+        other => panic!("{other:?}"),
+    }
+}

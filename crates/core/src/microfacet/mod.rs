@@ -258,8 +258,26 @@ impl Microfacet {
     }
 }
 
-impl LocalBsdf for Microfacet {
-    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+/// `w` mirrored through the surface.
+#[inline]
+fn mirrored(w: Vec3) -> Vec3 {
+    Vec3::new(w.x, w.y, -w.z)
+}
+
+impl Microfacet {
+    /// True if `wo` sees a two-sided plastic from below, which reflects as its front does with
+    /// both directions mirrored (the conductor mirrors itself).
+    #[inline]
+    fn seen_from_below(&self, wo: Vec3) -> bool {
+        let two_sided = match self {
+            Microfacet::Plastic(p) => p.two_sided,
+            Microfacet::RoughPlastic(p) => p.two_sided,
+            _ => false,
+        };
+        two_sided && wo.z < 0.0
+    }
+
+    fn front_eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
         match self {
             Microfacet::Conductor(c) => c.eval_pdf(wo, wi),
             Microfacet::Dielectric(d) => d.eval_pdf(wo, wi),
@@ -269,7 +287,7 @@ impl LocalBsdf for Microfacet {
         }
     }
 
-    fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<LocalSample> {
+    fn front_sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<LocalSample> {
         match self {
             Microfacet::Conductor(c) => c.sample(wo, u_lobe, u),
             Microfacet::Dielectric(d) => d.sample(wo, u_lobe, u),
@@ -277,6 +295,26 @@ impl LocalBsdf for Microfacet {
             Microfacet::RoughPlastic(p) => p.sample(wo, u_lobe, u),
             Microfacet::ThinDielectric(t) => t.sample(wo, u_lobe, u),
         }
+    }
+}
+
+impl LocalBsdf for Microfacet {
+    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        if self.seen_from_below(wo) {
+            return self.front_eval_pdf(mirrored(wo), mirrored(wi));
+        }
+        self.front_eval_pdf(wo, wi)
+    }
+
+    fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<LocalSample> {
+        if self.seen_from_below(wo) {
+            let s = self.front_sample(mirrored(wo), u_lobe, u)?;
+            return Some(LocalSample {
+                wi: mirrored(s.wi),
+                ..s
+            });
+        }
+        self.front_sample(wo, u_lobe, u)
     }
 }
 

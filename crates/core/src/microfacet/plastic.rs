@@ -23,6 +23,9 @@ pub struct Plastic {
     pub eta: f32,
     /// Account for the colour shift of repeated internal scattering (Mitsuba's `nonlinear`).
     pub nonlinear: bool,
+    /// Reflect alike from below, mirrored (Mitsuba's `twosided`); applied by
+    /// [`super::Microfacet`], which mirrors both directions to the front.
+    pub two_sided: bool,
 }
 
 /// The hemispherical average of the Fresnel reflectance for relative index `eta` (d'Eon and

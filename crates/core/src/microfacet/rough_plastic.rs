@@ -37,6 +37,10 @@ pub struct RoughPlastic {
     pub eta: f32,
     /// Account for the colour shift of repeated internal scattering (Mitsuba's `nonlinear`).
     pub nonlinear: bool,
+    /// Reflect alike from below, mirrored (Mitsuba's `twosided`; false from
+    /// [`RoughPlastic::new`]); applied by [`super::Microfacet`], which mirrors both directions to
+    /// the front.
+    pub two_sided: bool,
     /// The coating's transmittance at cosine `max(1e-6, i / (RES − 1))`.
     transmittance: [f32; TRANSMITTANCE_RES],
     /// The coating's diffuse reflectance from inside.
@@ -66,6 +70,7 @@ impl RoughPlastic {
             specular,
             eta,
             nonlinear,
+            two_sided: false,
             transmittance,
             internal_reflectance: (internal * 2.0 / TRANSMITTANCE_RES as f64) as f32,
         }

@@ -1,6 +1,7 @@
 //! Mitsuba BSDFs as `[[material]]` tables of our format: `diffuse` and the microfacet family
 //! keep their names and parameters (docs/scene-format.md, "The microfacet family"),
-//! `plastic` becomes our `smoothplastic`, `twosided` a flag on what it wraps.
+//! `plastic` becomes our `smoothplastic`, `twosided` a flag on what it wraps, `bumpmap` and
+//! `normalmap` the keys `bump_map` (with `bump_scale`) and `normal_map` on what they wrap.
 
 use toml::{Table, Value};
 
@@ -12,35 +13,145 @@ use crate::error::SceneError;
 /// What a BSDF element becomes: a material table without its name.
 pub(super) struct Converted {
     pub table: Table,
-    /// Texture file names the table refers to (relative to the scene file).
-    pub texture: Option<String>,
+    /// The table's texture keys, whose file names are relative to the scene file.
+    pub textures: Vec<TextureKey>,
 }
 
-/// Converts `node` (a `<bsdf>`); `two_sided` when a `twosided` wraps it.
+/// A texture key of a material table: a `bitmap`'s file and its options
+/// (docs/scene-format.md, "Textures").
+pub(super) struct TextureKey {
+    /// The material key (`texture`, `bump_map`, `normal_map`).
+    pub key: &'static str,
+    file: String,
+    options: Table,
+}
+
+impl TextureKey {
+    /// The key's value, with the file name as `file_name` maps it.
+    pub fn value(&self, file_name: &dyn Fn(&str) -> String) -> Value {
+        if self.options.is_empty() {
+            return file_name(&self.file).into();
+        }
+        let mut t = self.options.clone();
+        t.insert("file".into(), file_name(&self.file).into());
+        Value::Table(t)
+    }
+}
+
+/// Which wrappers enclose the BSDF being converted.
+#[derive(Clone, Copy, Default)]
+struct Wrapped {
+    two_sided: bool,
+    /// A `bumpmap` or `normalmap`.
+    perturbed: bool,
+}
+
+/// Converts `node` (a `<bsdf>`).
 pub(super) fn convert<'a>(
     node: &'a Node,
     resolve: &dyn Fn(&'a Node) -> Result<&'a Node, SceneError>,
-    two_sided: bool,
+    warnings: &mut Vec<String>,
+) -> Result<Converted, SceneError> {
+    convert_in(node, resolve, Wrapped::default(), warnings)
+}
+
+/// A top-level BSDF without an id: no shape can refer to it, and Mitsuba 3 builds it and
+/// leaves it unused (the staircase's `bumpmap`, whose nested BSDF the shapes name instead).
+/// Converted to check it, and reported as one warning.
+pub(super) fn unused<'a>(
+    node: &'a Node,
+    resolve: &dyn Fn(&'a Node) -> Result<&'a Node, SceneError>,
+    warnings: &mut Vec<String>,
+) -> Result<(), SceneError> {
+    convert(node, resolve, warnings)?;
+    warnings.push(node.at.warning(format!(
+        "<bsdf type=\"{}\"> has no id, so no shape uses it (Mitsuba ignores it too)",
+        node.plugin()?
+    )));
+    Ok(())
+}
+
+/// The one BSDF a wrapper holds, nested or referenced.
+fn wrapped_one<'a>(
+    p: &Props<'a>,
+    resolve: &dyn Fn(&'a Node) -> Result<&'a Node, SceneError>,
+) -> Result<&'a Node, SceneError> {
+    let mut inner: Vec<&'a Node> = p.objects("bsdf");
+    for r in p.refs() {
+        inner.push(resolve(r)?);
+    }
+    match inner.as_slice() {
+        [one] => Ok(one),
+        _ => Err(p.error(format!("wraps {} BSDFs, expected one", inner.len()))),
+    }
+}
+
+/// [`convert`] inside the wrappers `wrapped`.
+fn convert_in<'a>(
+    node: &'a Node,
+    resolve: &dyn Fn(&'a Node) -> Result<&'a Node, SceneError>,
+    wrapped: Wrapped,
     warnings: &mut Vec<String>,
 ) -> Result<Converted, SceneError> {
     let p = Props::new(node);
     let ty = node.plugin()?;
     let mut t = Table::new();
-    let mut texture = None;
+    let mut textures = Vec::new();
+    let two_sided = wrapped.two_sided;
     match ty {
         "twosided" => {
-            let mut inner: Vec<&'a Node> = p.objects("bsdf");
-            for r in p.refs() {
-                inner.push(resolve(r)?);
-            }
-            let [one] = inner.as_slice() else {
-                return Err(p.error(format!("wraps {} BSDFs, expected one", inner.len())));
-            };
+            let one = wrapped_one(&p, resolve)?;
             if two_sided {
                 return Err(p.error("a twosided inside a twosided"));
             }
             p.finish(warnings)?;
-            return convert(one, resolve, true, warnings);
+            let inner = Wrapped {
+                two_sided: true,
+                ..wrapped
+            };
+            return convert_in(one, resolve, inner, warnings);
+        }
+        "bumpmap" | "normalmap" => {
+            let one = wrapped_one(&p, resolve)?;
+            if wrapped.perturbed {
+                return Err(p.error("a bumpmap or normalmap inside another"));
+            }
+            let maps = p.objects("texture");
+            let map = match (ty, maps.as_slice()) {
+                // Mitsuba's normalmap reads its texture by name; bumpmap takes any one.
+                ("normalmap", _) => match p.color("normalmap", Role::Unbounded)? {
+                    Some(Color::Texture(tex)) => tex,
+                    _ => return Err(p.error("needs a texture named `normalmap`")),
+                },
+                (_, [one]) => *one,
+                (_, many) => {
+                    return Err(p.error(format!(
+                        "has {} textures, expected one height map",
+                        many.len()
+                    )))
+                }
+            };
+            let scale = if ty == "bumpmap" {
+                p.float("scale")?
+            } else {
+                None
+            };
+            p.finish(warnings)?;
+            let inner = Wrapped {
+                perturbed: true,
+                ..wrapped
+            };
+            let mut c = convert_in(one, resolve, inner, warnings)?;
+            let key = if ty == "bumpmap" {
+                "bump_map"
+            } else {
+                "normal_map"
+            };
+            c.textures.push(bitmap(map, key, warnings)?);
+            if let Some(s) = scale {
+                c.table.insert("bump_scale".into(), s.into());
+            }
+            return Ok(c);
         }
         "diffuse" => {
             t.insert("type".into(), "diffuse".into());
@@ -52,7 +163,7 @@ pub(super) fn convert<'a>(
                     t.insert("color".into(), rgb(c));
                 }
                 Some(Color::Texture(tex)) => {
-                    texture = Some(bitmap(tex, warnings)?);
+                    textures.push(bitmap(tex, "texture", warnings)?);
                     t.insert("color".into(), rgb([1.0; 3]));
                 }
             }
@@ -102,23 +213,27 @@ pub(super) fn convert<'a>(
                     t.insert("diffuse_reflectance".into(), rgb(c));
                 }
                 Some(Color::Texture(tex)) => {
-                    texture = Some(bitmap(tex, warnings)?);
+                    textures.push(bitmap(tex, "texture", warnings)?);
                     t.insert("diffuse_reflectance".into(), rgb([1.0; 3]));
                 }
             }
             if let Some(b) = p.boolean("nonlinear")? {
                 t.insert("nonlinear".into(), b.into());
             }
+            if two_sided {
+                t.insert("two_sided".into(), true.into());
+            }
         }
         other => {
             return Err(node.at.error(format!(
             "bsdf \"{other}\" is not supported (supported: diffuse, dielectric, thindielectric, \
-                 roughdielectric, conductor, roughconductor, plastic, roughplastic, twosided)"
+                 roughdielectric, conductor, roughconductor, plastic, roughplastic, twosided, \
+                 bumpmap, normalmap)"
         )))
         }
     }
     p.finish(warnings)?;
-    Ok(Converted { table: t, texture })
+    Ok(Converted { table: t, textures })
 }
 
 fn rgb(c: [f64; 3]) -> Value {
@@ -166,9 +281,13 @@ fn iors(p: &Props, t: &mut Table) -> Result<(), SceneError> {
     Ok(())
 }
 
-/// A `bitmap` texture's file, after checking that our textures do what it asks: sRGB
-/// 8-bit images looked up bilinearly with repeat wrapping.
-fn bitmap(tex: &Node, warnings: &mut Vec<String>) -> Result<String, SceneError> {
+/// A `bitmap` texture as material key `key`: its file and the options it sets (Mitsuba's
+/// defaults are ours: bilinear, repeat, sRGB).
+fn bitmap(
+    tex: &Node,
+    key: &'static str,
+    warnings: &mut Vec<String>,
+) -> Result<TextureKey, SceneError> {
     let p = Props::new(tex);
     if tex.plugin()? != "bitmap" {
         return Err(p.error("only bitmap textures are supported"));
@@ -177,21 +296,33 @@ fn bitmap(tex: &Node, warnings: &mut Vec<String>) -> Result<String, SceneError> 
         .string("filename")?
         .ok_or_else(|| p.error("has no filename"))?
         .to_string();
+    let mut options = Table::new();
     if let Some(f) = p.string("filter_type")? {
-        if f != "bilinear" {
+        if !matches!(f, "bilinear" | "nearest") {
             return Err(p.error(format!(
-                "filter_type \"{f}\" is not supported (bilinear is)"
+                "filter_type \"{f}\" is not supported (bilinear and nearest are)"
             )));
+        }
+        if f != "bilinear" {
+            options.insert("filter".into(), f.into());
         }
     }
     if let Some(w) = p.string("wrap_mode")? {
+        if !matches!(w, "repeat" | "mirror" | "clamp") {
+            return Err(p.error(format!(
+                "wrap_mode \"{w}\" is not supported (repeat, mirror and clamp are)"
+            )));
+        }
         if w != "repeat" {
-            return Err(p.error(format!("wrap_mode \"{w}\" is not supported (repeat is)")));
+            options.insert("wrap".into(), w.into());
         }
     }
-    if p.boolean("raw")? == Some(true) {
-        return Err(p.error("raw (linear) 8-bit data is not supported (sRGB is)"));
+    // Mitsuba reads every bitmap as sRGB unless told `raw`, normal maps too; our normal maps
+    // default to raw, so the choice is always written for them.
+    let raw = p.boolean("raw")?.unwrap_or(false);
+    if raw || key == "normal_map" {
+        options.insert("raw".into(), raw.into());
     }
     p.finish(warnings)?;
-    Ok(file)
+    Ok(TextureKey { key, file, options })
 }

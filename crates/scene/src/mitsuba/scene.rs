@@ -53,6 +53,7 @@ pub(super) fn build(
             "emitter" => b.environment(c)?,
             // Declarations: converted where a shape refers to them.
             "bsdf" | "texture" if c.attr("id").is_some() => {}
+            "bsdf" => bsdf::unused(c, &|r| resolve(&b.ids, r), b.warnings)?,
             other => {
                 return Err(c.at.error(format!(
                     "<{other}{}> is not supported at the top of a scene",
@@ -568,13 +569,13 @@ impl<'a> Builder<'a, '_> {
             return Ok(done.clone());
         }
         let ids = &self.ids;
-        let converted = bsdf::convert(b, &|r| resolve(ids, r), false, self.warnings)?;
+        let converted = bsdf::convert(b, &|r| resolve(ids, r), self.warnings)?;
         let name = b
             .attr("id")
             .map_or_else(|| format!("bsdf{}", self.by_node.len()), str::to_string);
         let mut t = converted.table;
-        if let Some(file) = converted.texture {
-            t.insert("texture".into(), (self.file_name)(&file).into());
+        for tex in &converted.textures {
+            t.insert(tex.key.into(), tex.value(self.file_name));
         }
         let done = (name, t);
         self.by_node.insert(b as *const Node, done.clone());

@@ -356,11 +356,7 @@ fn nan_texels(resolution: u32) -> Scene {
             _ => Rgb::new(0.2, 0.6, 0.3),
         })
         .collect();
-    b.scene.textures.push(Texture {
-        width: 4,
-        height: 4,
-        texels,
-    });
+    b.scene.textures.push(Texture::new(4, 4, texels));
     let mut m = Material::diffuse("textured", Rgb::splat(0.9));
     m.texture = Some(0);
     let textured = b.material(m);
