@@ -27,6 +27,7 @@ pub mod animation;
 pub mod camera;
 pub mod color;
 pub mod content_hash;
+pub mod delta_light;
 pub mod distribution;
 pub mod emission;
 pub mod environment;
