@@ -128,3 +128,121 @@ fn build(ctx: &Ctx, d: &Spanned<LightDesc>) -> Result<DeltaLight> {
         },
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::load::tests::{err, line_of, ok};
+    use glam::Vec3;
+    use rt_core::delta_light::DeltaLight;
+
+    fn light(toml: &str) -> DeltaLight {
+        let s = ok(&format!("[[light]]\n{toml}"));
+        assert_eq!(s.scene.delta_lights.len(), 1);
+        s.scene.delta_lights[0]
+    }
+
+    #[test]
+    fn each_kind_with_its_keys_and_defaults() {
+        let p = light("type = \"point\"\nposition = [1, 2, 3]\nintensity = [4, 5, 6]");
+        assert_eq!(
+            p,
+            DeltaLight::Point {
+                position: Vec3::new(1.0, 2.0, 3.0),
+                intensity: Vec3::new(4.0, 5.0, 6.0)
+            }
+        );
+        // Intensity defaults to 1; the spot's angles to Mitsuba's 20° and ¾ of the cutoff.
+        let DeltaLight::Spot {
+            axis,
+            intensity,
+            cutoff,
+            beam_width,
+            ..
+        } = light("type = \"spot\"\nposition = [0, 0, 0]\ndirection = [0, -2, 0]")
+        else {
+            panic!("not a spot")
+        };
+        assert_eq!((axis, intensity), (Vec3::NEG_Y, Vec3::ONE));
+        assert_eq!(
+            (cutoff, beam_width),
+            (20f32.to_radians(), 15f32.to_radians())
+        );
+        let DeltaLight::Spot { beam_width, .. } = light(
+            "type = \"spot\"\nposition = [0, 0, 0]\ndirection = [0, -1, 0]\ncutoff_angle = 40",
+        ) else {
+            panic!("not a spot")
+        };
+        assert_eq!(beam_width, 30f32.to_radians());
+        let d = light("type = \"directional\"\ndirection = [0, 0, 3]\nirradiance = [1, 2, 3]");
+        assert_eq!(
+            d,
+            DeltaLight::Directional {
+                direction: Vec3::Z,
+                irradiance: Vec3::new(1.0, 2.0, 3.0)
+            }
+        );
+        // Two lights, in file order, and the scene counts them as light sources.
+        let s = ok("[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\n[[light]]\ntype = \"directional\"\ndirection = [0, -1, 0]");
+        assert_eq!(s.scene.delta_lights.len(), 2);
+        assert!(s.scene.has_light_sources());
+    }
+
+    #[test]
+    fn bad_lights_are_one_line_at_the_value() {
+        let cases = [
+            ("type = \"area\"", "type", "light type \"area\" is unknown"),
+            (
+                "type = \"point\"\nposition = [0, 1, 0]\nirradiance = [1, 1, 1]",
+                "irradiance",
+                "a point light has no `irradiance`",
+            ),
+            (
+                "type = \"directional\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]",
+                "position",
+                "a directional light has no `position`",
+            ),
+            ("type = \"point\"", "[[light]]", "a point light needs a `position`"),
+            (
+                "type = \"directional\"",
+                "[[light]]",
+                "a directional light needs a `direction`",
+            ),
+            (
+                "type = \"directional\"\ndirection = [0, 0, 0]",
+                "direction",
+                "light direction must not be zero",
+            ),
+            (
+                "type = \"point\"\nposition = [0, nan, 0]",
+                "position",
+                "light position must be finite",
+            ),
+            (
+                "type = \"point\"\nposition = [0, 1, 0]\nintensity = [1, -1, 1]",
+                "intensity",
+                "light intensity must be in [0, 1e15]",
+            ),
+            (
+                "type = \"spot\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\ncutoff_angle = 0",
+                "cutoff_angle",
+                "light cutoff_angle must be in (0, 180] degrees",
+            ),
+            (
+                "type = \"spot\"\nposition = [0, 1, 0]\ndirection = [0, -1, 0]\ncutoff_angle = 30\nbeam_width = 31",
+                "beam_width",
+                "light beam_width must be in [0, cutoff_angle = 30] degrees",
+            ),
+            ("type = \"point\"\ncolor = [1, 1, 1]", "color", "unknown field `color`"),
+        ];
+        for (body, key, want) in cases {
+            let extra = format!("[[light]]\n{body}\n");
+            let e = err(&extra);
+            assert!(e.contains(want), "{body}: {e}");
+            let line = line_of(&extra, key);
+            assert!(
+                e.starts_with(&format!("t.toml:{line}:")),
+                "{body}: {e} (line {line})"
+            );
+        }
+    }
+}
