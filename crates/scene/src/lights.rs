@@ -238,7 +238,11 @@ mod tests {
             let extra = format!("[[light]]\n{body}\n");
             let e = err(&extra);
             assert!(e.contains(want), "{body}: {e}");
-            let line = line_of(&extra, key);
+            // The key's line within the table (the base scene has a `position` of its own).
+            let line = line_of(&extra, "[[light]]")
+                + body
+                    .find(&format!("{key} ="))
+                    .map_or(0, |i| body[..i].matches('\n').count() + 1);
             assert!(
                 e.starts_with(&format!("t.toml:{line}:")),
                 "{body}: {e} (line {line})"
