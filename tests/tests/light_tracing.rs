@@ -43,6 +43,42 @@ fn light_tracing_agrees_with_path_tracing_on_the_cornell_box() {
     );
 }
 
+/// Particles from a point, a spot and a directional light (beside the box's lamp) carry the
+/// same light as the path tracer's connections to them.
+#[test]
+fn light_tracing_agrees_with_path_tracing_under_delta_lights() {
+    use rt_core::delta_light::DeltaLight;
+    use rt_core::glam::Vec3;
+    let mut scene = shipped_scene("cornell-box.toml").with_resolution(SIZE, SIZE);
+    scene.delta_lights = vec![
+        DeltaLight::Point {
+            position: Vec3::new(150.0, 400.0, 250.0),
+            intensity: Vec3::new(3e4, 2e4, 1e4),
+        },
+        DeltaLight::Spot {
+            position: Vec3::new(400.0, 500.0, 100.0),
+            axis: Vec3::new(0.0, -1.0, 0.5).normalize(),
+            intensity: Vec3::splat(5e4),
+            cutoff: 0.5,
+            beam_width: 0.3,
+        },
+        DeltaLight::Directional {
+            direction: Vec3::new(0.2, -0.3, 1.0).normalize(),
+            irradiance: Vec3::splat(0.5),
+        },
+    ];
+    scene.build_lights();
+    let (honest, biased) = honest_and_biased(&scene);
+    assert!(
+        honest.same_within_noise(),
+        "light tracing disagrees: {honest:?}"
+    );
+    assert!(
+        !biased.same_within_noise(),
+        "control: 2 % of camera connections dropped passes: {biased:?}"
+    );
+}
+
 /// Through a thin lens (blur circles of about 2.5 pixels on the front block and the back
 /// wall), the connection samples the lens.
 #[test]

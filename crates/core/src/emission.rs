@@ -10,8 +10,12 @@
 //! and LuxCore sample (for a cube seen along an axis the disk is π/2 times larger). The choice
 //! between the environment and the triangles is the light sampler's (see
 //! [`LightSampler::sample`]): half and half when both emit.
+//!
+//! Delta lights ([`crate::delta_light`]) start particles too: a point light's uniformly on
+//! the sphere, a spot's uniformly in its cone, a directional light's on the same covering
+//! rectangle as the environment's, all along its direction.
 
-use crate::lights::LightSampler;
+use crate::lights::{Chosen, LightSampler};
 use crate::ray::spawn_ray;
 use crate::sampling::{cosine_hemisphere, uniform_triangle};
 use crate::{frame::Frame, triangle, Aabb, Ray, Rgb, Scene};
@@ -62,8 +66,10 @@ pub struct Emission {
     /// `Le · |cos| / (pdf_position · pdf_direction)`: the particle's throughput.
     pub beta: Rgb,
     /// The triangle point the path starts at, for connecting it to the camera directly; `None`
-    /// for the environment.
+    /// for the environment and delta lights.
     pub point: Option<EmitterPoint>,
+    /// The path starts at a delta light (which no camera sees).
+    pub delta: bool,
     /// Pdf of the start: the triangle point's area pdf (choice of light included), or for the
     /// environment the plane point's, `1 / plane area`.
     pub pdf_position: f32,
@@ -75,17 +81,17 @@ pub struct Emission {
 impl LightSampler {
     /// Chooses a point on an emissive triangle by power; `None` without emissive triangles or
     /// when `u_sel` chooses the environment.
+    /// Also `None` when it chooses a delta light.
     pub fn sample_emitter_point(&self, u_sel: f32, u_pos: Vec2) -> Option<EmitterPoint> {
         if u_sel < self.env_prob {
             return None;
         }
-        let dist = self.dist.as_ref()?;
-        let u_tri = ((u_sel - self.env_prob) / (1.0 - self.env_prob)).clamp(0.0, 0.999_999_94);
-        let (k, pmf, _) = dist.sample_discrete(u_tri);
-        let e = &self.records[k];
+        let Some((Chosen::Triangle(e), p_choice)) = self.choose(u_sel) else {
+            return None;
+        };
         let (b1, b2) = uniform_triangle(u_pos);
         let (point, error) = triangle::point_with_error(&e.vertices, b1, b2);
-        let pdf_area = pmf * (1.0 - self.env_prob) / e.area;
+        let pdf_area = p_choice / e.area;
         (pdf_area > 0.0 && pdf_area.is_finite()).then_some(EmitterPoint {
             point,
             error,
@@ -119,8 +125,23 @@ impl LightSampler {
                 dir,
                 beta,
                 point: None,
+                delta: false,
                 pdf_position: 1.0 / area,
                 pdf_direction: s.pdf * self.env_prob,
+            });
+        }
+        if let (Chosen::Delta(light), p_choice) = self.choose(u_sel)? {
+            let e = light.emit(bounds, u_pos, u_dir)?;
+            return Some(Emission {
+                origin: e.origin,
+                origin_error: Vec3::ZERO,
+                normal: e.dir,
+                dir: e.dir,
+                beta: e.beta / p_choice,
+                point: None,
+                delta: true,
+                pdf_position: e.pdf_position * p_choice,
+                pdf_direction: e.pdf_direction,
             });
         }
         let p = self.sample_emitter_point(u_sel, u_pos)?;
@@ -135,6 +156,7 @@ impl LightSampler {
             dir,
             beta,
             point: Some(p),
+            delta: false,
             pdf_position: p.pdf_area,
             pdf_direction: cos / (PI * faces),
         })

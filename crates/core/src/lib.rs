@@ -28,6 +28,7 @@ pub mod bump;
 pub mod camera;
 pub mod color;
 pub mod content_hash;
+pub mod delta_light;
 pub mod distribution;
 pub mod emission;
 pub mod environment;

@@ -1,21 +1,25 @@
-//! Light sampling: emissive triangles chosen in proportion to their power (thesis §2.3.5), and
-//! the environment.
+//! Light sampling: emissive triangles and delta lights ([`crate::delta_light`]) chosen in
+//! proportion to their power (thesis §2.3.5), and the environment.
 
+use crate::delta_light::DeltaLight;
 use crate::stage_time::StageTime;
 use crate::{
-    color::luminance, distribution::Distribution1D, sampling::uniform_triangle, triangle, Rgb,
-    Scene,
+    color::luminance, distribution::Distribution1D, sampling::power_heuristic,
+    sampling::uniform_triangle, triangle, Aabb, Rgb, Scene,
 };
 use glam::{Vec2, Vec3};
 use std::time::{Duration, Instant};
 
-/// Chooses lights for next-event estimation. Without emissive triangles it holds no emitter
-/// table and no power distribution (nothing is allocated); it may still sample the environment.
+/// Chooses lights for next-event estimation. Without emissive triangles or delta lights it
+/// holds no emitter table and no power distribution (nothing is allocated); it may still
+/// sample the environment.
 #[derive(Clone, Debug, Default)]
 pub struct LightSampler {
     /// What sampling needs of each emissive triangle, so that a sample reads one record instead
     /// of the triangle, its material and a normal recomputed every time.
     pub(crate) records: Vec<Emitter>,
+    /// The scene's delta lights; in the power distribution they follow the triangles.
+    pub(crate) deltas: Vec<DeltaLight>,
     pub(crate) dist: Option<Distribution1D>,
     total_power: f32,
     pub(crate) env_prob: f32,
@@ -44,6 +48,25 @@ pub struct LightSample {
     pub pdf: f32,
     /// The triangle emits from both faces (false for the environment).
     pub two_sided: bool,
+    /// The light is a delta light: `pdf` is only the probability of choosing it, `le` what
+    /// multiplies `f·|cos|` (`I/r²`, `E`), and BSDF sampling cannot find it.
+    pub delta: bool,
+}
+
+impl LightSample {
+    /// The MIS weight of this light-sampled contribution against BSDF sampling of the same
+    /// direction with pdf `bsdf_pdf`: the power heuristic, or 1 for a delta light (BSDF
+    /// sampling never finds one; `power_heuristic(p, 0)` is 1, so the arithmetic is shared).
+    #[inline]
+    pub fn mis_weight(&self, bsdf_pdf: f32) -> f32 {
+        power_heuristic(self.pdf, if self.delta { 0.0 } else { bsdf_pdf })
+    }
+}
+
+/// What [`LightSampler::choose`] picked besides the environment.
+pub(crate) enum Chosen<'a> {
+    Triangle(&'a Emitter),
+    Delta(&'a DeltaLight),
 }
 
 /// An emissive triangle as light sampling uses it: a copy of what sampling reads, next to each
@@ -83,6 +106,21 @@ fn triangle_power(scene: &Scene, prim: u32) -> f32 {
     triangle::area(&scene.triangles[prim as usize]) * luminance(m.emission) * m.emitting_faces()
 }
 
+/// The scene's delta lights that emit something (a black one is never chosen).
+fn delta_lights(scene: &Scene) -> Vec<DeltaLight> {
+    scene
+        .delta_lights
+        .iter()
+        .filter(|l| l.emits())
+        .copied()
+        .collect()
+}
+
+/// The box of the scene's triangles (what a directional light's power is measured over).
+fn scene_bounds(scene: &Scene) -> Aabb {
+    Aabb::from_points(scene.triangles.iter().flatten())
+}
+
 /// True if triangle `prim` is one the sampler samples: emissive with positive power.
 pub(crate) fn is_emitter(scene: &Scene, prim: u32) -> bool {
     scene.material_of(prim).is_emissive() && triangle_power(scene, prim) > 0.0
@@ -92,19 +130,30 @@ impl LightSampler {
     /// A sampler with nothing to sample, for integrators that do not sample lights.
     pub const NONE: LightSampler = LightSampler {
         records: Vec::new(),
+        deltas: Vec::new(),
         dist: None,
         total_power: 0.0,
         env_prob: 0.0,
         build_time: StageTime(Duration::ZERO),
     };
 
-    /// Collects the emissive triangles of `scene` and weighs them by power.
+    /// Collects the emissive triangles and delta lights of `scene` and weighs them by power.
     pub fn build(scene: &Scene) -> Self {
         let start = Instant::now();
         let emitters: Vec<u32> = (0..scene.triangles.len() as u32)
             .filter(|&i| is_emitter(scene, i))
             .collect();
-        let powers: Vec<f32> = emitters.iter().map(|&i| triangle_power(scene, i)).collect();
+        let mut powers: Vec<f32> = emitters.iter().map(|&i| triangle_power(scene, i)).collect();
+        let deltas = delta_lights(scene);
+        let bounds = if deltas
+            .iter()
+            .any(|l| matches!(l, DeltaLight::Directional { .. }))
+        {
+            scene_bounds(scene)
+        } else {
+            Aabb::default()
+        };
+        powers.extend(deltas.iter().map(|l| l.power_over_pi(&bounds)));
         let total_power: f32 = powers.iter().map(|&p| p as f64).sum::<f64>() as f32;
         let has_tris = total_power > 0.0;
         let has_env = !scene.environment.is_black();
@@ -117,6 +166,7 @@ impl LightSampler {
         Self {
             dist: has_tris.then(|| Distribution1D::new(&powers)),
             records: emitters.iter().map(|&i| Emitter::new(scene, i)).collect(),
+            deltas,
             total_power,
             env_prob,
             build_time: StageTime(start.elapsed()),
@@ -126,6 +176,7 @@ impl LightSampler {
     /// Bytes of the emitter table and power distribution (zero without emissive triangles).
     pub fn memory_bytes(&self) -> usize {
         std::mem::size_of_val(self.records.as_slice())
+            + std::mem::size_of_val(self.deltas.as_slice())
             + self.dist.as_ref().map_or(0, Distribution1D::memory_bytes)
     }
 
@@ -144,6 +195,26 @@ impl LightSampler {
         self.records.len()
     }
 
+    /// Number of delta lights that emit (and so may be chosen).
+    pub fn delta_count(&self) -> usize {
+        self.deltas.len()
+    }
+
+    /// Picks a triangle or delta light by power for `u_sel` in `[env_prob, 1)`, with the
+    /// probability of the pick (the choice over the environment included). `None` without
+    /// any.
+    #[inline]
+    pub(crate) fn choose(&self, u_sel: f32) -> Option<(Chosen<'_>, f32)> {
+        let dist = self.dist.as_ref()?;
+        let u_tri = ((u_sel - self.env_prob) / (1.0 - self.env_prob)).clamp(0.0, 0.999_999_94);
+        let (k, pmf, _) = dist.sample_discrete(u_tri);
+        let chosen = match self.records.get(k) {
+            Some(e) => Chosen::Triangle(e),
+            None => Chosen::Delta(&self.deltas[k - self.records.len()]),
+        };
+        Some((chosen, pmf * (1.0 - self.env_prob)))
+    }
+
     /// Samples a light as seen from `x`. `None` if the chosen point cannot contribute (back face
     /// of a one-sided emitter, grazing angle, zero pdf).
     pub fn sample(&self, scene: &Scene, x: Vec3, u_sel: f32, u: Vec2) -> Option<LightSample> {
@@ -158,12 +229,26 @@ impl LightSampler {
                 le: s.radiance,
                 pdf: s.pdf * self.env_prob,
                 two_sided: false,
+                delta: false,
             });
         }
-        let dist = self.dist.as_ref()?;
-        let u_tri = ((u_sel - self.env_prob) / (1.0 - self.env_prob)).clamp(0.0, 0.999_999_94);
-        let (k, pmf, _) = dist.sample_discrete(u_tri);
-        let e = &self.records[k];
+        let (e, p_choice) = match self.choose(u_sel)? {
+            (Chosen::Triangle(e), p_choice) => (e, p_choice),
+            (Chosen::Delta(light), p_choice) => {
+                let inc = light.incident(x)?;
+                return Some(LightSample {
+                    wi: inc.wi,
+                    point: inc.point,
+                    point_error: Vec3::ZERO,
+                    normal: Vec3::ZERO,
+                    dist: inc.dist,
+                    le: inc.le,
+                    pdf: p_choice,
+                    two_sided: false,
+                    delta: true,
+                });
+            }
+        };
         let (b1, b2) = uniform_triangle(u);
         let (p, point_error) = triangle::point_with_error(&e.vertices, b1, b2);
         let (n, area) = (e.normal, e.area);
@@ -185,7 +270,7 @@ impl LightSampler {
         if cos_l <= 0.0 || le.max_element() <= 0.0 {
             return None;
         }
-        let pdf = pmf * (1.0 - self.env_prob) * dist2 / (area * cos_l);
+        let pdf = p_choice * dist2 / (area * cos_l);
         Some(LightSample {
             wi,
             point: p,
@@ -195,6 +280,7 @@ impl LightSampler {
             le,
             pdf,
             two_sided: e.two_sided,
+            delta: false,
         })
     }
 

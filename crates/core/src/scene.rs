@@ -11,6 +11,7 @@
 use crate::{
     animation::{CameraMotion, MaterialMotion, Motion},
     bump::{self, NormalPerturbation},
+    delta_light::DeltaLight,
     environment::Environment,
     instance::{place_attributes, place_triangle, placement_error, Instance, Prototype},
     lights::LightSampler,
@@ -52,6 +53,8 @@ pub struct Scene {
     pub textures: Vec<Texture>,
     /// Distant illumination.
     pub environment: Environment,
+    /// Point, spot and directional lights.
+    pub delta_lights: Vec<DeltaLight>,
     /// Cameras; the first is the default.
     pub cameras: Vec<Camera>,
     /// Named triangle ranges (instances' world copies included).
@@ -128,6 +131,7 @@ impl Scene {
             materials: Vec::new(),
             textures: Vec::new(),
             environment: Environment::Constant(Rgb::ZERO),
+            delta_lights: Vec::new(),
             cameras: Vec::new(),
             objects: Vec::new(),
             prototypes: Vec::new(),
@@ -194,10 +198,12 @@ impl Scene {
     }
 
     /// True if something emits at some time: a triangle the light sampler would sample, a
-    /// triangle whose material's keyed emission is lit at some key, or a non-black
-    /// environment. Cheap (no light sampler is built), for warnings about black images.
+    /// triangle whose material's keyed emission is lit at some key, a delta light, or a
+    /// non-black environment. Cheap (no light sampler is built), for warnings about black
+    /// images.
     pub fn has_light_sources(&self) -> bool {
         !self.environment.is_black()
+            || self.delta_lights.iter().any(DeltaLight::emits)
             || (0..self.triangles.len() as u32).any(|i| crate::lights::is_emitter(self, i))
             || self.material_motions.iter().any(|m| {
                 m.keys().iter().any(|k| k.emission.max_element() > 0.0)
@@ -707,6 +713,7 @@ impl crate::content_hash::ContentHash for Scene {
             materials,
             textures,
             environment,
+            delta_lights,
             cameras,
             objects,
             prototypes,
@@ -724,6 +731,7 @@ impl crate::content_hash::ContentHash for Scene {
         materials.content_hash(out);
         textures.content_hash(out);
         environment.content_hash(out);
+        delta_lights.content_hash(out);
         cameras.content_hash(out);
         objects.content_hash(out);
         prototypes.content_hash(out);

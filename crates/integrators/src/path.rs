@@ -19,7 +19,7 @@ use crate::radiance_cache::{CacheRef, CacheTrail, RadianceCache, DIFFUSE_DOMINAT
 use crate::transport::{emission_weight, light_visible, survives_roulette};
 use crate::{Ctx, Integrator, RayCounters, SampleAux};
 use rt_core::material::{Bsdf, LayerClass};
-use rt_core::{lights::LightSampler, sampling::power_heuristic, Ray, Rgb, Sampler};
+use rt_core::{lights::LightSampler, Ray, Rgb, Sampler};
 use rt_film::LightSplit;
 
 /// Where one contribution to a sample goes in its [`LightSplit`]: reflected light carries its
@@ -273,7 +273,7 @@ impl Integrator for PathIntegrator {
                     if f.max_element() > 0.0 && cos > 0.0 {
                         counters.shadow_rays += 1;
                         if light_visible(ctx, si.p, si.p_error, si.ng, si.time, &ls) {
-                            let w = power_heuristic(ls.pdf, bsdf_pdf);
+                            let w = ls.mis_weight(bsdf_pdf);
                             let c = beta * f * ls.le * (cos * w / ls.pdf);
                             l += c;
                             if want_split {

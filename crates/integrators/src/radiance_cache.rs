@@ -101,6 +101,10 @@ impl Technique for CachedPasses {
         self.inner.motion_blur()
     }
 
+    fn delta_lights(&self) -> bool {
+        self.inner.delta_lights()
+    }
+
     fn stages(&self) -> Vec<TechniqueStage> {
         let mut s = self.inner.stages();
         s.push(TechniqueStage {

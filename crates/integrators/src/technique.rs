@@ -63,6 +63,15 @@ pub trait Technique: Send + Sync {
         false
     }
 
+    /// True if the technique renders scenes with delta lights (point, spot, directional;
+    /// [`rt_core::delta_light`]). Techniques that weigh light-path vertices against each
+    /// other by their area pdfs (BDPT's MIS, the partitioned renderer's VPLs and photon
+    /// projection maps) do not handle a light of no extent yet, and callers refuse the
+    /// combination.
+    fn delta_lights(&self) -> bool {
+        true
+    }
+
     /// True if the technique writes the lighting-split AOVs (emission, direct, indirect,
     /// diffuse, glossy, irradiance): a camera-ray estimator whose
     /// [`Integrator::writes_split`] says so. Callers refuse a film that asks for the split

@@ -96,6 +96,31 @@ pub(crate) struct SceneDesc {
     /// `[render]`.
     #[serde(default)]
     pub render: Option<RenderTableDesc>,
+    /// `[[light]]`: point, spot and directional lights.
+    #[serde(default)]
+    pub light: Vec<Spanned<LightDesc>>,
+}
+
+/// `[[light]]`: a light of no extent. Which keys a kind takes is checked when it is built
+/// (`lights.rs`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct LightDesc {
+    /// `point`, `spot` or `directional`.
+    #[serde(rename = "type")]
+    pub kind: Spanned<String>,
+    /// Where a point or spot light is.
+    pub position: Option<Spanned<V3>>,
+    /// A spot's axis, or the way a directional light's light travels.
+    pub direction: Option<Spanned<V3>>,
+    /// A point or spot light's radiant intensity (W/sr).
+    pub intensity: Option<Spanned<V3>>,
+    /// A directional light's irradiance (W/m²).
+    pub irradiance: Option<Spanned<V3>>,
+    /// A spot's half-angle of darkness beyond, degrees.
+    pub cutoff_angle: Option<Spanned<f32>>,
+    /// A spot's half-angle of full intensity, degrees.
+    pub beam_width: Option<Spanned<f32>>,
 }
 
 /// `[environment]`.
@@ -554,7 +579,7 @@ mod tests {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/scene-format.md");
         let doc = std::fs::read_to_string(path).unwrap();
         let rows: Vec<&str> = doc.lines().filter(|l| l.starts_with('|')).collect();
-        let types: [(&str, Vec<&str>); 13] = [
+        let types: [(&str, Vec<&str>); 14] = [
             ("SceneDesc", fields_of::<SceneDesc>()),
             ("EnvironmentDesc", fields_of::<EnvironmentDesc>()),
             ("SkyDesc", fields_of::<SkyDesc>()),
@@ -568,6 +593,7 @@ mod tests {
             ("InstanceDesc", fields_of::<InstanceDesc>()),
             ("AnimationDesc", fields_of::<AnimationDesc>()),
             ("KeyDesc", fields_of::<KeyDesc>()),
+            ("LightDesc", fields_of::<LightDesc>()),
         ];
         // The top level's fields are the tables; each must be one of the types above.
         assert_eq!(
@@ -580,7 +606,8 @@ mod tests {
                 "assign",
                 "instance",
                 "animation",
-                "render"
+                "render",
+                "light"
             ],
             "a new top-level table needs its *Desc type in this list"
         );
@@ -614,6 +641,7 @@ mod tests {
             "[[geometry]]",
             "[[assign]]",
             "[render]",
+            "[[light]]",
         ] {
             assert!(
                 doc.contains(table),

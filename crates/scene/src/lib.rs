@@ -60,6 +60,7 @@ mod geometry;
 mod gltf;
 mod image_io;
 mod instances;
+mod lights;
 mod load;
 mod material;
 mod microfacet;

@@ -65,6 +65,7 @@ pub(crate) fn load(
     if let Some(env) = &d.environment {
         scene.environment = environment(&ctx, env)?;
     }
+    scene.delta_lights = crate::lights::build_all(&ctx, &d.light)?;
     scene.cameras = cameras(&ctx, &d.camera)?;
     let mut mats = MaterialTable::default();
     for m in &d.material {
@@ -106,8 +107,8 @@ pub(crate) fn load(
     scene.compact_attributes();
     if !scene.has_light_sources() {
         ctx.warnings.push(
-            "the scene has no light: no emissive material is used and the environment is black, \
-             so the image will be black"
+            "the scene has no light: no emissive material is used, no [[light]] emits and the \
+             environment is black, so the image will be black"
                 .into(),
         );
     }

@@ -98,3 +98,14 @@ fn the_sky_examples_load_with_the_sun_where_they_say() {
     let direct = sun_of(&examples[1]);
     assert!((direct.y - 0.5).abs() < 1e-3 && direct.x > 0.86, "{direct}");
 }
+
+#[test]
+fn the_light_example_loads() {
+    let snippet = toml_blocks(&doc())
+        .into_iter()
+        .find(|b| b.contains("[[light]]"))
+        .expect("the [[light]] example");
+    let dir = tempfile::tempdir().unwrap();
+    let s = common::load_in(dir.path(), &snippet).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.scene.delta_lights.len(), 2);
+}

@@ -182,8 +182,8 @@ fn unsupported_elements_and_parameters_are_one_line_at_their_position() {
             "s.xml:8:41: bsdf \"diffuse\": parameter `roughness` is not supported",
         ),
         (
-            r#"<emitter type="point"/>"#,
-            "s.xml:8:1: emitter \"point\" is not supported",
+            r#"<emitter type="projector"/>"#,
+            "s.xml:8:1: emitter \"projector\" is not supported",
         ),
         (
             r#"<shape type="bsplinecurve"><string name="filename" value="a.txt"/></shape>"#,
@@ -668,5 +668,153 @@ fn the_staircase_from_the_shared_data_loads_as_mitsuba_reads_it() {
     match by_name("WoodStairs").microfacet {
         Some(rt_core::microfacet::Microfacet::RoughPlastic(p)) => assert!(p.two_sided),
         other => panic!("{other:?}"),
+    }
+}
+
+/// The one delta light of a scene around `emitter`, with the lit quad beside it.
+fn delta_light(emitter: &str) -> rt_core::delta_light::DeltaLight {
+    let s = load_files(
+        &[("s.xml", &scene("3.0.0", &format!("{LAMP}{emitter}")))],
+        &[],
+    )
+    .unwrap();
+    assert_eq!(s.scene.delta_lights.len(), 1, "{emitter}");
+    s.scene.delta_lights[0]
+}
+
+fn close(a: Vec3, b: Vec3) -> bool {
+    (a - b).length() < 1e-5 * b.length().max(1.0)
+}
+
+#[test]
+fn point_lights_by_position_or_to_world_with_spectral_intensity() {
+    use rt_core::delta_light::DeltaLight;
+    // The spectrum of `spectra_become_mitsubas_rgb`, as emission, times 1e5 (the
+    // cbox-point-light scene's): Mitsuba's RGB of it, scaled.
+    let DeltaLight::Point {
+        position,
+        intensity,
+    } = delta_light(
+        r#"<emitter type="point"><spectrum name="intensity" value="400:0, 500:800000, 600:1560000.0, 700:1840000.0"/>
+           <point name="position" x="278" y="500" z="-800"/></emitter>"#,
+    )
+    else {
+        panic!("not a point light")
+    };
+    assert_eq!(position, Vec3::new(278.0, 500.0, -800.0));
+    let want = Vec3::new(20.7108, 10.8546, 2.77115) * 1e5;
+    assert!(
+        (intensity - want).abs().max_element() < 1e-4 * want.x,
+        "{intensity}"
+    );
+    // The translation of to_world; intensity defaults to 1.
+    let l = delta_light(
+        r#"<emitter type="point"><transform name="to_world"><translate x="1" y="2" z="3"/></transform></emitter>"#,
+    );
+    assert_eq!(
+        l,
+        DeltaLight::Point {
+            position: Vec3::new(1.0, 2.0, 3.0),
+            intensity: Vec3::ONE
+        }
+    );
+}
+
+#[test]
+fn spot_lights_shine_along_to_worlds_z_with_mitsubas_angles() {
+    use rt_core::delta_light::DeltaLight;
+    // Mitsuba's documentation example: from (1, 1, 1) towards (1, 2, 1); defaults 20° and 15°.
+    let DeltaLight::Spot {
+        position,
+        axis,
+        intensity,
+        cutoff,
+        beam_width,
+    } = delta_light(
+        r#"<emitter type="spot"><rgb name="intensity" value="1, 2, 3"/><transform name="to_world">
+           <lookat origin="1, 1, 1" target="1, 2, 1" up="0, 0, 1"/></transform></emitter>"#,
+    )
+    else {
+        panic!("not a spot")
+    };
+    assert!(close(position, Vec3::ONE), "{position}");
+    assert!(close(axis, Vec3::Y), "{axis}");
+    assert_eq!(intensity, Vec3::new(1.0, 2.0, 3.0));
+    assert!((cutoff - 20f32.to_radians()).abs() < 1e-6);
+    assert!((beam_width - 15f32.to_radians()).abs() < 1e-6);
+    // Given angles, and a beam_width that defaults to ¾ of a given cutoff.
+    let DeltaLight::Spot {
+        cutoff, beam_width, ..
+    } = delta_light(r#"<emitter type="spot"><float name="cutoff_angle" value="40"/></emitter>"#)
+    else {
+        panic!("not a spot")
+    };
+    assert!((cutoff - 40f32.to_radians()).abs() < 1e-6);
+    assert!((beam_width - 30f32.to_radians()).abs() < 1e-6);
+}
+
+#[test]
+fn directional_lights_travel_along_direction_or_to_worlds_z() {
+    use rt_core::delta_light::DeltaLight;
+    let l = delta_light(
+        r#"<emitter type="directional"><vector name="direction" x="0" y="-2" z="0"/>
+           <rgb name="irradiance" value="3, 2, 1"/></emitter>"#,
+    );
+    assert_eq!(
+        l,
+        DeltaLight::Directional {
+            direction: Vec3::NEG_Y,
+            irradiance: Vec3::new(3.0, 2.0, 1.0)
+        }
+    );
+    // Mitsuba's default is +z; to_world turns it.
+    let DeltaLight::Directional { direction, .. } = delta_light(r#"<emitter type="directional"/>"#)
+    else {
+        panic!("not directional")
+    };
+    assert_eq!(direction, Vec3::Z);
+    let DeltaLight::Directional { direction, .. } = delta_light(
+        r#"<emitter type="directional"><transform name="to_world"><rotate x="1" angle="90"/></transform></emitter>"#,
+    ) else {
+        panic!("not directional")
+    };
+    assert!(close(direction, Vec3::NEG_Y), "{direction}");
+}
+
+#[test]
+fn bad_delta_emitters_are_one_line() {
+    let cases = [
+        (
+            r#"<emitter type="point"><point name="position" x="0" y="0" z="0"/><transform name="to_world"><translate x="1"/></transform></emitter>"#,
+            "give `position` or `to_world`, not both",
+        ),
+        (
+            r#"<emitter type="spot"><float name="cutoff_angle" value="10"/><float name="beam_width" value="20"/></emitter>"#,
+            "need 0 < cutoff_angle ≤ 180 and 0 ≤ beam_width ≤ cutoff_angle",
+        ),
+        (
+            r#"<emitter type="spot"><transform name="to_world"><scale x="1" y="2" z="1"/></transform></emitter>"#,
+            "to_world must be a rotation, translation and uniform scale",
+        ),
+        (
+            r#"<emitter type="directional"><vector name="direction" x="0" y="0" z="0"/></emitter>"#,
+            "direction must be a non-zero vector",
+        ),
+        (
+            r#"<emitter type="point"><texture name="intensity" type="bitmap"/></emitter>"#,
+            "a texture on `intensity` is not supported",
+        ),
+        (
+            r#"<emitter type="point"><float name="radius" value="1"/></emitter>"#,
+            "`radius` is not supported",
+        ),
+    ];
+    for (body, want) in cases {
+        let e = err(load_files(&[("s.xml", &scene("3.0.0", body))], &[]));
+        assert!(
+            e.starts_with("s.xml:8:") && e.contains(want),
+            "{body}:\n  {e}"
+        );
+        assert!(!e.contains('\n'), "{e}");
     }
 }

@@ -153,13 +153,19 @@ impl RenderReport {
         let env_sampled = !scene.environment.is_black();
         let light_stage = "light sampling structure";
         stages.push(match scene.lights_if_built() {
-            Some(lights) if lights.emitter_count() > 0 => Stage::ran(
+            Some(lights) if lights.emitter_count() + lights.delta_count() > 0 => Stage::ran(
                 light_stage,
                 "built",
                 Some(lights.build_time()),
                 Some(lights.memory_bytes()),
             )
-            .details(format!("{} emissive triangles", lights.emitter_count())),
+            .details(match lights.delta_count() {
+                0 => format!("{} emissive triangles", lights.emitter_count()),
+                n => format!(
+                    "{} emissive triangles, {n} point, spot or directional lights",
+                    lights.emitter_count()
+                ),
+            }),
             Some(_) if env_sampled => Stage::skipped(
                 light_stage,
                 "no emitters (light samples go to the environment)",

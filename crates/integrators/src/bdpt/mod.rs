@@ -89,6 +89,10 @@ impl Technique for Bdpt {
         "bdpt"
     }
 
+    fn delta_lights(&self) -> bool {
+        false
+    }
+
     fn splats(&self) -> bool {
         true
     }

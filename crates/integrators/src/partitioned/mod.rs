@@ -200,6 +200,10 @@ impl Technique for Partitioned {
         "partitioned"
     }
 
+    fn delta_lights(&self) -> bool {
+        false
+    }
+
     fn stages(&self) -> Vec<TechniqueStage> {
         let s = self.stats();
         let share = |a: u64, b: u64| 100.0 * a as f64 / b.max(1) as f64;

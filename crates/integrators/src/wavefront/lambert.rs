@@ -179,6 +179,9 @@ pub(crate) struct LambertQueue {
     light_wi: Column3,
     light_le: Column3,
     light_pdf: Vec<f32>,
+    /// 0 where the light is a delta light, whose MIS weight takes a BSDF pdf of 0
+    /// ([`LightSample::mis_weight`]), else 1.
+    light_bsdf_mis: Vec<f32>,
     has_light: Vec<f32>,
     u0: Vec<f32>,
     u1: Vec<f32>,
@@ -216,6 +219,7 @@ impl LambertQueue {
             light_wi: Column3::with_capacity(n),
             light_le: Column3::with_capacity(n),
             light_pdf: column(),
+            light_bsdf_mis: column(),
             has_light: column(),
             u0: column(),
             u1: column(),
@@ -267,6 +271,7 @@ impl LambertQueue {
                 self.light_wi.set(k, ls.wi);
                 self.light_le.set(k, ls.le);
                 self.light_pdf[k] = ls.pdf;
+                self.light_bsdf_mis[k] = if ls.delta { 0.0 } else { 1.0 };
                 self.has_light[k] = 1.0;
             }
             None => {
@@ -274,6 +279,7 @@ impl LambertQueue {
                 self.light_wi.set(k, si.ns);
                 self.light_le.set(k, Vec3::ZERO);
                 self.light_pdf[k] = 1.0;
+                self.light_bsdf_mis[k] = 1.0;
                 self.has_light[k] = 0.0;
             }
         }
@@ -335,6 +341,7 @@ impl LambertQueue {
         }
         for c in [
             &mut self.light_pdf,
+            &mut self.light_bsdf_mis,
             &mut self.has_light,
             &mut self.u0,
             &mut self.u1,
@@ -436,7 +443,7 @@ fn vertex(q: &mut LambertQueue, k: usize) {
     let (fl, bsdf_pdf) = shading.eval(f, light_wi);
     let cos = light_wi.dot(ns).abs();
     let contributes = L8::load(&q.has_light[k..]).gt(zero) & fl.any_positive() & cos.gt(zero);
-    let w = power_heuristic(light_pdf, bsdf_pdf);
+    let w = power_heuristic(light_pdf, bsdf_pdf * L8::load(&q.light_bsdf_mis[k..]));
     let le = q.light_le.load(k);
     let c = beta.mul(fl).mul(le).scale(cos * w / light_pdf);
     q.contribution.store(k, c);
@@ -479,7 +486,7 @@ mod tests {
     use rt_core::glam::Vec2;
     use rt_core::material::Bsdf;
     use rt_core::rng::SplitMix64;
-    use rt_core::sampling::{power_heuristic, uniform_sphere};
+    use rt_core::sampling::uniform_sphere;
     use rt_core::Material;
 
     fn unit(rng: &mut SplitMix64) -> Vec3 {
@@ -533,6 +540,7 @@ mod tests {
                     rng.range(0.01, 5.0)
                 },
                 two_sided: false,
+                delta: n % 17 == 0,
             });
             let si = SurfaceHit {
                 p: Vec3::ZERO,
@@ -555,7 +563,7 @@ mod tests {
                 let (f, bsdf_pdf) = bsdf.eval_pdf(ls.wi);
                 let cos = ls.wi.dot(ns).abs();
                 (f.max_element() > 0.0 && cos > 0.0)
-                    .then(|| beta * f * ls.le * (cos * power_heuristic(ls.pdf, bsdf_pdf) / ls.pdf))
+                    .then(|| beta * f * ls.le * (cos * ls.mis_weight(bsdf_pdf) / ls.pdf))
             });
             let sample = bsdf.sample(0.3, u).map(|s| (s.wi, s.weight, s.pdf));
             want.push((contribution, sample));

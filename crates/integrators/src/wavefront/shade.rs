@@ -9,7 +9,6 @@ use crate::{Ctx, PathIntegrator};
 use rt_core::glam::Vec3;
 use rt_core::lights::{LightSample, LightSampler};
 use rt_core::material::Bsdf;
-use rt_core::sampling::power_heuristic;
 use rt_core::scene::SurfaceHit;
 use rt_core::{Hit, Rgb};
 
@@ -100,7 +99,7 @@ impl Shader<'_> {
                 let (f, bsdf_pdf) = bsdf.eval_pdf(ls.wi);
                 let cos = ls.wi.dot(si.ns).abs();
                 if f.max_element() > 0.0 && cos > 0.0 {
-                    let w = power_heuristic(ls.pdf, bsdf_pdf);
+                    let w = ls.mis_weight(bsdf_pdf);
                     let contribution = path.beta * f * ls.le * (cos * w / ls.pdf);
                     let query = shadow_query(si.p, si.p_error, si.ng, si.time, &ls);
                     shadow = Some((query, PendingShadow { lane, contribution }));

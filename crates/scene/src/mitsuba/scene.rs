@@ -1,6 +1,7 @@
 //! The scene element tree as a TOML document of our format: sensor → `[[camera]]` and
 //! `[render]`, shapes → `[[geometry]]`, BSDFs → `[[material]]`, environment emitters →
-//! `[environment]`, the integrator → `[render]`.
+//! `[environment]`, point, spot and directional emitters → `[[light]]`, the integrator →
+//! `[render]`.
 
 use std::collections::{HashMap, HashSet};
 
@@ -41,6 +42,7 @@ pub(super) fn build(
         placed: 0,
         cameras: Vec::new(),
         environment: None,
+        lights: Vec::new(),
         render: Table::new(),
         warnings,
     };
@@ -76,6 +78,7 @@ pub(super) fn build(
         ("material", std::mem::take(&mut b.materials)),
         ("geometry", std::mem::take(&mut b.geometry)),
         ("instance", std::mem::take(&mut b.instances)),
+        ("light", std::mem::take(&mut b.lights)),
     ];
     for (key, tables) in arrays {
         if !tables.is_empty() {
@@ -123,6 +126,8 @@ struct Builder<'a, 'w> {
     placed: usize,
     cameras: Vec<Table>,
     environment: Option<Table>,
+    /// `[[light]]` tables of the point, spot and directional emitters.
+    lights: Vec<Table>,
     render: Table,
     warnings: &'w mut Vec<String>,
 }
@@ -646,14 +651,90 @@ impl<'a> Builder<'a, '_> {
                 }
                 self.environment = Some(t);
             }
+            kind @ ("point" | "spot" | "directional") => {
+                let light = delta_light(&p, kind)?;
+                self.lights.push(light);
+            }
             other => {
                 return Err(e.at.error(format!(
-                    "emitter \"{other}\" is not supported (area emitters on shapes, constant and envmap are)"
+                    "emitter \"{other}\" is not supported (area emitters on shapes, constant, envmap, point, spot and directional are)"
                 )))
             }
         }
         p.finish(self.warnings)
     }
+}
+
+/// The `[[light]]` table of a `point`, `spot` or `directional` emitter, with Mitsuba 3's
+/// parameters and defaults (`src/emitters/point.cpp`, `spot.cpp`, `directional.cpp`): a
+/// point's `position` or `to_world` translation; a spot at `to_world`'s origin shining along
+/// its +z, `cutoff_angle` 20° and `beam_width` ¾ of it by default; a directional light
+/// travelling along `direction` or `to_world`'s +z. Colours default to 1 and are reduced as
+/// emission (illuminant spectra, [`Role::Emission`]).
+fn delta_light(p: &Props, kind: &str) -> Result<Table, SceneError> {
+    let mut t = Table::new();
+    t.insert("type".into(), kind.into());
+    let colour = |name: &str| -> Result<Value, SceneError> {
+        let c = p.rgb(name, Role::Emission)?.unwrap_or([1.0; 3]);
+        Ok(arr(DVec3::from_array(c)))
+    };
+    let to_world = p.transform("to_world")?;
+    // The one of `name` (a point or vector) and `to_world` given, as Mitsuba allows only one.
+    let exclusive = |name: &str| -> Result<Option<DVec3>, SceneError> {
+        let v = p.point(name)?;
+        if v.is_some() && to_world.is_some() {
+            return Err(p.error(format!("give `{name}` or `to_world`, not both")));
+        }
+        Ok(v)
+    };
+    let m = to_world.unwrap_or(DMat4::IDENTITY);
+    let axis = || -> Result<DVec3, SceneError> {
+        // A spot's cone is the inverse transform's (Mitsuba); ours keeps only the axis, so
+        // the linear part must not scale unevenly or shear.
+        let r = glam::DMat3::from_mat4(m);
+        let g = r.transpose() * r;
+        let s = g.x_axis.x;
+        let conformal = s > 0.0
+            && (g - glam::DMat3::from_diagonal(DVec3::splat(s)))
+                .to_cols_array()
+                .iter()
+                .all(|v| v.abs() < 1e-4 * s);
+        if !conformal || m.row(3) != DVec4::W {
+            return Err(p.error("to_world must be a rotation, translation and uniform scale"));
+        }
+        Ok(m.transform_vector3(DVec3::Z).normalize())
+    };
+    match kind {
+        "point" => {
+            let position = exclusive("position")?.unwrap_or(m.transform_point3(DVec3::ZERO));
+            t.insert("position".into(), arr(position));
+            t.insert("intensity".into(), colour("intensity")?);
+        }
+        "spot" => {
+            let cutoff = p.float("cutoff_angle")?.unwrap_or(20.0);
+            let beam = p.float("beam_width")?.unwrap_or(cutoff * 0.75);
+            if !(cutoff > 0.0 && cutoff <= 180.0 && beam >= 0.0 && beam <= cutoff) {
+                return Err(p.error(format!(
+                    "cutoff_angle {cutoff} and beam_width {beam}: need 0 < cutoff_angle ≤ 180 and 0 ≤ beam_width ≤ cutoff_angle"
+                )));
+            }
+            t.insert("position".into(), arr(m.transform_point3(DVec3::ZERO)));
+            t.insert("direction".into(), arr(axis()?));
+            t.insert("intensity".into(), colour("intensity")?);
+            t.insert("cutoff_angle".into(), cutoff.into());
+            t.insert("beam_width".into(), beam.into());
+        }
+        _ => {
+            let direction = match exclusive("direction")? {
+                Some(d) if d.length() > 0.0 && d.is_finite() => d.normalize(),
+                Some(_) => return Err(p.error("direction must be a non-zero vector")),
+                None => axis()?,
+            };
+            t.insert("direction".into(), arr(direction));
+            t.insert("irradiance".into(), colour("irradiance")?);
+        }
+    }
+    Ok(t)
 }
 
 /// Position, view direction and up vector of a sensor's `to_world`, which must be rigid:

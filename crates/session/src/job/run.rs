@@ -86,6 +86,7 @@ impl RenderJob {
         let mut scene = scene.loaded.scene;
         self.set_shutter(&mut scene)?;
         self.check_filter(&scene)?;
+        self.check_lights(&scene)?;
         self.check_memory(&scene)?;
         if let Some(spec) = self.temporal() {
             if self.writes_part() {
@@ -208,6 +209,20 @@ impl RenderJob {
             self.scene.display(),
             camera.name,
             camera.filter,
+            self.settings.integrator.kind.name()
+        )))
+    }
+
+    /// Refuses a scene with delta lights for a technique that cannot render them
+    /// ([`rt_integrators::Technique::delta_lights`]).
+    fn check_lights(&self, scene: &Scene) -> Result<(), JobError> {
+        if scene.delta_lights.is_empty() || self.settings.integrator.build().delta_lights() {
+            return Ok(());
+        }
+        Err(JobError::Refused(format!(
+            "{}: the scene has point, spot or directional lights, which {} does not render \
+             yet; use path, wavefront, direct or light",
+            self.scene.display(),
             self.settings.integrator.kind.name()
         )))
     }
