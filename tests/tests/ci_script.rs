@@ -1,6 +1,7 @@
 //! `.ci/run` itself: a step that fails fails the run. The script is run from a copy of `.ci/`
-//! beside stub `cargo`, `.ci/setup`, `tools/oidn/setup.sh`, `.ci/slurm` and `.ci/kubernetes`
-//! that record their calls; so the test checks the script's control flow, not the tools.
+//! beside stub `cargo`, `.ci/setup`, `tools/oidn/setup.sh`, `.ci/python`, `.ci/slurm` and
+//! `.ci/kubernetes` that record their calls; so the test checks the script's control flow, not
+//! the tools.
 //!
 //! The failure it guards against: `bash .ci/setup && cargo test ...` under `set -e` skips the
 //! tests when setup fails and carries on (bash ignores a failure on the left of `&&`), and the
@@ -31,6 +32,7 @@ fn run_ci(setup_status: i32, fail_on: &str) -> (bool, String) {
         ".ci/setup",
         &format!("echo setup >> {log}; exit {setup_status}"),
     );
+    stub(".ci/python", &format!("echo python >> {log}"));
     stub(".ci/slurm", &format!("echo slurm >> {log}"));
     stub(".ci/kubernetes", &format!("echo kubernetes >> {log}"));
     stub(
@@ -83,6 +85,7 @@ fn every_step_runs_and_a_failing_one_fails_the_run() {
         "oidn-setup",
         "cargo test --release -p rt-denoise --features oidn",
         "cargo test --profile ci",
+        "python",
         "slurm",
         "kubernetes",
     ] {
