@@ -134,11 +134,23 @@ pub fn intersect_triangle(pre: &RayPrecomp, v: &[Vec3; 3], t_max: f32) -> Option
     if t.is_nan() || t <= 0.0 || t > t_max || t.is_infinite() || inv.is_infinite() {
         return None;
     }
-    // A NaN bound rejects, as the SIMD kernels' `t > bound` comparison does.
+    // A NaN bound rejects (the SIMD kernels hand such lanes to this test). A hit within the
+    // bound is decided again in double precision: rejecting it outright, as PBRT does, lets a
+    // ray that starts in a concave corner pass through the adjacent wall (`t` 4.06e-6 against
+    // a bound of 4.32e-6 on `render stress --only bad/closed-box --seed 5`).
     let bound = t_error_bound([ax, bx, cx], [ay, by, cy], [az, bz, cz], [u, v_, w], inv);
-    if bound.is_nan() || t <= bound {
+    if bound.is_nan() {
         return None;
     }
+    let t = if t <= bound {
+        // Also the better distance: the bound says `t` itself may be off by more than `t`.
+        match t_in_f64(pre, v, bound) {
+            Some(t) if t <= t_max => t,
+            _ => return None,
+        }
+    } else {
+        t
+    };
     Some(TriHit {
         t,
         b1: v_ * inv,
@@ -148,9 +160,10 @@ pub fn intersect_triangle(pre: &RayPrecomp, v: &[Vec3; 3], t_max: f32) -> Option
 
 /// A bound on the rounding error of the `t` that [`intersect_triangle`] computes, from the
 /// sheared vertices, the edge functions and `1 / det` (Pharr et al., PBRT-v3 §3.9.6): a hit at
-/// `t` no larger than this may lie behind the origin. Rejecting it matters for rays that start
-/// close to a huge triangle (a blade of grass on a floor 10⁵ across): the error of `t` grows with
-/// the triangle's size, not with the distance to it. SIMD versions of the test compute it with
+/// `t` no larger than this may lie behind the origin, and is decided again in double precision
+/// (`t_in_f64`). That matters for rays that start close to a huge triangle (a blade of grass
+/// on a floor 10⁵ across): the error of `t` grows with the triangle's size, not with the
+/// distance to it. SIMD versions of the test compute it with
 /// the same operations in the same order, so they agree bit for bit. The `max` operands are
 /// absolute values of finite numbers here (non-finite `det` or `t` were rejected before).
 #[inline(always)]
@@ -162,6 +175,41 @@ pub fn t_error_bound(x: [f32; 3], y: [f32; 3], z: [f32; 3], e: [f32; 3], inv_det
     let delta_y = gamma(5) * (max_y + max_z);
     let delta_e = 2.0 * (gamma(2) * max_x * max_y + delta_y * max_x + delta_x * max_y);
     3.0 * (gamma(3) * max_e * max_z + delta_e * max_z + delta_z * max_e) * inv_det.abs()
+}
+
+/// The distance along the sheared ray to the plane of `v`, computed in double precision, if it
+/// lies ahead of the origin: for a hit whose single-precision `t` is within its error `bound`.
+/// The ray and the vertices are the same `f32` values; in `f64` the vertices relative to the
+/// origin are exact and every later rounding is 2⁻²⁹ of the `f32` one, so the error of this `t`
+/// is the `f32` bound scaled by 2⁻²⁹ to first order (2⁻²⁶ below leaves a factor of 8). This
+/// tells a true hit a few ULPs ahead (the adjacent wall of a corner the ray starts in) from a
+/// hit on the surface the ray leaves, whose plane the origin offset
+/// ([`crate::ray::offset_ray_origin`]) puts behind the origin by far more than 2⁻²⁶ of the
+/// bound. The inside test stays the `f32` edge functions' (watertight between neighbours); only
+/// the distance to the plane is computed here, and it does not depend on where in the plane
+/// the ray meets it.
+#[cold]
+#[inline(never)]
+fn t_in_f64(pre: &RayPrecomp, v: &[Vec3; 3], bound: f32) -> Option<f32> {
+    let (kx, ky, kz) = (pre.kx, pre.ky, pre.kz);
+    let (sx, sy, sz) = (pre.sx as f64, pre.sy as f64, pre.sz as f64);
+    let rel = |p: Vec3| {
+        let d = [
+            p.x as f64 - pre.org.x as f64,
+            p.y as f64 - pre.org.y as f64,
+            p.z as f64 - pre.org.z as f64,
+        ];
+        (d[kx] - sx * d[kz], d[ky] - sy * d[kz], sz * d[kz])
+    };
+    let (ax, ay, az) = rel(v[0]);
+    let (bx, by, bz) = rel(v[1]);
+    let (cx, cy, cz) = rel(v[2]);
+    let u = cx * by - cy * bx;
+    let w_v = ax * cy - ay * cx;
+    let w = bx * ay - by * ax;
+    let t = (u * az + w_v * bz + w * cz) / (u + w_v + w);
+    let t32 = t as f32;
+    (t > bound as f64 * (-26f64).exp2() && t32 > 0.0 && t32.is_finite()).then_some(t32)
 }
 
 /// Unnormalised geometric normal `(v1 - v0) × (v2 - v0)`: it faces the side from which the
@@ -372,6 +420,52 @@ mod tests {
         assert!((h.b1 - 0.25).abs() < 1e-6 && (h.b2 - 0.5).abs() < 1e-6);
         let h = hit(Vec3::new(0.25, 0.5, -2.0), Vec3::Z, &tri).unwrap();
         assert!((h.t - 2.0).abs() < 1e-6);
+    }
+
+    /// The wall ahead of a ray that starts in a concave corner: a bounce ray of
+    /// `render stress --only bad/closed-box --seed 5` leaving the wall x = −1 of the box
+    /// [−1, 1]³ at 2.3·10⁻⁶ from the wall z = −1 and heading through it.
+    fn corner() -> ([Vec3; 3], Vec3, Vec3) {
+        let tri = [
+            Vec3::new(-1.0, 0.333_333_37, -1.0),
+            Vec3::new(-0.666_666_6, 0.666_666_6, -1.0),
+            Vec3::new(-1.0, 0.666_666_6, -1.0),
+        ];
+        let o = Vec3::new(-0.999_999_2, 0.336_885_27, -0.999_997_74);
+        (tri, o, Vec3::new(0.822_854_2, 0.110_302_76, -0.557_444_4))
+    }
+
+    #[test]
+    fn a_hit_within_the_error_bound_is_decided_in_double_precision() {
+        let (tri, o, d) = corner();
+        let pre = RayPrecomp::new(&Ray::new(o, d));
+        // The single-precision bound cannot tell this `t` from zero (PBRT rejects the hit and
+        // the ray leaves the box through the wall)...
+        let rel = |p: Vec3| {
+            let a = p - pre.org;
+            (
+                a[pre.kx] - pre.sx * a[pre.kz],
+                a[pre.ky] - pre.sy * a[pre.kz],
+                pre.sz * a[pre.kz],
+            )
+        };
+        let [(ax, ay, az), (bx, by, bz), (cx, cy, cz)] = tri.map(rel);
+        let (u, v, w) = (cx * by - cy * bx, ax * cy - ay * cx, bx * ay - by * ax);
+        let inv = 1.0 / (u + v + w);
+        let t = (u * az + v * bz + w * cz) * inv;
+        let bound = t_error_bound([ax, bx, cx], [ay, by, cy], [az, bz, cz], [u, v, w], inv);
+        assert!(t > 0.0 && t <= bound, "t {t}, bound {bound}");
+        // ...and it is a hit, at the distance to the plane.
+        let h = intersect_triangle(&pre, &tri, f32::INFINITY).expect("the wall ahead");
+        let want = (o.z + 1.0) / -d.z;
+        assert!((h.t - want).abs() < 1e-6 * want, "{} against {want}", h.t);
+        // Controls, from the same point: moving away from the wall (its plane 4·10⁻⁶ behind)
+        // and starting in the wall's plane itself (the surface a ray leaves) are no hits.
+        assert!(hit(o, d * Vec3::new(1.0, 1.0, -1.0), &tri).is_none());
+        for z in [1.0f32, -1.0] {
+            let on_plane = Vec3::new(o.x, o.y, -1.0);
+            assert!(hit(on_plane, d * Vec3::new(1.0, 1.0, z), &tri).is_none());
+        }
     }
 
     #[test]

@@ -117,9 +117,9 @@ pub(crate) fn intersect4_scalar(pre: &RayPrecomp4, p: &Tri4, t_max: f32) -> Hits
 /// AVX2 (eight lanes): `$ops` is a module of same-named lane operations on its vector type `V`
 /// ([`sse`] or [`avx`]), `$load(vertex, axis)` loads one coordinate of every lane. Each lane
 /// performs exactly the operations of [`intersect_triangle`] in the same order (no fused
-/// multiply-add), so the results agree bit for bit. Evaluates to the masks of lanes whose
-/// edge function was zero (to be redone by the scalar test) and of lanes that hit, and the
-/// vectors `t`, `b1`, `b2`.
+/// multiply-add), so the results agree bit for bit. Evaluates to the masks of lanes to be
+/// redone by the scalar test (an edge function of zero, or a `t` within its error bound) and
+/// of lanes that hit, and the vectors `t`, `b1`, `b2`.
 macro_rules! watertight_lanes {
     ($ops:ident, $pre:expr, $t_max:expr, $load:ident) => {{
         // No closures here: a closure is a function of its own, without the caller's
@@ -181,8 +181,8 @@ macro_rules! watertight_lanes {
         // `t` above its rounding error bound: `t_error_bound`, operation for operation. Most
         // packets hit nothing by here, and they skip the bound's two dozen operations.
         let hits = movemask(ok);
-        let hits = if hits == 0 {
-            0
+        let (hits, uncertain) = if hits == 0 {
+            (0, 0)
         } else {
             macro_rules! max3 {
                 ($a:expr, $b:expr, $c:expr) => {
@@ -212,9 +212,12 @@ macro_rules! watertight_lanes {
                 ),
                 abs!(inv),
             );
-            movemask(and(ok, gt(t, delta_t)))
+            // Hits within the bound (or with a NaN one) go to the scalar test, which decides
+            // them in double precision (`rt_core::triangle::intersect_triangle`).
+            let certain = gt(t, delta_t);
+            (movemask(and(ok, certain)), movemask(andnot(certain, ok)))
         };
-        (zero_edge, hits, t, mul(v, inv), mul(w, inv))
+        (zero_edge | uncertain, hits, t, mul(v, inv), mul(w, inv))
     }};
 }
 // The IOSP traversals gather their lanes straight from the triangle array.
