@@ -101,15 +101,22 @@ fn compare(a: &dyn Accel, s: &Scene, rays: &[(rt_core::Ray, f32)]) -> (usize, us
                 }
             };
         if let (Some(x), Some(y)) = (x, y) {
-            if x.prim == y.prim {
+            // (At the origin the two are the same point up to the placement's rounding, which
+            // moves the barycentrics of a hit at t ≈ 0 by more than its distance.)
+            if x.prim == y.prim && !at_origin(Some(x)) && !at_origin(Some(y)) {
                 // Barycentrics are ill-conditioned on slivers; the points they give are not.
                 let v = &s.triangles[x.prim as usize];
                 let (px, py) = (
                     rt_core::triangle::point_at(v, x.b1, x.b2),
                     rt_core::triangle::point_at(v, y.b1, y.b2),
                 );
+                // Along a grazing ray the crossing moves by the placement's rounding over the
+                // cosine (such hits were rejected before the test decided hits within its
+                // error bound in double precision).
+                let n = rt_core::triangle::geometric_normal(v).normalize();
+                let cos = ray.dir.normalize().dot(n).abs();
                 assert!(
-                    px.distance(py) < 10.0 * tol,
+                    px.distance(py) * cos < 10.0 * tol,
                     "hit points differ on {}: {x:?} vs {y:?}",
                     x.prim
                 );
