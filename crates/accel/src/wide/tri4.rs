@@ -488,8 +488,8 @@ pub(crate) unsafe fn intersect8_avx2(
     // `watertight_lanes!` passes axes below 3 (clamped) and vertices below 3, so each load
     // reads 16 bytes inside the 144 of a packet.
     let (zero_edge, sign_ok, t, b1, b2) = unsafe { watertight_lanes!(avx, pre, t_max, load) };
-    // Most pairs hit nothing and need no lane redone: then nothing is stored (the stores and
-    // the copies of the result were a tenth of a leaf's instructions).
+    // Most pairs hit nothing and need no lane redone: then nothing is stored or copied (the
+    // stores and the copy of the result ran at every pass).
     if sign_ok | zero_edge == 0 {
         return None;
     }
