@@ -615,6 +615,48 @@ mod tests {
         assert!(hits > 1000, "{hits}");
     }
 
+    /// A pair whose only candidate is a lane the SIMD test leaves to the scalar one (a ray
+    /// grazing a corner, its `t` within the f32 error bound: the case of `rt_core::triangle`'s
+    /// test for hits decided in double precision, from `293a0a2` on; before it both tests
+    /// reject it): the pair reports what the scalar test says, although no lane hit in the
+    /// SIMD test itself. Seen to fail, merged with `293a0a2`, when `intersect8_avx2` returned
+    /// `None` for `sign_ok == 0` alone.
+    #[test]
+    fn a_pair_whose_only_hit_is_redone_by_the_scalar_test_reports_it() {
+        let tri = [
+            Vec3::new(-1.0, 0.333_333_37, -1.0),
+            Vec3::new(-0.666_666_6, 0.666_666_6, -1.0),
+            Vec3::new(-1.0, 0.666_666_6, -1.0),
+        ];
+        let ray = Ray::new(
+            Vec3::new(-0.999_999_2, 0.336_885_27, -0.999_997_74),
+            Vec3::new(0.822_854_2, 0.110_302_76, -0.557_444_4),
+        );
+        let far = [
+            Vec3::new(50.0, 50.0, 50.0),
+            Vec3::new(51.0, 50.0, 50.0),
+            Vec3::new(50.0, 51.0, 50.0),
+        ];
+        let pre = RayPrecomp4::new(&ray);
+        let want = intersect_triangle(&pre.scalar, &tri, f32::INFINITY);
+        let p = Tri4::pack(&[far, far, tri]);
+        let q = Tri4::pack(&[far]);
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: AVX2 was just detected.
+            #[allow(unsafe_code)]
+            let got = unsafe { intersect8_avx2(&pre, &p, &q, f32::INFINITY) };
+            let got = got.unwrap_or_default();
+            // Lane 3 repeats the triangle of lane 2.
+            assert_eq!(got.mask, if want.is_some() { 0b1100 } else { 0 });
+            if let Some(w) = want {
+                assert_eq!(got.t[2].to_bits(), w.t.to_bits());
+            }
+        }
+        let got = intersect4(&pre, &p, f32::INFINITY);
+        assert_eq!(got.mask, if want.is_some() { 0b1100 } else { 0 });
+    }
+
     #[test]
     fn pack_repeats_the_last_triangle() {
         let a = [Vec3::ZERO, Vec3::X, Vec3::Y];
