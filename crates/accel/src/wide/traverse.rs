@@ -32,6 +32,10 @@ pub struct Slab {
     /// sign bit of `inv` so that `-0.0` goes with `-inf`.
     near: [usize; 3],
     far: [usize; 3],
+    /// `near` and `far` as float offsets into an eight-wide node's `bounds` (`8 * row`): the
+    /// AVX2 test's loads then scale a register instead of shifting a reloaded index.
+    near8: [usize; 3],
+    far8: [usize; 3],
 }
 
 impl Slab {
@@ -39,11 +43,15 @@ impl Slab {
     pub(crate) fn new(ray: &Ray) -> Self {
         let inv = ray.dir.recip().to_array();
         let neg = inv.map(|x| x.is_sign_negative() as usize);
+        let near = [0, 1, 2].map(|a| a + 3 * neg[a]);
+        let far = [0, 1, 2].map(|a| a + 3 - 3 * neg[a]);
         Self {
             org: ray.origin.to_array(),
             inv,
-            near: [0, 1, 2].map(|a| a + 3 * neg[a]),
-            far: [0, 1, 2].map(|a| a + 3 - 3 * neg[a]),
+            near,
+            far,
+            near8: near.map(|r| 8 * r),
+            far8: far.map(|r| 8 * r),
         }
     }
 
@@ -185,13 +193,15 @@ impl Slab {
         for axis in 0..3 {
             let o = _mm256_set1_ps(self.org[axis]);
             let inv = _mm256_set1_ps(self.inv[axis]);
-            // SAFETY: `Slab::new` makes every `near`/`far` index `a` or `a + 3` with `a < 3`, so
-            // both rows exist; each row is an `[f32; 8]`, 32 bytes, read whole without
-            // alignment needs. (Unchecked: the bounds checks cost a dozen instructions a node.)
+            // SAFETY: `Slab::new` makes every `near`/`far` index `a` or `a + 3` with `a < 3`, and
+            // `near8`/`far8` eight times those, so both rows exist; each row is an `[f32; 8]`,
+            // 32 bytes, read whole without alignment needs. (Unchecked: the bounds checks cost
+            // a dozen instructions a node.)
             let (lo, hi) = unsafe {
+                let b = bounds.as_ptr().cast::<f32>();
                 (
-                    _mm256_loadu_ps(bounds.get_unchecked(self.near[axis]).as_ptr()),
-                    _mm256_loadu_ps(bounds.get_unchecked(self.far[axis]).as_ptr()),
+                    _mm256_loadu_ps(b.add(self.near8[axis])),
+                    _mm256_loadu_ps(b.add(self.far8[axis])),
                 )
             };
             let near = _mm256_mul_ps(_mm256_sub_ps(lo, o), inv);
@@ -545,19 +555,27 @@ impl<N: WideNode> WideBvh<N> {
         let (mut p, end) = (first, first + count.div_ceil(4));
         #[cfg(target_arch = "x86_64")]
         if I::AVX2 {
-            while p + 1 < end {
+            while p < end {
+                // An odd last packet fills both halves and its upper lanes are ignored: one
+                // kernel for every pass, not a four-wide one after the eight-wide ones.
+                let (q, valid) = if p + 1 < end {
+                    (p + 1, 0xFF)
+                } else {
+                    (p, 0x0F)
+                };
                 // SAFETY: a value of an `Isa` whose `AVX2` is true is made only by
                 // `Avx2::detect`, after run-time detection found AVX2.
                 #[allow(unsafe_code)]
-                let h =
-                    unsafe { intersect8_avx2(pre, &self.packets[p], &self.packets[p + 1], t_max) };
-                let mut mask = h.mask;
-                while mask != 0 {
-                    let lane = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    let id = self.packet_ids[p + lane / 4][lane % 4];
-                    if closest.offer::<ANY_HIT>(h.t[lane], id, h.b1[lane], h.b2[lane]) {
-                        return true;
+                let h = unsafe { intersect8_avx2(pre, &self.packets[p], &self.packets[q], t_max) };
+                if let Some(h) = h {
+                    let mut mask = h.mask & valid;
+                    while mask != 0 {
+                        let lane = mask.trailing_zeros() as usize;
+                        mask &= mask - 1;
+                        let id = self.packet_ids[p + lane / 4][lane % 4];
+                        if closest.offer::<ANY_HIT>(h.t[lane], id, h.b1[lane], h.b2[lane]) {
+                            return true;
+                        }
                     }
                 }
                 p += 2;
