@@ -135,7 +135,8 @@ def test_rss_stays_bounded_over_100_small_renders(small_cornell):
 
 CHILD = textwrap.dedent(
     """
-    import json, sys, time, rt_renderer as rt
+    import json, signal, sys, time, rt_renderer as rt
+    print(f"SIGINT disposition at start: {signal.getsignal(signal.SIGINT)}", file=sys.stderr)
     scene = rt.Scene.load(sys.argv[1])
     kwargs = json.loads(sys.argv[2])
     def progress(done):
@@ -174,7 +175,9 @@ def test_ctrl_c_stops_a_render_at_the_next_pass(small_cornell, kwargs):
         out, err = child.communicate(timeout=20)
     except subprocess.TimeoutExpired:
         child.kill()
-        pytest.fail("the render did not stop within 20 s of SIGINT")
+        out, err = child.communicate()
+        # (Seen only inside a whole `.ci/run`: what the child said helps find why.)
+        pytest.fail(f"the render did not stop within 20 s of SIGINT; stdout {out!r}, stderr {err[-2000:]!r}")
     stopped = time.monotonic() - sent
     assert "KeyboardInterrupt" in err, err
     assert child.returncode != 0 and "finished" not in out
