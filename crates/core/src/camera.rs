@@ -32,6 +32,10 @@ pub struct Camera {
     /// The part of a larger image this camera renders (a crop window), or `None` for the
     /// whole image. The field of view is the larger image's; `width × height` is the crop's.
     pub crop: Option<Crop>,
+    /// Near clipping distance along the view axis: primary rays start on the plane at this
+    /// depth in front of the lens and light paths connect only to points beyond it (Mitsuba's
+    /// `near_clip`); 0 (the default) clips nothing.
+    pub near_clip: f32,
     tan_half: f32,
 }
 
@@ -94,6 +98,7 @@ impl Camera {
             focus_distance,
             filter: PixelFilter::Box,
             crop: None,
+            near_clip: 0.0,
             tan_half: (fov_y_deg.to_radians() * 0.5).tan(),
         }
     }
@@ -152,6 +157,17 @@ impl Camera {
         }
     }
 
+    /// The point of the lens that lens sample `lens` in [0,1)² picks (the centre of
+    /// projection for a pinhole): where a primary ray leaves the lens, before any near clip.
+    #[inline]
+    pub fn lens_point(&self, lens: Vec2) -> Vec3 {
+        if self.is_pinhole() {
+            return self.position;
+        }
+        let l = concentric_disk(lens) * self.aperture;
+        self.position + self.right * l.x + self.up * l.y
+    }
+
     /// True for a pinhole (aperture 0): [`Camera::generate_ray`] ignores its lens sample, so
     /// the render driver does not draw one.
     #[inline]
@@ -205,12 +221,23 @@ impl Camera {
         let sy = (1.0 - 2.0 * f.y) * tan_half;
         let d = forward + right * sx + up * sy;
         if self.is_pinhole() {
-            return Ray::new(position, d.normalize());
+            // `d` has depth 1 along the view axis, so `d · near` lies on the near plane.
+            let o = if self.near_clip > 0.0 {
+                position + d * self.near_clip
+            } else {
+                position
+            };
+            return Ray::new(o, d.normalize());
         }
         let focus = position + d * self.focus_distance;
         let l = concentric_disk(lens) * self.aperture;
         let o = position + right * l.x + up * l.y;
-        Ray::new(o, (focus - o).normalize())
+        let dir = (focus - o).normalize();
+        if self.near_clip > 0.0 {
+            // As Mitsuba's thin lens: the ray starts where it crosses the near plane.
+            return Ray::new(o + dir * (self.near_clip / dir.dot(forward)), dir);
+        }
+        Ray::new(o, dir)
     }
 
     /// Solid-angle pdf with which [`Camera::generate_ray`], at a raster position uniform over
@@ -290,6 +317,10 @@ pub struct CameraConnection {
     pub raster: Vec2,
     /// The point on the lens the connection ends at (the centre of projection for a pinhole).
     pub lens_point: Vec3,
+    /// Where the segment from the scene point to `lens_point` crosses the near clipping plane
+    /// (`lens_point` itself without a near clip): what lies beyond it, toward the lens, is
+    /// clipped away, as for primary rays, so visibility is tested up to here.
+    pub near_point: Vec3,
     /// Unit direction from the scene point towards `lens_point`.
     pub wi: Vec3,
     /// Distance from the scene point to `lens_point`.
@@ -304,8 +335,8 @@ pub struct CameraConnection {
 
 impl Camera {
     /// Connects world point `p` to the camera through lens sample `lens` in [0,1)² (ignored by a
-    /// pinhole), for light tracing. `None` if `p` is behind the lens or projects outside the
-    /// image.
+    /// pinhole), for light tracing. `None` if `p` is behind the lens or nearer than
+    /// [`Camera::near_clip`] along the view axis, or projects outside the image.
     ///
     /// Why `importance` is what it is: the driver averages radiance over a pixel's area `s` on
     /// the image plane at distance 1 and over the lens; through a lens point the solid angle
@@ -313,16 +344,11 @@ impl Camera {
     /// pixel's value is `∫ L dω / (A_pixel cos³θ)`, and `dω = cos_p dA / dist²` at the scene
     /// point. The uniform lens sample's pdf cancels the lens average.
     pub fn connect(&self, p: Vec3, lens: Vec2) -> Option<CameraConnection> {
-        let lens_point = if self.is_pinhole() {
-            self.position
-        } else {
-            let l = concentric_disk(lens) * self.aperture;
-            self.position + self.right * l.x + self.up * l.y
-        };
+        let lens_point = self.lens_point(lens);
         let v = p - lens_point;
         let z = v.dot(self.forward);
         let dist2 = v.length_squared();
-        if z <= 0.0 || dist2.is_nan() || dist2 <= 0.0 || !dist2.is_finite() {
+        if z <= 0.0 || z < self.near_clip || dist2.is_nan() || dist2 <= 0.0 || !dist2.is_finite() {
             return None;
         }
         // The point of the focus plane on the line from the lens point through `p` is what the
@@ -339,12 +365,18 @@ impl Camera {
             return None;
         }
         let dist = dist2.sqrt();
+        let near_point = if self.near_clip > 0.0 {
+            lens_point + v * (self.near_clip / z)
+        } else {
+            lens_point
+        };
         let cos = z / dist;
         let pixel_area = self.pixel_size().powi(2);
         let importance = 1.0 / (dist2 * pixel_area * cos * cos * cos);
         Some(CameraConnection {
             raster,
             lens_point,
+            near_point,
             wi: -v / dist,
             dist,
             importance,
@@ -368,6 +400,7 @@ impl crate::content_hash::ContentHash for Camera {
             focus_distance,
             filter,
             crop,
+            near_clip,
             tan_half: _,
         } = self;
         name.content_hash(out);
@@ -389,6 +422,11 @@ impl crate::content_hash::ContentHash for Camera {
         if let Some(c) = crop {
             [c.x0, c.y0, c.x1, c.y1].content_hash(out);
         }
+        // And a near clip.
+        if *near_clip > 0.0 {
+            "near_clip".content_hash(out);
+            near_clip.content_hash(out);
+        }
     }
 }
 
@@ -408,6 +446,34 @@ mod tests {
             aperture,
             5.0,
         )
+    }
+
+    #[test]
+    fn primary_rays_start_on_the_near_plane_and_nearer_points_do_not_connect() {
+        for aperture in [0.0, 0.2] {
+            let mut c = cam(aperture);
+            let open = c.clone();
+            c.near_clip = 1.5;
+            for film in [
+                Vec2::new(0.5, 0.5),
+                Vec2::new(100.0, 50.0),
+                Vec2::new(199.0, 7.0),
+            ] {
+                let lens = Vec2::new(0.8, 0.1);
+                let (r, o) = (c.generate_ray(film, lens), open.generate_ray(film, lens));
+                let depth = (r.origin - c.position).dot(c.forward);
+                assert!((depth - 1.5).abs() < 1e-5, "{depth}");
+                // The same line, moved along it.
+                assert!((r.dir - o.dir).length() < 1e-6);
+                let along = (r.origin - o.origin).cross(o.dir).length();
+                assert!(along < 1e-5, "{along}");
+                // A point just beyond the plane connects, one just before it does not.
+                let beyond = o.origin + o.dir * (1.6 / o.dir.dot(c.forward));
+                let before = o.origin + o.dir * (1.4 / o.dir.dot(c.forward));
+                assert!(c.connect(beyond, lens).is_some() && c.connect(before, lens).is_none());
+                assert!(open.connect(before, lens).is_some());
+            }
+        }
     }
 
     #[test]

@@ -242,7 +242,7 @@ fn splat(
         return;
     }
     counters.shadow_rays += 1;
-    let (r, t_max) = shadow_segment(p, p_error, n, c.lens_point, Vec3::ZERO, c.wi);
+    let (r, t_max) = shadow_segment(p, p_error, n, c.near_point, Vec3::ZERO, c.wi);
     if ctx.accel.occluded(&r, t_max) {
         return;
     }

@@ -184,6 +184,10 @@ pub(crate) struct CameraDesc {
     pub pixel_filter: Option<Spanned<String>>,
     /// `[x, y, width, height]`: the part of `resolution` rendered.
     pub crop: Option<Spanned<Arr<u32, 4>>>,
+    /// Depth along the view axis where primary rays start; default 0.
+    pub near_clip: Option<Spanned<f32>>,
+    /// Depth beyond which nothing would be seen: checked to cut no geometry, not applied.
+    pub far_clip: Option<Spanned<f32>>,
 }
 
 /// `[[material]]`.
@@ -267,6 +271,8 @@ pub(crate) struct GeometryDesc {
     pub p1: Option<Spanned<V3>>,
     /// Any kind: reverse every triangle's winding and negate its vertex normals.
     pub flip_normals: Option<Spanned<bool>>,
+    /// A mesh file or inline mesh: texture coordinates `(u, v)` become `(u, 1 - v)`.
+    pub flip_v: Option<Spanned<bool>>,
     // Inline triangle mesh.
     pub positions: Option<Spanned<Vec<V3>>>,
     pub indices: Option<Spanned<Vec<Arr<u32, 3>>>>,

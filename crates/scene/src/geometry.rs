@@ -207,6 +207,11 @@ fn build(
     if d.flip_normals.as_ref().is_some_and(|b| *b.get_ref()) {
         mesh.flip();
     }
+    if d.flip_v.as_ref().is_some_and(|b| *b.get_ref()) {
+        for uv in mesh.uvs.iter_mut().flatten().flatten() {
+            uv.y = 1.0 - uv.y;
+        }
+    }
     check_and_place(ctx, name, &origin, &mut mesh, transform.as_ref())?;
 
     let ids = match material {
@@ -283,7 +288,7 @@ fn kind<'a>(ctx: &Ctx, d: &'a GeometryDesc) -> Result<Kind<'a>> {
 /// Rejects keys that the geometry's kind does not use, and requires the ones it needs.
 fn check_keys(ctx: &Ctx, d: &GeometryDesc, kind: &Kind) -> Result<()> {
     let name = d.name.get_ref();
-    let keys: [(&str, Option<Range<usize>>); 15] = [
+    let keys: [(&str, Option<Range<usize>>); 16] = [
         ("vertices", d.vertices.as_ref().map(|s| s.span())),
         ("min", d.min.as_ref().map(|s| s.span())),
         ("max", d.max.as_ref().map(|s| s.span())),
@@ -299,9 +304,10 @@ fn check_keys(ctx: &Ctx, d: &GeometryDesc, kind: &Kind) -> Result<()> {
         ("indices", d.indices.as_ref().map(|s| s.span())),
         ("normals", d.normals.as_ref().map(|s| s.span())),
         ("uvs", d.uvs.as_ref().map(|s| s.span())),
+        ("flip_v", d.flip_v.as_ref().map(|s| s.span())),
     ];
     let (allowed, required, what): (&[&str], &[&str], String) = match kind {
-        Kind::File(_) => (&["smooth"], &[], "a mesh file".into()),
+        Kind::File(_) => (&["smooth", "flip_v"], &[], "a mesh file".into()),
         Kind::Shape("quad", _) => (&["vertices"], &["vertices"], "shape \"quad\"".into()),
         Kind::Shape("box", _) => (&["min", "max"], &["min", "max"], "shape \"box\"".into()),
         Kind::Shape("sphere", _) => (
@@ -320,7 +326,7 @@ fn check_keys(ctx: &Ctx, d: &GeometryDesc, kind: &Kind) -> Result<()> {
             "shape \"disk\"".into(),
         ),
         Kind::Inline => (
-            &["positions", "indices", "normals", "uvs", "smooth"],
+            &["positions", "indices", "normals", "uvs", "smooth", "flip_v"],
             &["positions", "indices"],
             "an inline mesh".into(),
         ),
@@ -909,6 +915,11 @@ mod tests {
             "normals are normalised"
         );
         assert_eq!(s.scene.uvs[3], Some([Vec2::Y, Vec2::X, Vec2::ONE]));
+        let flipped = ok(&geom(
+            "positions = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]]\nindices = [[0, 1, 2], [2, 1, 3]]\n\
+             uvs = [[0, 0], [1, 0], [0, 1], [1, 1]]\nflip_v = true",
+        ));
+        assert_eq!(flipped.scene.uvs[3], Some([Vec2::ZERO, Vec2::ONE, Vec2::X]));
         for (body, want) in [
             ("positions = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]\nindices = [[0, 1, 3]]", "indices[0] = [0, 1, 3] references position 3 but there are 3 positions"),
             ("positions = [[0, 0, 0], [1, 0, 0], [0, nan, 0]]\nindices = [[0, 1, 2]]", "position 2 is not finite"),

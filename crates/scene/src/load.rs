@@ -92,6 +92,7 @@ pub(crate) fn load(
         &mats,
         &mut scene,
     )?;
+    far_clips(&ctx, &d.camera, &scene)?;
     let render = render(&ctx, d.render)?;
 
     for name in mats.unused() {
@@ -542,6 +543,30 @@ fn camera(ctx: &Ctx, d: &CameraDesc) -> Result<Camera> {
         focus,
     );
     camera.crop = crop;
+    if let Some(n) = &d.near_clip {
+        camera.near_clip = *n.get_ref();
+        if !(camera.near_clip.is_finite() && camera.near_clip >= 0.0) {
+            return at(
+                n.span(),
+                format!(
+                    "near_clip must be finite and >= 0, got {}",
+                    camera.near_clip
+                ),
+            );
+        }
+    }
+    if let Some(f) = &d.far_clip {
+        let far = *f.get_ref();
+        if far.is_nan() || far <= camera.near_clip {
+            return at(
+                f.span(),
+                format!(
+                    "far_clip must be greater than near_clip ({}), got {far}",
+                    camera.near_clip
+                ),
+            );
+        }
+    }
     if let Some(f) = &d.pixel_filter {
         camera.filter = PixelFilter::parse(f.get_ref()).map_err(|e| {
             ctx.src
@@ -549,6 +574,43 @@ fn camera(ctx: &Ctx, d: &CameraDesc) -> Result<Camera> {
         })?;
     }
     Ok(camera)
+}
+
+/// A camera's `far_clip` is accepted only where it cuts nothing: every triangle lies nearer
+/// along the view axis. Applying it would mean a bounded primary ray in every integrator; a
+/// clip that would hide geometry is refused rather than ignored, so no image silently
+/// differs from what the scene asks for. A moving scene is not checked frame by frame, so
+/// there a far clip is refused.
+fn far_clips(ctx: &Ctx, descs: &[Spanned<CameraDesc>], scene: &Scene) -> Result<()> {
+    for (d, camera) in descs.iter().zip(&scene.cameras) {
+        let Some(f) = &d.get_ref().far_clip else {
+            continue;
+        };
+        let (far, name) = (*f.get_ref(), &camera.name);
+        if scene.instances.iter().any(|i| i.is_animated()) || !scene.camera_motions.is_empty() {
+            return Err(ctx.src.error_at(
+                f.span(),
+                format!("camera \"{name}\": far_clip is not supported in an animated scene"),
+            ));
+        }
+        let depth = scene
+            .triangles
+            .iter()
+            .flatten()
+            .map(|v| (*v - camera.position).dot(camera.forward))
+            .fold(f32::NEG_INFINITY, f32::max);
+        if depth >= far {
+            return Err(ctx.src.error_at(
+                f.span(),
+                format!(
+                    "camera \"{name}\": far_clip {far} would hide geometry (it reaches {depth} \
+                     along the view axis); far clipping is not supported: remove far_clip or \
+                     make it larger"
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// `[[assign]]`: sets the material of a half-open triangle range of one geometry.
@@ -1038,6 +1100,12 @@ material = "light"
             ),
             ("up = [0, 0, 0]", "is zero or parallel"),
             ("up = [0, nan, 0]", "up must be finite"),
+            ("near_clip = -1", "near_clip must be finite and >= 0"),
+            (
+                "near_clip = 2\nfar_clip = 1",
+                "far_clip must be greater than near_clip (2), got 1",
+            ),
+            ("far_clip = nan", "far_clip must be greater than near_clip"),
         ] {
             let e = cam(extra).unwrap_err();
             assert!(e.contains(want), "{extra}: {e}");

@@ -205,15 +205,55 @@ fn unsupported_elements_and_parameters_are_one_line_at_their_position() {
 #[test]
 fn ignored_parameters_are_warnings() {
     let text = scene("3.0.0", LAMP).replace(
-        r#"<float name="fov" value="45"/>"#,
-        r#"<float name="fov" value="45"/><float name="near_clip" value="0.1"/>"#,
+        r#"<rfilter type="box"/>"#,
+        r#"<rfilter type="box"/><string name="pixel_format" value="rgba"/>"#,
     );
     let s = load_files(&[("s.xml", &text)], &[]).unwrap();
     assert!(
-        s.warnings.iter().any(|w| w.contains("`near_clip` ignored")),
+        s.warnings
+            .iter()
+            .any(|w| w.contains("`pixel_format` ignored")),
         "{:?}",
         s.warnings
     );
+}
+
+#[test]
+fn near_and_far_clip_are_mitsubas() {
+    let with = |clips: &str| {
+        scene("3.0.0", LAMP).replace(
+            r#"<float name="fov" value="45"/>"#,
+            &format!(r#"<float name="fov" value="45"/>{clips}"#),
+        )
+    };
+    // Mitsuba's default near clip, and one given.
+    let s = load_files(&[("s.xml", &with(""))], &[]).unwrap();
+    assert_eq!(s.scene.cameras[0].near_clip, 0.01);
+    let s = load_files(
+        &[("s.xml", &with(r#"<float name="near_clip" value="0.5"/>"#))],
+        &[],
+    )
+    .unwrap();
+    assert_eq!(s.scene.cameras[0].near_clip, 0.5);
+    assert!(
+        s.warnings.iter().all(|w| !w.contains("clip")),
+        "{:?}",
+        s.warnings
+    );
+    // The lamp is 5 away: a far clip beyond it cuts nothing, one before it is refused.
+    let far = |f: f64| format!(r#"<float name="far_clip" value="{f}"/>"#);
+    assert!(load_files(&[("s.xml", &with(&far(6.0)))], &[]).is_ok());
+    let e = err(load_files(&[("s.xml", &with(&far(4.0)))], &[]));
+    assert!(e.contains("far_clip 4 would hide geometry"), "{e}");
+    assert!(!e.contains('\n'), "{e}");
+    let e = err(load_files(
+        &[(
+            "s.xml",
+            &with(r#"<float name="near_clip" value="2"/><float name="far_clip" value="1"/>"#),
+        )],
+        &[],
+    ));
+    assert!(e.contains("need 0 < near_clip < far_clip"), "{e}");
 }
 
 #[test]

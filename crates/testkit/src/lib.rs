@@ -78,6 +78,7 @@ pub trait SceneExt {
 /// The first camera of `scene` rebuilt with the given size and lens.
 fn first_camera_as(mut scene: Scene, size: (u32, u32), lens: (f32, f32)) -> Scene {
     let c = &scene.cameras[0];
+    let near_clip = c.near_clip;
     scene.cameras[0] = rt_core::Camera::look_at(
         &c.name,
         c.position,
@@ -91,6 +92,7 @@ fn first_camera_as(mut scene: Scene, size: (u32, u32), lens: (f32, f32)) -> Scen
         lens.0,
         lens.1,
     );
+    scene.cameras[0].near_clip = near_clip;
     scene
 }
 

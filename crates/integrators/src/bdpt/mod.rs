@@ -210,9 +210,12 @@ impl Bdpt {
         };
         let ray = camera.generate_ray(film_pos, lens);
         paths.camera.clear();
-        paths
-            .camera
-            .push(Vertex::endpoint(Kind::Camera, ray.origin, Rgb::ONE, 0.0));
+        paths.camera.push(Vertex::endpoint(
+            Kind::Camera,
+            camera.lens_point(lens),
+            Rgb::ONE,
+            0.0,
+        ));
         let pdf_dir = camera.pdf_direction(ray.dir);
         self.walk(
             ctx,
@@ -570,7 +573,7 @@ impl Bdpt {
             return None;
         }
         out.counters.shadow_rays += 1;
-        let (r, t_max) = shadow_segment(qs.p, qs.p_error, qs.ng, c.lens_point, Vec3::ZERO, c.wi);
+        let (r, t_max) = shadow_segment(qs.p, qs.p_error, qs.ng, c.near_point, Vec3::ZERO, c.wi);
         if ctx.accel.occluded(&r, t_max) {
             return None;
         }

@@ -247,8 +247,17 @@ impl<'a> Builder<'a, '_> {
             "fov".into(),
             vertical_fov(&p, fov, axis, w as f64, h as f64)?.into(),
         );
-        p.ignore("near_clip", "no near clipping plane");
-        p.ignore("far_clip", "no far clipping plane");
+        // Mitsuba's defaults, so that a camera inside geometry sees what Mitsuba's does; the
+        // far clip is checked to cut nothing when the scene loads (`load.rs`, `far_clips`).
+        let near = p.float("near_clip")?.unwrap_or(0.01);
+        let far = p.float("far_clip")?.unwrap_or(1e4);
+        if !(near.is_finite() && near > 0.0 && far > near) {
+            return Err(p.error(format!(
+                "near_clip {near} and far_clip {far}: need 0 < near_clip < far_clip"
+            )));
+        }
+        cam.insert("near_clip".into(), near.into());
+        cam.insert("far_clip".into(), far.into());
         if ty == "thinlens" {
             let r = p.float("aperture_radius")?.unwrap_or(0.03);
             cam.insert("aperture".into(), r.into());
@@ -445,6 +454,12 @@ impl<'a> Builder<'a, '_> {
                 }
                 if p.boolean("face_normals")? == Some(true) {
                     g.insert("smooth".into(), false.into());
+                }
+                // Mitsuba flips an OBJ's or PLY's v by default into its own convention (v = 0
+                // at the top row); ours is the files' own (v = 0 at the bottom row), so only
+                // `false` asks for a flip. (Serialized meshes store Mitsuba's convention.)
+                if ty != "serialized" && p.boolean("flip_tex_coords")? == Some(false) {
+                    g.insert("flip_v".into(), true.into());
                 }
             }
             "cylinder" => {
