@@ -1,7 +1,8 @@
 //! Bidirectional path tracing estimates the path tracer's image, all of it (camera rays that
 //! hit lights cover what light tracing cannot see): the two agree within noise by the block
 //! z-test of `estimators_agree.rs` on the Cornell box (pinhole and thin lens) and on a glass
-//! sphere under an environment map, where every light path starts by plane sampling. BDPT
+//! sphere under an environment map, where every light path starts by plane sampling, and on
+//! the box lit by a point, a spot and a directional light besides its lamp. BDPT
 //! splats its light-tracing strategy, so its variance comes from independent runs.
 //!
 //! Control: BDPT with 2 % of its connections reported occluded (`DroppedShadowRays`) must be
@@ -10,7 +11,7 @@
 use rt_integrators::Bdpt;
 use rt_testkit::agreement::{path_reference, render_in_passes, technique_estimate};
 use rt_testkit::stats::{compare_estimates, Comparison, ALPHA};
-use rt_testkit::{shipped_scene, SceneExt};
+use rt_testkit::{cornell_box_delta_lights, shipped_scene, SceneExt};
 
 const SIZE: u32 = 24;
 const BLOCK: u32 = 4;
@@ -58,6 +59,22 @@ fn bdpt_agrees_with_path_tracing_under_an_environment_map() {
     let scene = shipped_scene("environment.toml").with_resolution(SIZE, SIZE);
     let (honest, _) = compare(&scene, 64, false);
     assert!(honest.same_within_noise(), "bdpt disagrees: {honest:?}");
+}
+
+/// Delta lights start light subpaths and are sampled by next-event estimation; the strategy
+/// that would hit them (`s = 0`) cannot, and must drop out of their paths' weights.
+#[test]
+fn bdpt_agrees_with_path_tracing_under_delta_lights() {
+    let mut scene = shipped_scene("cornell-box.toml").with_resolution(SIZE, SIZE);
+    scene.delta_lights = cornell_box_delta_lights();
+    scene.build_lights();
+    let (honest, biased) = compare(&scene, 64, true);
+    assert!(honest.same_within_noise(), "bdpt disagrees: {honest:?}");
+    let biased = biased.expect("asked for");
+    assert!(
+        !biased.same_within_noise(),
+        "control: 2 % of connections dropped passes: {biased:?}"
+    );
 }
 
 #[test]

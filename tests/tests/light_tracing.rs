@@ -10,7 +10,7 @@
 use rt_integrators::LightTracer;
 use rt_testkit::agreement::{path_reference, render_in_passes, technique_estimate};
 use rt_testkit::stats::{compare_estimates, Comparison, ALPHA};
-use rt_testkit::{shipped_scene, SceneExt};
+use rt_testkit::{cornell_box_delta_lights, shipped_scene, SceneExt};
 
 const SIZE: u32 = 24;
 const BLOCK: u32 = 4;
@@ -47,26 +47,8 @@ fn light_tracing_agrees_with_path_tracing_on_the_cornell_box() {
 /// same light as the path tracer's connections to them.
 #[test]
 fn light_tracing_agrees_with_path_tracing_under_delta_lights() {
-    use rt_core::delta_light::DeltaLight;
-    use rt_core::glam::Vec3;
     let mut scene = shipped_scene("cornell-box.toml").with_resolution(SIZE, SIZE);
-    scene.delta_lights = vec![
-        DeltaLight::Point {
-            position: Vec3::new(150.0, 400.0, 250.0),
-            intensity: Vec3::new(3e4, 2e4, 1e4),
-        },
-        DeltaLight::Spot {
-            position: Vec3::new(400.0, 500.0, 100.0),
-            axis: Vec3::new(0.0, -1.0, 0.5).normalize(),
-            intensity: Vec3::splat(5e4),
-            cutoff: 0.5,
-            beam_width: 0.3,
-        },
-        DeltaLight::Directional {
-            direction: Vec3::new(0.2, -0.3, 1.0).normalize(),
-            irradiance: Vec3::splat(0.5),
-        },
-    ];
+    scene.delta_lights = cornell_box_delta_lights();
     scene.build_lights();
     let (honest, biased) = honest_and_biased(&scene);
     assert!(

@@ -189,6 +189,25 @@ impl DeltaLight {
         v.max(0.0) as f32
     }
 
+    /// Solid-angle pdf with which [`DeltaLight::emit`] sends a particle along unit `w`: the
+    /// uniform sphere's for a point, the uniform cone's inside a spot's cutoff (0 outside); 0
+    /// for a directional light, whose direction is a delta (bidirectional MIS reads that as
+    /// "no other strategy samples it").
+    pub fn pdf_emit_direction(&self, w: Vec3) -> f32 {
+        match *self {
+            DeltaLight::Point { .. } => sampling::UNIFORM_SPHERE_PDF,
+            DeltaLight::Spot { axis, cutoff, .. } => {
+                let cos_max = cutoff.cos();
+                if axis.dot(w) >= cos_max {
+                    1.0 / (2.0 * PI * (1.0 - cos_max))
+                } else {
+                    0.0
+                }
+            }
+            DeltaLight::Directional { .. } => 0.0,
+        }
+    }
+
     /// Starts a particle from the light: a point light's direction uniform on the sphere, a
     /// spot's uniform in its cutoff cone, a directional light's origin uniform on the plane
     /// covering `bounds` ([`crate::emission::plane_sample`]). `None` if it carries nothing.

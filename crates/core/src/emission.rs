@@ -18,7 +18,7 @@
 use crate::lights::{Chosen, LightSampler};
 use crate::ray::spawn_ray;
 use crate::sampling::{cosine_hemisphere, uniform_triangle};
-use crate::{frame::Frame, triangle, Aabb, Ray, Rgb, Scene};
+use crate::{delta_light::DeltaLight, frame::Frame, triangle, Aabb, Ray, Rgb, Scene};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -68,8 +68,8 @@ pub struct Emission {
     /// The triangle point the path starts at, for connecting it to the camera directly; `None`
     /// for the environment and delta lights.
     pub point: Option<EmitterPoint>,
-    /// The path starts at a delta light (which no camera sees).
-    pub delta: bool,
+    /// The delta light the path starts at (which no camera sees), if it does.
+    pub delta_light: Option<DeltaLight>,
     /// Pdf of the start: the triangle point's area pdf (choice of light included), or for the
     /// environment the plane point's, `1 / plane area`.
     pub pdf_position: f32,
@@ -125,7 +125,7 @@ impl LightSampler {
                 dir,
                 beta,
                 point: None,
-                delta: false,
+                delta_light: None,
                 pdf_position: 1.0 / area,
                 pdf_direction: s.pdf * self.env_prob,
             });
@@ -139,7 +139,7 @@ impl LightSampler {
                 dir: e.dir,
                 beta: e.beta / p_choice,
                 point: None,
-                delta: true,
+                delta_light: Some(*light),
                 pdf_position: e.pdf_position * p_choice,
                 pdf_direction: e.pdf_direction,
             });
@@ -156,7 +156,7 @@ impl LightSampler {
             dir,
             beta,
             point: Some(p),
-            delta: false,
+            delta_light: None,
             pdf_position: p.pdf_area,
             pdf_direction: cos / (PI * faces),
         })

@@ -215,6 +215,17 @@ impl LightSampler {
         Some((chosen, pmf * (1.0 - self.env_prob)))
     }
 
+    /// The delta light [`LightSampler::sample`] picks for `u_sel`, if it picks one.
+    pub fn chosen_delta(&self, u_sel: f32) -> Option<&DeltaLight> {
+        if u_sel < self.env_prob {
+            return None;
+        }
+        match self.choose(u_sel)? {
+            (Chosen::Delta(light), _) => Some(light),
+            _ => None,
+        }
+    }
+
     /// Samples a light as seen from `x`. `None` if the chosen point cannot contribute (back face
     /// of a one-sided emitter, grazing angle, zero pdf).
     pub fn sample(&self, scene: &Scene, x: Vec3, u_sel: f32, u: Vec2) -> Option<LightSample> {

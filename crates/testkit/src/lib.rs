@@ -64,6 +64,30 @@ pub fn shipped_scene(name: &str) -> Scene {
     scene_from_toml(&text)
 }
 
+/// A point, a spot and a directional light for the shipped Cornell box (millimetres), which
+/// light it beside its own lamp: the delta-light agreement tests' set.
+pub fn cornell_box_delta_lights() -> Vec<rt_core::delta_light::DeltaLight> {
+    use rt_core::delta_light::DeltaLight;
+    use rt_core::glam::Vec3;
+    vec![
+        DeltaLight::Point {
+            position: Vec3::new(150.0, 400.0, 250.0),
+            intensity: Vec3::new(3e4, 2e4, 1e4),
+        },
+        DeltaLight::Spot {
+            position: Vec3::new(400.0, 500.0, 100.0),
+            axis: Vec3::new(0.0, -1.0, 0.5).normalize(),
+            intensity: Vec3::splat(5e4),
+            cutoff: 0.5,
+            beam_width: 0.3,
+        },
+        DeltaLight::Directional {
+            direction: Vec3::new(0.2, -0.3, 1.0).normalize(),
+            irradiance: Vec3::splat(0.5),
+        },
+    ]
+}
+
 /// Changing a test scene's first camera.
 pub trait SceneExt {
     /// The scene with its first camera rendering `width × height` pixels (same view, lens

@@ -9,7 +9,10 @@
 //! path tracer's light sample), `t = 1` (the light subpath connected to the camera and splatted,
 //! as [`crate::LightTracer`] does), and the rest connecting a light vertex to a camera vertex
 //! by a shadow ray. Light subpaths from the environment start by plane sampling
-//! ([`rt_core::emission`]), so the environment takes part in every strategy.
+//! ([`rt_core::emission`]), so the environment takes part in every strategy. Delta lights
+//! (points, spots, directional lights) start light subpaths and are sampled by `s = 1`; as in
+//! pbrt-v4 (`IsDeltaLight`), the strategy `s = 0`, which cannot find them, drops out of their
+//! paths' weights.
 //!
 //! Choices and deviations from pbrt-v4:
 //! - The power heuristic (exponent 2), where pbrt-v4 uses the balance heuristic.
@@ -42,6 +45,8 @@ use crate::work;
 use crate::{Ctx, RayCounters};
 use rayon::prelude::*;
 use rt_core::{
+    delta_light::DeltaLight,
+    emission::plane_area,
     glam::{Vec2, Vec3},
     material::Bsdf,
     ray::{shadow_segment, spawn_ray},
@@ -87,10 +92,6 @@ struct ItemOutput {
 impl Technique for Bdpt {
     fn name(&self) -> &str {
         "bdpt"
-    }
-
-    fn delta_lights(&self) -> bool {
-        false
     }
 
     fn splats(&self) -> bool {
@@ -283,8 +284,11 @@ impl Bdpt {
         else {
             return;
         };
-        let start = match e.point {
-            Some(pt) => {
+        // The start, and the next vertex's density: the direction's for a point (converted to
+        // area at the hit), the plane point's for the environment and a directional light
+        // (`Densities::pdf_light`).
+        let (start, pdf_next) = match (e.point, e.delta_light) {
+            (Some(pt), _) => {
                 let mut v = Vertex::endpoint(Kind::Light, pt.point, Rgb::ONE, e.pdf_position);
                 v.p_error = pt.error;
                 v.ng = pt.normal;
@@ -292,19 +296,31 @@ impl Bdpt {
                 v.emission = pt.emission;
                 v.two_sided = pt.two_sided;
                 v.u_connect = [u_lens.x, u_lens.y, 0.0];
-                v
+                (v, e.pdf_direction)
+            }
+            // A directional light: a delta direction (density 0, which MIS reads as "no other
+            // strategy"); the plane point's density without the light's choice, as the
+            // environment's.
+            (None, Some(light @ DeltaLight::Directional { .. })) => {
+                let mut v = Vertex::endpoint(Kind::Env, -e.dir, Rgb::ONE, 0.0);
+                v.delta_light = Some(light);
+                let area = plane_area(&dens.bounds, e.dir);
+                (v, if area > 0.0 { 1.0 / area } else { 0.0 })
+            }
+            // A point or spot light: a delta position, chosen with `pdf_position`.
+            (None, Some(light)) => {
+                let mut v = Vertex::endpoint(Kind::Light, e.origin, Rgb::ONE, e.pdf_position);
+                v.delta_light = Some(light);
+                (v, e.pdf_direction)
             }
             // At infinity: the vertex's density is the direction's (solid angle).
-            None => Vertex::endpoint(Kind::Env, -e.dir, Rgb::ONE, e.pdf_direction),
+            (None, None) => (
+                Vertex::endpoint(Kind::Env, -e.dir, Rgb::ONE, e.pdf_direction),
+                e.pdf_position,
+            ),
         };
         path.push(start);
         let ray = e.ray();
-        // The next vertex's density: the direction's for a point emitter (converted to area at
-        // the hit), the plane point's for the environment (`Densities::pdf_light`).
-        let pdf_next = match e.point {
-            Some(_) => e.pdf_direction,
-            None => e.pdf_position,
-        };
         self.walk(
             ctx,
             ray,
@@ -490,6 +506,7 @@ impl Bdpt {
             qs_rev: dens.pdf(pt, None, qs),
             qsm_rev: dens.pdf(qs, Some(-w), qsm),
             qs_fwd: None,
+            qs_delta_light: false,
         };
         value * mis_weight(cam, light, s, t, &ov)
     }
@@ -524,8 +541,22 @@ impl Bdpt {
         if !light_visible(ctx, pt.p, pt.p_error, pt.ng, 0.0, &ls) {
             return Rgb::ZERO;
         }
-        // The sampled light as a vertex, for the densities of the other strategies.
-        let q = if ls.dist.is_infinite() {
+        // The sampled light as a vertex, for the densities of the other strategies. A delta
+        // light's is only its choice; BSDF sampling cannot reach it.
+        let delta_light = ls.delta.then(|| dens.lights.chosen_delta(u_sel).copied());
+        let q = if let Some(light) = delta_light {
+            let kind = if ls.dist.is_infinite() {
+                Kind::Env
+            } else {
+                Kind::Light
+            };
+            let mut q = Vertex::endpoint(kind, ls.point, Rgb::ONE, ls.pdf);
+            if kind == Kind::Env {
+                q.p = ls.wi;
+            }
+            q.delta_light = light;
+            q
+        } else if ls.dist.is_infinite() {
             Vertex::endpoint(Kind::Env, ls.wi, Rgb::ONE, ls.pdf)
         } else {
             let cos_l = ls.normal.dot(ls.wi).abs();
@@ -542,9 +573,14 @@ impl Bdpt {
         let ov = Overrides {
             pt_rev: dens.pdf_light(&q, pt),
             ptm_rev: dens.pdf(pt, Some(ls.wi), ptm),
-            qs_rev: to_area(bsdf_pdf, pt, &q),
+            qs_rev: if ls.delta {
+                0.0
+            } else {
+                to_area(bsdf_pdf, pt, &q)
+            },
             qsm_rev: 0.0,
             qs_fwd: Some(q.pdf_fwd),
+            qs_delta_light: ls.delta,
         };
         value * mis_weight(cam, light, 1, t, &ov)
     }
@@ -608,6 +644,8 @@ struct Overrides {
     qsm_rev: f32,
     /// For `s = 1`: the forward density of the sampled light vertex.
     qs_fwd: Option<f32>,
+    /// For `s = 1`: the sampled light is a delta light (no strategy with `s = 0` finds it).
+    qs_delta_light: bool,
 }
 
 /// The power-heuristic weight of strategy `(s, t)` for its path: `1 / Σ_i (p_i / p_s)²` over
@@ -652,8 +690,15 @@ fn mis_weight(cam: &[Vertex], light: &[Vertex], s: usize, t: usize, ov: &Overrid
         let r = remap(rev) / remap(fwd);
         ri *= r * r;
         let delta_here = i != s - 1 && light[i].delta;
-        // No light here is a delta light (points and directions are not supported).
-        let delta_before = i > 0 && light[i - 1].delta;
+        // Before the light's own vertex: whether the light is a delta light, which the camera
+        // subpath (strategy s = 0) cannot hit.
+        let delta_before = if i > 0 {
+            light[i - 1].delta
+        } else if ov.qs_fwd.is_some() {
+            ov.qs_delta_light
+        } else {
+            light[0].delta_light.is_some()
+        };
         if !delta_here && !delta_before {
             sum += ri;
         }

@@ -5,8 +5,8 @@
 //! solid-angle one (pbrt-v4's convention, `Vertex::ConvertDensity`).
 
 use rt_core::{
-    emission::plane_area, glam::Vec3, lights::LightSampler, material::Bsdf, Aabb, Camera, Material,
-    Rgb, Scene,
+    delta_light::DeltaLight, emission::plane_area, glam::Vec3, lights::LightSampler,
+    material::Bsdf, Aabb, Camera, Material, Rgb, Scene,
 };
 use std::f32::consts::FRAC_1_PI;
 
@@ -17,9 +17,11 @@ pub(super) enum Kind {
     Camera,
     /// A scattering point on a surface (it may emit too).
     Surface,
-    /// The point on an emissive triangle a light subpath starts at.
+    /// The point on an emissive triangle a light subpath starts at, or a point or spot
+    /// light's position ([`Vertex::delta_light`]).
     Light,
-    /// The environment, at infinity: `p` holds the unit direction towards it.
+    /// The environment, at infinity: `p` holds the unit direction towards it (also a
+    /// directional light's start, [`Vertex::delta_light`]).
     Env,
 }
 
@@ -56,6 +58,9 @@ pub(super) struct Vertex<'a> {
     /// so a vertex's dimensions do not depend on which strategies ran: next-event estimation
     /// (selection, point) on camera subpaths, the lens point on light subpaths.
     pub u_connect: [f32; 3],
+    /// The delta light a light subpath starts at ([`Kind::Light`] for a point or spot,
+    /// [`Kind::Env`] for a directional light): no camera-side strategy can find it.
+    pub delta_light: Option<DeltaLight>,
 }
 
 impl<'a> Vertex<'a> {
@@ -78,11 +83,14 @@ impl<'a> Vertex<'a> {
             emission: Rgb::ZERO,
             two_sided: false,
             u_connect: [0.0; 3],
+            delta_light: None,
         }
     }
 
+    /// On a surface (with a normal that turns densities into area densities); a point or spot
+    /// light is not.
     pub fn on_surface(&self) -> bool {
-        matches!(self.kind, Kind::Surface | Kind::Light)
+        matches!(self.kind, Kind::Surface | Kind::Light) && self.delta_light.is_none()
     }
 
     /// A scattering vertex a strategy may connect to: it has a non-delta lobe.
@@ -169,7 +177,7 @@ impl Densities<'_> {
     }
 
     /// Density with which a light subpath starting at light `from` (an emitter point, an
-    /// emissive surface or the environment) reaches `to` as its next vertex.
+    /// emissive surface, a delta light or the environment) reaches `to` as its next vertex.
     pub fn pdf_light(&self, from: &Vertex, to: &Vertex) -> f32 {
         let (w, _) = direction(from, to);
         if from.kind == Kind::Env {
@@ -181,6 +189,9 @@ impl Densities<'_> {
                 1.0
             };
             return if area > 0.0 { cos / area } else { 0.0 };
+        }
+        if let Some(light) = &from.delta_light {
+            return to_area(light.pdf_emit_direction(w), from, to);
         }
         let two_sided = match from.kind {
             Kind::Light => from.two_sided,

@@ -221,7 +221,7 @@ impl RenderJob {
         }
         Err(JobError::Refused(format!(
             "{}: the scene has point, spot or directional lights, which {} does not render \
-             yet; use path, wavefront, direct or light",
+             yet; use path, wavefront, direct, light or bdpt",
             self.scene.display(),
             self.settings.integrator.kind.name()
         )))
