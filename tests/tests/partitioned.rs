@@ -1,14 +1,15 @@
 //! The path-space-partitioned renderer estimates the path tracer's image: with the VPL clamp
 //! off, on the Cornell box (no specular surface, so parts A and D only) the two agree within
 //! noise by the block z-test, and a 2 % dropped-connection control is caught. On a scene with
-//! glass (parts B and C) the histogram's half-pixel blur is its only bias. Also: bit-identical
-//! images for any thread count.
+//! glass (parts B and C) the histogram's half-pixel blur is its only bias. The box lit by a
+//! point, a spot and a directional light besides its lamp agrees too (the lights become VPLs of
+//! their own, unclamped). Also: bit-identical images for any thread count.
 
 use rt_film::AovSet;
 use rt_integrators::{PartitionOptions, Partitioned};
 use rt_testkit::agreement::{path_reference, reference_blocks, technique_blocks};
 use rt_testkit::stats::{compare_estimates, Comparison, Estimate, ALPHA};
-use rt_testkit::{shipped_scene, Renderer, SceneExt};
+use rt_testkit::{cornell_box_delta_lights, shipped_scene, Renderer, SceneExt};
 
 const SIZE: u32 = 24;
 const BLOCK: u32 = 4;
@@ -55,6 +56,20 @@ fn compare_with(
 #[test]
 fn partitioned_agrees_with_path_tracing_on_the_cornell_box() {
     let scene = shipped_scene("cornell-box.toml").with_resolution(SIZE, SIZE);
+    let honest = compare(&scene, 32, 0.0, unclamped());
+    assert!(
+        honest.same_within_noise(),
+        "partitioned disagrees: {honest:?}"
+    );
+    let biased = compare(&scene, 32, 0.02, unclamped());
+    assert!(!biased.same_within_noise(), "control passes: {biased:?}");
+}
+
+#[test]
+fn partitioned_agrees_with_path_tracing_under_delta_lights() {
+    let mut scene = shipped_scene("cornell-box.toml").with_resolution(SIZE, SIZE);
+    scene.delta_lights = cornell_box_delta_lights();
+    scene.build_lights();
     let honest = compare(&scene, 32, 0.0, unclamped());
     assert!(
         honest.same_within_noise(),

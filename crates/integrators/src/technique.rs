@@ -65,8 +65,8 @@ pub trait Technique: Send + Sync {
 
     /// True if the technique renders scenes with delta lights (point, spot, directional;
     /// [`rt_core::delta_light`]). Techniques that weigh light-path vertices against each
-    /// other by their area pdfs (the partitioned renderer's VPLs and photon projection maps)
-    /// do not handle a light of no extent yet, and callers refuse the combination.
+    /// other by their area pdfs would not handle a light of no extent and say so here; callers
+    /// refuse the combination.
     fn delta_lights(&self) -> bool {
         true
     }

@@ -232,11 +232,13 @@ impl Partitioned {
                     sampler.start_light_path(k, index);
                     let photon = match sources[item.light] {
                         PhotonSource::Light(light) => {
-                            photon_ray(light, map, bounds, sampler.next_2d()).map(|ray| Photon {
-                                ray,
-                                beta: light.beta / per_light as f32,
-                                lambda: None,
-                                vertices: 0,
+                            photon_ray(light, map, bounds, sampler.next_2d()).map(|(ray, w)| {
+                                Photon {
+                                    ray,
+                                    beta: light.beta * w / per_light as f32,
+                                    lambda: None,
+                                    vertices: 0,
+                                }
                             })
                         }
                         PhotonSource::Vpl(vpl) => {
@@ -376,21 +378,29 @@ fn vpl_photon(
     })
 }
 
-/// The ray of a photon from `light` for random numbers `u`, or `None` when the projection map
-/// rejects its direction (it would meet a diffuse surface first).
+/// The ray of a photon from `light` for random numbers `u` and what multiplies the light's
+/// `beta` for it (1, or a point or spot light's emission over the direction's pdf), or `None`
+/// when the projection map rejects its direction (it would meet a diffuse surface first).
 fn photon_ray(
     light: &PrimaryLight,
     map: Option<&ProjectionMap>,
     bounds: &Aabb,
     u: Vec2,
-) -> Option<Ray> {
+) -> Option<(Ray, Rgb)> {
     if light.travel != Vec3::ZERO {
         let (o, _) = plane_sample(bounds, light.travel, u)?;
-        return Some(Ray::new(o, light.travel));
+        return Some((Ray::new(o, light.travel), Rgb::ONE));
+    }
+    if let Some(delta) = &light.delta {
+        let e = delta.emit(bounds, Vec2::ZERO, u)?;
+        if map.is_some_and(|m| !m.allows(e.dir)) {
+            return None;
+        }
+        return Some((Ray::new(e.origin, e.dir), e.beta));
     }
     let (n, dir, _) = cosine_emission(light.n, light.two_sided, u)?;
     if map.is_some_and(|m| !m.allows(dir)) {
         return None;
     }
-    Some(spawn_ray(light.p, light.p_error, n, dir))
+    Some((spawn_ray(light.p, light.p_error, n, dir), Rgb::ONE))
 }

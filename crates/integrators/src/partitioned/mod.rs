@@ -17,6 +17,11 @@
 //! specular part of the vertices they pass. So no MIS is needed and even non-reciprocal
 //! materials converge to one image.
 //!
+//! Point, spot and directional lights take part as the emitters do: each is a VPL of its own
+//! (its light at an eye vertex is exact, `I·falloff/r²` or `E`, so it is not clamped) and a
+//! source of caustic photons sent as [`rt_core::delta_light::DeltaLight::emit`] sends
+//! particles (a point's projection map covers the whole sphere).
+//!
 //! Each pass (one sample index) regenerates everything: one eye path per pixel, `vpl_paths`
 //! particle walks (a VPL at every vertex with a diffuse part, culled against 256 eye vertices
 //! chosen by a Halton sequence), the caustic photons (`photons` per pass, from the walks'
@@ -198,10 +203,6 @@ impl Partitioned {
 impl Technique for Partitioned {
     fn name(&self) -> &str {
         "partitioned"
-    }
-
-    fn delta_lights(&self) -> bool {
-        false
     }
 
     fn stages(&self) -> Vec<TechniqueStage> {

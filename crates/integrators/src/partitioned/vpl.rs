@@ -8,6 +8,8 @@ use super::{Culling, Partitioned};
 use crate::transport::{adjoint_cos, importance_weight, survives_roulette};
 use crate::{Ctx, RayCounters};
 use rt_core::{
+    delta_light::DeltaLight,
+    emission::plane_area,
     glam::{Vec2, Vec3},
     material::{Bsdf, LayerClass},
     ray::{shadow_segment, spawn_ray},
@@ -25,6 +27,9 @@ pub(super) enum Source<'a> {
     /// A diffuse surface point lit by the walk; the diffuse part of its BSDF for light
     /// arriving from the walk's side.
     Surface { bsdf: Bsdf<'a>, wo: Vec3, ns: Vec3 },
+    /// A point, spot or directional light itself: what it sends to an eye vertex is exact
+    /// (`I·falloff/r²` or `E`), so its geometric term is not clamped.
+    Delta { light: DeltaLight },
 }
 
 /// One virtual point light.
@@ -51,8 +56,12 @@ pub(super) struct PrimaryLight {
     pub travel: Vec3,
     /// `Le / pdf_position` (emitters: Le times π and the faces over the area pdf, the cosine
     /// direction's weight; environment: radiance over the direction's pdf times the plane's
-    /// area), over the number of walks.
+    /// area), over the number of walks. For a point or spot light, one over the probability
+    /// of choosing it, over the number of walks: each photon then carries what
+    /// [`DeltaLight::emit`] gives its direction.
     pub beta: Rgb,
+    /// A point or spot light, whose photons leave it as [`DeltaLight::emit`] sends them.
+    pub delta: Option<DeltaLight>,
 }
 
 impl Partitioned {
@@ -95,6 +104,7 @@ impl Partitioned {
                         two_sided: pt.two_sided,
                         travel: Vec3::ZERO,
                         beta: pt.emission * (std::f32::consts::PI * faces / pt.pdf_area * scale),
+                        delta: None,
                     });
                     vpls.push(Vpl {
                         source: Source::Emitter {
@@ -108,6 +118,40 @@ impl Partitioned {
                         bounce: 0,
                     });
                 }
+                None if e.delta_light.is_some() => {
+                    let light = e.delta_light.expect("checked");
+                    // The probability of choosing the light: `pdf_position` holds it times the
+                    // position's density (1 for a point or spot, the plane's for a direction).
+                    let choice = match light {
+                        DeltaLight::Directional { .. } => {
+                            e.pdf_position * plane_area(bounds, e.dir)
+                        }
+                        _ => e.pdf_position,
+                    };
+                    let directional = matches!(light, DeltaLight::Directional { .. });
+                    primaries.push(PrimaryLight {
+                        p: e.origin,
+                        p_error: Vec3::ZERO,
+                        n: e.dir,
+                        // A point's photons may leave in any direction: the whole sphere's map.
+                        two_sided: true,
+                        travel: if directional { e.dir } else { Vec3::ZERO },
+                        beta: if directional {
+                            e.beta * scale
+                        } else {
+                            Rgb::splat(scale / choice)
+                        },
+                        delta: (!directional).then_some(light),
+                    });
+                    vpls.push(Vpl {
+                        source: Source::Delta { light },
+                        p: e.origin,
+                        p_error: Vec3::ZERO,
+                        ng: Vec3::ZERO,
+                        beta: Rgb::splat(scale / choice),
+                        bounce: 0,
+                    });
+                }
                 None => {
                     primaries.push(PrimaryLight {
                         p: e.origin,
@@ -116,6 +160,7 @@ impl Partitioned {
                         two_sided: false,
                         travel: e.dir,
                         beta: e.beta * scale,
+                        delta: None,
                     });
                     vpls.push(Vpl {
                         source: Source::Distant { dir: -e.dir },
@@ -256,6 +301,20 @@ impl Partitioned {
                 continue;
             }
             let (w, value) = match &v.source {
+                Source::Delta { light } => {
+                    let Some(inc) = light.incident(e.p) else {
+                        continue;
+                    };
+                    let value = bsdf.eval(inc.wi) * inc.le * v.beta * inc.wi.dot(e.ns).abs();
+                    if value.max_element() <= 0.0 || !value.is_finite() {
+                        continue;
+                    }
+                    counters.shadow_rays += 1;
+                    if !delta_light_occluded(ctx, e, &inc) {
+                        sum += value;
+                    }
+                    continue;
+                }
                 Source::Distant { dir } => {
                     let f = bsdf.eval(*dir);
                     (*dir, f * v.beta * dir.dot(e.ns).abs())
@@ -299,6 +358,21 @@ impl Partitioned {
         }
         e.beta * sum
     }
+}
+
+/// True if something blocks the light `inc` arriving at eye vertex `e` (a shadow ray to the
+/// light's position, or towards a directional light's infinity).
+fn delta_light_occluded(
+    ctx: &Ctx<'_>,
+    e: &EyeVertex,
+    inc: &rt_core::delta_light::DeltaIncidence,
+) -> bool {
+    if inc.dist.is_infinite() {
+        let r = spawn_ray(e.p, e.p_error, e.ng, inc.wi);
+        return ctx.accel.occluded(&r, f32::INFINITY);
+    }
+    let (r, t_max) = shadow_segment(e.p, e.p_error, e.ng, inc.point, Vec3::ZERO, Vec3::ZERO);
+    ctx.accel.occluded(&r, t_max)
 }
 
 /// The `i`-th point of the 2D Halton sequence (bases 2 and 3).
