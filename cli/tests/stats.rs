@@ -189,7 +189,7 @@ fn requested_aovs_are_allocated_and_leave_the_beauty_image_unchanged() {
     assert_skipped(&plain, "film squares (variance)", "no consumer");
     assert_eq!(
         assert_holds(&table, "film squares (variance)", "allocated"),
-        PIXELS * 48
+        PIXELS * 96
     );
     assert_eq!(
         assert_holds(&table, "film AOV albedo", "allocated"),

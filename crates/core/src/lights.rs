@@ -18,6 +18,9 @@ pub struct LightSampler {
     /// What sampling needs of each emissive triangle, so that a sample reads one record instead
     /// of the triangle, its material and a normal recomputed every time.
     pub(crate) records: Vec<Emitter>,
+    /// The triangle index of each record, ascending: how a triangle found by a ray finds its
+    /// record's probability in `dist`.
+    prims: Vec<u32>,
     /// The scene's delta lights; in the power distribution they follow the triangles.
     pub(crate) deltas: Vec<DeltaLight>,
     pub(crate) dist: Option<Distribution1D>,
@@ -130,6 +133,7 @@ impl LightSampler {
     /// A sampler with nothing to sample, for integrators that do not sample lights.
     pub const NONE: LightSampler = LightSampler {
         records: Vec::new(),
+        prims: Vec::new(),
         deltas: Vec::new(),
         dist: None,
         total_power: 0.0,
@@ -166,6 +170,7 @@ impl LightSampler {
         Self {
             dist: has_tris.then(|| Distribution1D::new(&powers)),
             records: emitters.iter().map(|&i| Emitter::new(scene, i)).collect(),
+            prims: emitters,
             deltas,
             total_power,
             env_prob,
@@ -310,10 +315,24 @@ impl LightSampler {
         if area <= 0.0 || cos_l.is_nan() || cos_l <= 0.0 {
             return 0.0;
         }
-        // The same product as `pdf_emitter_area · dist2 / cos_l`, kept in this order so path
-        // tracing's bits did not change when the area pdf got its own function.
-        let pmf = triangle_power(scene, prim) / self.total_power;
-        pmf * (1.0 - self.env_prob) * dist2 / (area * cos_l)
+        self.choice_probability(prim) * dist2 / (area * cos_l)
+    }
+
+    /// The probability with which [`LightSampler::choose`] picks triangle `prim` (the choice
+    /// over the environment included); zero for a triangle it never picks.
+    ///
+    /// Read from the power table's cumulative sums, the very numbers `choose` compares `u`
+    /// with, not recomputed as `power / total`: the two differ where a triangle's share is
+    /// below the cumulative sums' f32 resolution (2⁻²⁴ near 1). A 10⁻⁴-wide lamp of
+    /// [`crate::material::MAX_RADIANCE`] next to big ones has a share of 9·10⁻⁹; its two
+    /// triangles got 0 and 6·10⁻⁸ in the table, so MIS weighed the one never sampled as if it
+    /// were and the path tracer lost a fifth of the image (`bad/emitters-zero-and-max`).
+    #[inline]
+    fn choice_probability(&self, prim: u32) -> f32 {
+        let (Some(dist), Ok(k)) = (self.dist.as_ref(), self.prims.binary_search(&prim)) else {
+            return 0.0;
+        };
+        dist.discrete_pmf(k) * (1.0 - self.env_prob)
     }
 
     /// Area pdf of a point on emissive triangle `prim` as [`LightSampler::sample`] and
@@ -328,8 +347,7 @@ impl LightSampler {
         if area.is_nan() || area <= 0.0 {
             return 0.0;
         }
-        let pmf = triangle_power(scene, prim) / self.total_power;
-        pmf * (1.0 - self.env_prob) / area
+        self.choice_probability(prim) / area
     }
 
     /// Solid-angle pdf of sampling environment direction `d`.
@@ -361,5 +379,62 @@ mod tests {
             .lights()
             .pdf_triangle(&scene, 0, p + Vec3::Y, p, Vec3::Y);
         assert!(pdf > 0.0 && pdf.is_finite());
+    }
+
+    /// The emitters of `bad/emitters-zero-and-max`: two big lamps of the largest radiance and
+    /// a 10⁻⁴-wide one, whose triangles' shares (9·10⁻⁹) are below the f32 resolution of the
+    /// power table's cumulative sums. Every triangle's reported choice probability must be
+    /// the fraction of all f32 `u` on the 2⁻²⁴ lattice (every `u` a sampler gives in
+    /// [0.5, 1), a superset elsewhere) with which `choose` picks it; with the probability
+    /// recomputed as `power / total`, the tiny lamp's triangles reported 9·10⁻⁹ and were
+    /// picked with 0 and 6·10⁻⁸.
+    #[test]
+    fn reported_choice_probabilities_are_the_sampled_ones_for_a_tiny_bright_lamp() {
+        let mut scene = Scene::empty();
+        let mut lamp = Material::diffuse("lamp", Rgb::ZERO);
+        lamp.emission = Rgb::splat(crate::material::MAX_RADIANCE);
+        scene.materials.push(lamp.clone());
+        lamp.two_sided = true;
+        scene.materials.push(lamp);
+        let quad = |s: &mut Scene, o: Vec3, a: Vec3, b: Vec3, m: u32| {
+            s.push_triangle([o, o + a, o + a + b], m);
+            s.push_triangle([o, o + a + b, o + b], m);
+        };
+        quad(&mut scene, Vec3::new(-0.5, 2.0, -0.5), Vec3::Z, Vec3::X, 0);
+        quad(
+            &mut scene,
+            Vec3::splat(0.5),
+            Vec3::X * 1e-4,
+            Vec3::Y * 1e-4,
+            1,
+        );
+        quad(&mut scene, Vec3::ZERO, Vec3::Y * 0.3, Vec3::X * 0.3, 0);
+        scene.build_lights();
+        let lights = scene.lights();
+        assert_eq!(lights.emitter_count(), 6);
+        let mut picks = [0u64; 6];
+        const N: u32 = 1 << 24;
+        for i in 0..N {
+            let u = i as f32 / N as f32;
+            let Some((Chosen::Triangle(e), _)) = lights.choose(u) else {
+                panic!("u = {u} chose no triangle");
+            };
+            let k = lights
+                .records
+                .iter()
+                .position(|r| std::ptr::eq(r, e))
+                .expect("a record");
+            picks[k] += 1;
+        }
+        for (k, &n) in picks.iter().enumerate() {
+            let prim = k as u32;
+            let reported =
+                lights.pdf_emitter_area(&scene, prim) * triangle::area(&scene.triangles[k]);
+            let sampled = n as f32 / N as f32;
+            assert!(
+                (reported - sampled).abs() <= 1e-6 * sampled.max(1e-9),
+                "triangle {k}: reported {reported:e}, picked with {sampled:e}"
+            );
+        }
     }
 }

@@ -1,6 +1,6 @@
 //! The film: a grid of pixel statistics plus optional first-hit AOVs.
 
-use crate::fixed::{sample_variance, sample_variance3, Sum1, Sum3};
+use crate::fixed::{sample_variance, sample_variance3, Squares3, Sum1, Sum3};
 use crate::pixel::{FeatureSquares, FirstHit, HalfSums, LightSplit, PixelStats, SplitSums};
 use crate::samples::SampleRecords;
 use crate::splat::{Splat, SplatSums};
@@ -196,7 +196,7 @@ pub struct FilmBuffers {
     /// First-hit AOVs to accumulate, and which outputs will be written. Its `variance` flag
     /// implies [`FilmBuffers::variance`].
     pub aovs: AovSet,
-    /// Sums of squares per pixel, for the variance of the mean (48 bytes per pixel).
+    /// Sums of squares per pixel, for the variance of the mean (96 bytes per pixel).
     pub variance: bool,
     /// Sums and counts of the even-numbered samples, from which the odd ones follow (64 bytes
     /// per pixel).
@@ -294,7 +294,7 @@ impl FilmMemory {
         use std::mem::size_of;
         FilmMemory {
             mean: n * (size_of::<u32>() + size_of::<Sum3>()),
-            variance: of(buffers.variance, size_of::<Sum3>()),
+            variance: of(buffers.variance, size_of::<Squares3>()),
             halves: of(buffers.halves, size_of::<EvenSums>()),
             first_hits: of(a.any_first_hit(), size_of::<u32>()),
             albedo: of(a.albedo, size_of::<Sum3>()),
@@ -403,7 +403,7 @@ pub struct Film {
     buffers: FilmBuffers,
     pub(crate) counts: Vec<u32>,
     pub(crate) sums: Vec<Sum3>,
-    pub(crate) squares: Vec<Sum3>,
+    pub(crate) squares: Vec<Squares3>,
     pub(crate) even: Vec<EvenSums>,
     pub(crate) aov: AovBuffers,
     pub(crate) splats: SplatSums,
@@ -420,7 +420,7 @@ pub struct FilmStripe<'a> {
     pub width: u32,
     counts: &'a mut [u32],
     sums: &'a mut [Sum3],
-    squares: &'a mut [Sum3],
+    squares: &'a mut [Squares3],
     even: &'a mut [EvenSums],
     aov: AovSlices<'a>,
     discarded: &'a AtomicU64,
@@ -468,7 +468,7 @@ impl FilmStripe<'_> {
         self.counts[i] += 1;
         self.sums[i].add(radiance);
         if let Some(q) = self.squares.get_mut(i) {
-            q.add_squares(radiance);
+            q.add(radiance);
         }
         if let (Some(e), true) = (self.even.get_mut(i), index.is_multiple_of(2)) {
             e.sum.add(radiance);
@@ -1012,7 +1012,7 @@ mod tests {
             },
         );
         let m = film.memory();
-        assert_eq!(m.variance, Some(16 * 48));
+        assert_eq!(m.variance, Some(16 * 96));
         assert_eq!((m.halves, m.first_hits, m.albedo), (None, None, None));
         assert!(film.buffers().variance && !film.buffers().halves);
         assert_eq!(film.variance_image().unwrap().len(), 16);
@@ -1035,7 +1035,7 @@ mod tests {
 
         let film = Film::new(4, 4, all_buffers());
         let per_pixel = film.memory_bytes() / 16;
-        assert_eq!(per_pixel, 52 + 48 + 64 + 4 + 48 + 48 + 16 + 48);
+        assert_eq!(per_pixel, 52 + 96 + 64 + 4 + 48 + 48 + 16 + 48);
         assert!(film.half_image(1).is_some());
         assert!(AovSet::parse_list(["albedo", "bogus"]).is_err());
         let all = AovSet::parse_list(AOV_NAMES).unwrap();

@@ -13,33 +13,49 @@
 //! Costs, chosen on purpose:
 //! - Resolution: 2⁻³² ≈ 2.3·10⁻¹⁰ per sample (the mean's error is below that), far under an
 //!   `f32` output's precision for anything but near-black pixels.
-//! - Range: a sample's value is clamped to ±2³¹ (a radiance of two billion is a bug or a
-//!   firefly no image survives); the sums then hold 2⁶⁴ samples of first moments and 2³²
-//!   (the `u32` count's limit) of squares without overflow.
-//! - Squares (for variances) are rounded from the rounded value, so a constant pixel's
-//!   variance may come out as ~10⁻¹⁰ instead of zero.
-//! - Memory: 16 bytes per channel and sum instead of 4 (see [`crate::FilmMemory`]).
+//! - Range: a sample's value is clamped to ±2⁶⁰ (10¹⁸); the sums then hold 2³⁴ samples
+//!   without overflow. It was ±2³¹ ("a radiance of two billion is a bug"), while a scene may
+//!   have emitters of radiance `rt_core::material::MAX_RADIANCE` (10¹⁵): every sample seeing
+//!   them was cut to 2·10⁹, and `bad/emitters-zero-and-max` came out at 6.5·10⁷ (path) and
+//!   8.1·10⁷ (BDPT) where the image is 8.3·10¹¹.
+//! - Squares (for variances) of values below 2³¹ are rounded from the rounded value on the
+//!   2⁻³² grid, so a constant pixel's variance may come out as ~10⁻¹⁰ instead of zero; those
+//!   of larger values, which would overflow it, go to a second sum on a grid of 2³²
+//!   ([`Squares3`]; relative resolution 2⁻³⁰ or better).
+//! - Memory: 16 bytes per channel and sum instead of 4 (see [`crate::FilmMemory`]), 32 for
+//!   the squares of radiance.
 
 use rt_core::glam::Vec3;
 
 /// One unit of the grid, as a real number: 2³².
 pub(crate) const ONE: f64 = 4_294_967_296.0;
-/// Largest magnitude a sample's value is kept at: 2³¹.
-const LIMIT: f32 = 2_147_483_648.0;
+/// Largest magnitude a sample's value is kept at: 2⁶⁰.
+const LIMIT: f32 = (1u64 << 60) as f32;
+/// Largest magnitude whose square the 2⁻³² grid holds (2³¹): squares of larger values go to
+/// [`Squares3`]'s coarse sum; the features' squares ([`Sum3::add_squares`]) are clamped here.
+const SQUARE_LIMIT: f32 = 2_147_483_648.0;
 
-/// `x` on the grid, rounded to nearest (halves away from zero), clamped to ±2³¹.
+/// `x` on the grid, rounded to nearest (halves away from zero), clamped to ±2⁶⁰.
 #[inline]
-pub(crate) fn to_fixed(x: f32) -> i64 {
+pub(crate) fn to_fixed(x: f32) -> i128 {
     let v = f64::from(x.clamp(-LIMIT, LIMIT)) * ONE;
-    // `as` saturates at 2⁶³ and maps NaN (never passed: callers drop non-finite samples) to 0.
-    (v + 0.5f64.copysign(v)) as i64
+    // `as` maps NaN (never passed: callers drop non-finite samples) to 0.
+    (v + 0.5f64.copysign(v)) as i128
 }
 
-/// The square of a grid value, on the grid (rounded to nearest).
+/// The square of `x` (clamped to ±2³¹) on the grid, rounded to nearest from the rounded value.
 #[inline]
-fn square(q: i64) -> i128 {
-    let q = i128::from(q);
+fn square(x: f32) -> i128 {
+    let q = to_fixed(x.clamp(-SQUARE_LIMIT, SQUARE_LIMIT));
     (q * q + (1 << 31)) >> 32
+}
+
+/// `x²` for `|x| ≥ 2³¹` (clamped to 2⁶⁰) in units of 2³², rounded to nearest: the square of an
+/// `f32` is exact in `f64`, and so is the division by a power of two.
+#[inline]
+fn coarse_square(x: f32) -> i128 {
+    let x = f64::from(x.clamp(-LIMIT, LIMIT));
+    (x * x / ONE).round() as i128
 }
 
 /// A grid sum as a real number. Sums that fit in 64 bits (nearly all) take the hardware
@@ -59,12 +75,12 @@ pub(crate) struct Sum1(pub i128);
 impl Sum1 {
     #[inline]
     pub fn add(&mut self, x: f32) {
-        self.0 += i128::from(to_fixed(x));
+        self.0 += to_fixed(x);
     }
 
     #[inline]
     pub fn add_square(&mut self, x: f32) {
-        self.0 += square(to_fixed(x));
+        self.0 += square(x);
     }
 
     #[inline]
@@ -94,7 +110,7 @@ impl Sum3 {
             return;
         }
         for (s, x) in self.0.iter_mut().zip(v.to_array()) {
-            *s += i128::from(to_fixed(x));
+            *s += to_fixed(x);
         }
     }
 
@@ -104,7 +120,7 @@ impl Sum3 {
             return;
         }
         for (s, x) in self.0.iter_mut().zip(v.to_array()) {
-            *s += square(to_fixed(x));
+            *s += square(x);
         }
     }
 
@@ -135,11 +151,64 @@ impl Sum3 {
 /// exact, so only the final subtraction rounds); zero below two samples, never negative.
 #[inline]
 pub(crate) fn sample_variance(n: u64, sum: i128, squares: i128) -> f32 {
+    variance_from(n, sum, real(squares))
+}
+
+/// [`sample_variance`] from the sum of squares as a real number.
+#[inline]
+fn variance_from(n: u64, sum: i128, squares: f64) -> f32 {
     if n < 2 {
         return 0.0;
     }
-    let (s, q, n) = (real(sum), real(squares), n as f64);
-    ((q - s * s / n) / (n - 1.0)).max(0.0) as f32
+    let (s, n) = (real(sum), n as f64);
+    ((squares - s * s / n) / (n - 1.0)).max(0.0) as f32
+}
+
+/// Exact sums of the squares of a colour's channels over a range of up to ±2⁶⁰: squares of
+/// values below 2³¹ on the 2⁻³² grid (`fine`), of larger ones on a grid of 2³² (`coarse`), so
+/// neither overflows and both stay integers (order-independent).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Squares3 {
+    pub fine: [i128; 3],
+    pub coarse: [i128; 3],
+}
+
+impl Squares3 {
+    #[inline]
+    pub fn add(&mut self, v: Vec3) {
+        if v == Vec3::ZERO {
+            return;
+        }
+        for (k, x) in v.to_array().into_iter().enumerate() {
+            if x.abs() < SQUARE_LIMIT {
+                self.fine[k] += square(x);
+            } else {
+                self.coarse[k] += coarse_square(x);
+            }
+        }
+    }
+
+    #[inline]
+    pub fn merge(&mut self, o: &Squares3) {
+        for k in 0..3 {
+            self.fine[k] += o.fine[k];
+            self.coarse[k] += o.coarse[k];
+        }
+    }
+
+    /// The sum of squares of channel `k` as a real number.
+    #[inline]
+    fn real(&self, k: usize) -> f64 {
+        real(self.fine[k]) + self.coarse[k] as f64 * ONE
+    }
+
+    /// Unbiased sample variance per channel of `n` samples summing to `sum`.
+    #[inline]
+    pub fn variance(&self, n: u64, sum: &Sum3) -> Vec3 {
+        Vec3::from_array(std::array::from_fn(|k| {
+            variance_from(n, sum.0[k], self.real(k))
+        }))
+    }
 }
 
 /// [`sample_variance`] per channel.
@@ -175,7 +244,7 @@ mod tests {
         assert!((f64::from(forward.mean(1000).x) - exact).abs() < 1e-6 * exact);
         assert_eq!(to_fixed(1.0), 1 << 32);
         assert_eq!(to_fixed(-0.75), -(3 << 30));
-        assert_eq!(to_fixed(f32::MAX), i64::MAX, "clamped, saturating at 2^63");
+        assert_eq!(to_fixed(f32::MAX), 1 << 92, "clamped to 2^60");
         assert_eq!(to_fixed(1e-10), 0, "below half a unit");
         assert_eq!(to_fixed(2e-10), 1);
         // The fast conversion agrees with the general one across the 64-bit boundary.
@@ -216,5 +285,35 @@ mod tests {
         }
         assert!(big.0 > 0);
         assert_eq!(sample_variance(1, 5, 5), 0.0);
+    }
+
+    /// Samples of an emitter of the largest radiance a scene may have (10¹⁵) keep their value
+    /// and their variance; with the old clamp at 2³¹ the mean of these was 1.4·10⁹.
+    #[test]
+    fn bright_samples_keep_their_value_and_variance() {
+        let xs = [1e15f32, 3e15, 0.5, 2e9, 7.0e12, 1e-3];
+        let (mut s, mut q) = (Sum3::default(), Squares3::default());
+        for &x in &xs {
+            s.add(Vec3::splat(x));
+            q.add(Vec3::splat(x));
+        }
+        let n = xs.len() as f64;
+        let mean = xs.iter().map(|&x| f64::from(x)).sum::<f64>() / n;
+        let var = xs
+            .iter()
+            .map(|&x| (f64::from(x) - mean).powi(2))
+            .sum::<f64>()
+            / (n - 1.0);
+        let got_mean = f64::from(s.mean(xs.len() as u64).x);
+        assert!(
+            (got_mean - mean).abs() < 1e-6 * mean,
+            "{got_mean} vs {mean}"
+        );
+        let got = f64::from(q.variance(xs.len() as u64, &s).y);
+        assert!((got - var).abs() < 1e-6 * var, "{got} vs {var}");
+        // 2³⁴ samples at the clamp do not overflow either sum.
+        let top = f32::MAX;
+        assert_eq!(to_fixed(top) << 34, (1i128 << 92) << 34);
+        assert!(coarse_square(top).checked_mul(1 << 34).is_some());
     }
 }

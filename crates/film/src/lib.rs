@@ -2,7 +2,7 @@
 //!
 //! [`Film`] keeps per-pixel statistics in separate buffers, and only those a consumer asked
 //! for in its [`FilmBuffers`]: the sum and sample count always (52 bytes per pixel); the sums
-//! of squares for the variance of the mean (48 bytes); the even-numbered samples' sums, from
+//! of squares for the variance of the mean (96 bytes); the even-numbered samples' sums, from
 //! which the two half-images that the thesis' stopping criterion (Dammertz §6.2) and the
 //! error estimators of the denoisers compare follow (64 bytes); each first-hit AOV (albedo,
 //! shading normal, depth, world position), their sums of squares and their shared hit count;
@@ -42,7 +42,7 @@
 //! assert_eq!(film.pixel(0, 0).mean(), Vec3::splat(2.0));
 //! assert_eq!(film.pixel(0, 0).variance_of_mean(), Some(Vec3::splat(1.0)));
 //! assert!(film.half_image(0).is_none());
-//! assert_eq!(film.memory_bytes(), 2 * (52 + 48));
+//! assert_eq!(film.memory_bytes(), 2 * (52 + 96));
 //! ```
 #![forbid(unsafe_code)]
 

@@ -6,7 +6,7 @@
 use rt_core::glam::Vec3;
 use rt_core::Rgb;
 
-use crate::fixed::{sample_variance3, Sum1, Sum3};
+use crate::fixed::{Squares3, Sum1, Sum3};
 
 /// The means and counts of the even- and odd-numbered samples of one pixel: two independent
 /// half-estimates whose difference the stopping criterion (Dammertz §6.2) and the GREE error
@@ -55,13 +55,13 @@ impl PixelStats {
     pub(crate) fn new(
         sum: &Sum3,
         n: u32,
-        squares: Option<&Sum3>,
+        squares: Option<&Squares3>,
         halves: Option<HalfSums>,
     ) -> Self {
         Self {
             mean: sum.mean(n.into()),
             n,
-            sample_variance: squares.map(|q| sample_variance3(n.into(), sum, q)),
+            sample_variance: squares.map(|q| q.variance(n.into(), sum)),
             halves,
         }
     }
@@ -241,12 +241,12 @@ mod tests {
     use super::*;
 
     fn stats(xs: &[f32]) -> PixelStats {
-        let (mut sum, mut sq, mut even) = (Sum3::default(), Sum3::default(), Sum3::default());
+        let (mut sum, mut sq, mut even) = (Sum3::default(), Squares3::default(), Sum3::default());
         let mut n = [0u32; 2];
         for (i, &x) in xs.iter().enumerate() {
             let x = Rgb::splat(x);
             sum.add(x);
-            sq.add_squares(x);
+            sq.add(x);
             if i % 2 == 0 {
                 even.add(x);
             }

@@ -13,7 +13,7 @@
 //! Per-sample records ([`FilmBuffers::samples`]) are not encoded.
 
 use crate::film::{EvenSums, Film};
-use crate::fixed::{Sum1, Sum3};
+use crate::fixed::{Squares3, Sum1, Sum3};
 use crate::pixel::{FeatureSquares, SplitSums};
 use crate::FilmBuffers;
 
@@ -204,6 +204,22 @@ impl Sums for Sum3 {
     }
 }
 
+impl Sums for Squares3 {
+    const N: usize = 6;
+    fn values(&self) -> impl Iterator<Item = i128> {
+        self.fine.into_iter().chain(self.coarse)
+    }
+    fn from_values(mut v: impl FnMut(usize) -> i128) -> Self {
+        Squares3 {
+            fine: [v(0), v(1), v(2)],
+            coarse: [v(3), v(4), v(5)],
+        }
+    }
+    fn add_values(&mut self, o: &Self) {
+        self.merge(o);
+    }
+}
+
 impl Sums for FeatureSquares {
     const N: usize = 10;
     fn values(&self) -> impl Iterator<Item = i128> {
@@ -273,7 +289,7 @@ fn pixel_bytes(b: &FilmBuffers) -> usize {
     let keep = |k: bool, n: usize| if k { n } else { 0 };
     u32::BYTES
         + Sum3::BYTES
-        + keep(b.variance || a.variance, Sum3::BYTES)
+        + keep(b.variance || a.variance, Squares3::BYTES)
         + keep(b.halves, EvenSums::BYTES)
         + keep(a.any_first_hit(), u32::BYTES)
         + keep(a.albedo, Sum3::BYTES)

@@ -187,7 +187,10 @@ impl LightTracer {
             let material = &scene.materials[si.material as usize];
             let wo = -ray.dir;
             let tint = scene.tint(material, si.uv);
-            let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo).with_wavelength(lambda);
+            // Importance's BSDF: refraction without radiance's `1/η²`.
+            let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo)
+                .with_wavelength(lambda)
+                .adjoint();
             let bsdf = if self.spectral {
                 bsdf
             } else {

@@ -26,7 +26,7 @@ pub struct RoughDielectric {
 impl RoughDielectric {
     /// `η_transmitted / η_incident` for light arriving from the side of `w`.
     #[inline]
-    fn eta_from(&self, w: Vec3) -> f32 {
+    pub(crate) fn eta_from(&self, w: Vec3) -> f32 {
         if w.z > 0.0 {
             self.eta
         } else {

@@ -167,6 +167,16 @@ impl Microfacet {
         }
     }
 
+    /// What a transmitted value is multiplied by in importance transport
+    /// ([`crate::material::Bsdf::adjoint`]): `η(wo)²` for a dielectric interface, whose
+    /// refraction scales radiance by `1/η²`; 1 for a thin sheet, which does not.
+    pub fn adjoint_scale(&self, wo: Vec3) -> f32 {
+        match self {
+            Microfacet::Dielectric(d) => d.eta_from(wo).powi(2),
+            _ => 1.0,
+        }
+    }
+
     /// [`LocalBsdf::sample`] under a texture's `tint`.
     pub fn sample_tinted(&self, tint: Rgb, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<LocalSample> {
         match self.tinted(tint) {

@@ -27,7 +27,9 @@
 //!   does. The layered material's coat weights depend on the outgoing direction only (not
 //!   reciprocal); light vertices evaluate it with `wo` towards the light, so on coated materials
 //!   light strategies estimate the adjoint and the MIS blend differs slightly from the path
-//!   tracer's image. Diffuse, glossy, mirror and glass layers are reciprocal.
+//!   tracer's image. Diffuse, glossy and mirror layers are reciprocal; refraction is up to
+//!   `η²`, which light vertices leave out (`rt_core::material::Bsdf::adjoint`; with radiance's
+//!   `1/η²` there, light through an open sheet of rough glass came out `η²` off).
 //! - The camera strategy `t = 0` (a light path hitting the lens) and `s = 1, t = 1` (a light
 //!   point connected to the camera) are not used, as in pbrt: camera rays that hit a light cover
 //!   those paths.
@@ -380,7 +382,12 @@ impl Bdpt {
             v.material = Some(material);
             v.tint = tint;
             v.prim = si.prim;
-            v.bsdf = Some(Bsdf::new(material, tint, si.ns, si.ng, wo).with_wavelength(lambda));
+            let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo).with_wavelength(lambda);
+            // A light subpath carries importance: refraction without radiance's `1/η²`.
+            v.bsdf = Some(match mode {
+                Transport::Radiance => bsdf,
+                Transport::Importance => bsdf.adjoint(),
+            });
             v.pdf_fwd = if path[prev].kind == Kind::Env {
                 // Plane sampling: uniform over the plane perpendicular to the ray.
                 pdf * si.ng.dot(wo).abs()
