@@ -333,8 +333,10 @@ impl Partitioned {
             let u_bsdf = sampler.next_2d();
             let u_rr = sampler.next_1d();
             // Only the specular part carries a photon on: its diffuse part is the VPLs'.
+            // Importance's BSDF, as the light tracer's (refraction without `1/η²`).
             let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo)
                 .with_wavelength(lambda)
+                .adjoint()
                 .restricted(LayerClass::Specular);
             let Some(s) = bsdf.sample(u_layer, u_bsdf) else {
                 return;

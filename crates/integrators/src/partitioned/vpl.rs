@@ -214,7 +214,11 @@ impl Partitioned {
             let material = &scene.materials[si.material as usize];
             let wo = -ray.dir;
             let tint = scene.tint(material, si.uv);
-            let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo).with_wavelength(lambda);
+            // Importance's BSDF (refraction without radiance's `1/η²`), as the light tracer's;
+            // the VPL keeps it too: it reflects light arriving from `wo`.
+            let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo)
+                .with_wavelength(lambda)
+                .adjoint();
             let u_layer = sampler.next_1d();
             let u_bsdf = sampler.next_2d();
             let u_rr = sampler.next_1d();
