@@ -41,7 +41,9 @@
 //! connections never need a wavelength the path does not have yet.
 
 use crate::bump::NormalPerturbation;
-use crate::microfacet::Microfacet;
+use crate::microfacet::{Microfacet, ParamTextures};
+use crate::tint::Tint;
+use std::borrow::Cow;
 use crate::{
     frame::Frame,
     sampling::{blinn_phong_half, blinn_phong_half_pdf, cosine_hemisphere},
@@ -151,6 +153,8 @@ pub struct Material {
     /// A bump or normal map bending the shading normal ([`crate::bump`]), applied where the
     /// scene builds a hit ([`crate::scene::Scene::surface`]).
     pub perturbation: Option<NormalPerturbation>,
+    /// Textures on the microfacet BSDF's parameters ([`crate::microfacet::ParamTextures`]).
+    pub param_textures: ParamTextures,
 }
 
 /// A material parameter outside its valid range.
@@ -204,6 +208,7 @@ impl Material {
             texture: None,
             microfacet: None,
             perturbation: None,
+            param_textures: ParamTextures::default(),
         }
     }
 
@@ -404,8 +409,9 @@ pub struct Bsdf<'a> {
     /// for operation, so both give the same bits.
     lambert: Option<Rgb>,
     /// The material's microfacet BSDF, which replaces the layers when present (the texture's
-    /// tint applies through [`Microfacet::eval_pdf_tinted`] and [`Microfacet::sample_tinted`]).
-    micro: Option<&'a Microfacet>,
+    /// tint applies through [`Microfacet::eval_pdf_tinted`] and [`Microfacet::sample_tinted`]):
+    /// borrowed, or a copy with the textured parameters in place.
+    micro: Option<Cow<'a, Microfacet>>,
     /// The path's wavelength, nm (`None`: an RGB path).
     wavelength: Option<f32>,
     /// Dispersive layers use their wavelength-dependent index (false: `ior` = `n_d`, as an RGB
@@ -414,10 +420,15 @@ pub struct Bsdf<'a> {
 }
 
 impl<'a> Bsdf<'a> {
-    /// Builds the BSDF of `material` with texture `tint` at a point with unit shading normal `ns`
-    /// and unit geometric normal `ng` (both on the front side), for outgoing direction `wo` (unit,
-    /// pointing away from the surface).
-    pub fn new(material: &'a Material, tint: Rgb, ns: Vec3, ng: Vec3, wo: Vec3) -> Self {
+    /// Builds the BSDF of `material` with texture values `tint` (a colour alone, or what
+    /// [`crate::Scene::tint`] reads) at a point with unit shading normal `ns` and unit geometric
+    /// normal `ng` (both on the front side), for outgoing direction `wo` (unit, pointing away
+    /// from the surface).
+    pub fn new(material: &'a Material, tint: impl Into<Tint>, ns: Vec3, ng: Vec3, wo: Vec3) -> Self {
+        let Tint {
+            color: tint,
+            params,
+        } = tint.into();
         let frame = Frame::from_normal(ns);
         let wo_local = frame.to_local(wo);
         let mut weights = [0.0f32; MAX_LAYERS];
@@ -435,8 +446,11 @@ impl<'a> Bsdf<'a> {
             }
             has_non_delta |= *w > 0.0 && !l.is_delta();
         }
-        let micro = material.microfacet.as_ref();
-        let total = match micro {
+        let micro = material
+            .microfacet
+            .as_ref()
+            .map(|m| m.with_params(&params).map_or(Cow::Borrowed(m), Cow::Owned));
+        let total = match &micro {
             // One "layer" of weight one: the checks of `total` below hold as for layers.
             Some(m) => {
                 has_non_delta = m.has_non_delta();
@@ -543,7 +557,7 @@ impl<'a> Bsdf<'a> {
 
     /// Reflectance at normal incidence summed over layers: the albedo AOV.
     pub fn albedo(&self) -> Rgb {
-        if let Some(m) = self.micro {
+        if let Some(m) = &self.micro {
             return m.albedo_tinted(self.tint);
         }
         self.layers
@@ -588,7 +602,7 @@ impl<'a> Bsdf<'a> {
         if let Some(f) = self.lambert {
             return lambert_eval_pdf(f, wi_local, reflect);
         }
-        if let Some(m) = self.micro {
+        if let Some(m) = &self.micro {
             return m.eval_pdf_tinted(self.tint, self.wo_local, wi_local);
         }
         let mut f = Rgb::ZERO;
@@ -610,7 +624,7 @@ impl<'a> Bsdf<'a> {
         if self.total <= 0.0 {
             return None;
         }
-        if let Some(m) = self.micro {
+        if let Some(m) = &self.micro {
             return self.sample_microfacet(m, u_layer, u);
         }
         // Pick a layer in proportion to its weight; rounding past the end lands on the last
@@ -899,6 +913,7 @@ impl crate::content_hash::ContentHash for Material {
             texture,
             microfacet,
             perturbation,
+            param_textures,
         } = self;
         name.content_hash(out);
         layers.content_hash(out);
@@ -911,6 +926,9 @@ impl crate::content_hash::ContentHash for Material {
         // Only when present, as the microfacet BSDF: older scenes keep their hashes.
         if let Some(p) = perturbation {
             format!("{p:?}").content_hash(out);
+        }
+        if !param_textures.is_empty() {
+            format!("{param_textures:?}").content_hash(out);
         }
     }
 }

@@ -92,9 +92,9 @@ pub(crate) fn build(ctx: &mut Ctx, d: &Spanned<MaterialDesc>) -> Result<Material
 /// [`build`] without the bump or normal map.
 fn build_bsdf(ctx: &mut Ctx, d: &MaterialDesc) -> Result<Material> {
     let name = d.name.get_ref();
+    let src = ctx.src;
     let err = |span: Range<usize>, msg: String| {
-        ctx.src
-            .error_at(span, format!("material \"{name}\": {msg}"))
+        src.error_at(span, format!("material \"{name}\": {msg}"))
     };
     if name.is_empty() || name.contains('/') {
         return Err(ctx.src.error_at(
@@ -240,8 +240,7 @@ fn build_bsdf(ctx: &mut Ctx, d: &MaterialDesc) -> Result<Material> {
     }
     m.two_sided = d.two_sided.unwrap_or(false);
     if let Some(t) = &d.texture {
-        let (path, options) = crate::texture_desc::read(ctx, name, t, false)?;
-        m.texture = Some(ctx.textures.load(&path, options)?);
+        m.texture = Some(crate::texture_desc::load(ctx, name, t, false)?);
     }
     if let Err(e) = m.validate() {
         // Point at the value that is wrong.
