@@ -1,8 +1,8 @@
 //! Image textures: linear RGB texels looked up with Mitsuba 3's `bitmap` options (bilinear or
 //! nearest filtering; repeat, mirror or clamp wrapping, a `to_uv` transform), as colours, as
 //! scalars (luminance) and as the scalar's gradient in uv, which bump mapping needs
-//! ([`crate::bump`]). Mitsuba's `checkerboard` is a 2×2 image read nearest and repeated
-//! ([`Texture::checkerboard`]).
+//! ([`crate::bump`]). Mitsuba's `checkerboard` is a two-texel texture whose lookup picks a
+//! texel by Mitsuba's rule ([`Texture::checkerboard`], [`Layout`]).
 
 use crate::Rgb;
 use glam::{Affine2, Vec2};
@@ -67,6 +67,17 @@ impl Wrap {
     }
 }
 
+/// How a lookup finds its texels.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Layout {
+    /// Rows of texels covering [0, 1]².
+    #[default]
+    Image,
+    /// Mitsuba 3's `checkerboard` (checkerboard.cpp): texel 0 (`color0`) where `frac(u) > ½`
+    /// equals `frac(v) > ½`, texel 1 elsewhere.
+    Checkerboard,
+}
+
 /// A linear-RGB image used to modulate material parameters. Texels outside [0, 1] (or NaN)
 /// are read as clamped (NaN as 0).
 #[derive(Clone, Debug)]
@@ -83,6 +94,8 @@ pub struct Texture {
     pub wrap: Wrap,
     /// Maps the surface's uv to the image's (Mitsuba's `to_uv`; the identity by default).
     pub to_uv: Affine2,
+    /// An image, or a checkerboard of its two texels.
+    pub layout: Layout,
 }
 
 /// The texels and weights a lookup at one point combines.
@@ -104,18 +117,18 @@ impl Texture {
             filter: Filter::Bilinear,
             wrap: Wrap::Repeat,
             to_uv: Affine2::IDENTITY,
+            layout: Layout::Image,
         }
     }
 
     /// Mitsuba 3's `checkerboard`: `color0` where the fractional parts of `u` and `v` (after
-    /// `to_uv`) are both at most ½ or both above, `color1` elsewhere. A 2×2 image, nearest and
-    /// repeating (exactly ½ falls to the upper half, where Mitsuba has the lower: a set of
-    /// measure zero).
+    /// `to_uv`) are both at most ½ or both above, `color1` elsewhere. Piecewise constant: its
+    /// gradient is zero, as a nearest lookup's.
     pub fn checkerboard(color0: Rgb, color1: Rgb, to_uv: Affine2) -> Self {
-        // Row 0 is the top (v in (½, 1)); column 0 the left (u in [0, ½)).
-        let mut t = Self::new(2, 2, vec![color1, color0, color0, color1]);
+        let mut t = Self::new(2, 1, vec![color0, color1]);
         t.filter = Filter::Nearest;
         t.to_uv = to_uv;
+        t.layout = Layout::Checkerboard;
         t
     }
 
@@ -124,6 +137,17 @@ impl Texture {
     fn footprint(&self, uv: Vec2) -> Option<Footprint> {
         let (w, h) = (self.width as i64, self.height as i64);
         let uv = self.to_uv.transform_point2(uv);
+        if self.layout == Layout::Checkerboard {
+            if !uv.is_finite() {
+                return None;
+            }
+            let high = (uv - uv.floor()).cmpgt(Vec2::splat(0.5));
+            let k = (high.x != high.y) as usize;
+            return Some(Footprint {
+                at: [k; 4],
+                f: Vec2::ZERO,
+            });
+        }
         if w == 0 || h == 0 || !uv.is_finite() {
             return None;
         }
@@ -208,6 +232,7 @@ impl crate::content_hash::ContentHash for Texture {
             filter,
             wrap,
             to_uv,
+            layout,
         } = self;
         width.content_hash(out);
         height.content_hash(out);
@@ -216,8 +241,8 @@ impl crate::content_hash::ContentHash for Texture {
         if (*filter, *wrap) != (Filter::Bilinear, Wrap::Repeat) {
             format!("{filter:?}{wrap:?}").content_hash(out);
         }
-        if *to_uv != Affine2::IDENTITY {
-            format!("{to_uv:?}").content_hash(out);
+        if *to_uv != Affine2::IDENTITY || *layout != Layout::Image {
+            format!("{to_uv:?}{layout:?}").content_hash(out);
         }
     }
 }
@@ -303,6 +328,11 @@ mod tests {
             checked += 1;
         }
         assert!(checked > 1900);
+        // On the edges: ½ and 0 belong to the lower half.
+        let t = Texture::checkerboard(c0, c1, Affine2::IDENTITY);
+        for (uv, want) in [((0.5, 0.5), c0), ((0.0, 0.0), c0), ((0.5, 0.7), c1), ((1.0, 0.3), c0)] {
+            assert_eq!(t.lookup(Vec2::from(uv)), want, "uv {uv:?}");
+        }
     }
 
     /// The gradient is the finite difference of the scalar lookup, in both directions.
