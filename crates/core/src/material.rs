@@ -155,6 +155,10 @@ pub struct Material {
     pub perturbation: Option<NormalPerturbation>,
     /// Textures on the microfacet BSDF's parameters ([`crate::microfacet::ParamTextures`]).
     pub param_textures: ParamTextures,
+    /// Mitsuba's `mask`: the probability in [0, 1] that light meets the surface (`None`:
+    /// opaque); otherwise it passes straight through ([`Bsdf`]). Its texture is
+    /// `param_textures.opacity`.
+    pub opacity: Option<f32>,
 }
 
 /// A material parameter outside its valid range.
@@ -183,6 +187,9 @@ pub enum MaterialError {
     /// A microfacet BSDF's parameter out of range.
     #[error("{0}")]
     Microfacet(String),
+    /// A mask's opacity outside [0, 1].
+    #[error("opacity must be in [0, 1], got {0}")]
+    Opacity(f32),
 }
 
 fn check_color(c: Rgb, what: &str, layer: usize) -> Result<(), MaterialError> {
@@ -209,6 +216,7 @@ impl Material {
             microfacet: None,
             perturbation: None,
             param_textures: ParamTextures::default(),
+            opacity: None,
         }
     }
 
@@ -270,6 +278,11 @@ impl Material {
         if let Some(m) = &self.microfacet {
             m.validate().map_err(MaterialError::Microfacet)?;
         }
+        if let Some(o) = self.opacity {
+            if !(0.0..=1.0).contains(&o) {
+                return Err(MaterialError::Opacity(o));
+            }
+        }
         let mut sum = 0.0;
         for (i, l) in self.layers.iter().enumerate() {
             let bad = |what: String| Err(MaterialError::Layer { layer: i, what });
@@ -330,6 +343,9 @@ impl Material {
     /// material. Shading kernels that handle only this case ask here.
     #[inline]
     pub fn plain_lambert(&self, tint: Rgb) -> Option<Rgb> {
+        if self.opacity.is_some() || self.param_textures.opacity.is_some() {
+            return None;
+        }
         match self.layers.as_slice() {
             [l] if is_plain_lambert(l) && l.weight > 0.0 => {
                 Some(l.color * tint * FRAC_1_PI * l.weight)
@@ -414,6 +430,14 @@ pub struct Bsdf<'a> {
     micro: Option<Cow<'a, Microfacet>>,
     /// The path's wavelength, nm (`None`: an RGB path).
     wavelength: Option<f32>,
+    /// Mitsuba's `mask` (Mitsuba 3, `mask.cpp`): the probability that light meets the surface
+    /// (1 without a mask). The rest passes straight through: a delta transmission lobe along
+    /// `−wo` of weight one, sampled with probability `1 − opacity`; the other lobes' values
+    /// and pdfs are scaled by `opacity`.
+    opacity: f32,
+    /// The pass-through lobe is part of this BSDF (false for its diffuse part,
+    /// [`Bsdf::restricted`]: the pass-through is specular).
+    pass_through: bool,
     /// Dispersive layers use their wavelength-dependent index (false: `ior` = `n_d`, as an RGB
     /// renderer would; for tests that compare against the renderer without spectral code).
     spectral: bool,
@@ -461,6 +485,10 @@ impl<'a> Bsdf<'a> {
         // `color_at` of a plain Lambertian layer is `color · tint` at every angle, and its
         // one weight is `1 · weight`.
         let lambert = material.plain_lambert(tint);
+        let opacity = params
+            .opacity
+            .or(material.opacity)
+            .map_or(1.0, |o| o.clamp(0.0, 1.0));
         Self {
             layers: &material.layers,
             tint,
@@ -470,10 +498,12 @@ impl<'a> Bsdf<'a> {
             wo_local,
             weights,
             total,
-            has_non_delta,
             lambert,
             micro,
             wavelength: None,
+            opacity,
+            pass_through: true,
+            has_non_delta: has_non_delta && opacity > 0.0,
             spectral: true,
         }
     }
@@ -509,6 +539,18 @@ impl<'a> Bsdf<'a> {
     /// The probability with which [`Bsdf::sample`] picks a layer of `class`: the class's share
     /// of the layer weights (0 for a BSDF that reflects nothing).
     pub fn share(&self, class: LayerClass) -> f32 {
+        let inner = self.share_opaque(class);
+        if !self.pass_through || self.opacity >= 1.0 {
+            return inner;
+        }
+        match class {
+            LayerClass::Diffuse => self.opacity * inner,
+            LayerClass::Specular => 1.0 - self.opacity * (1.0 - inner),
+        }
+    }
+
+    /// [`Bsdf::share`] among the lobes a mask lets light meet.
+    fn share_opaque(&self, class: LayerClass) -> f32 {
         if self.total <= 0.0 {
             return 0.0;
         }
@@ -531,6 +573,13 @@ impl<'a> Bsdf<'a> {
     /// parts sum to the whole, which is how the path-space partition (Dammertz 2011, §6.3)
     /// splits a vertex into its diffuse and its specular part.
     pub fn restricted(&self, class: LayerClass) -> Self {
+        let mut b = self.restricted_layers(class);
+        b.pass_through &= class == LayerClass::Specular;
+        b
+    }
+
+    /// [`Bsdf::restricted`] of the layers (or the microfacet BSDF).
+    fn restricted_layers(&self, class: LayerClass) -> Self {
         let mut b = self.clone();
         if b.micro.is_some() {
             if class != LayerClass::Specular {
@@ -557,6 +606,10 @@ impl<'a> Bsdf<'a> {
 
     /// Reflectance at normal incidence summed over layers: the albedo AOV.
     pub fn albedo(&self) -> Rgb {
+        self.albedo_opaque() * self.opacity
+    }
+
+    fn albedo_opaque(&self) -> Rgb {
         if let Some(m) = &self.micro {
             return m.albedo_tinted(self.tint);
         }
@@ -591,7 +644,28 @@ impl<'a> Bsdf<'a> {
     }
 
     /// `(f, pdf)` in one pass.
+    #[inline]
     pub fn eval_pdf(&self, wi: Vec3) -> (Rgb, f32) {
+        let (f, pdf) = self.eval_pdf_opaque(wi);
+        if self.opacity >= 1.0 {
+            return (f, pdf);
+        }
+        (f * self.opacity, pdf * self.selection())
+    }
+
+    /// The probability that [`Bsdf::sample`] samples the lobes other than a mask's
+    /// pass-through.
+    #[inline]
+    fn selection(&self) -> f32 {
+        if self.pass_through {
+            self.opacity
+        } else {
+            1.0
+        }
+    }
+
+    /// [`Bsdf::eval_pdf`] of the lobes a mask lets light meet.
+    fn eval_pdf_opaque(&self, wi: Vec3) -> (Rgb, f32) {
         if self.total <= 0.0 {
             return (Rgb::ZERO, 0.0);
         }
@@ -621,6 +695,33 @@ impl<'a> Bsdf<'a> {
     /// Samples an incident direction. `u_layer` picks the layer and (reused after rescaling) the
     /// reflection/refraction branch; `u` samples the lobe.
     pub fn sample(&self, u_layer: f32, u: Vec2) -> Option<BsdfSample> {
+        if self.opacity >= 1.0 {
+            return self.sample_opaque(u_layer, u);
+        }
+        let mut u_layer = u_layer;
+        if self.pass_through {
+            if u_layer >= self.opacity {
+                // Through the mask: the light continues as if the surface were not there.
+                return Some(BsdfSample {
+                    wi: -self.wo,
+                    weight: Rgb::ONE,
+                    pdf: 1.0 - self.opacity,
+                    delta: true,
+                    transmitted: true,
+                    wavelength: self.wavelength,
+                });
+            }
+            u_layer = (u_layer / self.opacity).min(0.999_999_94);
+        }
+        let sel = self.selection();
+        let mut s = self.sample_opaque(u_layer, u)?;
+        s.pdf *= sel;
+        s.weight *= self.opacity / sel;
+        Some(s)
+    }
+
+    /// [`Bsdf::sample`] of the lobes a mask lets light meet.
+    fn sample_opaque(&self, u_layer: f32, u: Vec2) -> Option<BsdfSample> {
         if self.total <= 0.0 {
             return None;
         }
@@ -682,7 +783,7 @@ impl<'a> Bsdf<'a> {
                 wavelength,
             });
         }
-        let (f, pdf) = self.eval_pdf(wi);
+        let (f, pdf) = self.eval_pdf_opaque(wi);
         if pdf <= 0.0 || !pdf.is_finite() {
             return None;
         }
@@ -914,6 +1015,7 @@ impl crate::content_hash::ContentHash for Material {
             microfacet,
             perturbation,
             param_textures,
+            opacity,
         } = self;
         name.content_hash(out);
         layers.content_hash(out);
@@ -929,6 +1031,9 @@ impl crate::content_hash::ContentHash for Material {
         }
         if !param_textures.is_empty() {
             format!("{param_textures:?}").content_hash(out);
+        }
+        if let Some(o) = opacity {
+            o.content_hash(out);
         }
     }
 }

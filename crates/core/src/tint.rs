@@ -24,6 +24,7 @@ impl Tint {
             alpha_v: None,
             specular_reflectance: None,
             specular_transmittance: None,
+            opacity: None,
         },
     };
 }

@@ -226,6 +226,8 @@ pub(crate) struct MaterialDesc {
     pub specular_transmittance: Option<Spanned<toml::Value>>,
     pub diffuse_reflectance: Option<Spanned<V3>>,
     pub nonlinear: Option<Spanned<bool>>,
+    /// Mitsuba's `mask`: a number in [0, 1] or a texture (`param_desc.rs`); any type.
+    pub opacity: Option<Spanned<toml::Value>>,
 }
 
 /// One entry of a material's `layers` array.

@@ -86,6 +86,19 @@ impl MaterialTable {
 pub(crate) fn build(ctx: &mut Ctx, d: &Spanned<MaterialDesc>) -> Result<Material> {
     let mut m = build_bsdf(ctx, d.get_ref())?;
     m.perturbation = crate::texture_desc::perturbation(ctx, d.get_ref())?;
+    if let Some(v) = &d.get_ref().opacity {
+        let name = d.get_ref().name.get_ref();
+        match crate::param_desc::scalar(ctx, name, "opacity", v)? {
+            crate::param_desc::Param::Const(o) if !(0.0..=1.0).contains(&o) => {
+                return Err(ctx.src.error_at(
+                    v.span(),
+                    format!("material \"{name}\": opacity must be in [0, 1], got {o}"),
+                ))
+            }
+            crate::param_desc::Param::Const(o) => m.opacity = Some(o),
+            crate::param_desc::Param::Texture(t) => m.param_textures.opacity = Some(t),
+        }
+    }
     Ok(m)
 }
 

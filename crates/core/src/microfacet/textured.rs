@@ -30,6 +30,8 @@ pub struct ParamTextures {
     pub specular_reflectance: Option<u32>,
     /// `specular_transmittance`.
     pub specular_transmittance: Option<u32>,
+    /// A mask's opacity ([`crate::Material::opacity`]; any material type).
+    pub opacity: Option<u32>,
 }
 
 /// The textured parameters' values at one surface point (`None`: the material's constant).
@@ -43,6 +45,8 @@ pub struct ParamValues {
     pub specular_reflectance: Option<Rgb>,
     /// See [`ParamTextures::specular_transmittance`].
     pub specular_transmittance: Option<Rgb>,
+    /// See [`ParamTextures::opacity`].
+    pub opacity: Option<f32>,
 }
 
 impl ParamTextures {
@@ -65,6 +69,7 @@ impl ParamTextures {
             alpha_v: scalar(self.alpha_v),
             specular_reflectance: colour(self.specular_reflectance),
             specular_transmittance: colour(self.specular_transmittance),
+            opacity: scalar(self.opacity),
         }
     }
 }
@@ -91,6 +96,7 @@ impl Microfacet {
     /// changes nothing. A parameter the type does not have is ignored (the loaders refuse
     /// such textures).
     pub fn with_params(&self, v: &ParamValues) -> Option<Self> {
+        let v = ParamValues { opacity: None, ..*v };
         if v.is_empty() {
             return None;
         }

@@ -1,7 +1,8 @@
 //! Mitsuba BSDFs as `[[material]]` tables of our format: `diffuse` and the microfacet family
 //! keep their names and parameters (docs/scene-format.md, "The microfacet family"),
-//! `plastic` becomes our `smoothplastic`, `twosided` a flag on what it wraps, `bumpmap` and
-//! `normalmap` the keys `bump_map` (with `bump_scale`) and `normal_map` on what they wrap.
+//! `plastic` becomes our `smoothplastic`, `twosided` a flag on what it wraps, `mask` the key
+//! `opacity` on what it wraps, `bumpmap` and `normalmap` the keys `bump_map` (with
+//! `bump_scale`) and `normal_map` on what they wrap.
 
 use toml::{Table, Value};
 
@@ -82,7 +83,11 @@ fn wrapped_one<'a>(
 ) -> Result<&'a Node, SceneError> {
     let mut inner: Vec<&'a Node> = p.objects("bsdf");
     for r in p.refs() {
-        inner.push(resolve(r)?);
+        // A `<ref>` to a texture is a parameter, read by name.
+        let n = resolve(r)?;
+        if n.tag == "bsdf" {
+            inner.push(n);
+        }
     }
     match inner.as_slice() {
         [one] => Ok(one),
@@ -114,6 +119,27 @@ fn convert_in<'a>(
                 ..wrapped
             };
             return convert_in(one, resolve, inner, warnings);
+        }
+        "mask" => {
+            // Mitsuba's default opacity is 0.5.
+            let texture_key = match p.named_texture("opacity", resolve)? {
+                Some(tex) => Some(texture(tex, "opacity", warnings)?),
+                None => None,
+            };
+            let opacity = p.float("opacity")?.unwrap_or(0.5);
+            let one = wrapped_one(&p, resolve)?;
+            p.finish(warnings)?;
+            let mut c = convert_in(one, resolve, wrapped, warnings)?;
+            if c.table.contains_key("opacity") || c.textures.iter().any(|t| t.key == "opacity") {
+                return Err(node.at.error("a mask inside a mask is not supported"));
+            }
+            match texture_key {
+                Some(t) => c.textures.push(t),
+                None => {
+                    c.table.insert("opacity".into(), opacity.into());
+                }
+            }
+            return Ok(c);
         }
         "bumpmap" | "normalmap" => {
             let one = wrapped_one(&p, resolve)?;
@@ -233,7 +259,7 @@ fn convert_in<'a>(
             return Err(node.at.error(format!(
             "bsdf \"{other}\" is not supported (supported: diffuse, dielectric, thindielectric, \
                  roughdielectric, conductor, roughconductor, plastic, roughplastic, twosided, \
-                 bumpmap, normalmap)"
+                 mask, bumpmap, normalmap)"
         )))
         }
     }
