@@ -113,6 +113,13 @@ fn a_textured_parameter_renders_as_its_constant() {
             r#"<ref name="specular_reflectance" id="magenta"/>"#.into(),
             r#"<rgb name="specular_reflectance" value="1, 0, 1"/>"#.into(),
         ),
+        // A mask's opacity (its default is 0.5).
+        (
+            "mask",
+            r#"<bsdf type="diffuse"/>"#.into(),
+            constant_checkerboard("opacity", a),
+            format!(r#"<float name="opacity" value="{la:?}"/>"#),
+        ),
     ];
     for (ty, fixed, textured, constant) in &cases {
         let bsdf = |param: &str| format!(r#"<bsdf type="{ty}">{fixed}{param}</bsdf>"#);
@@ -149,6 +156,14 @@ fn bad_textures_are_one_error_line_naming_the_file() {
         (
             r#"<bsdf type="roughconductor"><ref name="alpha" id="nothing"/></bsdf>"#,
             "no element has this id",
+        ),
+        (
+            r#"<bsdf type="mask"><float name="opacity" value="1.5"/><bsdf type="diffuse"/></bsdf>"#,
+            "opacity must be in [0, 1], got 1.5",
+        ),
+        (
+            r#"<bsdf type="mask"><bsdf type="mask"><bsdf type="diffuse"/></bsdf></bsdf>"#,
+            "a mask inside a mask is not supported",
         ),
     ];
     for (bsdf, want) in cases {

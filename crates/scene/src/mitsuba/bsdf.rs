@@ -122,11 +122,10 @@ fn convert_in<'a>(
         }
         "mask" => {
             // Mitsuba's default opacity is 0.5.
-            let texture_key = match p.named_texture("opacity", resolve)? {
-                Some(tex) => Some(texture(tex, "opacity", warnings)?),
-                None => None,
+            let (texture_key, opacity) = match p.named_texture("opacity", resolve)? {
+                Some(tex) => (Some(texture(tex, "opacity", warnings)?), 0.5),
+                None => (None, p.float("opacity")?.unwrap_or(0.5)),
             };
-            let opacity = p.float("opacity")?.unwrap_or(0.5);
             let one = wrapped_one(&p, resolve)?;
             p.finish(warnings)?;
             let mut c = convert_in(one, resolve, wrapped, warnings)?;
