@@ -43,7 +43,6 @@
 use crate::bump::NormalPerturbation;
 use crate::microfacet::{Microfacet, ParamTextures};
 use crate::tint::Tint;
-use std::borrow::Cow;
 use crate::{
     frame::Frame,
     sampling::{blinn_phong_half, blinn_phong_half_pdf, cosine_hemisphere},
@@ -51,6 +50,7 @@ use crate::{
     Rgb,
 };
 use glam::{Vec2, Vec3};
+use std::borrow::Cow;
 use std::f32::consts::{FRAC_1_PI, PI};
 
 /// Most layers a material may have: the BSDF keeps per-layer weights in a fixed array so that
@@ -448,7 +448,13 @@ impl<'a> Bsdf<'a> {
     /// [`crate::Scene::tint`] reads) at a point with unit shading normal `ns` and unit geometric
     /// normal `ng` (both on the front side), for outgoing direction `wo` (unit, pointing away
     /// from the surface).
-    pub fn new(material: &'a Material, tint: impl Into<Tint>, ns: Vec3, ng: Vec3, wo: Vec3) -> Self {
+    pub fn new(
+        material: &'a Material,
+        tint: impl Into<Tint>,
+        ns: Vec3,
+        ng: Vec3,
+        wo: Vec3,
+    ) -> Self {
         let Tint {
             color: tint,
             params,

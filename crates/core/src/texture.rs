@@ -330,7 +330,12 @@ mod tests {
         assert!(checked > 1900);
         // On the edges: ½ and 0 belong to the lower half.
         let t = Texture::checkerboard(c0, c1, Affine2::IDENTITY);
-        for (uv, want) in [((0.5, 0.5), c0), ((0.0, 0.0), c0), ((0.5, 0.7), c1), ((1.0, 0.3), c0)] {
+        for (uv, want) in [
+            ((0.5, 0.5), c0),
+            ((0.0, 0.0), c0),
+            ((0.5, 0.7), c1),
+            ((1.0, 0.3), c0),
+        ] {
             assert_eq!(t.lookup(Vec2::from(uv)), want, "uv {uv:?}");
         }
     }

@@ -72,7 +72,10 @@ fn masked_sampling_matches_the_pdf_chi_square() {
         n,
         &mut rng,
     );
-    assert!(!r.passes(alpha), "the χ² test missed a wrong opacity: {r:?}");
+    assert!(
+        !r.passes(alpha),
+        "the χ² test missed a wrong opacity: {r:?}"
+    );
 }
 
 #[test]

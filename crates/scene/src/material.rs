@@ -106,9 +106,8 @@ pub(crate) fn build(ctx: &mut Ctx, d: &Spanned<MaterialDesc>) -> Result<Material
 fn build_bsdf(ctx: &mut Ctx, d: &MaterialDesc) -> Result<Material> {
     let name = d.name.get_ref();
     let src = ctx.src;
-    let err = |span: Range<usize>, msg: String| {
-        src.error_at(span, format!("material \"{name}\": {msg}"))
-    };
+    let err =
+        |span: Range<usize>, msg: String| src.error_at(span, format!("material \"{name}\": {msg}"));
     if name.is_empty() || name.contains('/') {
         return Err(ctx.src.error_at(
             d.name.span(),

@@ -10,8 +10,8 @@ use crate::load::{finite3, Ctx};
 use crate::param_desc::{self, Param};
 use rt_core::microfacet::named::{CONDUCTORS, DIELECTRICS};
 use rt_core::microfacet::{
-    named_conductor, named_ior, Distribution, DistributionKind, Microfacet, ParamTextures,
-    Plastic, RoughConductor, RoughDielectric, RoughPlastic, ThinDielectric,
+    named_conductor, named_ior, Distribution, DistributionKind, Microfacet, ParamTextures, Plastic,
+    RoughConductor, RoughDielectric, RoughPlastic, ThinDielectric,
 };
 use rt_core::{Material, Rgb};
 use std::ops::Range;
@@ -70,9 +70,8 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
     let name = d.name.get_ref();
     // A copy of the source, so that loading textures (which needs `ctx`) can come between.
     let src = ctx.src;
-    let err = |span: Range<usize>, msg: String| {
-        src.error_at(span, format!("material \"{name}\": {msg}"))
-    };
+    let err =
+        |span: Range<usize>, msg: String| src.error_at(span, format!("material \"{name}\": {msg}"));
     // Keys of the layered model have no meaning here.
     let layered = [
         ("color", d.color.as_ref().map(|v| v.span())),
@@ -291,7 +290,11 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
 }
 
 /// A roughness key: a positive number or a texture; [`DEFAULT_ALPHA`] when absent.
-fn alpha(ctx: &mut Ctx, d: &MaterialDesc, v: &Option<toml::Spanned<toml::Value>>) -> Result<Param<f32>> {
+fn alpha(
+    ctx: &mut Ctx,
+    d: &MaterialDesc,
+    v: &Option<toml::Spanned<toml::Value>>,
+) -> Result<Param<f32>> {
     let Some(v) = v else {
         return Ok(Param::Const(DEFAULT_ALPHA));
     };

@@ -62,7 +62,9 @@ pub(crate) fn colour(
     let bad = |ctx: &Ctx| {
         ctx.src.error_at(
             v.span(),
-            format!("material \"{name}\": `{key}` must be [r, g, b] of finite numbers or a texture"),
+            format!(
+                "material \"{name}\": `{key}` must be [r, g, b] of finite numbers or a texture"
+            ),
         )
     };
     match v.get_ref() {

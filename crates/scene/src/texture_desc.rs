@@ -84,9 +84,7 @@ fn number(v: &Value) -> Option<f32> {
 /// A reflectance: a number or `[r, g, b]`, each in [0, 1].
 fn colour(v: &Value) -> Option<Rgb> {
     let c = match v {
-        Value::Array(a) if a.len() == 3 => {
-            Rgb::new(number(&a[0])?, number(&a[1])?, number(&a[2])?)
-        }
+        Value::Array(a) if a.len() == 3 => Rgb::new(number(&a[0])?, number(&a[1])?, number(&a[2])?),
         other => Rgb::splat(number(other)?),
     };
     (c.min_element() >= 0.0 && c.max_element() <= 1.0).then_some(c)
@@ -108,12 +106,7 @@ fn affine(v: &Value) -> Option<Affine2> {
 
 /// The file (resolved against the scene's directory) and options of texture value `v` of
 /// material `name`.
-fn read(
-    ctx: &Ctx,
-    name: &str,
-    v: &Spanned<Value>,
-    raw: bool,
-) -> Result<(PathBuf, TextureOptions)> {
+fn read(ctx: &Ctx, name: &str, v: &Spanned<Value>, raw: bool) -> Result<(PathBuf, TextureOptions)> {
     let (file, options) = parse(v.get_ref(), raw).map_err(|e| {
         ctx.src
             .error_at(v.span(), format!("material \"{name}\": {e}"))

@@ -96,7 +96,10 @@ impl Microfacet {
     /// changes nothing. A parameter the type does not have is ignored (the loaders refuse
     /// such textures).
     pub fn with_params(&self, v: &ParamValues) -> Option<Self> {
-        let v = ParamValues { opacity: None, ..*v };
+        let v = ParamValues {
+            opacity: None,
+            ..*v
+        };
         if v.is_empty() {
             return None;
         }

@@ -201,7 +201,14 @@ fn convert_in<'a>(
         }
         "conductor" | "roughconductor" => {
             t.insert("type".into(), ty.into());
-            rough(&p, &mut t, &mut textures, ty == "roughconductor", resolve, warnings)?;
+            rough(
+                &p,
+                &mut t,
+                &mut textures,
+                ty == "roughconductor",
+                resolve,
+                warnings,
+            )?;
             if let Some(m) = p.string("material")? {
                 t.insert("material".into(), m.into());
             }
@@ -210,14 +217,28 @@ fn convert_in<'a>(
                     t.insert(key.into(), rgb(c));
                 }
             }
-            reflectance(&p, &mut t, &mut textures, "specular_reflectance", resolve, warnings)?;
+            reflectance(
+                &p,
+                &mut t,
+                &mut textures,
+                "specular_reflectance",
+                resolve,
+                warnings,
+            )?;
             if two_sided {
                 t.insert("two_sided".into(), true.into());
             }
         }
         "dielectric" | "thindielectric" | "roughdielectric" => {
             t.insert("type".into(), ty.into());
-            rough(&p, &mut t, &mut textures, ty == "roughdielectric", resolve, warnings)?;
+            rough(
+                &p,
+                &mut t,
+                &mut textures,
+                ty == "roughdielectric",
+                resolve,
+                warnings,
+            )?;
             iors(&p, &mut t)?;
             for key in ["specular_reflectance", "specular_transmittance"] {
                 reflectance(&p, &mut t, &mut textures, key, resolve, warnings)?;
@@ -236,7 +257,14 @@ fn convert_in<'a>(
             );
             rough(&p, &mut t, &mut textures, rough_one, resolve, warnings)?;
             iors(&p, &mut t)?;
-            reflectance(&p, &mut t, &mut textures, "specular_reflectance", resolve, warnings)?;
+            reflectance(
+                &p,
+                &mut t,
+                &mut textures,
+                "specular_reflectance",
+                resolve,
+                warnings,
+            )?;
             match colour(&p, "diffuse_reflectance", resolve)? {
                 None => {}
                 Some(Color::Rgb(c)) => {

@@ -206,12 +206,9 @@ impl<'a> Props<'a> {
         resolve: &dyn Fn(&'a Node) -> Result<&'a Node, SceneError>,
     ) -> Result<Option<&'a Node>, SceneError> {
         let node = self.node;
-        let Some((i, c)) = node
-            .children
-            .iter()
-            .enumerate()
-            .find(|(_, c)| c.attr("name") == Some(name) && matches!(c.tag.as_str(), "texture" | "ref"))
-        else {
+        let Some((i, c)) = node.children.iter().enumerate().find(|(_, c)| {
+            c.attr("name") == Some(name) && matches!(c.tag.as_str(), "texture" | "ref")
+        }) else {
             return Ok(None);
         };
         self.read.borrow_mut()[i] = true;
