@@ -41,7 +41,7 @@
 //! connections never need a wavelength the path does not have yet.
 
 use crate::bump::NormalPerturbation;
-use crate::microfacet::{Microfacet, ParamTextures};
+use crate::microfacet::{Microfacet, ParamTextures, ParamValues};
 use crate::tint::Tint;
 use crate::{
     frame::Frame,
@@ -50,7 +50,6 @@ use crate::{
     Rgb,
 };
 use glam::{Vec2, Vec3};
-use std::borrow::Cow;
 use std::f32::consts::{FRAC_1_PI, PI};
 
 /// Most layers a material may have: the BSDF keeps per-layer weights in a fixed array so that
@@ -425,9 +424,11 @@ pub struct Bsdf<'a> {
     /// for operation, so both give the same bits.
     lambert: Option<Rgb>,
     /// The material's microfacet BSDF, which replaces the layers when present (the texture's
-    /// tint applies through [`Microfacet::eval_pdf_tinted`] and [`Microfacet::sample_tinted`]):
-    /// borrowed, or a copy with the textured parameters in place.
-    micro: Option<Cow<'a, Microfacet>>,
+    /// tint applies through [`Microfacet::eval_pdf_tinted`] and [`Microfacet::sample_tinted`],
+    /// the textured parameters `params` through [`Bsdf::with_micro`].
+    micro: Option<&'a Microfacet>,
+    /// The textured parameters' values at this point (all `None` for most materials).
+    params: ParamValues,
     /// The path's wavelength, nm (`None`: an RGB path).
     wavelength: Option<f32>,
     /// Mitsuba's `mask` (Mitsuba 3, `mask.cpp`): the probability that light meets the surface
@@ -476,11 +477,8 @@ impl<'a> Bsdf<'a> {
             }
             has_non_delta |= *w > 0.0 && !l.is_delta();
         }
-        let micro = material
-            .microfacet
-            .as_ref()
-            .map(|m| m.with_params(&params).map_or(Cow::Borrowed(m), Cow::Owned));
-        let total = match &micro {
+        let micro = material.microfacet.as_ref();
+        let total = match micro {
             // One "layer" of weight one: the checks of `total` below hold as for layers.
             Some(m) => {
                 has_non_delta = m.has_non_delta();
@@ -506,6 +504,7 @@ impl<'a> Bsdf<'a> {
             total,
             lambert,
             micro,
+            params,
             wavelength: None,
             opacity,
             pass_through: true,
@@ -616,8 +615,8 @@ impl<'a> Bsdf<'a> {
     }
 
     fn albedo_opaque(&self) -> Rgb {
-        if let Some(m) = &self.micro {
-            return m.albedo_tinted(self.tint);
+        if let Some(a) = self.with_micro(|m| m.albedo_tinted(self.tint)) {
+            return a;
         }
         self.layers
             .iter()
@@ -682,8 +681,9 @@ impl<'a> Bsdf<'a> {
         if let Some(f) = self.lambert {
             return lambert_eval_pdf(f, wi_local, reflect);
         }
-        if let Some(m) = &self.micro {
-            return m.eval_pdf_tinted(self.tint, self.wo_local, wi_local);
+        if let Some(r) = self.with_micro(|m| m.eval_pdf_tinted(self.tint, self.wo_local, wi_local))
+        {
+            return r;
         }
         let mut f = Rgb::ZERO;
         let mut pdf = 0.0;
@@ -731,8 +731,8 @@ impl<'a> Bsdf<'a> {
         if self.total <= 0.0 {
             return None;
         }
-        if let Some(m) = &self.micro {
-            return self.sample_microfacet(m, u_layer, u);
+        if let Some(s) = self.with_micro(|m| self.sample_microfacet(m, u_layer, u)) {
+            return s;
         }
         // Pick a layer in proportion to its weight; rounding past the end lands on the last
         // layer with weight.
@@ -805,6 +805,17 @@ impl<'a> Bsdf<'a> {
 }
 
 impl Bsdf<'_> {
+    /// `f` of the microfacet BSDF with the textured parameters in place (a copy of it only for
+    /// a material with textured parameters); `None` for a layered material.
+    #[inline]
+    fn with_micro<R>(&self, f: impl FnOnce(&Microfacet) -> R) -> Option<R> {
+        let m = self.micro?;
+        Some(match m.with_params(&self.params) {
+            Some(textured) => f(&textured),
+            None => f(m),
+        })
+    }
+
     /// [`Bsdf::sample`] for a microfacet material: the local sample in world space, kept only
     /// where it is consistent with the geometric normal too.
     fn sample_microfacet(&self, m: &Microfacet, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {

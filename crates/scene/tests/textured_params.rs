@@ -167,7 +167,9 @@ fn bad_textures_are_one_error_line_naming_the_file() {
         ),
     ];
     for (bsdf, want) in cases {
-        let e = load(dir.path(), bsdf).err().expect(bsdf);
+        let Err(e) = load(dir.path(), bsdf) else {
+            panic!("{bsdf} loaded");
+        };
         assert!(e.contains("s.xml") && e.contains(want), "{bsdf}: {e}");
         assert_eq!(e.lines().count(), 1, "{e}");
     }
