@@ -50,6 +50,7 @@ pub mod shapes;
 pub mod spectral;
 pub mod stage_time;
 pub mod texture;
+pub mod tint;
 pub mod transform;
 pub mod triangle;
 

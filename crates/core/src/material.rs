@@ -41,7 +41,8 @@
 //! connections never need a wavelength the path does not have yet.
 
 use crate::bump::NormalPerturbation;
-use crate::microfacet::Microfacet;
+use crate::microfacet::{Microfacet, ParamTextures, ParamValues};
+use crate::tint::Tint;
 use crate::{
     frame::Frame,
     sampling::{blinn_phong_half, blinn_phong_half_pdf, cosine_hemisphere},
@@ -151,6 +152,12 @@ pub struct Material {
     /// A bump or normal map bending the shading normal ([`crate::bump`]), applied where the
     /// scene builds a hit ([`crate::scene::Scene::surface`]).
     pub perturbation: Option<NormalPerturbation>,
+    /// Textures on the microfacet BSDF's parameters ([`crate::microfacet::ParamTextures`]).
+    pub param_textures: ParamTextures,
+    /// Mitsuba's `mask`: the probability in [0, 1] that light meets the surface (`None`:
+    /// opaque); otherwise it passes straight through ([`Bsdf`]). Its texture is
+    /// `param_textures.opacity`.
+    pub opacity: Option<f32>,
 }
 
 /// A material parameter outside its valid range.
@@ -179,6 +186,9 @@ pub enum MaterialError {
     /// A microfacet BSDF's parameter out of range.
     #[error("{0}")]
     Microfacet(String),
+    /// A mask's opacity outside [0, 1].
+    #[error("opacity must be in [0, 1], got {0}")]
+    Opacity(f32),
 }
 
 fn check_color(c: Rgb, what: &str, layer: usize) -> Result<(), MaterialError> {
@@ -204,6 +214,8 @@ impl Material {
             texture: None,
             microfacet: None,
             perturbation: None,
+            param_textures: ParamTextures::default(),
+            opacity: None,
         }
     }
 
@@ -265,6 +277,11 @@ impl Material {
         if let Some(m) = &self.microfacet {
             m.validate().map_err(MaterialError::Microfacet)?;
         }
+        if let Some(o) = self.opacity {
+            if !(0.0..=1.0).contains(&o) {
+                return Err(MaterialError::Opacity(o));
+            }
+        }
         let mut sum = 0.0;
         for (i, l) in self.layers.iter().enumerate() {
             let bad = |what: String| Err(MaterialError::Layer { layer: i, what });
@@ -325,6 +342,9 @@ impl Material {
     /// material. Shading kernels that handle only this case ask here.
     #[inline]
     pub fn plain_lambert(&self, tint: Rgb) -> Option<Rgb> {
+        if self.opacity.is_some() || self.param_textures.opacity.is_some() {
+            return None;
+        }
         match self.layers.as_slice() {
             [l] if is_plain_lambert(l) && l.weight > 0.0 => {
                 Some(l.color * tint * FRAC_1_PI * l.weight)
@@ -404,10 +424,21 @@ pub struct Bsdf<'a> {
     /// for operation, so both give the same bits.
     lambert: Option<Rgb>,
     /// The material's microfacet BSDF, which replaces the layers when present (the texture's
-    /// tint applies through [`Microfacet::eval_pdf_tinted`] and [`Microfacet::sample_tinted`]).
+    /// tint applies through [`Microfacet::eval_pdf_tinted`] and [`Microfacet::sample_tinted`],
+    /// the textured parameters `params` through [`Bsdf::with_micro`].
     micro: Option<&'a Microfacet>,
+    /// The textured parameters' values at this point (all `None` for most materials).
+    params: ParamValues,
     /// The path's wavelength, nm (`None`: an RGB path).
     wavelength: Option<f32>,
+    /// Mitsuba's `mask` (Mitsuba 3, `mask.cpp`): the probability that light meets the surface
+    /// (1 without a mask). The rest passes straight through: a delta transmission lobe along
+    /// `−wo` of weight one, sampled with probability `1 − opacity`; the other lobes' values
+    /// and pdfs are scaled by `opacity`.
+    opacity: f32,
+    /// The pass-through lobe is part of this BSDF (false for its diffuse part,
+    /// [`Bsdf::restricted`]: the pass-through is specular).
+    pass_through: bool,
     /// Dispersive layers use their wavelength-dependent index (false: `ior` = `n_d`, as an RGB
     /// renderer would; for tests that compare against the renderer without spectral code).
     spectral: bool,
@@ -416,10 +447,21 @@ pub struct Bsdf<'a> {
 }
 
 impl<'a> Bsdf<'a> {
-    /// Builds the BSDF of `material` with texture `tint` at a point with unit shading normal `ns`
-    /// and unit geometric normal `ng` (both on the front side), for outgoing direction `wo` (unit,
-    /// pointing away from the surface).
-    pub fn new(material: &'a Material, tint: Rgb, ns: Vec3, ng: Vec3, wo: Vec3) -> Self {
+    /// Builds the BSDF of `material` with texture values `tint` (a colour alone, or what
+    /// [`crate::Scene::tint`] reads) at a point with unit shading normal `ns` and unit geometric
+    /// normal `ng` (both on the front side), for outgoing direction `wo` (unit, pointing away
+    /// from the surface).
+    pub fn new(
+        material: &'a Material,
+        tint: impl Into<Tint>,
+        ns: Vec3,
+        ng: Vec3,
+        wo: Vec3,
+    ) -> Self {
+        let Tint {
+            color: tint,
+            params,
+        } = tint.into();
         let frame = Frame::from_normal(ns);
         let wo_local = frame.to_local(wo);
         let mut weights = [0.0f32; MAX_LAYERS];
@@ -449,6 +491,10 @@ impl<'a> Bsdf<'a> {
         // `color_at` of a plain Lambertian layer is `color · tint` at every angle, and its
         // one weight is `1 · weight`.
         let lambert = material.plain_lambert(tint);
+        let opacity = params
+            .opacity
+            .or(material.opacity)
+            .map_or(1.0, |o| o.clamp(0.0, 1.0));
         Self {
             layers: &material.layers,
             tint,
@@ -458,10 +504,13 @@ impl<'a> Bsdf<'a> {
             wo_local,
             weights,
             total,
-            has_non_delta,
             lambert,
             micro,
+            params,
             wavelength: None,
+            opacity,
+            pass_through: true,
+            has_non_delta: has_non_delta && opacity > 0.0,
             spectral: true,
             adjoint: false,
         }
@@ -512,6 +561,18 @@ impl<'a> Bsdf<'a> {
     /// The probability with which [`Bsdf::sample`] picks a layer of `class`: the class's share
     /// of the layer weights (0 for a BSDF that reflects nothing).
     pub fn share(&self, class: LayerClass) -> f32 {
+        let inner = self.share_opaque(class);
+        if !self.pass_through || self.opacity >= 1.0 {
+            return inner;
+        }
+        match class {
+            LayerClass::Diffuse => self.opacity * inner,
+            LayerClass::Specular => 1.0 - self.opacity * (1.0 - inner),
+        }
+    }
+
+    /// [`Bsdf::share`] among the lobes a mask lets light meet.
+    fn share_opaque(&self, class: LayerClass) -> f32 {
         if self.total <= 0.0 {
             return 0.0;
         }
@@ -534,6 +595,13 @@ impl<'a> Bsdf<'a> {
     /// parts sum to the whole, which is how the path-space partition (Dammertz 2011, §6.3)
     /// splits a vertex into its diffuse and its specular part.
     pub fn restricted(&self, class: LayerClass) -> Self {
+        let mut b = self.restricted_layers(class);
+        b.pass_through &= class == LayerClass::Specular;
+        b
+    }
+
+    /// [`Bsdf::restricted`] of the layers (or the microfacet BSDF).
+    fn restricted_layers(&self, class: LayerClass) -> Self {
         let mut b = self.clone();
         if b.micro.is_some() {
             if class != LayerClass::Specular {
@@ -560,8 +628,12 @@ impl<'a> Bsdf<'a> {
 
     /// Reflectance at normal incidence summed over layers: the albedo AOV.
     pub fn albedo(&self) -> Rgb {
-        if let Some(m) = self.micro {
-            return m.albedo_tinted(self.tint);
+        self.albedo_opaque() * self.opacity
+    }
+
+    fn albedo_opaque(&self) -> Rgb {
+        if let Some(a) = self.with_micro(|m| m.albedo_tinted(self.tint)) {
+            return a;
         }
         self.layers
             .iter()
@@ -594,7 +666,28 @@ impl<'a> Bsdf<'a> {
     }
 
     /// `(f, pdf)` in one pass.
+    #[inline]
     pub fn eval_pdf(&self, wi: Vec3) -> (Rgb, f32) {
+        let (f, pdf) = self.eval_pdf_opaque(wi);
+        if self.opacity >= 1.0 {
+            return (f, pdf);
+        }
+        (f * self.opacity, pdf * self.selection())
+    }
+
+    /// The probability that [`Bsdf::sample`] samples the lobes other than a mask's
+    /// pass-through.
+    #[inline]
+    fn selection(&self) -> f32 {
+        if self.pass_through {
+            self.opacity
+        } else {
+            1.0
+        }
+    }
+
+    /// [`Bsdf::eval_pdf`] of the lobes a mask lets light meet.
+    fn eval_pdf_opaque(&self, wi: Vec3) -> (Rgb, f32) {
         if self.total <= 0.0 {
             return (Rgb::ZERO, 0.0);
         }
@@ -605,12 +698,15 @@ impl<'a> Bsdf<'a> {
         if let Some(f) = self.lambert {
             return lambert_eval_pdf(f, wi_local, reflect);
         }
-        if let Some(m) = self.micro {
+        if let Some(r) = self.with_micro(|m| {
             let (f, pdf) = m.eval_pdf_tinted(self.tint, self.wo_local, wi_local);
             if self.adjoint && !reflect {
-                return (f * m.adjoint_scale(self.wo_local), pdf);
+                (f * m.adjoint_scale(self.wo_local), pdf)
+            } else {
+                (f, pdf)
             }
-            return (f, pdf);
+        }) {
+            return r;
         }
         let mut f = Rgb::ZERO;
         let mut pdf = 0.0;
@@ -633,11 +729,38 @@ impl<'a> Bsdf<'a> {
     /// Samples an incident direction. `u_layer` picks the layer and (reused after rescaling) the
     /// reflection/refraction branch; `u` samples the lobe.
     pub fn sample(&self, u_layer: f32, u: Vec2) -> Option<BsdfSample> {
+        if self.opacity >= 1.0 {
+            return self.sample_opaque(u_layer, u);
+        }
+        let mut u_layer = u_layer;
+        if self.pass_through {
+            if u_layer >= self.opacity {
+                // Through the mask: the light continues as if the surface were not there.
+                return Some(BsdfSample {
+                    wi: -self.wo,
+                    weight: Rgb::ONE,
+                    pdf: 1.0 - self.opacity,
+                    delta: true,
+                    transmitted: true,
+                    wavelength: self.wavelength,
+                });
+            }
+            u_layer = (u_layer / self.opacity).min(0.999_999_94);
+        }
+        let sel = self.selection();
+        let mut s = self.sample_opaque(u_layer, u)?;
+        s.pdf *= sel;
+        s.weight *= self.opacity / sel;
+        Some(s)
+    }
+
+    /// [`Bsdf::sample`] of the lobes a mask lets light meet.
+    fn sample_opaque(&self, u_layer: f32, u: Vec2) -> Option<BsdfSample> {
         if self.total <= 0.0 {
             return None;
         }
-        if let Some(m) = self.micro {
-            return self.sample_microfacet(m, u_layer, u);
+        if let Some(s) = self.with_micro(|m| self.sample_microfacet(m, u_layer, u)) {
+            return s;
         }
         // Pick a layer in proportion to its weight; rounding past the end lands on the last
         // layer with weight.
@@ -702,7 +825,7 @@ impl<'a> Bsdf<'a> {
                 wavelength,
             });
         }
-        let (f, pdf) = self.eval_pdf(wi);
+        let (f, pdf) = self.eval_pdf_opaque(wi);
         if pdf <= 0.0 || !pdf.is_finite() {
             return None;
         }
@@ -718,6 +841,17 @@ impl<'a> Bsdf<'a> {
 }
 
 impl Bsdf<'_> {
+    /// `f` of the microfacet BSDF with the textured parameters in place (a copy of it only for
+    /// a material with textured parameters); `None` for a layered material.
+    #[inline]
+    fn with_micro<R>(&self, f: impl FnOnce(&Microfacet) -> R) -> Option<R> {
+        let m = self.micro?;
+        Some(match m.with_params(&self.params) {
+            Some(textured) => f(&textured),
+            None => f(m),
+        })
+    }
+
     /// [`Bsdf::sample`] for a microfacet material: the local sample in world space, kept only
     /// where it is consistent with the geometric normal too.
     fn sample_microfacet(&self, m: &Microfacet, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
@@ -938,6 +1072,8 @@ impl crate::content_hash::ContentHash for Material {
             texture,
             microfacet,
             perturbation,
+            param_textures,
+            opacity,
         } = self;
         name.content_hash(out);
         layers.content_hash(out);
@@ -950,6 +1086,12 @@ impl crate::content_hash::ContentHash for Material {
         // Only when present, as the microfacet BSDF: older scenes keep their hashes.
         if let Some(p) = perturbation {
             format!("{p:?}").content_hash(out);
+        }
+        if !param_textures.is_empty() {
+            format!("{param_textures:?}").content_hash(out);
+        }
+        if let Some(o) = opacity {
+            o.content_hash(out);
         }
     }
 }

@@ -590,12 +590,17 @@ impl Scene {
         moved
     }
 
-    /// Texture tint of material `m` at `uv` (white without a texture).
+    /// What material `m`'s textures read at `uv`: its texture's colour (white without one)
+    /// and its textured parameters.
     #[inline]
-    pub fn tint(&self, m: &Material, uv: Vec2) -> Rgb {
-        match m.texture {
+    pub fn tint(&self, m: &Material, uv: Vec2) -> crate::tint::Tint {
+        let color = match m.texture {
             Some(t) => self.textures[t as usize].lookup(uv),
             None => Rgb::ONE,
+        };
+        crate::tint::Tint {
+            color,
+            params: m.param_textures.lookup(&self.textures, uv),
         }
     }
 }

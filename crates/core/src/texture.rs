@@ -1,9 +1,11 @@
 //! Image textures: linear RGB texels looked up with Mitsuba 3's `bitmap` options (bilinear or
-//! nearest filtering; repeat, mirror or clamp wrapping), as colours, as scalars (luminance) and
-//! as the scalar's gradient in uv, which bump mapping needs ([`crate::bump`]).
+//! nearest filtering; repeat, mirror or clamp wrapping, a `to_uv` transform), as colours, as
+//! scalars (luminance) and as the scalar's gradient in uv, which bump mapping needs
+//! ([`crate::bump`]). Mitsuba's `checkerboard` is a two-texel texture whose lookup picks a
+//! texel by Mitsuba's rule ([`Texture::checkerboard`], [`Layout`]).
 
 use crate::Rgb;
-use glam::Vec2;
+use glam::{Affine2, Vec2};
 
 /// A texel component as a reflectance multiplier: clamped to [0, 1], NaN counted as 0.
 ///
@@ -65,6 +67,17 @@ impl Wrap {
     }
 }
 
+/// How a lookup finds its texels.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Layout {
+    /// Rows of texels covering [0, 1]².
+    #[default]
+    Image,
+    /// Mitsuba 3's `checkerboard` (checkerboard.cpp): texel 0 (`color0`) where `frac(u) > ½`
+    /// equals `frac(v) > ½`, texel 1 elsewhere.
+    Checkerboard,
+}
+
 /// A linear-RGB image used to modulate material parameters. Texels outside [0, 1] (or NaN)
 /// are read as clamped (NaN as 0).
 #[derive(Clone, Debug)]
@@ -79,6 +92,10 @@ pub struct Texture {
     pub filter: Filter,
     /// Wrapping outside [0, 1]².
     pub wrap: Wrap,
+    /// Maps the surface's uv to the image's (Mitsuba's `to_uv`; the identity by default).
+    pub to_uv: Affine2,
+    /// An image, or a checkerboard of its two texels.
+    pub layout: Layout,
 }
 
 /// The texels and weights a lookup at one point combines.
@@ -99,13 +116,38 @@ impl Texture {
             texels,
             filter: Filter::Bilinear,
             wrap: Wrap::Repeat,
+            to_uv: Affine2::IDENTITY,
+            layout: Layout::Image,
         }
+    }
+
+    /// Mitsuba 3's `checkerboard`: `color0` where the fractional parts of `u` and `v` (after
+    /// `to_uv`) are both at most ½ or both above, `color1` elsewhere. Piecewise constant: its
+    /// gradient is zero, as a nearest lookup's.
+    pub fn checkerboard(color0: Rgb, color1: Rgb, to_uv: Affine2) -> Self {
+        let mut t = Self::new(2, 1, vec![color0, color1]);
+        t.filter = Filter::Nearest;
+        t.to_uv = to_uv;
+        t.layout = Layout::Checkerboard;
+        t
     }
 
     /// The texels around `uv`, or `None` for an empty image or a non-finite `uv`.
     #[inline]
     fn footprint(&self, uv: Vec2) -> Option<Footprint> {
         let (w, h) = (self.width as i64, self.height as i64);
+        let uv = self.to_uv.transform_point2(uv);
+        if self.layout == Layout::Checkerboard {
+            if !uv.is_finite() {
+                return None;
+            }
+            let high = (uv - uv.floor()).cmpgt(Vec2::splat(0.5));
+            let k = (high.x != high.y) as usize;
+            return Some(Footprint {
+                at: [k; 4],
+                f: Vec2::ZERO,
+            });
+        }
         if w == 0 || h == 0 || !uv.is_finite() {
             return None;
         }
@@ -176,7 +218,8 @@ impl Texture {
         let d_dx = (b - a) * (1.0 - fy) + (d - c) * fy;
         let d_dy = bot - top;
         let grad = Vec2::new(d_dx * self.width as f32, -d_dy * self.height as f32);
-        (value, grad)
+        // The chain rule through `to_uv`: the gradient in the surface's uv.
+        (value, self.to_uv.matrix2.transpose() * grad)
     }
 }
 
@@ -188,6 +231,8 @@ impl crate::content_hash::ContentHash for Texture {
             texels,
             filter,
             wrap,
+            to_uv,
+            layout,
         } = self;
         width.content_hash(out);
         height.content_hash(out);
@@ -195,6 +240,9 @@ impl crate::content_hash::ContentHash for Texture {
         // Only when not the default, so that scenes keep the hashes they had before the options.
         if (*filter, *wrap) != (Filter::Bilinear, Wrap::Repeat) {
             format!("{filter:?}{wrap:?}").content_hash(out);
+        }
+        if *to_uv != Affine2::IDENTITY || *layout != Layout::Image {
+            format!("{to_uv:?}{layout:?}").content_hash(out);
         }
     }
 }
@@ -259,13 +307,48 @@ mod tests {
         assert!((t.lookup(mid).x - 1.0 / 6.0).abs() < 1e-6);
     }
 
+    /// Mitsuba 3's rule (checkerboard.cpp): `color0` where `frac(u) > ½` equals
+    /// `frac(v) > ½`, after `to_uv`; checked away from the edges (within 1e-3 of a half).
+    #[test]
+    fn checkerboard_follows_mitsubas_rule() {
+        let (c0, c1) = (Rgb::new(0.4, 0.1, 0.0), Rgb::new(0.2, 0.9, 1.0));
+        let to_uv = Affine2::from_scale_angle_translation(Vec2::new(3.0, 5.0), 0.3, Vec2::X);
+        let t = Texture::checkerboard(c0, c1, to_uv);
+        let mut rng = crate::rng::SplitMix64::new(7);
+        let mut checked = 0;
+        for _ in 0..2000 {
+            let uv = Vec2::new(rng.f32() * 4.0 - 2.0, rng.f32() * 4.0 - 2.0);
+            let p = to_uv.transform_point2(uv);
+            let f = p - p.floor();
+            if (f - 0.5).abs().min_element() < 1e-3 || f.min_element() < 1e-3 {
+                continue;
+            }
+            let want = if (f.x > 0.5) == (f.y > 0.5) { c0 } else { c1 };
+            assert_eq!(t.lookup(uv), want, "uv {uv}");
+            checked += 1;
+        }
+        assert!(checked > 1900);
+        // On the edges: ½ and 0 belong to the lower half.
+        let t = Texture::checkerboard(c0, c1, Affine2::IDENTITY);
+        for (uv, want) in [
+            ((0.5, 0.5), c0),
+            ((0.0, 0.0), c0),
+            ((0.5, 0.7), c1),
+            ((1.0, 0.3), c0),
+        ] {
+            assert_eq!(t.lookup(Vec2::from(uv)), want, "uv {uv:?}");
+        }
+    }
+
     /// The gradient is the finite difference of the scalar lookup, in both directions.
     #[test]
     fn scalar_gradient_is_the_derivative_of_the_lookup() {
         let texels = (0..12)
             .map(|i| Rgb::new((i * 7 % 5) as f32 / 4.0, (i % 3) as f32 / 2.0, 0.3))
             .collect();
-        let t = Texture::new(4, 3, texels);
+        let mut t = Texture::new(4, 3, texels);
+        // A `to_uv` that shears, scales and moves: the gradient is in the surface's uv.
+        t.to_uv = Affine2::from_cols_array(&[1.3, 0.2, -0.4, 0.9, 0.1, 0.25]);
         let h = 1e-3;
         for uv in [
             Vec2::new(0.3, 0.4),

@@ -214,9 +214,10 @@ pub(crate) struct MaterialDesc {
     pub dispersion: Option<Spanned<toml::Value>>,
     // The microfacet family (`microfacet.rs`), with Mitsuba's parameter names.
     pub distribution: Option<Spanned<String>>,
-    pub alpha: Option<Spanned<f32>>,
-    pub alpha_u: Option<Spanned<f32>>,
-    pub alpha_v: Option<Spanned<f32>>,
+    /// Numbers or textures (`param_desc.rs`).
+    pub alpha: Option<Spanned<toml::Value>>,
+    pub alpha_u: Option<Spanned<toml::Value>>,
+    pub alpha_v: Option<Spanned<toml::Value>>,
     pub eta: Option<Spanned<V3>>,
     pub k: Option<Spanned<V3>>,
     /// A number or one of Mitsuba's named indices (`"water"`, `"bk7"`, ...).
@@ -224,10 +225,13 @@ pub(crate) struct MaterialDesc {
     pub ext_ior: Option<Spanned<toml::Value>>,
     /// A conductor's named metal (`"Au"`, ...), as Mitsuba's `material`.
     pub material: Option<Spanned<String>>,
-    pub specular_reflectance: Option<Spanned<V3>>,
-    pub specular_transmittance: Option<Spanned<V3>>,
+    /// Colours or textures (`param_desc.rs`).
+    pub specular_reflectance: Option<Spanned<toml::Value>>,
+    pub specular_transmittance: Option<Spanned<toml::Value>>,
     pub diffuse_reflectance: Option<Spanned<V3>>,
     pub nonlinear: Option<Spanned<bool>>,
+    /// Mitsuba's `mask`: a number in [0, 1] or a texture (`param_desc.rs`); any type.
+    pub opacity: Option<Spanned<toml::Value>>,
 }
 
 /// One entry of a material's `layers` array.

@@ -66,6 +66,7 @@ mod material;
 mod microfacet;
 pub mod mitsuba;
 mod obj;
+mod param_desc;
 mod ply;
 pub mod procedural;
 pub mod raw;

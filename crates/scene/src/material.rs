@@ -86,16 +86,28 @@ impl MaterialTable {
 pub(crate) fn build(ctx: &mut Ctx, d: &Spanned<MaterialDesc>) -> Result<Material> {
     let mut m = build_bsdf(ctx, d.get_ref())?;
     m.perturbation = crate::texture_desc::perturbation(ctx, d.get_ref())?;
+    if let Some(v) = &d.get_ref().opacity {
+        let name = d.get_ref().name.get_ref();
+        match crate::param_desc::scalar(ctx, name, "opacity", v)? {
+            crate::param_desc::Param::Const(o) if !(0.0..=1.0).contains(&o) => {
+                return Err(ctx.src.error_at(
+                    v.span(),
+                    format!("material \"{name}\": opacity must be in [0, 1], got {o}"),
+                ))
+            }
+            crate::param_desc::Param::Const(o) => m.opacity = Some(o),
+            crate::param_desc::Param::Texture(t) => m.param_textures.opacity = Some(t),
+        }
+    }
     Ok(m)
 }
 
 /// [`build`] without the bump or normal map.
 fn build_bsdf(ctx: &mut Ctx, d: &MaterialDesc) -> Result<Material> {
     let name = d.name.get_ref();
-    let err = |span: Range<usize>, msg: String| {
-        ctx.src
-            .error_at(span, format!("material \"{name}\": {msg}"))
-    };
+    let src = ctx.src;
+    let err =
+        |span: Range<usize>, msg: String| src.error_at(span, format!("material \"{name}\": {msg}"));
     if name.is_empty() || name.contains('/') {
         return Err(ctx.src.error_at(
             d.name.span(),
@@ -240,8 +252,7 @@ fn build_bsdf(ctx: &mut Ctx, d: &MaterialDesc) -> Result<Material> {
     }
     m.two_sided = d.two_sided.unwrap_or(false);
     if let Some(t) = &d.texture {
-        let (path, options) = crate::texture_desc::read(ctx, name, t, false)?;
-        m.texture = Some(ctx.textures.load(&path, options)?);
+        m.texture = Some(crate::texture_desc::load(ctx, name, t, false)?);
     }
     if let Err(e) = m.validate() {
         // Point at the value that is wrong.

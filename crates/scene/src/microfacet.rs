@@ -7,9 +7,10 @@
 use crate::desc::MaterialDesc;
 use crate::error::Result;
 use crate::load::{finite3, Ctx};
+use crate::param_desc::{self, Param};
 use rt_core::microfacet::named::{CONDUCTORS, DIELECTRICS};
 use rt_core::microfacet::{
-    named_conductor, named_ior, Distribution, DistributionKind, Microfacet, Plastic,
+    named_conductor, named_ior, Distribution, DistributionKind, Microfacet, ParamTextures, Plastic,
     RoughConductor, RoughDielectric, RoughPlastic, ThinDielectric,
 };
 use rt_core::{Material, Rgb};
@@ -67,10 +68,10 @@ pub(crate) fn stray_key(d: &MaterialDesc) -> Option<(&'static str, Range<usize>)
 /// Builds a material of type `kind` (one of [`TYPES`]).
 pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Material> {
     let name = d.name.get_ref();
-    let err = |span: Range<usize>, msg: String| {
-        ctx.src
-            .error_at(span, format!("material \"{name}\": {msg}"))
-    };
+    // A copy of the source, so that loading textures (which needs `ctx`) can come between.
+    let src = ctx.src;
+    let err =
+        |span: Range<usize>, msg: String| src.error_at(span, format!("material \"{name}\": {msg}"));
     // Keys of the layered model have no meaning here.
     let layered = [
         ("color", d.color.as_ref().map(|v| v.span())),
@@ -101,6 +102,7 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
             ));
         }
     }
+    let mut textures = ParamTextures::default();
     let rough = kind.starts_with("rough");
     let conductor = kind.ends_with("conductor");
     let plastic = kind == "smoothplastic" || kind == "roughplastic";
@@ -153,41 +155,34 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
                 "an anisotropic surface needs both `alpha_u` and `alpha_v`".into(),
             ));
         }
-        let alpha = |v: &Option<toml::Spanned<f32>>| -> Result<f32> {
-            match v {
-                None => Ok(DEFAULT_ALPHA),
-                Some(s) => {
-                    let a = *s.get_ref();
-                    if a.is_finite() && a > 0.0 {
-                        Ok(a)
-                    } else {
-                        Err(err(
-                            s.span(),
-                            format!("roughness must be a positive number, got {a}"),
-                        ))
-                    }
-                }
-            }
+        let (au, av) = match &d.alpha {
+            Some(_) => (&d.alpha, &d.alpha),
+            None => (&d.alpha_u, &d.alpha_v),
         };
-        let (ax, ay) = match &d.alpha {
-            Some(_) => (alpha(&d.alpha)?, alpha(&d.alpha)?),
-            None => (alpha(&d.alpha_u)?, alpha(&d.alpha_v)?),
-        };
-        Some(Distribution::new(kind_d, ax, ay))
+        let (au, av) = (alpha(ctx, d, au)?, alpha(ctx, d, av)?);
+        textures.alpha_u = au.texture();
+        textures.alpha_v = av.texture();
+        Some(Distribution::new(
+            kind_d,
+            au.constant_or(DEFAULT_ALPHA),
+            av.constant_or(DEFAULT_ALPHA),
+        ))
     } else {
         None
     };
+    // Keys a type does not take were refused above, so reading them gives their defaults.
+    let reflectance = colour(ctx, d, &d.specular_reflectance, "specular_reflectance")?;
+    let transmittance = colour(ctx, d, &d.specular_transmittance, "specular_transmittance")?;
     let rgb = |v: &Option<toml::Spanned<crate::desc::V3>>, what: &str, default: Rgb| match v {
         Some(v) => finite3(ctx, v, what),
         None => Ok(default),
     };
-    // Keys a type does not take were refused above, so reading them gives their defaults.
-    let reflectance = rgb(&d.specular_reflectance, "specular_reflectance", Rgb::ONE)?;
-    let transmittance = rgb(
-        &d.specular_transmittance,
-        "specular_transmittance",
-        Rgb::ONE,
-    )?;
+    textures.specular_reflectance = reflectance.texture();
+    textures.specular_transmittance = transmittance.texture();
+    let (reflectance, transmittance) = (
+        reflectance.constant_or(Rgb::ONE),
+        transmittance.constant_or(Rgb::ONE),
+    );
     // Interior over exterior index, with the interior's default.
     let eta = |default_int: f32| -> Result<f32> {
         let int = ior(&d.int_ior, "int_ior", default_int).map_err(|(s, e)| err(s, e))?;
@@ -251,6 +246,14 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
                             .into(),
                     ));
                 }
+                if let (Some(_), Some(a)) = (textures.alpha_u, &d.alpha) {
+                    return Err(err(
+                        a.span(),
+                        "roughplastic's `alpha` takes no texture (Mitsuba 3 tabulates its \
+                         coating for one roughness)"
+                            .into(),
+                    ));
+                }
                 let mut p = RoughPlastic::new(dist, diffuse, reflectance, eta, nonlinear);
                 p.two_sided = two_sided;
                 Microfacet::RoughPlastic(p)
@@ -272,18 +275,50 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
         })
     };
     let mut m = Material::microfacet(name, bsdf);
+    m.param_textures = textures;
     if let Some(e) = &d.emission {
         m.emission = finite3(ctx, e, "emission")?;
     }
     m.two_sided = d.two_sided.unwrap_or(false);
     if let Some(t) = &d.texture {
-        let (path, options) = crate::texture_desc::read(ctx, name, t, false)?;
-        m.texture = Some(ctx.textures.load(&path, options)?);
+        m.texture = Some(crate::texture_desc::load(ctx, name, t, false)?);
     }
     if let Err(e) = m.validate() {
         return Err(err(d.name.span(), e.to_string()));
     }
     Ok(m)
+}
+
+/// A roughness key: a positive number or a texture; [`DEFAULT_ALPHA`] when absent.
+fn alpha(
+    ctx: &mut Ctx,
+    d: &MaterialDesc,
+    v: &Option<toml::Spanned<toml::Value>>,
+) -> Result<Param<f32>> {
+    let Some(v) = v else {
+        return Ok(Param::Const(DEFAULT_ALPHA));
+    };
+    let name = d.name.get_ref();
+    match param_desc::scalar(ctx, name, "alpha", v)? {
+        Param::Const(a) if !(a.is_finite() && a > 0.0) => Err(ctx.src.error_at(
+            v.span(),
+            format!("material \"{name}\": roughness must be a positive number, got {a}"),
+        )),
+        p => Ok(p),
+    }
+}
+
+/// A colour key: `[r, g, b]` or a texture; white when absent.
+fn colour(
+    ctx: &mut Ctx,
+    d: &MaterialDesc,
+    v: &Option<toml::Spanned<toml::Value>>,
+    key: &str,
+) -> Result<Param<Rgb>> {
+    match v {
+        None => Ok(Param::Const(Rgb::ONE)),
+        Some(v) => param_desc::colour(ctx, d.name.get_ref(), key, v),
+    }
 }
 
 /// An index of refraction: a positive number or one of Mitsuba's names; `default` when absent.

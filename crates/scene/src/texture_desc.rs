@@ -1,14 +1,19 @@
 //! A material's texture keys. A texture is a file name, or a table
 //! `{ file = "...", filter = "bilinear" | "nearest", wrap = "repeat" | "mirror" | "clamp",
 //! raw = false }` (Mitsuba's `bitmap` options; `raw` reads the values as linear data instead of
-//! sRGB colours). `bump_map` (with `bump_scale`, default 1) and `normal_map` bend the shading
-//! normal ([`rt_core::bump`]); a normal map is raw unless it says otherwise.
+//! sRGB colours), or Mitsuba's checkerboard `{ type = "checkerboard", color0 = 0.4,
+//! color1 = 0.2, to_uv = [[a, b, c], [d, e, f]] }` (colours a number or `[r, g, b]`; `to_uv`
+//! maps `(u, v)` to `(a·u + b·v + c, d·u + e·v + f)`, the identity by default).
+//! `bump_map` (with `bump_scale`, default 1) and `normal_map` bend the shading normal
+//! ([`rt_core::bump`]); a normal map is raw unless it says otherwise.
 
 use std::ops::Range;
 use std::path::PathBuf;
 
 use rt_core::bump::NormalPerturbation;
-use rt_core::texture::{Filter, Wrap};
+use rt_core::glam::Affine2;
+use rt_core::texture::{Filter, Texture, Wrap};
+use rt_core::Rgb;
 use toml::{Spanned, Value};
 
 use crate::desc::MaterialDesc;
@@ -18,18 +23,90 @@ use crate::load::Ctx;
 
 /// Loads the texture `v` names for material `name`; `raw` is the default of its `raw` key.
 pub(crate) fn load(ctx: &mut Ctx, name: &str, v: &Spanned<Value>, raw: bool) -> Result<u32> {
+    if let Some(t) = v.get_ref().as_table().filter(|t| t.contains_key("type")) {
+        let texture = checkerboard(t).map_err(|e| {
+            ctx.src
+                .error_at(v.span(), format!("material \"{name}\": {e}"))
+        })?;
+        return Ok(ctx.textures.add(texture));
+    }
     let (path, options) = read(ctx, name, v, raw)?;
     ctx.textures.load(&path, options)
 }
 
+/// A `{ type = "checkerboard", ... }` table (the only texture type besides files).
+fn checkerboard(t: &toml::Table) -> std::result::Result<Texture, String> {
+    let mut colors = [Rgb::splat(0.4), Rgb::splat(0.2)];
+    let mut to_uv = Affine2::IDENTITY;
+    for (key, value) in t {
+        match key.as_str() {
+            "type" => match value.as_str() {
+                Some("checkerboard") => {}
+                Some(other) => {
+                    return Err(format!(
+                        "texture type \"{other}\" is not supported (checkerboard is; an image \
+                         is a file name or {{ file = ... }})"
+                    ))
+                }
+                None => return Err("texture `type` must be a string".into()),
+            },
+            "color0" | "color1" => {
+                let c = colour(value).ok_or_else(|| {
+                    format!("checkerboard `{key}` must be a number or [r, g, b] in [0, 1]")
+                })?;
+                colors[(key == "color1") as usize] = c;
+            }
+            "to_uv" => {
+                to_uv = affine(value).ok_or_else(|| {
+                    "checkerboard `to_uv` must be [[a, b, c], [d, e, f]] of finite numbers"
+                        .to_string()
+                })?
+            }
+            other => {
+                return Err(format!(
+                    "unknown checkerboard key `{other}` (the keys are type, color0, color1, to_uv)"
+                ))
+            }
+        }
+    }
+    Ok(Texture::checkerboard(colors[0], colors[1], to_uv))
+}
+
+fn number(v: &Value) -> Option<f32> {
+    let x = match v {
+        Value::Float(x) => *x as f32,
+        Value::Integer(i) => *i as f32,
+        _ => return None,
+    };
+    x.is_finite().then_some(x)
+}
+
+/// A reflectance: a number or `[r, g, b]`, each in [0, 1].
+fn colour(v: &Value) -> Option<Rgb> {
+    let c = match v {
+        Value::Array(a) if a.len() == 3 => Rgb::new(number(&a[0])?, number(&a[1])?, number(&a[2])?),
+        other => Rgb::splat(number(other)?),
+    };
+    (c.min_element() >= 0.0 && c.max_element() <= 1.0).then_some(c)
+}
+
+/// `[[a, b, c], [d, e, f]]`: `(u, v) ↦ (a·u + b·v + c, d·u + e·v + f)`.
+fn affine(v: &Value) -> Option<Affine2> {
+    let rows = v.as_array().filter(|r| r.len() == 2)?;
+    let mut m = [[0.0f32; 3]; 2];
+    for (row, r) in m.iter_mut().zip(rows) {
+        let r = r.as_array().filter(|r| r.len() == 3)?;
+        for (x, y) in row.iter_mut().zip(r) {
+            *x = number(y)?;
+        }
+    }
+    let [[a, b, c], [d, e, f]] = m;
+    Some(Affine2::from_cols_array(&[a, d, b, e, c, f]))
+}
+
 /// The file (resolved against the scene's directory) and options of texture value `v` of
 /// material `name`.
-pub(crate) fn read(
-    ctx: &Ctx,
-    name: &str,
-    v: &Spanned<Value>,
-    raw: bool,
-) -> Result<(PathBuf, TextureOptions)> {
+fn read(ctx: &Ctx, name: &str, v: &Spanned<Value>, raw: bool) -> Result<(PathBuf, TextureOptions)> {
     let (file, options) = parse(v.get_ref(), raw).map_err(|e| {
         ctx.src
             .error_at(v.span(), format!("material \"{name}\": {e}"))

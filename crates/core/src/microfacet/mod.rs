@@ -19,6 +19,7 @@ mod fresnel;
 pub mod named;
 mod plastic;
 mod rough_plastic;
+mod textured;
 mod thin;
 
 pub use conductor::RoughConductor;
@@ -27,6 +28,7 @@ pub use distribution::{Distribution, DistributionKind, MIN_ALPHA};
 pub use fresnel::fresnel_conductor;
 pub use plastic::{fresnel_diffuse_reflectance, Plastic};
 pub use rough_plastic::RoughPlastic;
+pub use textured::{ParamTextures, ParamValues};
 pub use thin::ThinDielectric;
 
 use crate::Rgb;

@@ -48,7 +48,7 @@ pub(super) struct Vertex<'a> {
     /// The BSDF for `wo` (surfaces).
     pub bsdf: Option<Bsdf<'a>>,
     pub material: Option<&'a Material>,
-    pub tint: Rgb,
+    pub tint: rt_core::tint::Tint,
     /// Triangle index (surfaces and emitters), for the light sampler's pdf.
     pub prim: u32,
     /// Radiance the emitter leaves (light vertices).
@@ -78,7 +78,7 @@ impl<'a> Vertex<'a> {
             delta: false,
             bsdf: None,
             material: None,
-            tint: Rgb::ONE,
+            tint: rt_core::tint::Tint::NONE,
             prim: u32::MAX,
             emission: Rgb::ZERO,
             two_sided: false,

@@ -29,7 +29,7 @@ pub(super) struct EyeVertex {
     /// Throughput from the camera, the choice of the diffuse part included (`1 / p_D`).
     pub beta: Rgb,
     pub material: u32,
-    pub tint: Rgb,
+    pub tint: rt_core::tint::Tint,
     /// Radius of its caustic-histogram bin: half the pixel footprint at this distance.
     pub radius: f32,
     /// Scattering vertices of the eye path, this one included.

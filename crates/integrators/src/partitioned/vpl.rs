@@ -18,6 +18,9 @@ use rt_core::{
 
 /// What a VPL is.
 #[derive(Clone)]
+// Most VPLs are surface points, which hold their BSDF (with its textured parameters) inline:
+// boxing it would allocate per VPL for no memory saved.
+#[allow(clippy::large_enum_variant)]
 pub(super) enum Source<'a> {
     /// A point on an emissive triangle: radiance `le` to the front (both faces if two-sided).
     Emitter { le: Rgb, two_sided: bool },

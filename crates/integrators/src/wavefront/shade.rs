@@ -67,7 +67,7 @@ impl Shader<'_> {
         }
         let tint = scene.tint(material, si.uv);
         if !first_hit_wanted {
-            if let Some(f) = material.plain_lambert(tint) {
+            if let Some(f) = material.plain_lambert(tint.color) {
                 // The BSDF stage runs for all such vertices at once (`LambertQueue::run`);
                 // `finish_lambert` takes the path on from its result.
                 let light = if self.use_nee {

@@ -1,7 +1,8 @@
 //! Mitsuba BSDFs as `[[material]]` tables of our format: `diffuse` and the microfacet family
 //! keep their names and parameters (docs/scene-format.md, "The microfacet family"),
-//! `plastic` becomes our `smoothplastic`, `twosided` a flag on what it wraps, `bumpmap` and
-//! `normalmap` the keys `bump_map` (with `bump_scale`) and `normal_map` on what they wrap.
+//! `plastic` becomes our `smoothplastic`, `twosided` a flag on what it wraps, `mask` the key
+//! `opacity` on what it wraps, `bumpmap` and `normalmap` the keys `bump_map` (with
+//! `bump_scale`) and `normal_map` on what they wrap.
 
 use toml::{Table, Value};
 
@@ -17,23 +18,27 @@ pub(super) struct Converted {
     pub textures: Vec<TextureKey>,
 }
 
-/// A texture key of a material table: a `bitmap`'s file and its options
-/// (docs/scene-format.md, "Textures").
+/// A texture key of a material table: a `bitmap`'s file and its options, or a
+/// `checkerboard` table (docs/scene-format.md, "Textures").
 pub(super) struct TextureKey {
-    /// The material key (`texture`, `bump_map`, `normal_map`).
+    /// The material key (`texture`, `bump_map`, `normal_map`, or a textured parameter's name).
     pub key: &'static str,
-    file: String,
+    /// The bitmap's file; `None` for a checkerboard, which is `options` alone.
+    file: Option<String>,
     options: Table,
 }
 
 impl TextureKey {
     /// The key's value, with the file name as `file_name` maps it.
     pub fn value(&self, file_name: &dyn Fn(&str) -> String) -> Value {
+        let Some(file) = &self.file else {
+            return Value::Table(self.options.clone());
+        };
         if self.options.is_empty() {
-            return file_name(&self.file).into();
+            return file_name(file).into();
         }
         let mut t = self.options.clone();
-        t.insert("file".into(), file_name(&self.file).into());
+        t.insert("file".into(), file_name(file).into());
         Value::Table(t)
     }
 }
@@ -78,7 +83,11 @@ fn wrapped_one<'a>(
 ) -> Result<&'a Node, SceneError> {
     let mut inner: Vec<&'a Node> = p.objects("bsdf");
     for r in p.refs() {
-        inner.push(resolve(r)?);
+        // A `<ref>` to a texture is a parameter, read by name.
+        let n = resolve(r)?;
+        if n.tag == "bsdf" {
+            inner.push(n);
+        }
     }
     match inner.as_slice() {
         [one] => Ok(one),
@@ -110,6 +119,26 @@ fn convert_in<'a>(
                 ..wrapped
             };
             return convert_in(one, resolve, inner, warnings);
+        }
+        "mask" => {
+            // Mitsuba's default opacity is 0.5.
+            let (texture_key, opacity) = match p.named_texture("opacity", resolve)? {
+                Some(tex) => (Some(texture(tex, "opacity", warnings)?), 0.5),
+                None => (None, p.float("opacity")?.unwrap_or(0.5)),
+            };
+            let one = wrapped_one(&p, resolve)?;
+            p.finish(warnings)?;
+            let mut c = convert_in(one, resolve, wrapped, warnings)?;
+            if c.table.contains_key("opacity") || c.textures.iter().any(|t| t.key == "opacity") {
+                return Err(node.at.error("a mask inside a mask is not supported"));
+            }
+            match texture_key {
+                Some(t) => c.textures.push(t),
+                None => {
+                    c.table.insert("opacity".into(), opacity.into());
+                }
+            }
+            return Ok(c);
         }
         "bumpmap" | "normalmap" => {
             let one = wrapped_one(&p, resolve)?;
@@ -147,7 +176,7 @@ fn convert_in<'a>(
             } else {
                 "normal_map"
             };
-            c.textures.push(bitmap(map, key, warnings)?);
+            c.textures.push(texture(map, key, warnings)?);
             if let Some(s) = scale {
                 c.table.insert("bump_scale".into(), s.into());
             }
@@ -155,7 +184,7 @@ fn convert_in<'a>(
         }
         "diffuse" => {
             t.insert("type".into(), "diffuse".into());
-            match p.color("reflectance", Role::Reflectance)? {
+            match colour(&p, "reflectance", resolve)? {
                 None => {
                     t.insert("color".into(), rgb([0.5; 3]));
                 }
@@ -163,7 +192,7 @@ fn convert_in<'a>(
                     t.insert("color".into(), rgb(c));
                 }
                 Some(Color::Texture(tex)) => {
-                    textures.push(bitmap(tex, "texture", warnings)?);
+                    textures.push(texture(tex, "texture", warnings)?);
                     t.insert("color".into(), rgb([1.0; 3]));
                 }
             }
@@ -172,7 +201,14 @@ fn convert_in<'a>(
         }
         "conductor" | "roughconductor" => {
             t.insert("type".into(), ty.into());
-            rough(&p, &mut t, ty == "roughconductor")?;
+            rough(
+                &p,
+                &mut t,
+                &mut textures,
+                ty == "roughconductor",
+                resolve,
+                warnings,
+            )?;
             if let Some(m) = p.string("material")? {
                 t.insert("material".into(), m.into());
             }
@@ -181,17 +217,32 @@ fn convert_in<'a>(
                     t.insert(key.into(), rgb(c));
                 }
             }
-            reflectance(&p, &mut t, "specular_reflectance")?;
+            reflectance(
+                &p,
+                &mut t,
+                &mut textures,
+                "specular_reflectance",
+                resolve,
+                warnings,
+            )?;
             if two_sided {
                 t.insert("two_sided".into(), true.into());
             }
         }
         "dielectric" | "thindielectric" | "roughdielectric" => {
             t.insert("type".into(), ty.into());
-            rough(&p, &mut t, ty == "roughdielectric")?;
+            rough(
+                &p,
+                &mut t,
+                &mut textures,
+                ty == "roughdielectric",
+                resolve,
+                warnings,
+            )?;
             iors(&p, &mut t)?;
-            reflectance(&p, &mut t, "specular_reflectance")?;
-            reflectance(&p, &mut t, "specular_transmittance")?;
+            for key in ["specular_reflectance", "specular_transmittance"] {
+                reflectance(&p, &mut t, &mut textures, key, resolve, warnings)?;
+            }
         }
         "plastic" | "roughplastic" => {
             let rough_one = ty == "roughplastic";
@@ -204,16 +255,23 @@ fn convert_in<'a>(
                 }
                 .into(),
             );
-            rough(&p, &mut t, rough_one)?;
+            rough(&p, &mut t, &mut textures, rough_one, resolve, warnings)?;
             iors(&p, &mut t)?;
-            reflectance(&p, &mut t, "specular_reflectance")?;
-            match p.color("diffuse_reflectance", Role::Reflectance)? {
+            reflectance(
+                &p,
+                &mut t,
+                &mut textures,
+                "specular_reflectance",
+                resolve,
+                warnings,
+            )?;
+            match colour(&p, "diffuse_reflectance", resolve)? {
                 None => {}
                 Some(Color::Rgb(c)) => {
                     t.insert("diffuse_reflectance".into(), rgb(c));
                 }
                 Some(Color::Texture(tex)) => {
-                    textures.push(bitmap(tex, "texture", warnings)?);
+                    textures.push(texture(tex, "texture", warnings)?);
                     t.insert("diffuse_reflectance".into(), rgb([1.0; 3]));
                 }
             }
@@ -228,7 +286,7 @@ fn convert_in<'a>(
             return Err(node.at.error(format!(
             "bsdf \"{other}\" is not supported (supported: diffuse, dielectric, thindielectric, \
                  roughdielectric, conductor, roughconductor, plastic, roughplastic, twosided, \
-                 bumpmap, normalmap)"
+                 mask, bumpmap, normalmap)"
         )))
         }
     }
@@ -236,20 +294,50 @@ fn convert_in<'a>(
     Ok(Converted { table: t, textures })
 }
 
+/// A colour parameter: a constant, a nested texture or a `<ref>` to one.
+fn colour<'a>(
+    p: &Props<'a>,
+    key: &str,
+    resolve: &dyn Fn(&'a Node) -> Result<&'a Node, SceneError>,
+) -> Result<Option<Color<'a>>, SceneError> {
+    match p.named_texture(key, resolve)? {
+        Some(t) => Ok(Some(Color::Texture(t))),
+        None => p.color(key, Role::Reflectance),
+    }
+}
+
 fn rgb(c: [f64; 3]) -> Value {
     Value::Array(c.iter().map(|&v| Value::Float(v)).collect())
 }
 
-/// A constant reflectance parameter copied under the same name.
-fn reflectance(p: &Props, t: &mut Table, key: &str) -> Result<(), SceneError> {
-    if let Some(c) = p.rgb(key, Role::Reflectance)? {
+/// A reflectance parameter copied under the same name: a constant, or a texture (nested or
+/// `<ref>`).
+fn reflectance<'a>(
+    p: &Props<'a>,
+    t: &mut Table,
+    textures: &mut Vec<TextureKey>,
+    key: &'static str,
+    resolve: &dyn Fn(&'a Node) -> Result<&'a Node, SceneError>,
+    warnings: &mut Vec<String>,
+) -> Result<(), SceneError> {
+    if let Some(tex) = p.named_texture(key, resolve)? {
+        textures.push(texture(tex, key, warnings)?);
+    } else if let Some(c) = p.rgb(key, Role::Reflectance)? {
         t.insert(key.into(), rgb(c));
     }
     Ok(())
 }
 
-/// `distribution`, `alpha` or `alpha_u` and `alpha_v` of the rough ones.
-fn rough(p: &Props, t: &mut Table, is_rough: bool) -> Result<(), SceneError> {
+/// `distribution`, `alpha` or `alpha_u` and `alpha_v` of the rough ones (numbers or
+/// textures).
+fn rough<'a>(
+    p: &Props<'a>,
+    t: &mut Table,
+    textures: &mut Vec<TextureKey>,
+    is_rough: bool,
+    resolve: &dyn Fn(&'a Node) -> Result<&'a Node, SceneError>,
+    warnings: &mut Vec<String>,
+) -> Result<(), SceneError> {
     if !is_rough {
         return Ok(());
     }
@@ -257,7 +345,9 @@ fn rough(p: &Props, t: &mut Table, is_rough: bool) -> Result<(), SceneError> {
         t.insert("distribution".into(), d.into());
     }
     for key in ["alpha", "alpha_u", "alpha_v"] {
-        if let Some(v) = p.float(key)? {
+        if let Some(tex) = p.named_texture(key, resolve)? {
+            textures.push(texture(tex, key, warnings)?);
+        } else if let Some(v) = p.float(key)? {
             t.insert(key.into(), v.into());
         }
     }
@@ -281,6 +371,49 @@ fn iors(p: &Props, t: &mut Table) -> Result<(), SceneError> {
     Ok(())
 }
 
+/// A texture as material key `key`: a `bitmap` or a `checkerboard`.
+fn texture(
+    tex: &Node,
+    key: &'static str,
+    warnings: &mut Vec<String>,
+) -> Result<TextureKey, SceneError> {
+    match tex.plugin()? {
+        "bitmap" => bitmap(tex, key, warnings),
+        "checkerboard" => checkerboard(tex, key, warnings),
+        other => Err(Props::new(tex).error(format!(
+            "texture \"{other}\" is not supported (bitmap and checkerboard are)"
+        ))),
+    }
+}
+
+/// A `checkerboard`: its constant colours (Mitsuba's defaults 0.4 and 0.2) and the 2-D part
+/// of `to_uv` (`(u, v) ↦ (m00·u + m01·v + m03, m10·u + m11·v + m13)`, as Mitsuba 3.9 reads
+/// it).
+fn checkerboard(
+    tex: &Node,
+    key: &'static str,
+    warnings: &mut Vec<String>,
+) -> Result<TextureKey, SceneError> {
+    let p = Props::new(tex);
+    let mut options = Table::new();
+    options.insert("type".into(), "checkerboard".into());
+    for c in ["color0", "color1"] {
+        if let Some(v) = p.rgb(c, Role::Reflectance)? {
+            options.insert(c.into(), rgb(v));
+        }
+    }
+    if let Some(m) = p.transform("to_uv")? {
+        let row = |r: usize| rgb([m.col(0)[r], m.col(1)[r], m.col(3)[r]]);
+        options.insert("to_uv".into(), Value::Array(vec![row(0), row(1)]));
+    }
+    p.finish(warnings)?;
+    Ok(TextureKey {
+        key,
+        file: None,
+        options,
+    })
+}
+
 /// A `bitmap` texture as material key `key`: its file and the options it sets (Mitsuba's
 /// defaults are ours: bilinear, repeat, sRGB).
 fn bitmap(
@@ -289,9 +422,6 @@ fn bitmap(
     warnings: &mut Vec<String>,
 ) -> Result<TextureKey, SceneError> {
     let p = Props::new(tex);
-    if tex.plugin()? != "bitmap" {
-        return Err(p.error("only bitmap textures are supported"));
-    }
     let file = p
         .string("filename")?
         .ok_or_else(|| p.error("has no filename"))?
@@ -324,5 +454,9 @@ fn bitmap(
         options.insert("raw".into(), raw.into());
     }
     p.finish(warnings)?;
-    Ok(TextureKey { key, file, options })
+    Ok(TextureKey {
+        key,
+        file: Some(file),
+        options,
+    })
 }

@@ -197,6 +197,32 @@ impl<'a> Props<'a> {
         out
     }
 
+    /// Parameter `name` when it is a texture: a nested `<texture name="...">` or a
+    /// `<ref name="..." id="...">` to one (resolved by `resolve`), marked read; `None` when the
+    /// parameter is absent or a constant.
+    pub fn named_texture(
+        &self,
+        name: &str,
+        resolve: &dyn Fn(&'a Node) -> Result<&'a Node, SceneError>,
+    ) -> Result<Option<&'a Node>, SceneError> {
+        let node = self.node;
+        let Some((i, c)) = node.children.iter().enumerate().find(|(_, c)| {
+            c.attr("name") == Some(name) && matches!(c.tag.as_str(), "texture" | "ref")
+        }) else {
+            return Ok(None);
+        };
+        self.read.borrow_mut()[i] = true;
+        let t = if c.tag == "ref" { resolve(c)? } else { c };
+        if t.tag != "texture" {
+            return Err(c.at.error(format!(
+                "{}: `{name}` refers to a <{}>, expected a <texture>",
+                self.what(),
+                t.tag
+            )));
+        }
+        Ok(Some(t))
+    }
+
     /// Accepts parameter `name` without using it, with a warning saying why.
     pub fn ignore(&self, name: &str, why: &str) {
         if let Some((_, c)) = self.find(name) {
