@@ -53,7 +53,7 @@
 //! use rt_accel::AccelSpec;
 //! use rt_core::{glam::Vec3, Ray};
 //! let triangles = [[Vec3::ZERO, Vec3::X, Vec3::Y]];
-//! let accel = AccelSpec::default().build(&triangles);
+//! let accel = AccelSpec::default().build(&triangles).expect("a bvh8 holds one triangle");
 //! assert_eq!(accel.name(), "bvh8");
 //! let hit = accel.intersect(&Ray::new(Vec3::new(0.2, 0.2, 1.0), -Vec3::Z), f32::INFINITY);
 //! assert_eq!(hit.map(|h| h.t), Some(1.0));
@@ -65,6 +65,7 @@
 
 pub mod bench;
 pub mod brute_force;
+pub mod build_input;
 pub mod bvh2;
 pub mod crack_free;
 pub mod grid;
@@ -77,6 +78,7 @@ pub mod two_level;
 pub mod wide;
 
 pub use brute_force::BruteForce;
+pub use build_input::BuildInput;
 pub use grid::{GridError, IrregularGrid, IrregularGridParams, UniformGrid, UniformGridParams};
 
 /// A structure that breaks one of its invariants (found by its `validate`, which the tests and
