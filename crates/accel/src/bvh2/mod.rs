@@ -22,10 +22,9 @@ pub use node::Node;
 pub use split::{split_pieces, split_references};
 pub use stats::BvhStats;
 
-use crate::traversal::with_counter;
 use build::Config;
 use glam::Vec3;
-use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
+use rt_core::{Aabb, Accel};
 
 /// Knobs of [`Bvh2::build`]. Out-of-range values are clamped rather than rejected.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -145,26 +144,7 @@ impl Accel for Bvh2 {
         "bvh"
     }
 
-    fn closest_hit(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        counters: Option<&mut TraversalCounters>,
-    ) -> Option<Hit> {
-        with_counter!(counters, |c| self.traverse::<false, _>(ray, t_max, c))
-    }
-
-    fn any_hit(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        _toward: Option<Vec3>,
-        counters: Option<&mut TraversalCounters>,
-    ) -> bool {
-        with_counter!(counters, |c| self
-            .traverse::<true, _>(ray, t_max, c)
-            .is_some())
-    }
+    crate::traversal::queries_by_traverse!();
 
     fn bounds(&self) -> Aabb {
         self.nodes.first().map_or(Aabb::EMPTY, Node::aabb)
