@@ -3,7 +3,7 @@
 //! The tree is stored depth-first in one array of 32-byte [`Node`]s with the two children of
 //! every inner node side by side. The triangles are copied in leaf order, so a leaf's triangles
 //! are contiguous in memory, and [`Bvh2::prim_ids`] maps each copy back to the caller's index,
-//! which is what [`Hit::prim`] reports.
+//! which is what [`Hit::prim`](rt_core::Hit::prim) reports.
 //!
 //! With [`BuildParams::split`] the builder partitions pieces of triangles rather than triangles
 //! (see [`split_references`]), so a triangle can fill several leaf slots; each slot still holds
@@ -11,15 +11,15 @@
 
 pub(crate) mod build;
 mod compact;
+mod evh_split;
 mod node;
-mod split;
 mod stats;
 mod traverse;
 mod validate;
 
 pub use build::MAX_BINS;
+pub use evh_split::{split_pieces, split_references};
 pub use node::Node;
-pub use split::{split_pieces, split_references};
 pub use stats::BvhStats;
 
 use build::Config;
@@ -95,7 +95,7 @@ pub struct Bvh2 {
 }
 
 impl Bvh2 {
-    /// Builds the hierarchy over `triangles`, whose indices become [`Hit::prim`]. Any input is
+    /// Builds the hierarchy over `triangles`, whose indices become [`Hit::prim`](rt_core::Hit::prim). Any input is
     /// accepted: empty, degenerate, duplicated or huge triangles. Infinite coordinates build
     /// without panicking but are of course never hit sensibly.
     ///

@@ -2,7 +2,7 @@
 //! orders, with or without entry distances on the stack.
 
 use super::bvh::{slot_of, Isa, WideNode};
-use super::node::{leaf_parts, EMPTY, LEAF_BIT};
+use super::qbvh_node::{leaf_parts, EMPTY, LEAF_BIT};
 #[cfg(target_arch = "x86_64")]
 use super::tri4::intersect8_avx2;
 use super::tri4::{intersect4, RayPrecomp4};
@@ -579,8 +579,8 @@ impl<N: WideNode> WideBvh<N> {
 mod tests {
     use super::*;
     use crate::wide::bvh::WideNode;
-    use crate::wide::node::{leaf_code, QNode, NO_PARENT};
-    use crate::wide::node8::Node8;
+    use crate::wide::bvh8_node::Node8;
+    use crate::wide::qbvh_node::{leaf_code, QNode, NO_PARENT};
     use glam::Vec3;
 
     #[test]

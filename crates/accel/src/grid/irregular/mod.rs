@@ -104,7 +104,7 @@ fn unpack(b: &VBox) -> ([u32; 3], [u32; 3]) {
 }
 
 impl IrregularGrid {
-    /// Builds the grid over `triangles`, whose indices become [`Hit::prim`]. Any triangles are
+    /// Builds the grid over `triangles`, whose indices become [`Hit::prim`](rt_core::Hit::prim). Any triangles are
     /// accepted; those with a non-finite vertex are never hit.
     pub fn build(triangles: &[[Vec3; 3]], params: &IrregularGridParams) -> Result<Self, GridError> {
         build::build(triangles, params)

@@ -39,7 +39,7 @@ pub struct UniformGrid {
 }
 
 impl UniformGrid {
-    /// Builds the grid over `triangles`, whose indices become [`Hit::prim`]. Any triangles are
+    /// Builds the grid over `triangles`, whose indices become [`Hit::prim`](rt_core::Hit::prim). Any triangles are
     /// accepted; those with a non-finite vertex are never hit.
     pub fn build(triangles: &[[Vec3; 3]], params: &UniformGridParams) -> Result<Self, GridError> {
         check_count(triangles.len())?;
