@@ -21,7 +21,7 @@ pub struct FilmBuffers {
     /// Sums and counts of the even-numbered samples, from which the odd ones follow (64 bytes
     /// per pixel).
     pub halves: bool,
-    /// Every camera sample kept apart ([`SampleRecords`], 56 bytes per sample): radiance,
+    /// Every camera sample kept apart ([`SampleRecords`](crate::SampleRecords), 56 bytes per sample): radiance,
     /// first-hit guides and circle of confusion, for sample-space filters (SBMF). The render
     /// driver (`rt_integrators::render_samples`) fills them from camera samples; light-path
     /// splats belong to no pixel's samples and are not recorded.
@@ -51,7 +51,7 @@ impl FilmBuffers {
         self
     }
 
-    /// Also keep every sample's record ([`Film::sample_records`]).
+    /// Also keep every sample's record ([`Film::sample_records`](crate::Film::sample_records)).
     pub fn with_samples(mut self) -> Self {
         self.samples = true;
         self
@@ -97,7 +97,7 @@ pub struct FilmMemory {
 impl FilmMemory {
     /// What `Film::new(width, height, buffers)` holds once every pixel has
     /// `samples_per_pixel` samples (per-sample records grow with them) and, with `splats`,
-    /// after the first light-path splat: the sizes [`Film::memory`] reports, computed without
+    /// after the first light-path splat: the sizes [`Film::memory`](crate::Film::memory) reports, computed without
     /// allocating, so that a render that cannot fit is refused before it starts.
     pub fn estimate(
         width: u32,
