@@ -1,10 +1,10 @@
 //! `render`: the command-line front end. It parses arguments (clap), calls the libraries and
-//! prints. `render SCENE` turns its flags into an `rt_session::RenderJob` and runs it
-//! (`render.rs`); `plan`, `part` and `merge` (`parts.rs`) cut, run and merge jobs; `reference`,
-//! `experiment`, `compare`, `bench-accel` and `bench-anim` call `rt-experiment`; `stress` calls
-//! `rt-validate`; `view` (`view/`) drives an `rt_session::viewer::LiveView` from a window or
-//! headless. Libraries return typed errors; this turns them into one line on stderr and a
-//! non-zero exit code (2 for usage errors, 1 for everything else).
+//! prints. `render SCENE` runs an `rt_session::RenderJob` (`render.rs`); `plan`, `part`, `merge`
+//! (`parts.rs`) cut, run and merge jobs; `reference`, `experiment`, `compare`, `bench-accel`,
+//! `bench-anim` call `rt-experiment`; `denoise` (`denoise.rs`) filters a saved frame, `convert`
+//! a Mitsuba scene, `gen-scene` writes a procedural scene as OBJ, `stress` calls `rt-validate`,
+//! `view` (`view/`) drives an `rt_session::viewer::LiveView`. Libraries return typed errors;
+//! this prints one line on stderr and exits non-zero (2 for usage errors, 1 otherwise).
 
 mod args;
 mod bench_accel;

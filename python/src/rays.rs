@@ -46,7 +46,7 @@ impl Accel {
         let tris = triangle_list(triangles, indices)?;
         let pool = rt_session::job::thread_pool(threads).map_err(rt_err)?;
         let accel = py
-            .detach(|| pool.install(|| parsed.try_build(&tris)))
+            .detach(|| pool.install(|| parsed.build(&tris)))
             .map_err(|e| rt_err(format!("accel={spec}: {e}")))?;
         Ok(Accel {
             accel,

@@ -81,7 +81,9 @@ transform = {{ translate = [{}, 0, {}], rotate = [0, {}, 0], scale = [1.6, 0.8, 
 }
 
 fn render(scene: &rt_core::Scene, kind: AccelKind, seed: u32) -> rt_film::Film {
-    let accel = AccelSpec::new(kind).build_scene(scene);
+    let accel = AccelSpec::new(kind)
+        .build(scene)
+        .expect("the structure builds over the scene");
     Renderer::new(scene)
         .with_accel(accel.as_ref())
         .threads(2)

@@ -99,7 +99,9 @@ fn shadows_on_a_sliver_fan_ground_follow_the_geometry() {
     let scene = scene_from_toml(SCENE);
     let band = 0.05;
     for kind in AccelKind::ALL {
-        let accel = AccelSpec::new(kind).build(&scene.triangles);
+        let accel = AccelSpec::new(kind)
+            .build(&scene.triangles)
+            .expect("the structure builds");
         let (mut checked, mut shadowed, mut wrong) = (0, 0, Vec::new());
         // Ground points on a grid around both blocks, seen from straight above.
         for i in 0..120 {

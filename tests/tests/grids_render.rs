@@ -43,11 +43,7 @@ fn grids_render_the_default_structures_image() {
             "{name}: only {lit} pixels lit"
         );
         for spec in ["grid", "irregular-grid"] {
-            let accel = spec
-                .parse::<AccelSpec>()
-                .unwrap()
-                .try_build_scene(&scene)
-                .unwrap();
+            let accel = spec.parse::<AccelSpec>().unwrap().build(&scene).unwrap();
             let got = image(&scene, accel.as_ref());
             let differing = got
                 .chunks(3)

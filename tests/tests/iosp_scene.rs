@@ -26,12 +26,14 @@ fn render(scene: &rt_core::Scene, accel: &dyn rt_core::Accel, seed: u32) -> rt_f
 #[test]
 fn iosp_renders_the_flat_bvh_image_from_a_reordered_scene() {
     let scene = shipped_scene("cornell-box.toml").with_resolution(32, 32);
-    let flat = AccelSpec::new(AccelKind::Bvh8).build_scene(&scene);
+    let flat = AccelSpec::new(AccelKind::Bvh8)
+        .build(&scene)
+        .expect("the structure builds over the scene");
     let reference = render(&scene, flat.as_ref(), 1);
     for kind in [AccelKind::Iosp0, AccelKind::Iosp4, AccelKind::Iosp2] {
         let mut permuted = scene.clone();
         let accel = AccelSpec::new(kind)
-            .try_build_scene_mut(&mut permuted)
+            .build(rt_accel::BuildInput::SceneToReorder(&mut permuted))
             .unwrap();
         assert_ne!(
             permuted.triangles, scene.triangles,
@@ -56,7 +58,9 @@ fn an_instanced_scene_keeps_its_order_and_renders_through_the_index_map() {
         .unwrap()
         .with_resolution(24, 16);
     scene.set_time(1.0);
-    let flat = AccelSpec::new(AccelKind::Bvh8).build_scene(&scene);
+    let flat = AccelSpec::new(AccelKind::Bvh8)
+        .build(&scene)
+        .expect("the structure builds over the scene");
     let reference = render(&scene, flat.as_ref(), 1);
     assert!(
         rt_testkit::stats::image_mean(&reference).0 > 0.01,
@@ -64,7 +68,7 @@ fn an_instanced_scene_keeps_its_order_and_renders_through_the_index_map() {
     );
     let mut kept = scene.clone();
     let accel = AccelSpec::new(AccelKind::Iosp0)
-        .try_build_scene_mut(&mut kept)
+        .build(rt_accel::BuildInput::SceneToReorder(&mut kept))
         .unwrap();
     assert_eq!(
         kept.triangles, scene.triangles,

@@ -69,7 +69,9 @@ fn estimate(film: &rt_film::Film) -> Estimate {
 }
 
 fn render(scene: &Scene, kind: AccelKind, spp: u32, seed: u32) -> Estimate {
-    let accel = AccelSpec::new(kind).build_scene(scene);
+    let accel = AccelSpec::new(kind)
+        .build(scene)
+        .expect("the structure builds over the scene");
     let buffers = FilmBuffers::from(AovSet::default()).with_variance();
     let (film, _) = Renderer::new(scene)
         .with_accel(accel.as_ref())

@@ -114,7 +114,9 @@ max = [2.0, 0.5, 1.0]
 material = "m"
 "#,
     );
-    let accel = rt_accel::AccelSpec::new(rt_accel::AccelKind::Bvh8).build(&scene.triangles);
+    let accel = rt_accel::AccelSpec::new(rt_accel::AccelKind::Bvh8)
+        .build(&scene.triangles)
+        .expect("the default structure builds");
     let bounds = accel.bounds();
     let size = bounds.extent();
     let faces = Vec3::new(size.y * size.z, size.x * size.z, size.x * size.y);

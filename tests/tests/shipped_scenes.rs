@@ -67,7 +67,10 @@ fn render(path: &Path, technique: &str, camera: Option<&str>) -> Result<Film, St
         .map_err(|e| e.to_string())?;
     let camera = ImageSize::Pixels(SIZE.0, SIZE.1)
         .apply(pick_camera(&loaded.scene, path, camera).map_err(|e| e.to_string())?);
-    let accel = settings.accel.build_scene(&loaded.scene);
+    let accel = settings
+        .accel
+        .build(&loaded.scene)
+        .expect("the structure builds over the scene");
     let integrator = settings.integrator.build();
     let session = Session {
         ctx: Ctx {

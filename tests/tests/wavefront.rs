@@ -145,7 +145,9 @@ fn wavefront_images_are_the_scalar_images_under_motion_blur() {
     scene.set_time(1.0);
     scene.shutter = 0.5;
     assert!(scene.is_motion_blurred(&scene.cameras[0].name));
-    let accel = AccelSpec::new(AccelKind::TwoLevel).build_scene(&scene);
+    let accel = AccelSpec::new(AccelKind::TwoLevel)
+        .build(&scene)
+        .expect("the structure builds over the scene");
     let r = Renderer::new(&scene).with_accel(accel.as_ref()).threads(2);
     let want = contents(&render(&r, &scalar(8), &[pass(0..4)], 3));
     let w = Wavefront::new(PathIntegrator::new(8), 32);

@@ -37,7 +37,13 @@ fn main() {
     };
     let mut structures: Vec<(Box<dyn Accel>, f64, Option<usize>)> = vec![
         {
-            let (a, ms) = timed(&|| "bvh8".parse::<AccelSpec>().unwrap().build(&tris));
+            let (a, ms) = timed(&|| {
+                "bvh8"
+                    .parse::<AccelSpec>()
+                    .unwrap()
+                    .build(&tris)
+                    .expect("the structure builds")
+            });
             (a, ms, None)
         },
         {

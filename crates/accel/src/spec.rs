@@ -25,15 +25,16 @@
 //! | `t=T` | clusters | entry points are object nodes smaller than the scene's size over T (default 8) |
 //! | `top=rebuild\|refit` | two-level | per frame, rebuild the top level over the instances' boxes or refit it (default `rebuild`) |
 //!
-//! `iosp0`, `iosp4` and `iosp2` take no options. They live in the triangle order:
-//! [`AccelSpec::try_build_scene_mut`] reorders the scene to match (nothing stored beyond the
-//! triangles), [`AccelSpec::build`] over a slice maps hits back through an index map, and so
+//! `iosp0`, `iosp4` and `iosp2` take no options. They live in the triangle order: built over
+//! [`BuildInput::SceneToReorder`] they reorder the scene to match (nothing stored beyond the
+//! triangles); over a slice or a `&Scene` they map hits back through an index map, and so
 //! does a scene with instances (each frame rewrites an instance's world copy in its own
 //! contiguous range, which a reordering would scatter).
 //!
-//! `two-level` takes the bvh8 options for its object BVHs; built over a scene
-//! ([`AccelSpec::build_scene`]) it follows moving instances by [`Accel::update`].
+//! `two-level` takes the bvh8 options for its object BVHs; built over a scene it follows
+//! moving instances by [`Accel::update`].
 
+use crate::build_input::BuildInput;
 use crate::wide::{Order, TriangleTest, WideOptions};
 use crate::{BruteForce, BuildParams, Bvh2, Bvh8, Qbvh, Split};
 use glam::Vec3;
@@ -273,29 +274,31 @@ impl AccelSpec {
         }
     }
 
-    /// Builds the structure over `scene`'s triangles as they are now. Two-level structures
-    /// build their object BVHs from the scene's prototypes and place its instances (and then
-    /// follow them with [`Accel::update`]); the others see the flat triangles.
+    /// Builds the structure over `input`: a scene (`&Scene`), a scene it may reorder
+    /// ([`BuildInput::SceneToReorder`]) or bare triangles (`&[[Vec3; 3]]`); see
+    /// [`BuildInput`] for what each means to the two-level and IOSP kinds.
     ///
-    /// # Panics
-    /// Where [`AccelSpec::try_build_scene`] fails: a grid past its `u32` limits.
-    pub fn build_scene(&self, scene: &rt_core::Scene) -> Box<dyn Accel> {
-        self.try_build_scene(scene)
-            .unwrap_or_else(|e| panic!("{self}: {e}"))
+    /// # Errors
+    /// Why the structure cannot hold the input ([`BuildError`]): a grid or IOSP past its
+    /// `u32` limits, or a scene that cannot be reordered.
+    pub fn build<'a>(
+        &self,
+        input: impl Into<BuildInput<'a>>,
+    ) -> Result<Box<dyn Accel>, BuildError> {
+        match input.into() {
+            BuildInput::Scene(scene) => self.build_over_scene(scene),
+            BuildInput::SceneToReorder(scene) => self.build_reordering(scene),
+            BuildInput::Triangles(triangles) => self.build_over_triangles(triangles),
+        }
     }
 
-    /// Builds over `scene`, reordering its triangles (and their attributes) for the
-    /// structures that live in the triangle order (IOSP: nothing stored beyond the
-    /// triangles); the others as [`AccelSpec::try_build_scene`].
-    pub fn try_build_scene_mut(
-        &self,
-        scene: &mut rt_core::Scene,
-    ) -> Result<Box<dyn Accel>, BuildError> {
+    /// [`BuildInput::SceneToReorder`]: IOSP permutes the scene, the others build over it.
+    fn build_reordering(&self, scene: &mut rt_core::Scene) -> Result<Box<dyn Accel>, BuildError> {
         // Each frame rewrites an instance's world copy in its contiguous range, which a
         // reordering would scatter: over an instanced scene IOSP keeps the order and answers
         // through its index map (4 bytes per triangle, counted in its memory).
         if !scene.instances.is_empty() {
-            return self.try_build_scene(scene);
+            return self.build_over_scene(scene);
         }
         let (accel, perm): (Box<dyn Accel>, Vec<u32>) = match self.kind {
             AccelKind::Iosp0 => {
@@ -310,15 +313,15 @@ impl AccelSpec {
                 let (a, p) = crate::Iosp2::build(&scene.triangles)?;
                 (Box::new(a), p)
             }
-            _ => return self.try_build_scene(scene),
+            _ => return self.build_over_scene(scene),
         };
         scene.permute_triangles(&perm)?;
         Ok(accel)
     }
 
-    /// [`AccelSpec::build_scene`], or why the structure cannot hold the scene (grids index
-    /// triangles and cell references with `u32`).
-    pub fn try_build_scene(&self, scene: &rt_core::Scene) -> Result<Box<dyn Accel>, BuildError> {
+    /// [`BuildInput::Scene`]: two-level kinds from the prototypes and instances, the others
+    /// over the flat triangles.
+    fn build_over_scene(&self, scene: &rt_core::Scene) -> Result<Box<dyn Accel>, BuildError> {
         Ok(match self.kind {
             AccelKind::TwoLevel => Box::new(crate::TwoLevel::build(
                 scene,
@@ -332,26 +335,13 @@ impl AccelSpec {
                 &self.wide,
                 self.cluster_t,
             )),
-            _ => self.try_build(&scene.triangles)?,
+            _ => self.build_over_triangles(&scene.triangles)?,
         })
     }
 
-    /// Builds the structure over `triangles` (whose indices become [`rt_core::Hit::prim`]);
-    /// a two-level structure gets them as one static object.
-    ///
-    /// # Panics
-    /// Where [`AccelSpec::try_build`] fails: a grid past its `u32` limits.
-    pub fn build(&self, triangles: &[[Vec3; 3]]) -> Box<dyn Accel> {
-        self.try_build(triangles)
-            .unwrap_or_else(|e| panic!("{self}: {e}"))
-    }
-
-    /// [`AccelSpec::build`], or why the structure cannot hold the triangles.
-    ///
-    /// The IOSP kinds answer in the caller's order through an index map
-    /// ([`crate::iosp::Unpermuted`], 4 bytes per triangle); [`AccelSpec::try_build_scene_mut`]
-    /// reorders the scene instead and stores nothing.
-    pub fn try_build(&self, triangles: &[[Vec3; 3]]) -> Result<Box<dyn Accel>, BuildError> {
+    /// [`BuildInput::Triangles`]. The IOSP kinds answer in the caller's order through an
+    /// index map ([`crate::iosp::Unpermuted`], 4 bytes per triangle).
+    fn build_over_triangles(&self, triangles: &[[Vec3; 3]]) -> Result<Box<dyn Accel>, BuildError> {
         use crate::iosp::Unpermuted;
         Ok(match self.kind {
             AccelKind::Iosp0 => {

@@ -190,7 +190,11 @@ fn a_structure_that_does_not_follow_the_animation_fails_the_check() {
     let mut cs = contenders(&s, &["two-level"]);
     cs.push(Contender {
         name: "stale".into(),
-        accel: Box::new(Stale(AccelSpec::default().build(&s.triangles))),
+        accel: Box::new(Stale(
+            AccelSpec::default()
+                .build(&s.triangles)
+                .expect("the structure builds"),
+        )),
         follow: Follow::Update,
         entries: None,
         build_seconds: 0.0,

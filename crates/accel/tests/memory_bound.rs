@@ -29,7 +29,9 @@ fn every_structure_holds_at_most_half_its_bound() {
     ] {
         let scene = rt_testkit::shipped_scene(name);
         for kind in AccelKind::ALL {
-            let accel = AccelSpec::new(kind).build_scene(&scene);
+            let accel = AccelSpec::new(kind)
+                .build(&scene)
+                .expect("the structure builds over the scene");
             check(name, scene.triangle_count(), kind, accel.memory_bytes());
         }
     }
@@ -41,7 +43,9 @@ fn every_structure_holds_at_most_half_its_bound() {
             continue;
         };
         for kind in AccelKind::ALL.into_iter().filter(|k| !k.is_two_level()) {
-            let accel = AccelSpec::new(kind).build(&tris);
+            let accel = AccelSpec::new(kind)
+                .build(&tris)
+                .expect("the structure builds");
             check(mesh, tris.len(), kind, accel.memory_bytes());
         }
     }

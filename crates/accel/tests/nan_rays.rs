@@ -26,7 +26,9 @@ fn non_finite_rays_hit_nothing() {
         ),
     ];
     for kind in AccelKind::ALL {
-        let accel = AccelSpec::new(kind).build(&tris);
+        let accel = AccelSpec::new(kind)
+            .build(&tris)
+            .expect("the structure builds");
         for r in &bad {
             assert!(
                 accel.intersect(r, f32::INFINITY).is_none(),

@@ -36,7 +36,11 @@ fn every_option_matches_brute_force() {
         for seed in 0..3u64 {
             let mut rng = Rng::new(9_000 + 10 * k as u64 + seed);
             let tris = soup(&mut rng, 1500);
-            let accel = spec.parse::<AccelSpec>().unwrap().build(&tris);
+            let accel = spec
+                .parse::<AccelSpec>()
+                .unwrap()
+                .build(&tris)
+                .expect("the structure builds");
             let oracle = BruteForce::new(&tris);
             let mut hits = 0;
             for (i, (ray, t_max)) in rays(&mut rng, &tris, 2000).into_iter().enumerate() {
@@ -74,11 +78,19 @@ fn shadow_cache_never_changes_an_answer() {
 fn shadow_cache_matches_brute_force(spec: &str, other_spec: &str) {
     let mut rng = Rng::new(4242);
     let tris = soup(&mut rng, 300);
-    let cached = spec.parse::<AccelSpec>().unwrap().build(&tris);
+    let cached = spec
+        .parse::<AccelSpec>()
+        .unwrap()
+        .build(&tris)
+        .expect("the structure builds");
     // A second cached structure queried on the same thread, interleaved: tables must not
     // leak node indices between structures.
     let other_tris = soup(&mut rng, 500);
-    let other = other_spec.parse::<AccelSpec>().unwrap().build(&other_tris);
+    let other = other_spec
+        .parse::<AccelSpec>()
+        .unwrap()
+        .build(&other_tris)
+        .expect("the structure builds");
     let oracle = BruteForce::new(&tris);
     let other_oracle = BruteForce::new(&other_tris);
     let lights: Vec<Vec3> = (0..4).map(|_| rng.unit_vec() * 3.0).collect();
@@ -117,7 +129,11 @@ fn shadow_cache_is_per_thread() {
 fn shadow_cache_per_thread_matches_brute_force(spec: &str) {
     let mut rng = Rng::new(777);
     let tris = soup(&mut rng, 2000);
-    let cached = spec.parse::<AccelSpec>().unwrap().build(&tris);
+    let cached = spec
+        .parse::<AccelSpec>()
+        .unwrap()
+        .build(&tris)
+        .expect("the structure builds");
     let oracle = BruteForce::new(&tris);
     std::thread::scope(|s| {
         for t in 0..4u64 {
@@ -144,7 +160,11 @@ fn shadow_cache_per_thread_matches_brute_force(spec: &str) {
 fn crack_free_leaves_hit_closed_meshes() {
     let mesh = common::icosphere(3);
     let tris = mesh.triangles();
-    let watertight = "qbvh".parse::<AccelSpec>().unwrap().build(&tris);
+    let watertight = "qbvh"
+        .parse::<AccelSpec>()
+        .unwrap()
+        .build(&tris)
+        .expect("the structure builds");
     let mut rng = Rng::new(31);
     let targets: Vec<Vec3> = (0..3000)
         .map(|i| {
@@ -161,7 +181,11 @@ fn crack_free_leaves_hit_closed_meshes() {
         "qbvh:isect=hybrid",
         "bvh8:isect=subdivision",
     ] {
-        let accel = spec.parse::<AccelSpec>().unwrap().build(&tris);
+        let accel = spec
+            .parse::<AccelSpec>()
+            .unwrap()
+            .build(&tris)
+            .expect("the structure builds");
         for &p in &targets {
             // From outside, well away from grazing (a grazing ray may pass an ulp beside
             // a convex edge).

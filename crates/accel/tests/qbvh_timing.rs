@@ -41,7 +41,11 @@ fn structures_and_options() {
         })
         .collect();
     // Incoherent: from the primary hits, uniformly random directions.
-    let reference = "bvh".parse::<AccelSpec>().unwrap().build(&tris);
+    let reference = "bvh"
+        .parse::<AccelSpec>()
+        .unwrap()
+        .build(&tris)
+        .expect("the structure builds");
     let mut rng = Rng::new(3);
     let incoherent: Vec<Ray> = primary
         .iter()
@@ -64,7 +68,7 @@ fn structures_and_options() {
     for spec in specs.split(',') {
         let spec: AccelSpec = spec.parse().unwrap();
         let start = Instant::now();
-        let a = spec.build(&tris);
+        let a = spec.build(&tris).expect("the structure builds");
         let build = start.elapsed().as_secs_f64();
         for (name, rays) in [("primary", &primary), ("incoherent", &incoherent)] {
             let mut best = f64::INFINITY;

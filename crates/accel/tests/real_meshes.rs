@@ -39,7 +39,9 @@ fn check_mesh(relative: &str, n_brute: usize, n_bvh: usize) {
         &rays(&mut rng, &tris, n_brute),
     );
     if n_bvh > 0 {
-        let bvh = AccelSpec::new(rt_accel::AccelKind::Bvh).build(&tris);
+        let bvh = AccelSpec::new(rt_accel::AccelKind::Bvh)
+            .build(&tris)
+            .expect("the structure builds");
         check_specs(relative, &tris, bvh.as_ref(), &rays(&mut rng, &tris, n_bvh));
     }
 }
@@ -53,7 +55,11 @@ fn check_specs(
     let n_rays = rays.len();
     let oracle_name = oracle.name();
     for spec in SPECS {
-        let accel = spec.parse::<AccelSpec>().unwrap().build(tris);
+        let accel = spec
+            .parse::<AccelSpec>()
+            .unwrap()
+            .build(tris)
+            .expect("the structure builds");
         let (mut hits, mut outside_box) = (0, 0);
         for (i, (ray, t_max)) in rays.iter().enumerate() {
             match check_ray(accel.as_ref(), oracle, ray, *t_max, tris) {

@@ -144,7 +144,7 @@ fn streams_of_random_rays_match_single_rays() {
     let set = rays(&mut rng, &tris, 6000);
     let (rays, t_max): (Vec<Ray>, Vec<f32>) = set.into_iter().unzip();
     for spec in specs() {
-        let accel = spec.build(&tris);
+        let accel = spec.build(&tris).expect("the structure builds");
         let counts = same_as_single(&*accel, &rays, &t_max, "soup");
         both_answers(counts, rays.len(), "soup");
         // Streams of every length, including ones shorter than any packet.
@@ -178,7 +178,7 @@ fn streams_of_coherent_rays_match_single_rays() {
     );
     tris.extend(soup(&mut rng, 500));
     for spec in specs() {
-        let accel = spec.build(&tris);
+        let accel = spec.build(&tris).expect("the structure builds");
         let (mut counts, mut n) = ([0, 0], 0);
         for eye in [
             Vec3::new(0.3, 2.5, 3.5),

@@ -19,7 +19,9 @@ fn rays_inside_a_small_room_test_few_triangles() {
         tris.extend(grid_cube(1).transformed(|p| centre + p * 0.25).triangles());
     }
     assert!(tris.len() <= FINE_LEAVES_MAX_TRIANGLES);
-    let accel = AccelSpec::default().build(&tris);
+    let accel = AccelSpec::default()
+        .build(&tris)
+        .expect("the structure builds");
     let oracle = BruteForce::new(&tris);
     let mut rng = Rng::new(77);
     let mut counters = TraversalCounters::default();

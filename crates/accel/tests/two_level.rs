@@ -153,7 +153,7 @@ fn two_level_and_clusters_match_brute_force_on_every_frame() {
     ] {
         let mut rng = Rng::new(7);
         let mut s = scene(&mut rng, 12);
-        let mut a = spec.build_scene(&s);
+        let mut a = spec.build(&s).expect("the structure builds over the scene");
         let mut total = (0, 0);
         for frame in 0..5 {
             if frame > 0 {
@@ -197,9 +197,13 @@ fn clustering_cuts_objects_into_more_entries_as_t_grows() {
 fn flat_structures_do_not_update_in_place_and_a_new_scene_needs_a_build() {
     let mut rng = Rng::new(3);
     let s = scene(&mut rng, 4);
-    let mut flat = AccelSpec::new(AccelKind::Bvh8).build_scene(&s);
+    let mut flat = AccelSpec::new(AccelKind::Bvh8)
+        .build(&s)
+        .expect("the structure builds over the scene");
     assert!(!flat.update(&s));
-    let mut two = AccelSpec::new(AccelKind::TwoLevel).build_scene(&s);
+    let mut two = AccelSpec::new(AccelKind::TwoLevel)
+        .build(&s)
+        .expect("the structure builds over the scene");
     let other = scene(&mut Rng::new(4), 5);
     assert!(!two.update(&other), "different instances: rebuild");
 }
@@ -208,7 +212,9 @@ fn flat_structures_do_not_update_in_place_and_a_new_scene_needs_a_build() {
 fn rays_spawned_from_instance_hits_leave_their_triangle() {
     let mut rng = Rng::new(11);
     let s = scene(&mut rng, 8);
-    let a = AccelSpec::new(AccelKind::TwoLevel).build_scene(&s);
+    let a = AccelSpec::new(AccelKind::TwoLevel)
+        .build(&s)
+        .expect("the structure builds over the scene");
     let mut checked = 0;
     for (ray, t_max) in rays(&mut rng, &s.triangles, 20_000) {
         let Some(hit) = a.intersect(&ray, t_max) else {
@@ -279,12 +285,14 @@ fn motion_blurred_rays_hit_the_scene_at_their_time() {
     let mut rng = Rng::new(21);
     let mut s = scene(&mut rng, 10);
     s.set_time(open);
-    let closed = AccelSpec::new(AccelKind::TwoLevel).build_scene(&s);
+    let closed = AccelSpec::new(AccelKind::TwoLevel)
+        .build(&s)
+        .expect("the structure builds over the scene");
     s.shutter = shutter;
     let mut clusters = AccelSpec::new(AccelKind::Clusters);
     clusters.cluster_t = 8.0;
     for spec in [AccelSpec::new(AccelKind::TwoLevel), clusters] {
-        let a = spec.build_scene(&s);
+        let a = spec.build(&s).expect("the structure builds over the scene");
         assert!(a.interpolates_motion());
         let (mut total, mut bad, mut control_bad, mut shaded) = (0, 0, 0, 0);
         for k in 0..12 {
@@ -343,13 +351,17 @@ fn every_structure_matches_brute_force_on_every_frame() {
         let mut rng = Rng::new(31);
         let mut s = scene(&mut rng, 6);
         let spec = AccelSpec::new(kind);
-        let mut a = spec.try_build_scene_mut(&mut s).unwrap();
+        let mut a = spec
+            .build(rt_accel::BuildInput::SceneToReorder(&mut s))
+            .unwrap();
         let (mut total, mut bad) = (0, 0);
         for frame in 0..3 {
             if frame > 0 {
                 s.set_time(frame as f32 * 0.4);
                 if !a.update(&s) {
-                    a = spec.try_build_scene_mut(&mut s).unwrap();
+                    a = spec
+                        .build(rt_accel::BuildInput::SceneToReorder(&mut s))
+                        .unwrap();
                 }
             }
             let rays = rays(&mut rng, &s.triangles, 1500);

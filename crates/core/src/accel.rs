@@ -1,6 +1,7 @@
 //! The `Accel` seam: the only interface through which integrators query geometry.
 //!
-//! Implementations live in `rt-accel` (binned-SAH BVH now; QBVH and IOSP later). Integrators
+//! Implementations live in `rt-accel` (binary, four- and eight-wide BVHs, two-level and clustered
+//! BVHs, grids, IOSP; `rt_accel::AccelSpec` names and builds them). Integrators
 //! take `&dyn Accel`: one virtual call per ray is noise next to the traversal itself, and it keeps
 //! the integrators independent of which structure the user picked.
 

@@ -19,6 +19,7 @@ use rt_film::{read_rgb, AovSet, Film, FilmBuffers};
 use rt_integrators::Ctx;
 use rt_metrics::{compare, CompareOptions, Metrics};
 use rt_session::{render_adaptive, Budgets, Session, StopReason, StopRule};
+use std::collections::hash_map::Entry;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -186,7 +187,9 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
             } => {
                 let req = scene.reference_request(*estimator, *spp, *seed);
                 let base = done_runs * UNITS;
-                let built = accel.build_scene(&scene.loaded.scene);
+                let built = accel
+                    .build(&scene.loaded.scene)
+                    .map_err(|e| ExperimentError::Run(format!("{}: {accel}: {e}", scene.name)))?;
                 let got = crate::reference::obtain(
                     &req,
                     (accel, built.as_ref()),
@@ -227,9 +230,14 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
         let scene = &plan.scenes[pair.scene];
         let method = &plan.methods[pair.method];
         let reference = &references[pair.scene];
-        let accel = accels
-            .entry((pair.scene, pair.accel.to_string()))
-            .or_insert_with(|| pair.accel.build_scene(&scene.loaded.scene));
+        let accel = match accels.entry((pair.scene, pair.accel.to_string())) {
+            Entry::Occupied(built) => built.into_mut(),
+            Entry::Vacant(slot) => {
+                slot.insert(pair.accel.build(&scene.loaded.scene).map_err(|e| {
+                    ExperimentError::Run(format!("{}: {}: {e}", scene.name, pair.accel))
+                })?)
+            }
+        };
         let integrator = pair.estimator.build();
         let denoiser: Option<Box<dyn Denoiser>> = method
             .denoiser

@@ -108,7 +108,9 @@ impl Order {
         write_to: Option<&Path>,
         progress: &(dyn Fn(f64) + Sync),
     ) -> Result<Obtained> {
-        let accel = self.accel.build_scene(scene);
+        let accel = self.accel.build(scene).map_err(|e| {
+            ExperimentError::Run(format!("{}: {}: {e}", scene_path.display(), self.accel))
+        })?;
         let req = self.request(scene_path, scene);
         obtain(
             &req,

@@ -391,7 +391,7 @@ fn references(
                 let updated = accel.as_mut().is_some_and(|a| a.update(req.scene));
                 if !updated {
                     accel =
-                        Some(accel_spec.try_build_scene(req.scene).map_err(|e| {
+                        Some(accel_spec.build(req.scene).map_err(|e| {
                             run_error(format!("{}: {accel_spec}: {e}", scene.name))
                         })?);
                 }

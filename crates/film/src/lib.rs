@@ -46,6 +46,8 @@
 //! ```
 #![forbid(unsafe_code)]
 
+mod aov_set;
+mod buffers;
 mod film;
 mod fixed;
 mod guides;
@@ -58,9 +60,9 @@ pub mod samples;
 mod splat;
 pub mod stopping;
 
-pub use film::{
-    AovSet, FeatureVariances, Film, FilmBuffers, FilmMemory, FilmStripe, UnknownAov, AOV_NAMES,
-};
+pub use aov_set::{AovFlag, AovSet, UnknownAov, AOV_FLAGS, AOV_NAMES};
+pub use buffers::{FilmBuffers, FilmMemory};
+pub use film::{FeatureVariances, Film, FilmStripe};
 pub use guides::{GuideBuffers, GuideError, ReflectedGuides, NO_ID};
 pub use input::{decode_raw, decode_srgb, read_rgb};
 pub use noisy_frame::{Channel, FrameError, NoisyFrame};

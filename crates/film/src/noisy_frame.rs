@@ -116,73 +116,21 @@ impl Channel {
         }
     }
 
-    /// How to get this channel into a frame, for error messages.
+    /// How to get this channel into a frame, for error messages: the hint of the last flag
+    /// of [`crate::AOV_FLAGS`] that the channel needs (a feature's variance needs the feature
+    /// and `feature-variance`, whose hint names both).
     pub fn hint(self) -> &'static str {
-        match self {
-            Channel::Colour => "every frame has it",
-            Channel::Samples => {
-                "sample records are never saved to a file: denoise while rendering, render SCENE --denoiser ..."
-            }
-            Channel::AlbedoVariance
-            | Channel::NormalVariance
-            | Channel::PositionVariance
-            | Channel::DepthVariance => {
-                "render it with --aov feature-variance and the feature, or --aov denoise for every channel"
-            }
-            Channel::Variance => "render it with --aov variance, or --aov denoise for every channel",
-            Channel::Halves => "render it with --aov halves, or --aov denoise for every channel",
-            Channel::Albedo => "render it with --aov albedo, or --aov denoise for every channel",
-            Channel::Normal => "render it with --aov normal, or --aov denoise for every channel",
-            Channel::Position => "render it with --aov position, or --aov denoise for every channel",
-            Channel::Depth => "render it with --aov depth, or --aov denoise for every channel",
-            Channel::Emission => "render it with --aov emission, or --aov denoise for every channel",
-            Channel::Direct => "render it with --aov direct, or --aov denoise for every channel",
-            Channel::Indirect => "render it with --aov indirect, or --aov denoise for every channel",
-            Channel::Diffuse => "render it with --aov diffuse, or --aov denoise for every channel",
-            Channel::Glossy => "render it with --aov glossy, or --aov denoise for every channel",
-            Channel::Irradiance => {
-                "render it with --aov irradiance, or --aov denoise for every channel"
-            }
-        }
+        crate::AOV_FLAGS
+            .iter()
+            .rev()
+            .find(|f| f.channels.contains(&self))
+            .map_or("every frame has it", |f| f.hint)
     }
 }
 
 impl fmt::Display for Channel {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
-    }
-}
-
-impl AovSet {
-    /// The smallest set whose film gives a [`NoisyFrame`] with every channel of `channels`
-    /// (through [`NoisyFrame::from_film`] with the same set): what a consumer that reads those
-    /// channels, e.g. a denoiser's `needs()`, must ask the film for. A feature's variance
-    /// needs the feature too; the colour image is always there.
-    pub fn for_channels(channels: &[Channel]) -> AovSet {
-        let mut s = AovSet::default();
-        for c in channels {
-            match c {
-                Channel::Colour => {}
-                Channel::Variance => s.variance = true,
-                Channel::Halves => s.halves = true,
-                Channel::Albedo => s.albedo = true,
-                Channel::AlbedoVariance => (s.albedo, s.feature_variance) = (true, true),
-                Channel::Normal => s.normal = true,
-                Channel::NormalVariance => (s.normal, s.feature_variance) = (true, true),
-                Channel::Position => s.position = true,
-                Channel::PositionVariance => (s.position, s.feature_variance) = (true, true),
-                Channel::Depth => s.depth = true,
-                Channel::DepthVariance => (s.depth, s.feature_variance) = (true, true),
-                Channel::Emission => s.emission = true,
-                Channel::Direct => s.direct = true,
-                Channel::Indirect => s.indirect = true,
-                Channel::Diffuse => s.diffuse = true,
-                Channel::Glossy => s.glossy = true,
-                Channel::Irradiance => s.irradiance = true,
-                Channel::Samples => s.samples = true,
-            }
-        }
-        s
     }
 }
 

@@ -12,7 +12,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let scene = rt_scene::procedural::generate("rotated")?;
     let mut camera = scene.cameras[0].clone();
     (camera.width, camera.height) = (64, 48);
-    let accel = rt_accel::AccelSpec::default().build(&scene.triangles);
+    let accel = rt_accel::AccelSpec::default()
+        .build(&scene.triangles)
+        .expect("the default structure builds");
     let ctx = Ctx {
         scene: &scene,
         accel: accel.as_ref(),

@@ -222,7 +222,9 @@ mod tests {
         let scene = rt_scene::procedural::generate("worst-case").unwrap();
         let mut camera = scene.cameras[0].clone();
         (camera.width, camera.height) = (24, 16);
-        let accel = rt_accel::AccelSpec::default().build(&scene.triangles);
+        let accel = rt_accel::AccelSpec::default()
+            .build(&scene.triangles)
+            .expect("the default structure builds");
         let ctx = Ctx {
             scene: &scene,
             accel: accel.as_ref(),

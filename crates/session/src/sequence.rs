@@ -294,13 +294,13 @@ impl SequenceRenderer {
         scene.set_time(time);
         let updated = self.accel.as_mut().is_some_and(|a| a.update(scene));
         if !updated {
-            let built =
-                self.accel_spec
-                    .try_build_scene_mut(scene)
-                    .map_err(|e| SequenceError::Accel {
-                        accel: self.accel_spec.to_string(),
-                        message: e.to_string(),
-                    })?;
+            let built = self
+                .accel_spec
+                .build(rt_accel::BuildInput::SceneToReorder(scene))
+                .map_err(|e| SequenceError::Accel {
+                    accel: self.accel_spec.to_string(),
+                    message: e.to_string(),
+                })?;
             self.accel = Some(built);
         }
         times.update = t.elapsed();

@@ -17,7 +17,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let loaded = rt_scene::load_any(std::path::Path::new(scene_path))?;
     let scene = loaded.scene;
     let camera = scene.cameras[0].resized(size, size);
-    let accel = rt_accel::AccelSpec::default_for_scene(&scene).build_scene(&scene);
+    let accel = rt_accel::AccelSpec::default_for_scene(&scene)
+        .build(&scene)
+        .expect("the structure builds over the scene");
     let ctx = Ctx {
         scene: &scene,
         accel: accel.as_ref(),

@@ -86,7 +86,9 @@ fn light(g: &GuideBuffers) -> RgbImage {
 }
 
 fn guides(s: &Scene, cam: &Camera, prev: Option<&Camera>) -> GuideBuffers {
-    let accel = rt_accel::AccelSpec::default().build_scene(s);
+    let accel = rt_accel::AccelSpec::default()
+        .build(s)
+        .expect("the structure builds over the scene");
     let ctx = Ctx {
         scene: s,
         accel: accel.as_ref(),
@@ -237,7 +239,9 @@ fn mirrored_lamp() -> (RgbImage, RgbImage, usize, usize) {
     .unwrap()
     .scene;
     let camera = scene.cameras[0].clone();
-    let accel = rt_accel::AccelSpec::default().build_scene(&scene);
+    let accel = rt_accel::AccelSpec::default()
+        .build(&scene)
+        .expect("the structure builds over the scene");
     let ctx = Ctx {
         scene: &scene,
         accel: accel.as_ref(),

@@ -156,7 +156,9 @@ fn world_light(p: Vec3) -> Rgb {
 }
 
 fn guides_for(scene: &rt_core::Scene, camera: &Camera, prev: Option<&Camera>) -> GuideBuffers {
-    let accel = rt_accel::AccelSpec::default().build_scene(scene);
+    let accel = rt_accel::AccelSpec::default()
+        .build(scene)
+        .expect("the structure builds over the scene");
     let ctx = Ctx {
         scene,
         accel: accel.as_ref(),

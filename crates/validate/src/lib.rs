@@ -61,7 +61,11 @@ impl LoadError {
 /// large triangles in leaves shared with others, where the binary BVH often culls them by a
 /// flat box, so they also show false hits that the binary BVH would hide.
 pub fn default_accel(scene: &Scene) -> Box<dyn rt_core::Accel> {
-    rt_accel::AccelSpec::default().build_scene(scene)
+    // Only the grids and IOSP have size limits ([`rt_accel::BuildError`]); a BVH8 holds any
+    // scene, so this cannot fail.
+    rt_accel::AccelSpec::default()
+        .build(scene)
+        .expect("the default BVH8 builds over any scene")
 }
 
 /// A bare mesh file as a scene ([`rt_scene::load_mesh`]), without its placeholder camera.

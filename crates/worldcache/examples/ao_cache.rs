@@ -38,7 +38,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let lod: u32 = args.get(2).map_or(Ok(6), |s| s.parse())?;
     let frames: u32 = args.get(3).map_or(Ok(32), |s| s.parse())?;
     let scene = rt_scene::procedural::generate(name)?;
-    let accel = rt_accel::AccelSpec::default().build(&scene.triangles);
+    let accel = rt_accel::AccelSpec::default().build(&scene.triangles)?;
     let mut camera = scene.cameras[0].clone();
     (camera.width, camera.height) = (160, 120);
     let (w, h) = (camera.width, camera.height);

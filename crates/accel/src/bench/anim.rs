@@ -66,7 +66,7 @@ impl Contender {
                 let n = a.entry_count();
                 (Box::new(a), Some(n))
             }
-            _ => (spec.try_build(&scene.triangles)?, None),
+            _ => (spec.build(&scene.triangles)?, None),
         };
         let build_seconds = t.elapsed().as_secs_f64();
         Ok(Self {
@@ -105,7 +105,7 @@ impl Contender {
                 Ok(None)
             }
             Follow::Rebuild(spec) => {
-                let fresh = spec.try_build(&scene.triangles)?;
+                let fresh = spec.build(&scene.triangles)?;
                 Ok(Some(std::mem::replace(&mut self.accel, fresh)))
             }
         }
@@ -376,7 +376,7 @@ pub fn run(
     let mut rays = Vec::new();
     for frame in options.frames.clone() {
         scene.set_time((f64::from(frame) / options.fps) as f32);
-        let reference = pool.install(|| reference_spec.try_build(&scene.triangles))?;
+        let reference = pool.install(|| reference_spec.build(&scene.triangles))?;
         let sets = pool.install(|| frame_rays(scene, reference.as_ref(), options, frame))?;
         let count = |name: &str| {
             sets.iter()

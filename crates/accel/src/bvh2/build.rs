@@ -2,7 +2,7 @@
 //! Hierarchies", 2007), evaluated on all three axes.
 
 use super::node::Node;
-use super::{compact, split, BuildParams};
+use super::{compact, evh_split, BuildParams};
 use glam::{Vec3, Vec3A};
 use rt_core::Aabb;
 use std::mem::MaybeUninit;
@@ -82,7 +82,7 @@ pub(crate) struct Built {
 pub(crate) fn build(triangles: &[[Vec3; 3]], cfg: &Config) -> Built {
     // This panics beyond u32::MAX / 2 references, the count that the u32 node and slot indices
     // and the depth invariant of `build_node` allow.
-    let mut refs = split::references(triangles, cfg.split, cfg.parallel);
+    let mut refs = evh_split::references(triangles, cfg.split, cfg.parallel);
     if refs.is_empty() {
         return Built {
             nodes: Vec::new(),

@@ -3,7 +3,7 @@
 //! The tree is stored depth-first in one array of 32-byte [`Node`]s with the two children of
 //! every inner node side by side. The triangles are copied in leaf order, so a leaf's triangles
 //! are contiguous in memory, and [`Bvh2::prim_ids`] maps each copy back to the caller's index,
-//! which is what [`Hit::prim`] reports.
+//! which is what [`Hit::prim`](rt_core::Hit::prim) reports.
 //!
 //! With [`BuildParams::split`] the builder partitions pieces of triangles rather than triangles
 //! (see [`split_references`]), so a triangle can fill several leaf slots; each slot still holds
@@ -11,21 +11,20 @@
 
 pub(crate) mod build;
 mod compact;
+mod evh_split;
 mod node;
-mod split;
 mod stats;
 mod traverse;
 mod validate;
 
 pub use build::MAX_BINS;
+pub use evh_split::{split_pieces, split_references};
 pub use node::Node;
-pub use split::{split_pieces, split_references};
 pub use stats::BvhStats;
 
-use crate::traversal::with_counter;
 use build::Config;
 use glam::Vec3;
-use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
+use rt_core::{Aabb, Accel};
 
 /// Knobs of [`Bvh2::build`]. Out-of-range values are clamped rather than rejected.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -96,7 +95,7 @@ pub struct Bvh2 {
 }
 
 impl Bvh2 {
-    /// Builds the hierarchy over `triangles`, whose indices become [`Hit::prim`]. Any input is
+    /// Builds the hierarchy over `triangles`, whose indices become [`Hit::prim`](rt_core::Hit::prim). Any input is
     /// accepted: empty, degenerate, duplicated or huge triangles. Infinite coordinates build
     /// without panicking but are of course never hit sensibly.
     ///
@@ -145,26 +144,7 @@ impl Accel for Bvh2 {
         "bvh"
     }
 
-    fn closest_hit(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        counters: Option<&mut TraversalCounters>,
-    ) -> Option<Hit> {
-        with_counter!(counters, |c| self.traverse::<false, _>(ray, t_max, c))
-    }
-
-    fn any_hit(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        _toward: Option<Vec3>,
-        counters: Option<&mut TraversalCounters>,
-    ) -> bool {
-        with_counter!(counters, |c| self
-            .traverse::<true, _>(ray, t_max, c)
-            .is_some())
-    }
+    crate::traversal::queries_by_traverse!();
 
     fn bounds(&self) -> Aabb {
         self.nodes.first().map_or(Aabb::EMPTY, Node::aabb)

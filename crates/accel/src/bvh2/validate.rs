@@ -1,7 +1,7 @@
 //! Structural self-check of a built tree, for tests and debugging.
 
 use super::build::MAX_DEPTH;
-use super::{split, Bvh2, Split};
+use super::{evh_split, Bvh2, Split};
 use crate::traversal::inside;
 use glam::Vec3;
 
@@ -155,7 +155,7 @@ impl Bvh2 {
         }
         // Time is the pieces of a triangle times its leaves, which is small at sensible
         // thresholds (a few references per triangle) and fine for tests at extreme ones.
-        for r in split::references(originals, self.config.split, false) {
+        for r in evh_split::references(originals, self.config.split, false) {
             let id = r.index as usize;
             let covered = leaves[start[id]..fill[id]]
                 .iter()

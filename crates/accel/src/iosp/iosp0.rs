@@ -4,11 +4,11 @@
 use super::heap::{self, MAX_TRIANGLES};
 use super::lanes::SlotTest;
 use super::{bounds_of, IospError, TriBox};
-use crate::traversal::{with_counter, Closest, Counter, SlabRay};
+use crate::traversal::{Closest, Counter, SlabRay};
 use crate::wide::tri4::RayPrecomp4;
 use crate::ValidationError;
 use glam::Vec3;
-use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
+use rt_core::{Aabb, Accel, Hit, Ray};
 
 /// The completely implicit IOSP hierarchy: a complete binary tree over the triangles, stored
 /// as a heap inside the triangle array, with no nodes at all (see the [module](super) doc and
@@ -122,26 +122,7 @@ impl Accel for Iosp0 {
         "iosp0"
     }
 
-    fn closest_hit(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        counters: Option<&mut TraversalCounters>,
-    ) -> Option<Hit> {
-        with_counter!(counters, |c| self.traverse::<false, _>(ray, t_max, c))
-    }
-
-    fn any_hit(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        _toward: Option<Vec3>,
-        counters: Option<&mut TraversalCounters>,
-    ) -> bool {
-        with_counter!(counters, |c| self
-            .traverse::<true, _>(ray, t_max, c)
-            .is_some())
-    }
+    crate::traversal::queries_by_traverse!();
 
     fn bounds(&self) -> Aabb {
         self.bounds

@@ -2,11 +2,11 @@
 
 use super::iosp4_build::{self, SAH_DEPTH};
 use super::{bounds_of, slab_of, IospError, TriBox};
-use crate::traversal::{with_counter, Closest, Counter, SlabRay, FAR_SCALE};
+use crate::traversal::{Closest, Counter, SlabRay, FAR_SCALE};
 use crate::ValidationError;
 use glam::Vec3;
 use rt_core::triangle::{intersect_triangle, RayPrecomp};
-use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
+use rt_core::{Aabb, Accel, Hit, Ray};
 
 /// The node word. Bits `[1:0]`: the children's bounding axis (`0..=2`, which is also the axis
 /// this node's triangles were partitioned on) or `3` for a leaf. Inner node: bits `[31:2]` are
@@ -267,26 +267,7 @@ impl Accel for Iosp4 {
         "iosp4"
     }
 
-    fn closest_hit(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        counters: Option<&mut TraversalCounters>,
-    ) -> Option<Hit> {
-        with_counter!(counters, |c| self.traverse::<false, _>(ray, t_max, c))
-    }
-
-    fn any_hit(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        _toward: Option<Vec3>,
-        counters: Option<&mut TraversalCounters>,
-    ) -> bool {
-        with_counter!(counters, |c| self
-            .traverse::<true, _>(ray, t_max, c)
-            .is_some())
-    }
+    crate::traversal::queries_by_traverse!();
 
     fn bounds(&self) -> Aabb {
         self.bounds

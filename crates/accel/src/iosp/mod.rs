@@ -110,17 +110,17 @@
 
 mod heap;
 mod iosp0;
+mod iosp2;
 mod iosp4;
 mod iosp4_build;
 mod lanes;
 mod permuted;
 pub mod split;
-mod two_level;
 
 pub use iosp0::Iosp0;
+pub use iosp2::{Iosp2, DEFAULT_TOP_BYTES, DEFAULT_TOP_LEVELS};
 pub use iosp4::Iosp4;
 pub use permuted::Unpermuted;
-pub use two_level::{Iosp2, DEFAULT_TOP_BYTES, DEFAULT_TOP_LEVELS};
 
 use glam::Vec3;
 

@@ -1,6 +1,6 @@
 //! An IOSP structure for callers that cannot reorder their triangles: hits are mapped back to
 //! the caller's order through the permutation, at 4 bytes per triangle. The renderer reorders
-//! the scene instead ([`crate::AccelSpec::try_build_scene_mut`]) and stores nothing.
+//! the scene instead ([`crate::BuildInput::SceneToReorder`]) and stores nothing.
 
 use glam::Vec3;
 use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
@@ -56,7 +56,7 @@ impl<A: Accel> Accel for Unpermuted<A> {
 
     /// The inner structure's only: the index map stands in for the caller reordering its
     /// per-triangle data, which the renderer does instead of keeping a map
-    /// ([`crate::AccelSpec::try_build_scene_mut`]); [`Accel::memory_bytes`] counts it.
+    /// ([`crate::BuildInput::SceneToReorder`]); [`Accel::memory_bytes`] counts it.
     fn structure_bytes(&self) -> Option<usize> {
         self.inner.structure_bytes()
     }

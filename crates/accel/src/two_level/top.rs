@@ -3,12 +3,11 @@
 
 use crate::bvh2::build::{build_over_boxes, MAX_DEPTH};
 use crate::bvh2::Node;
-use crate::traversal::FAR_SCALE;
+use crate::traversal::{insert_by_distance, Stack};
 use crate::wide::{Avx2, Slab};
 use crate::BuildParams;
 use glam::Vec3;
 use rt_core::{Aabb, Ray, TraversalCounters};
-use std::mem::MaybeUninit;
 
 /// How the top level follows the placements from frame to frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -227,9 +226,7 @@ impl Top {
         }
         let slab = Slab::new(ray);
         let mut t_cull = t_max;
-        // Uninitialised: zeroing 1.5 KB per ray showed up as 7 % of a clustered trace.
-        let mut stack = [const { MaybeUninit::<(u32, f32)>::uninit() }; STACK];
-        let mut sp = 0;
+        let mut stack = Stack::<STACK, true>::new();
         let mut cur = 0u32;
         loop {
             if cur & ENTRY != 0 {
@@ -257,47 +254,23 @@ impl Top {
                 };
                 #[cfg(not(target_arch = "x86_64"))]
                 let (mask, t) = slab.hit8(&node.bounds, t_cull);
-                if mask != 0 {
-                    // The hit slots by entry distance, nearest first.
-                    let mut hits = [(0.0f32, 0u32); WIDTH];
-                    let mut n = 0;
-                    let mut rest = mask;
-                    while rest != 0 {
-                        let lane = rest.trailing_zeros() as usize;
-                        rest &= rest - 1;
-                        let t_lane = t[lane];
-                        {
-                            let mut k = n;
-                            while k > 0 && hits[k - 1].0 > t_lane {
-                                hits[k] = hits[k - 1];
-                                k -= 1;
-                            }
-                            hits[k] = (t_lane, node.children[lane]);
-                            n += 1;
-                        }
-                    }
-                    for &(t_far, code) in hits[1..n].iter().rev() {
-                        stack[sp].write((code, t_far));
-                        sp += 1;
-                    }
-                    cur = hits[0].1;
+                // The hit slots by entry distance, nearest first.
+                let (mut hits, mut n) = ([(0.0f32, 0u32); WIDTH], 0);
+                let mut rest = mask;
+                while rest != 0 {
+                    let lane = rest.trailing_zeros() as usize;
+                    rest &= rest - 1;
+                    n = insert_by_distance(&mut hits, n, t[lane], node.children[lane]);
+                }
+                if let Some(nearest) = stack.push_all_but_nearest(&hits[..n]) {
+                    cur = nearest;
                     continue;
                 }
             }
             // The nearest pending subtree that can still hold something closer.
-            loop {
-                if sp == 0 {
-                    return;
-                }
-                sp -= 1;
-                // SAFETY: every slot below `sp` was written by the push above before `sp`
-                // passed it, and `sp` only decreases here.
-                #[allow(unsafe_code)]
-                let (code, t_entry) = unsafe { stack[sp].assume_init() };
-                if t_entry <= t_cull * FAR_SCALE {
-                    cur = code;
-                    break;
-                }
+            match stack.pop(t_cull) {
+                Some(code) => cur = code,
+                None => return,
             }
         }
     }

@@ -6,7 +6,7 @@
 //! only after run-time detection found AVX2, so code holding one may call AVX2 kernels; the
 //! eight-wide box test then tests all eight boxes in one 256-bit register.
 
-use super::node::{QChild, QNode};
+use super::qbvh_node::{QChild, QNode};
 use super::traverse::Slab;
 use super::Order;
 use rt_core::Aabb;
@@ -105,19 +105,19 @@ pub trait WideNode: Copy + Debug + PartialEq + Send + Sync + sealed::Sealed + 's
 
     /// The decoded child in slot `slot`.
     fn child(&self, slot: usize) -> QChild {
-        super::node::decode(self.code(slot))
+        super::qbvh_node::decode(self.code(slot))
     }
 
     /// Number of non-empty slots.
     fn occupied(&self) -> usize {
         (0..Self::WIDTH)
-            .filter(|&s| self.code(s) != super::node::EMPTY)
+            .filter(|&s| self.code(s) != super::qbvh_node::EMPTY)
             .count()
     }
 
     /// Index of the parent node, `None` for the root.
     fn parent(&self) -> Option<usize> {
-        (self.parent_code() != super::node::NO_PARENT).then_some(self.parent_code() as usize)
+        (self.parent_code() != super::qbvh_node::NO_PARENT).then_some(self.parent_code() as usize)
     }
 
     /// The slot of rank `rank` (0 = nearest) in split-plane order for a direction in `octant`

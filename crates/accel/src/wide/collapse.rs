@@ -3,7 +3,7 @@
 //! al. 2017 (the BVH8, see [`Plan`]).
 
 use super::bvh::{order_word, WideNode};
-use super::node::{leaf_code, MAX_LEAF_TRIANGLES, NO_AXES, NO_AXIS, NO_PARENT};
+use super::qbvh_node::{leaf_code, MAX_LEAF_TRIANGLES, NO_AXES, NO_AXIS, NO_PARENT};
 use super::tri4::Tri4;
 use crate::bvh2::Node;
 use glam::Vec3;

@@ -12,12 +12,12 @@
 //! collapse, the traversal loop, the shadow cache and the validator.
 
 mod bvh;
+mod bvh8_node;
 mod collapse;
-mod node;
-mod node8;
 mod options;
 #[cfg(target_arch = "x86_64")]
 mod packet;
+mod qbvh_node;
 mod shadow_cache;
 mod stream;
 mod traverse;
@@ -25,9 +25,9 @@ pub(crate) mod tri4;
 mod validate;
 
 pub use bvh::{Avx2, Baseline, Isa, WideNode};
-pub use node::{QChild, QNode, EMPTY, LEAF_BIT, MAX_LEAF_TRIANGLES, MAX_TRIANGLES, NO_AXIS};
-pub use node8::Node8;
+pub use bvh8_node::Node8;
 pub use options::{Order, TriangleTest, WideOptions, DEFAULT_INTERSECTION_COST, DEFAULT_LEAF_SIZE};
+pub use qbvh_node::{QChild, QNode, EMPTY, LEAF_BIT, MAX_LEAF_TRIANGLES, MAX_TRIANGLES, NO_AXIS};
 pub(crate) use traverse::Slab;
 pub use tri4::Tri4;
 

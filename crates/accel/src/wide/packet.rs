@@ -12,8 +12,8 @@
 //! order leaves are visited in.
 
 use super::bvh::Avx2;
-use super::node::{EMPTY, LEAF_BIT};
-use super::node8::Node8;
+use super::bvh8_node::Node8;
+use super::qbvh_node::{EMPTY, LEAF_BIT};
 use super::traverse::{octant, PreparedRay, STACK_SIZE};
 use super::WideBvh;
 use crate::traversal::{Closest, NoCount, FAR_SCALE};

@@ -17,7 +17,7 @@
 //! scene's units.
 
 use super::bvh::{Avx2, Baseline, Isa, WideNode};
-use super::node::{EMPTY, LEAF_BIT, NO_PARENT};
+use super::qbvh_node::{EMPTY, LEAF_BIT, NO_PARENT};
 use super::traverse::{octant, Slab, STACK_SIZE};
 use super::tri4::RayPrecomp4;
 use super::WideBvh;

@@ -11,7 +11,7 @@
 use super::bvh::Avx2;
 use super::bvh::{Baseline, Isa, WideNode};
 #[cfg(target_arch = "x86_64")]
-use super::node8::Node8;
+use super::bvh8_node::Node8;
 #[cfg(target_arch = "x86_64")]
 use super::packet::{same_octant, Entry, PACKET};
 #[cfg(target_arch = "x86_64")]

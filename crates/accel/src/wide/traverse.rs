@@ -2,15 +2,14 @@
 //! orders, with or without entry distances on the stack.
 
 use super::bvh::{slot_of, Isa, WideNode};
-use super::node::{leaf_parts, EMPTY, LEAF_BIT};
+use super::qbvh_node::{leaf_parts, EMPTY, LEAF_BIT};
 #[cfg(target_arch = "x86_64")]
 use super::tri4::intersect8_avx2;
 use super::tri4::{intersect4, RayPrecomp4};
 use super::{TriangleTest, WideBvh};
 use crate::crack_free::{intersect_hybrid, intersect_subdivision, SubdivRay};
-use crate::traversal::{Closest, Counter, FAR_SCALE};
+use crate::traversal::{Closest, Counter, Stack, FAR_SCALE};
 use rt_core::{Aabb, Hit, Ray};
-use std::mem::MaybeUninit;
 
 /// Deepest node the traversal stack supports: the binary tree's depth bound (64) plus the
 /// levels that split over-long leaves (at most 12 for 2^27 triangles).
@@ -292,56 +291,6 @@ pub(crate) fn octant(ray: &Ray) -> usize {
         | usize::from(ray.dir.z.is_sign_negative()) << 2
 }
 
-/// Slots still to visit: child codes and, with the t-stack, their entry distances.
-///
-/// The arrays are left uninitialised: zeroing 2 KB per ray cost more than a short traversal.
-struct Stack<const TSTACK: bool> {
-    codes: [MaybeUninit<u32>; STACK_SIZE],
-    ts: [MaybeUninit<f32>; STACK_SIZE],
-    len: usize,
-}
-
-impl<const TSTACK: bool> Stack<TSTACK> {
-    #[inline(always)]
-    fn new() -> Self {
-        Self {
-            codes: [const { MaybeUninit::uninit() }; STACK_SIZE],
-            ts: [const { MaybeUninit::uninit() }; STACK_SIZE],
-            len: 0,
-        }
-    }
-
-    #[inline(always)]
-    fn push(&mut self, code: u32, t: f32) {
-        self.codes[self.len].write(code);
-        if TSTACK {
-            self.ts[self.len].write(t);
-        }
-        self.len += 1;
-    }
-
-    /// The most recently pushed slot that may still hold something within `cull_t`.
-    #[inline(always)]
-    #[allow(unsafe_code)]
-    fn pop(&mut self, cull_t: f32) -> Option<u32> {
-        while self.len > 0 {
-            self.len -= 1;
-            // SAFETY: `push` wrote `codes[i]` (and `ts[i]` when `TSTACK`) for every `i < len`
-            // before incrementing `len`, and nothing else changes `len` or the arrays.
-            let (code, keep) = unsafe {
-                (
-                    self.codes[self.len].assume_init(),
-                    !TSTACK || self.ts[self.len].assume_init() <= cull_t * FAR_SCALE,
-                )
-            };
-            if keep {
-                return Some(code);
-            }
-        }
-        None
-    }
-}
-
 impl<N: WideNode> WideBvh<N> {
     /// The one traversal loop behind every query; `ANY_HIT` returns the first hit found,
     /// `ORDER` is one of [`UNSORTED`], [`DISTANCE`], [`SPLIT_PLANE`]; `isa` picks the box test.
@@ -384,7 +333,7 @@ impl<N: WideNode> WideBvh<N> {
         }
 
         let mut closest = Closest::new(t_max);
-        let mut stack = Stack::<TSTACK>::new();
+        let mut stack = Stack::<STACK_SIZE, TSTACK>::new();
         // The root, or an entry point of a clustered top level (a node or a leaf).
         let mut cur: u32 = start;
         loop {
@@ -630,8 +579,8 @@ impl<N: WideNode> WideBvh<N> {
 mod tests {
     use super::*;
     use crate::wide::bvh::WideNode;
-    use crate::wide::node::{leaf_code, QNode, NO_PARENT};
-    use crate::wide::node8::Node8;
+    use crate::wide::bvh8_node::Node8;
+    use crate::wide::qbvh_node::{leaf_code, QNode, NO_PARENT};
     use glam::Vec3;
 
     #[test]

@@ -1,7 +1,7 @@
 //! Structural self-check of a collapsed tree.
 
 use super::bvh::WideNode;
-use super::node::{QChild, EMPTY, NO_PARENT};
+use super::qbvh_node::{QChild, EMPTY, NO_PARENT};
 use super::traverse::MAX_DEPTH;
 use super::WideBvh;
 use crate::traversal::inside;

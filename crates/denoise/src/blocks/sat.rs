@@ -1,37 +1,79 @@
-//! The box mean by summed-area table: each output is the mean over the `(2r+1)²` window cut at
-//! the image border (the window shrinks, so a constant image stays constant up to the edge),
-//! at a cost independent of `r`.
+//! Summed-area tables (Crow 1984): any box's sum is four lookups, whatever its size. One
+//! table type for single-channel planes (the box mean below, for the guided filter) and RGBα
+//! layers (SBMF's sweep-blur, which reuses one per layer for every filter scale).
 //!
 //! The table is kept in `f64`: a window sum is a difference of two large prefix sums, and in
 //! `f32` that difference loses the digits a guided filter's covariances need.
+//!
+//! [`BoxMean`]: each output is the mean over the `(2r+1)²` window cut at the image border (the
+//! window shrinks, so a constant image stays constant up to the edge), at a cost independent
+//! of `r`.
 
 use super::{window, STRIP_ROWS};
 use rayon::prelude::*;
 
-/// A reusable summed-area table for `w × h` single-channel planes (one allocation for any
-/// number of planes of that size).
-#[derive(Debug)]
-pub struct BoxMean {
-    w: usize,
-    h: usize,
-    /// `(w + 1) × (h + 1)` prefix sums; row 0 and column 0 are zero.
-    table: Vec<f64>,
+/// What a [`SummedAreaTable`] sums: `f64` per channel of an `f32` source pixel.
+pub trait SatValue: Copy + Send + Sync {
+    /// A source pixel.
+    type Source: Copy + Sync;
+    /// The empty sum.
+    const ZERO: Self;
+    /// A source pixel in `f64`.
+    fn widen(p: Self::Source) -> Self;
+    /// Channel-wise sum.
+    fn add(self, o: Self) -> Self;
 }
 
-impl BoxMean {
-    /// A table for planes of `w × h` pixels.
+impl SatValue for f64 {
+    type Source = f32;
+    const ZERO: Self = 0.0;
+    #[inline(always)]
+    fn widen(p: f32) -> Self {
+        f64::from(p)
+    }
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        self + o
+    }
+}
+
+impl SatValue for [f64; 4] {
+    type Source = [f32; 4];
+    const ZERO: Self = [0.0; 4];
+    #[inline(always)]
+    fn widen(p: [f32; 4]) -> Self {
+        p.map(f64::from)
+    }
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        std::array::from_fn(|c| self[c] + o[c])
+    }
+}
+
+/// A reusable summed-area table for `w × h` images (one allocation for any number of images
+/// of that size): entry `(x, y)` of the `(w + 1) × (h + 1)` grid is the sum over the pixels
+/// left of `x` and above `y`; row 0 and column 0 are zero.
+#[derive(Debug)]
+pub struct SummedAreaTable<T> {
+    w: usize,
+    h: usize,
+    table: Vec<T>,
+}
+
+impl<T: SatValue> SummedAreaTable<T> {
+    /// An empty table for images of `w × h` pixels.
     pub fn new(w: usize, h: usize) -> Self {
         Self {
             w,
             h,
-            table: vec![0.0; (w + 1) * (h + 1)],
+            table: vec![T::ZERO; (w + 1) * (h + 1)],
         }
     }
 
-    /// Writes the box mean of radius `r` of `src` into `out` (both `w × h`, row-major).
-    pub fn apply(&mut self, src: &[f32], r: usize, out: &mut [f32]) {
+    /// Rebuilds the table from `src` (`w × h`, row-major).
+    pub fn build(&mut self, src: &[T::Source]) {
         let (w, h) = (self.w, self.h);
-        assert!(src.len() == w * h && out.len() == w * h, "plane size");
+        assert_eq!(src.len(), w * h, "image size");
         if src.is_empty() {
             return;
         }
@@ -41,10 +83,10 @@ impl BoxMean {
             .par_chunks_mut(stride)
             .zip(src.par_chunks(w))
             .for_each(|(t, row)| {
-                let mut acc = 0.0f64;
-                t[0] = 0.0;
+                let mut acc = T::ZERO;
+                t[0] = T::ZERO;
                 for (tx, &v) in t[1..].iter_mut().zip(row) {
-                    acc += f64::from(v);
+                    acc = acc.add(T::widen(v));
                     *tx = acc;
                 }
             });
@@ -52,9 +94,41 @@ impl BoxMean {
             let (above, rest) = self.table.split_at_mut((y + 1) * stride);
             let prev = &above[y * stride..];
             for (c, &p) in rest[..stride].iter_mut().zip(prev) {
-                *c += p;
+                *c = c.add(p);
             }
         }
+    }
+
+    /// Row `y` of the grid (`w + 1` entries): the sums over the pixels above `y`.
+    #[inline(always)]
+    pub fn row(&self, y: usize) -> &[T] {
+        let stride = self.w + 1;
+        &self.table[y * stride..(y + 1) * stride]
+    }
+}
+
+/// The box mean of single-channel planes by a [`SummedAreaTable`].
+#[derive(Debug)]
+pub struct BoxMean {
+    table: SummedAreaTable<f64>,
+}
+
+impl BoxMean {
+    /// A table for planes of `w × h` pixels.
+    pub fn new(w: usize, h: usize) -> Self {
+        Self {
+            table: SummedAreaTable::new(w, h),
+        }
+    }
+
+    /// Writes the box mean of radius `r` of `src` into `out` (both `w × h`, row-major).
+    pub fn apply(&mut self, src: &[f32], r: usize, out: &mut [f32]) {
+        let (w, h) = (self.table.w, self.table.h);
+        assert!(src.len() == w * h && out.len() == w * h, "plane size");
+        if src.is_empty() {
+            return;
+        }
+        self.table.build(src);
         let table = &self.table;
         out.par_chunks_mut(w * STRIP_ROWS)
             .enumerate()
@@ -62,8 +136,8 @@ impl BoxMean {
                 for (i, orow) in strip.chunks_mut(w).enumerate() {
                     let y = s * STRIP_ROWS + i;
                     let (y0, y1) = window(y, r, h);
-                    let top = &table[y0 * stride..(y0 + 1) * stride];
-                    let bottom = &table[(y1 + 1) * stride..(y1 + 2) * stride];
+                    let top = table.row(y0);
+                    let bottom = table.row(y1 + 1);
                     let rows = (y1 - y0 + 1) as f64;
                     for (x, o) in orow.iter_mut().enumerate() {
                         let (x0, x1) = window(x, r, w);

@@ -177,7 +177,13 @@ pub fn run(bench: AccelBench, info: &dyn Fn(&str)) -> Result<Vec<Row>, BenchErro
     // The reference every structure is checked against, which also generates the rays.
     let reference_spec: AccelSpec = "bvh".parse().expect("static spec");
     let t = Instant::now();
-    let reference = pool.install(|| reference_spec.build(&scene.triangles));
+    let reference = pool
+        .install(|| reference_spec.build(&scene.triangles))
+        .map_err(|e| BenchError::Build {
+            input: bench.input.clone(),
+            spec: reference_spec.to_string(),
+            message: e.to_string(),
+        })?;
     let reference_ms = t.elapsed().as_secs_f64() * 1e3;
 
     let (camera, fallback_light) = match bench.view {
@@ -237,13 +243,13 @@ pub fn run(bench: AccelBench, info: &dyn Fn(&str)) -> Result<Vec<Row>, BenchErro
             let t = Instant::now();
             // From the scene, so two-level kinds place its instances (over bare triangles they
             // would be one static object); every kind keeps the triangle order the rays use.
-            let a =
-                pool.install(|| spec.try_build_scene(scene))
-                    .map_err(|e| BenchError::Build {
-                        input: bench.input.clone(),
-                        spec: name.clone(),
-                        message: e.to_string(),
-                    })?;
+            let a = pool
+                .install(|| spec.build(scene))
+                .map_err(|e| BenchError::Build {
+                    input: bench.input.clone(),
+                    spec: name.clone(),
+                    message: e.to_string(),
+                })?;
             (Some(a), t.elapsed().as_secs_f64() * 1e3)
         };
         let accel = fresh.as_deref().unwrap_or(reference.as_ref());

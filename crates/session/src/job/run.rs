@@ -126,7 +126,11 @@ impl RenderJob {
                 .is_some_and(|a| pool.install(|| a.update(&scene)));
             if !updated {
                 // IOSP reorders the scene's triangles to store nothing beyond them.
-                let built = pool.install(|| self.settings.accel.try_build_scene_mut(&mut scene));
+                let built = pool.install(|| {
+                    self.settings
+                        .accel
+                        .build(rt_accel::BuildInput::SceneToReorder(&mut scene))
+                });
                 accel = Some(built.map_err(|e| {
                     JobError::Refused(format!(
                         "{}: --accel {}: {e}",

@@ -9,10 +9,9 @@ mod traverse;
 
 use super::domain::{finite, Domain};
 use super::{Binning, GridError};
-use crate::traversal::with_counter;
 use crate::ValidationError;
 use glam::Vec3;
-use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
+use rt_core::{Aabb, Accel};
 
 /// Knobs of [`IrregularGrid::build`]; defaults as explained in the [module documentation](super).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -105,7 +104,7 @@ fn unpack(b: &VBox) -> ([u32; 3], [u32; 3]) {
 }
 
 impl IrregularGrid {
-    /// Builds the grid over `triangles`, whose indices become [`Hit::prim`]. Any triangles are
+    /// Builds the grid over `triangles`, whose indices become [`Hit::prim`](rt_core::Hit::prim). Any triangles are
     /// accepted; those with a non-finite vertex are never hit.
     pub fn build(triangles: &[[Vec3; 3]], params: &IrregularGridParams) -> Result<Self, GridError> {
         build::build(triangles, params)
@@ -318,26 +317,7 @@ impl Accel for IrregularGrid {
         "irregular-grid"
     }
 
-    fn closest_hit(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        counters: Option<&mut TraversalCounters>,
-    ) -> Option<Hit> {
-        with_counter!(counters, |c| self.traverse::<false, _>(ray, t_max, c))
-    }
-
-    fn any_hit(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        _toward: Option<Vec3>,
-        counters: Option<&mut TraversalCounters>,
-    ) -> bool {
-        with_counter!(counters, |c| self
-            .traverse::<true, _>(ray, t_max, c)
-            .is_some())
-    }
+    crate::traversal::queries_by_traverse!();
 
     fn bounds(&self) -> Aabb {
         self.domain.map_or(Aabb::EMPTY, |d| Aabb::new(d.min, d.max))

@@ -5,9 +5,8 @@ mod dda;
 use super::domain::{cleary, padded_bounds, Domain};
 use super::lists::{bin, Lists};
 use super::{check_count, check_positive, Binning, GridError};
-use crate::traversal::with_counter;
 use glam::Vec3;
-use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
+use rt_core::{Aabb, Accel};
 
 /// Knobs of [`UniformGrid::build`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -40,7 +39,7 @@ pub struct UniformGrid {
 }
 
 impl UniformGrid {
-    /// Builds the grid over `triangles`, whose indices become [`Hit::prim`]. Any triangles are
+    /// Builds the grid over `triangles`, whose indices become [`Hit::prim`](rt_core::Hit::prim). Any triangles are
     /// accepted; those with a non-finite vertex are never hit.
     pub fn build(triangles: &[[Vec3; 3]], params: &UniformGridParams) -> Result<Self, GridError> {
         check_count(triangles.len())?;
@@ -112,26 +111,7 @@ impl Accel for UniformGrid {
         "uniform-grid"
     }
 
-    fn closest_hit(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        counters: Option<&mut TraversalCounters>,
-    ) -> Option<Hit> {
-        with_counter!(counters, |c| self.traverse::<false, _>(ray, t_max, c))
-    }
-
-    fn any_hit(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        _toward: Option<Vec3>,
-        counters: Option<&mut TraversalCounters>,
-    ) -> bool {
-        with_counter!(counters, |c| self
-            .traverse::<true, _>(ray, t_max, c)
-            .is_some())
-    }
+    crate::traversal::queries_by_traverse!();
 
     fn bounds(&self) -> Aabb {
         self.domain.map_or(Aabb::EMPTY, |d| Aabb::new(d.min, d.max))

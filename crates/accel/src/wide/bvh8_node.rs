@@ -1,7 +1,7 @@
 //! The 256-byte eight-wide node.
 
 use super::bvh::{Isa, WideNode};
-use super::node::{empty_bounds, get_bounds, set_bounds, EMPTY};
+use super::qbvh_node::{empty_bounds, get_bounds, set_bounds, EMPTY};
 use super::traverse::Slab;
 use super::Order;
 use rt_core::Aabb;
@@ -119,7 +119,7 @@ impl WideNode for Node8 {
 mod tests {
     use super::*;
     use crate::wide::bvh::order_word;
-    use crate::wide::node::{leaf_code, QChild, NO_PARENT};
+    use crate::wide::qbvh_node::{leaf_code, QChild, NO_PARENT};
     use glam::Vec3;
 
     #[test]

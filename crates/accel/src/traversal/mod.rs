@@ -1,5 +1,9 @@
 //! Pieces every traversal and validator in this crate shares.
 
+mod stack;
+
+pub(crate) use stack::{insert_by_distance, Stack};
+
 use glam::Vec3;
 use rt_core::triangle::{intersect_triangle, RayPrecomp};
 use rt_core::{Aabb, Hit, Ray, TraversalCounters};
@@ -41,6 +45,36 @@ macro_rules! with_counter {
     };
 }
 pub(crate) use with_counter;
+
+/// The `closest_hit` and `any_hit` of an [`rt_core::Accel`] impl whose structure has an
+/// inherent `traverse::<ANY_HIT, C: Counter>(&self, ray, t_max, counter) -> Option<Hit>`
+/// (any hit: the first one found): each query dispatches once on its counters
+/// ([`with_counter!`]), and the shadow-ray target is not used.
+macro_rules! queries_by_traverse {
+    () => {
+        fn closest_hit(
+            &self,
+            ray: &rt_core::Ray,
+            t_max: f32,
+            counters: Option<&mut rt_core::TraversalCounters>,
+        ) -> Option<rt_core::Hit> {
+            $crate::traversal::with_counter!(counters, |c| self.traverse::<false, _>(ray, t_max, c))
+        }
+
+        fn any_hit(
+            &self,
+            ray: &rt_core::Ray,
+            t_max: f32,
+            _toward: Option<glam::Vec3>,
+            counters: Option<&mut rt_core::TraversalCounters>,
+        ) -> bool {
+            $crate::traversal::with_counter!(counters, |c| self
+                .traverse::<true, _>(ray, t_max, c)
+                .is_some())
+        }
+    };
+}
+pub(crate) use queries_by_traverse;
 
 /// The counter of the uncounted queries.
 pub(crate) struct NoCount;

@@ -5,12 +5,12 @@
 use super::heap::{self, MAX_TRIANGLES};
 use super::lanes::SlotTest;
 use super::{IospError, TriBox};
-use crate::traversal::{with_counter, Closest, Counter, SlabRay, FAR_SCALE};
+use crate::traversal::{insert_by_distance, Closest, Counter, SlabRay, Stack};
 use crate::wide::tri4::RayPrecomp4;
 use crate::wide::Slab;
 use crate::{BuildParams, Bvh2, Node, ValidationError};
 use glam::Vec3;
-use rt_core::{Aabb, Accel, Hit, Ray, TraversalCounters};
+use rt_core::{Aabb, Accel, Hit, Ray};
 use std::ops::Range;
 
 /// Levels of the SAH top in the thesis' measurements.
@@ -289,8 +289,7 @@ impl Iosp2 {
         let tris = &self.triangles[..];
         // (node << 2 | lane) of a heap, or a node index, with the HEAP bit; entry distance.
         const HEAP: u32 = 1 << 31;
-        let mut stack = [(0u32, 0f32); STACK];
-        let mut sp = 0;
+        let mut stack = Stack::<STACK, true>::new();
         let mut cur = 0u32;
         loop {
             if cur & HEAP != 0 {
@@ -316,9 +315,8 @@ impl Iosp2 {
                 let node = &self.nodes[cur as usize];
                 counter.boxes(4);
                 let (mask, t) = slab4.hit4(&node.bounds, closest.cull_t);
-                // Hit slots nearest first: insertion sort of at most four.
-                let mut order = [(0f32, 0u32); 4];
-                let mut n = 0;
+                // The hit slots by entry distance, nearest first.
+                let (mut hits, mut n) = ([(0.0f32, 0u32); 4], 0);
                 let mut rest = mask;
                 while rest != 0 {
                     let lane = rest.trailing_zeros() as usize;
@@ -332,33 +330,16 @@ impl Iosp2 {
                         heap::prefetch_slots(tris, start, node.count[lane].min(2) as usize);
                         HEAP | (cur << 2) | lane as u32
                     };
-                    let mut k = n;
-                    while k > 0 && order[k - 1].0 > t[lane] {
-                        order[k] = order[k - 1];
-                        k -= 1;
-                    }
-                    order[k] = (t[lane], code);
-                    n += 1;
+                    n = insert_by_distance(&mut hits, n, t[lane], code);
                 }
-                if n > 0 {
-                    for &(t, code) in order[1..n].iter().rev() {
-                        stack[sp] = (code, t);
-                        sp += 1;
-                    }
-                    cur = order[0].1;
+                if let Some(nearest) = stack.push_all_but_nearest(&hits[..n]) {
+                    cur = nearest;
                     continue;
                 }
             }
-            loop {
-                if sp == 0 {
-                    return closest.hit;
-                }
-                sp -= 1;
-                let (code, t) = stack[sp];
-                if t <= closest.cull_t * FAR_SCALE {
-                    cur = code;
-                    break;
-                }
+            match stack.pop(closest.cull_t) {
+                Some(code) => cur = code,
+                None => return closest.hit,
             }
         }
     }
@@ -526,26 +507,7 @@ impl Accel for Iosp2 {
         "iosp2"
     }
 
-    fn closest_hit(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        counters: Option<&mut TraversalCounters>,
-    ) -> Option<Hit> {
-        with_counter!(counters, |c| self.traverse::<false, _>(ray, t_max, c))
-    }
-
-    fn any_hit(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        _toward: Option<Vec3>,
-        counters: Option<&mut TraversalCounters>,
-    ) -> bool {
-        with_counter!(counters, |c| self
-            .traverse::<true, _>(ray, t_max, c)
-            .is_some())
-    }
+    crate::traversal::queries_by_traverse!();
 
     fn bounds(&self) -> Aabb {
         self.bounds
