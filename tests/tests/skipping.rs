@@ -135,7 +135,7 @@ fn requested_buffers_are_allocated_and_filled() {
     let n = 16 * 12;
     assert_eq!(
         (m.variance, m.first_hits, m.albedo),
-        (Some(n * 48), Some(n * 4), Some(n * 48))
+        (Some(n * 96), Some(n * 4), Some(n * 48))
     );
     assert_eq!(
         (m.normal, m.depth, m.position, m.halves),

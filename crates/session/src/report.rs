@@ -392,7 +392,7 @@ mod tests {
             "constant environment"
         );
         for (name, per_pixel) in [
-            ("film squares (variance)", 48),
+            ("film squares (variance)", 96),
             ("film half-buffers", 64),
             ("film AOV hit count", 4),
             ("film AOV albedo", 48),
