@@ -4,33 +4,7 @@
 //! environment within 4 standard errors; rough ones and plastic lose energy to single scattering but never
 //! gain it. Control: a conductor reflecting 97 % is told apart from a lossless one.
 
-use rt_integrators::{PathIntegrator, Wavefront, DEFAULT_LANES};
-use rt_testkit::furnace::{scene_toml as furnace, L};
-use rt_testkit::stats::image_mean;
-use rt_testkit::{render, scene_from_toml, Renderer};
-
-/// The furnace image's mean and its standard error, from the path tracer with light sampling,
-/// without it, and from the wavefront tracer.
-fn means(material: &str, spp: u32) -> Vec<(f64, f64)> {
-    let scene = scene_from_toml(&furnace(material));
-    let mut out = vec![
-        image_mean(&render(&scene, &PathIntegrator::new(1000), spp, 1)),
-        image_mean(&render(&scene, &PathIntegrator::bsdf_only(1000), spp, 2)),
-    ];
-    let wavefront = Wavefront::new(PathIntegrator::new(1000), DEFAULT_LANES);
-    let buffers = rt_film::FilmBuffers::for_outputs(rt_film::AovSet::default()).with_variance();
-    let (film, _) = Renderer::new(&scene)
-        .threads(2)
-        .render_technique(&wavefront, buffers, spp, 3);
-    out.push(image_mean(&film));
-    out
-}
-
-fn lossless(material: &str) -> bool {
-    means(material, 64)
-        .iter()
-        .all(|&(mean, se)| (mean - L as f64).abs() <= 4.0 * se + 1e-4)
-}
+use rt_testkit::furnace::{lossless, tracer_means as means, L};
 
 #[test]
 fn smooth_microfacet_materials_are_lossless_in_the_furnace() {

@@ -106,26 +106,8 @@ fn wavefront_images_are_the_scalar_images_on_every_shipped_scene() {
 /// (no MIS weight) go through the vectorised Lambertian stage and the scalar one alike.
 #[test]
 fn wavefront_images_are_the_scalar_images_with_point_spot_and_directional_lights() {
-    use rt_core::delta_light::DeltaLight;
-    use rt_core::glam::Vec3;
     let mut scene = shipped_scene("cornell-box.toml").with_resolution(24, 16);
-    scene.delta_lights = vec![
-        DeltaLight::Point {
-            position: Vec3::new(150.0, 400.0, 250.0),
-            intensity: Vec3::new(3e4, 2e4, 1e4),
-        },
-        DeltaLight::Spot {
-            position: Vec3::new(400.0, 500.0, 100.0),
-            axis: Vec3::new(0.0, -1.0, 0.5).normalize(),
-            intensity: Vec3::splat(5e4),
-            cutoff: 0.5,
-            beam_width: 0.3,
-        },
-        DeltaLight::Directional {
-            direction: Vec3::new(0.2, -0.3, 1.0).normalize(),
-            irradiance: Vec3::splat(0.5),
-        },
-    ];
+    scene.delta_lights = rt_testkit::cornell_box_delta_lights();
     scene.build_lights();
     assert_eq!(scene.lights().delta_count(), 3);
     assert_same("delta lights", &scene, 8, 4);

@@ -261,6 +261,18 @@ mod tests {
         }
     }
 
+    /// The mean and sample variance of `xs`, in `f64`.
+    fn mean_and_variance(xs: &[f32]) -> (f64, f64) {
+        let n = xs.len() as f64;
+        let mean = xs.iter().map(|&x| f64::from(x)).sum::<f64>() / n;
+        let var = xs
+            .iter()
+            .map(|&x| (f64::from(x) - mean).powi(2))
+            .sum::<f64>()
+            / (n - 1.0);
+        (mean, var)
+    }
+
     #[test]
     fn variance_from_exact_sums() {
         let xs = [0.5f32, 2.0, 7.25, 1.0, 1e-3, 4.0, 3.5];
@@ -269,13 +281,7 @@ mod tests {
             s.add(x);
             q.add_square(x);
         }
-        let n = xs.len() as f64;
-        let mean = xs.iter().map(|&x| f64::from(x)).sum::<f64>() / n;
-        let var = xs
-            .iter()
-            .map(|&x| (f64::from(x) - mean).powi(2))
-            .sum::<f64>()
-            / (n - 1.0);
+        let (_, var) = mean_and_variance(&xs);
         let got = f64::from(sample_variance(xs.len() as u64, s.0, q.0));
         assert!((got - var).abs() < 1e-6 * var, "{got} vs {var}");
         // Large counts of the largest values stay in range.
@@ -297,13 +303,7 @@ mod tests {
             s.add(Vec3::splat(x));
             q.add(Vec3::splat(x));
         }
-        let n = xs.len() as f64;
-        let mean = xs.iter().map(|&x| f64::from(x)).sum::<f64>() / n;
-        let var = xs
-            .iter()
-            .map(|&x| (f64::from(x) - mean).powi(2))
-            .sum::<f64>()
-            / (n - 1.0);
+        let (mean, var) = mean_and_variance(&xs);
         let got_mean = f64::from(s.mean(xs.len() as u64).x);
         assert!(
             (got_mean - mean).abs() < 1e-6 * mean,

@@ -67,3 +67,35 @@ vertices = [[-100.0, -100.0, 0.0], [100.0, -100.0, 0.0], [100.0, 100.0, 0.0], [-
 material = "m"
 "#
 }
+
+/// The furnace image's mean and its standard error for `material` at `spp`, from the path
+/// tracer with light sampling, without it, and from the wavefront tracer (seeds 1, 2, 3).
+pub fn tracer_means(material: &str, spp: u32) -> Vec<(f64, f64)> {
+    use rt_integrators::{PathIntegrator, Wavefront, DEFAULT_LANES};
+    let scene = crate::scene_from_toml(&scene_toml(material));
+    let mean = crate::stats::image_mean;
+    let mut out = vec![
+        mean(&crate::render(&scene, &PathIntegrator::new(1000), spp, 1)),
+        mean(&crate::render(
+            &scene,
+            &PathIntegrator::bsdf_only(1000),
+            spp,
+            2,
+        )),
+    ];
+    let wavefront = Wavefront::new(PathIntegrator::new(1000), DEFAULT_LANES);
+    let buffers = rt_film::FilmBuffers::for_outputs(rt_film::AovSet::default()).with_variance();
+    let (film, _) = crate::Renderer::new(&scene)
+        .threads(2)
+        .render_technique(&wavefront, buffers, spp, 3);
+    out.push(mean(&film));
+    out
+}
+
+/// True if every tracer's furnace image of `material` (64 spp) is the environment [`L`] within
+/// 4 standard errors.
+pub fn lossless(material: &str) -> bool {
+    tracer_means(material, 64)
+        .iter()
+        .all(|&(mean, se)| (mean - L as f64).abs() <= 4.0 * se + 1e-4)
+}

@@ -550,18 +550,14 @@ impl Bdpt {
         }
         // The sampled light as a vertex, for the densities of the other strategies. A delta
         // light's is only its choice; BSDF sampling cannot reach it.
-        let delta_light = ls.delta.then(|| dens.lights.chosen_delta(u_sel).copied());
-        let q = if let Some(light) = delta_light {
-            let kind = if ls.dist.is_infinite() {
-                Kind::Env
+        let q = if ls.delta {
+            let (kind, p) = if ls.dist.is_infinite() {
+                (Kind::Env, ls.wi)
             } else {
-                Kind::Light
+                (Kind::Light, ls.point)
             };
-            let mut q = Vertex::endpoint(kind, ls.point, Rgb::ONE, ls.pdf);
-            if kind == Kind::Env {
-                q.p = ls.wi;
-            }
-            q.delta_light = light;
+            let mut q = Vertex::endpoint(kind, p, Rgb::ONE, ls.pdf);
+            q.delta_light = dens.lights.chosen_delta(u_sel).copied();
             q
         } else if ls.dist.is_infinite() {
             Vertex::endpoint(Kind::Env, ls.wi, Rgb::ONE, ls.pdf)

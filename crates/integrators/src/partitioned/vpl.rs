@@ -97,8 +97,8 @@ impl Partitioned {
             let Some(e) = lights.sample_emission(scene, bounds, u_sel, u_pos, u_dir) else {
                 continue;
             };
-            match e.point {
-                Some(pt) => {
+            match (e.point, e.delta_light) {
+                (Some(pt), _) => {
                     let faces = if pt.two_sided { 2.0 } else { 1.0 };
                     primaries.push(PrimaryLight {
                         p: pt.point,
@@ -121,8 +121,7 @@ impl Partitioned {
                         bounce: 0,
                     });
                 }
-                None if e.delta_light.is_some() => {
-                    let light = e.delta_light.expect("checked");
+                (None, Some(light)) => {
                     // The probability of choosing the light: `pdf_position` holds it times the
                     // position's density (1 for a point or spot, the plane's for a direction).
                     let choice = match light {
@@ -155,7 +154,7 @@ impl Partitioned {
                         bounce: 0,
                     });
                 }
-                None => {
+                (None, None) => {
                     primaries.push(PrimaryLight {
                         p: e.origin,
                         p_error: Vec3::ZERO,
