@@ -594,13 +594,19 @@ impl Scene {
     /// and its textured parameters.
     #[inline]
     pub fn tint(&self, m: &Material, uv: Vec2) -> crate::tint::Tint {
-        let color = match m.texture {
+        crate::tint::Tint {
+            color: self.texture_color(m, uv),
+            params: m.param_textures.lookup(&self.textures, uv),
+        }
+    }
+
+    /// The colour part of [`Scene::tint`] alone: all a plain Lambertian layer reads
+    /// ([`Material::plain_lambert`]), without filling the textured parameters in.
+    #[inline]
+    pub fn texture_color(&self, m: &Material, uv: Vec2) -> Rgb {
+        match m.texture {
             Some(t) => self.textures[t as usize].lookup(uv),
             None => Rgb::ONE,
-        };
-        crate::tint::Tint {
-            color,
-            params: m.param_textures.lookup(&self.textures, uv),
         }
     }
 }

@@ -65,9 +65,8 @@ impl Shader<'_> {
             path.done = true;
             return None;
         }
-        let tint = scene.tint(material, si.uv);
         if !first_hit_wanted {
-            if let Some(f) = material.plain_lambert(tint.color) {
+            if let Some(f) = material.plain_lambert(scene.texture_color(material, si.uv)) {
                 // The BSDF stage runs for all such vertices at once (`LambertQueue::run`);
                 // `finish_lambert` takes the path on from its result.
                 let light = if self.use_nee {
@@ -79,6 +78,7 @@ impl Shader<'_> {
                 return None;
             }
         }
+        let tint = scene.tint(material, si.uv);
         let bsdf = Bsdf::new(material, tint, si.ns, si.ng, wo).with_wavelength(path.lambda);
         let bsdf = if self.settings.spectral {
             bsdf
