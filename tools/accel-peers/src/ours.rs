@@ -23,7 +23,9 @@ pub fn build(spec: &str, tris: &[[Vec3; 3]]) -> anyhow::Result<Box<dyn Peer>> {
         .map_err(|e| anyhow::anyhow!("--accel {spec}: {e}"))?;
     Ok(Box::new(Ours {
         name: spec.to_string(),
-        accel: parsed.build(tris),
+        accel: parsed
+            .build(tris)
+            .map_err(|e| anyhow::anyhow!("--accel {spec}: {e}"))?,
         stream,
     }))
 }
