@@ -25,16 +25,36 @@ pub struct Baseline;
 
 /// Proof that the CPU has AVX2: made only by [`Avx2::detect`].
 #[derive(Clone, Copy, Debug)]
-pub struct Avx2(());
+pub struct Avx2 {
+    avx512vl: bool,
+}
 
 impl Avx2 {
     /// `Some` if the CPU running this has AVX2.
     pub fn detect() -> Option<Self> {
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx2") {
-            return Some(Self(()));
+            return Some(Self {
+                avx512vl: std::is_x86_feature_detected!("avx512f")
+                    && std::is_x86_feature_detected!("avx512vl"),
+            });
         }
         None
+    }
+
+    /// True if the CPU also has AVX-512F and AVX-512VL. The traversal's AVX2 code, compiled
+    /// with them enabled, is EVEX-encoded and gets 32 vector registers instead of 16: the
+    /// ray's constants stay in registers across node visits instead of being reloaded
+    /// (`docs/benchmarks.md`, "AVX-512VL registers"). The operations, and so the answers,
+    /// are the same.
+    pub fn avx512vl(self) -> bool {
+        self.avx512vl
+    }
+
+    /// The same proof with AVX-512VL left unused (tests compare the two compilations).
+    #[cfg(test)]
+    pub(crate) fn without_avx512vl(self) -> Self {
+        Self { avx512vl: false }
     }
 }
 

@@ -239,9 +239,71 @@ impl WideBvh<Node8> {
     /// # Safety
     ///
     /// The CPU must support AVX2.
-    #[target_feature(enable = "avx2")]
     #[allow(unsafe_code)]
     unsafe fn packets_avx2<const ANY_HIT: bool>(
+        &self,
+        rays: &[Ray],
+        t_max: &[f32],
+        emit: impl FnMut(usize, Option<Hit>),
+        avx2: Avx2,
+    ) {
+        // SAFETY: the caller guarantees AVX2; `avx512vl()` says whether the CPU has AVX-512F
+        // and AVX-512VL. Any-hit streams stay in the AVX2 compilation, as single any-hit
+        // queries do (`WideBvh::query_isa`).
+        unsafe {
+            if !ANY_HIT && avx2.avx512vl() {
+                self.packets_evex::<ANY_HIT>(rays, t_max, emit, avx2)
+            } else {
+                self.packets_vex::<ANY_HIT>(rays, t_max, emit, avx2)
+            }
+        }
+    }
+
+    /// [`WideBvh::packets_avx2`] compiled for AVX2 alone.
+    ///
+    /// # Safety
+    ///
+    /// The CPU must support AVX2.
+    #[target_feature(enable = "avx2")]
+    #[allow(unsafe_code)]
+    unsafe fn packets_vex<const ANY_HIT: bool>(
+        &self,
+        rays: &[Ray],
+        t_max: &[f32],
+        emit: impl FnMut(usize, Option<Hit>),
+        avx2: Avx2,
+    ) {
+        // SAFETY: as this function's.
+        unsafe { self.packets_body::<ANY_HIT>(rays, t_max, emit, avx2) }
+    }
+
+    /// [`WideBvh::packets_avx2`] compiled with AVX-512F and AVX-512VL too: the same
+    /// operations with 32 vector registers ([`Avx2::avx512vl`]).
+    ///
+    /// # Safety
+    ///
+    /// The CPU must support AVX2, AVX-512F and AVX-512VL.
+    #[target_feature(enable = "avx2,avx512f,avx512vl")]
+    #[allow(unsafe_code)]
+    unsafe fn packets_evex<const ANY_HIT: bool>(
+        &self,
+        rays: &[Ray],
+        t_max: &[f32],
+        emit: impl FnMut(usize, Option<Hit>),
+        avx2: Avx2,
+    ) {
+        // SAFETY: as this function's.
+        unsafe { self.packets_body::<ANY_HIT>(rays, t_max, emit, avx2) }
+    }
+
+    /// The loop of [`WideBvh::packets_avx2`], inlined into each compilation.
+    ///
+    /// # Safety
+    ///
+    /// The CPU must support AVX2.
+    #[inline(always)]
+    #[allow(unsafe_code)]
+    unsafe fn packets_body<const ANY_HIT: bool>(
         &self,
         rays: &[Ray],
         t_max: &[f32],
