@@ -5,7 +5,7 @@
 //! determinism tests.
 
 use crate::mutants::DroppedShadowRays;
-use crate::stats::{normal_equivalent, Estimate};
+use crate::stats::{compare_estimates, normal_equivalent, Comparison, Estimate};
 use crate::Renderer;
 use rt_core::{Rgb, SampleStream, Scene};
 use rt_film::{AovSet, Film, FilmBuffers};
@@ -107,6 +107,65 @@ pub fn technique_blocks(
         })
         .collect();
     Estimate::from_runs(&blocks)
+}
+
+/// How independent runs of a technique whose pixels share samples compare with a reference of
+/// independent pixels: [`runs_against_reference`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RunsAgreement {
+    /// The block means (each block one "pixel"); only its block part is read.
+    pub blocks: Comparison,
+    /// The whole images' means; only its image part is read.
+    pub image: Comparison,
+}
+
+impl RunsAgreement {
+    /// True if neither a block nor the whole image differs by more than its tolerance (half
+    /// the false-alarm rate each, as in `compare_estimates`).
+    pub fn same_within_noise(&self) -> bool {
+        self.blocks.max_block_z <= self.blocks.block_crit
+            && self.image.image_z.abs() <= self.image.image_crit
+    }
+}
+
+/// `runs` (independent images of a `width`-wide technique, `width` and height multiples of
+/// `block`) against `reference` (per-pixel means and variances of independent pixels, e.g. a
+/// path tracer's film), at the scale of `block × block` blocks and of the whole image, each
+/// variance of the runs from the spread of the runs' block (image) means. Techniques whose
+/// samples light many pixels (a world-space cache, VPLs) correlate pixels far apart: summing
+/// per-pixel spreads understates a block's variance, and the whole image's even more (the
+/// world cache's default: 1.6× per 4×4 block, 9× over a 16×16 image; two sets of 8 honest
+/// runs then differed at an image z of up to 6).
+pub fn runs_against_reference(
+    runs: &[Vec<Rgb>],
+    reference: &Estimate,
+    width: u32,
+    block: u32,
+    alpha: f64,
+) -> RunsAgreement {
+    let of_runs = |means: &dyn Fn(&[Rgb]) -> Vec<Rgb>| {
+        Estimate::from_runs(&runs.iter().map(|r| means(r)).collect::<Vec<_>>())
+    };
+    let blocks = compare_estimates(
+        &of_runs(&|r| block_means(r, width, block)),
+        &reference_blocks(reference, width, block),
+        width / block,
+        1,
+        alpha,
+    );
+    let mean = |image: &[Rgb]| vec![image.iter().copied().sum::<Rgb>() / image.len() as f32];
+    let n = reference.mean.len() as f32;
+    let reference_image = Estimate {
+        mean: mean(&reference.mean),
+        // The mean of the variances over n: the variance of the mean of n independent pixels.
+        variance: mean(&reference.variance)
+            .into_iter()
+            .map(|v| v / n)
+            .collect(),
+        runs: reference.runs,
+    };
+    let image = compare_estimates(&of_runs(&mean), &reference_image, 1, 1, alpha);
+    RunsAgreement { blocks, image }
 }
 
 /// `technique` on `threads` threads with seed 3, in passes cut at the sample indices `cuts`
