@@ -8,8 +8,8 @@ use super::{load_scene, refuse, Frames, JobError, JobScene, RenderJob};
 use crate::frames::frame_path;
 use crate::memory::Estimate;
 use crate::{
-    frame_seed, pick_camera, render_adaptive, render_adaptive_until, Adaptive, RenderReport,
-    ReportInputs, SequenceRenderer,
+    frame_seed, pick_camera, render_adaptive_until, Adaptive, RenderReport, ReportInputs,
+    SequenceRenderer,
 };
 use rt_core::{Accel, Camera, Scene};
 use rt_film::{AovSet, Film, FilmBuffers, OutputOptions};
@@ -175,7 +175,7 @@ impl RenderJob {
     }
 
     /// The single-frame denoiser, built (`None` without one, or with a temporal one).
-    fn frame_denoiser(&self) -> Result<Option<Box<dyn rt_denoise::Denoiser>>, JobError> {
+    pub fn frame_denoiser(&self) -> Result<Option<Box<dyn rt_denoise::Denoiser>>, JobError> {
         match &self.settings.denoiser {
             Some(rt_temporal::TemporalSpec::PerFrame(spec)) => spec
                 .build()
@@ -280,46 +280,8 @@ impl RenderJob {
         Ok(())
     }
 
-    /// Renders this job's samples (or its slice's) of one image of `ctx` with `technique`
-    /// into a new film and returns it: no file is written. For callers that hold their own
-    /// scene, structure and camera (an experiment's references). Fixed and adaptive jobs
-    /// only.
-    pub fn render_film(
-        &self,
-        ctx: &Ctx<'_>,
-        technique: &dyn Technique,
-        sink: &dyn JobSink,
-    ) -> Result<(Film, RenderStats), JobError> {
-        let camera = ctx.camera;
-        let denoiser = self.frame_denoiser()?;
-        let mut film = Film::new(
-            camera.width,
-            camera.height,
-            self.film_buffers(denoiser.as_deref()),
-        );
-        let stats = match &self.stop {
-            Some(rule) => {
-                render_adaptive(ctx, technique, &mut film, self.settings.seed, rule, &|f| {
-                    sink.progress(f)
-                })
-                .map_err(|e| JobError::Refused(format!("--error {}", e.0)))?
-                .stats
-            }
-            None => {
-                let cut = Cut {
-                    samples: self.slice.samples.clone().unwrap_or(0..self.settings.spp),
-                    region: self
-                        .slice
-                        .rect()
-                        .unwrap_or(rt_film::Rect::full(camera.width, camera.height)),
-                };
-                self.fixed_pass(ctx, technique, &mut film, self.settings.seed, &cut, sink)
-            }
-        };
-        Ok((film, stats))
-    }
-
-    fn fixed_pass(
+    /// Renders the samples and pixels of `cut` into `film` in one pass.
+    pub(super) fn fixed_pass(
         &self,
         ctx: &Ctx<'_>,
         technique: &dyn Technique,
