@@ -21,7 +21,7 @@ use rt_denoise::NoisyFrame;
 use rt_film::{read_rgb, AovSet};
 use rt_integrators::{Ctx, Technique};
 use rt_metrics::{compare, CompareOptions, Metrics};
-use rt_session::{Budgets, FilmStop, StopReason, StopRule};
+use rt_session::{Budgets, FilmStop, RenderJob, StopReason, StopRule};
 use std::collections::hash_map::Entry;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -261,7 +261,8 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
                     opts: &opts,
                     out,
                 },
-                (&ctx, technique.as_ref(), pair.seed),
+                (&ctx, technique.as_ref()),
+                &|b| pair.job(scene, method, Some(&Budgets::Spp(vec![b])), None),
                 &method.runs,
                 &mut rows,
                 progress,
@@ -434,14 +435,16 @@ struct GreeMethod<'a> {
     out: &'a Path,
 }
 
-/// Renders a GREE method at each of its budgets (each from scratch: GREE's split of a budget
-/// is not a prefix of a larger one's), measures the composite and its noisy image, and
+/// Renders a GREE method at each of its budgets, each the job `job_at(b)` run from scratch
+/// ([`RenderJob::gree_run`] with the plan's bank; GREE's split of a budget is not a prefix of
+/// a larger one's), measures the composite and its noisy image, and
 /// records the rows; returns the last composite and noisy image. The row's `samples` are every
 /// sample traced (noisy image and caches), its `seconds` the render of both, its
 /// `denoise_seconds` the bank plus GREE's own stages.
 fn run_gree(
     m: GreeMethod<'_>,
-    (ctx, technique, seed): (&Ctx<'_>, &dyn Technique, u32),
+    (ctx, technique): (&Ctx<'_>, &dyn Technique),
+    job_at: &dyn Fn(u32) -> RenderJob,
     runs: &Runs,
     rows: &mut Vec<Row>,
     progress: &dyn Progress,
@@ -451,12 +454,6 @@ fn run_gree(
         return Err(fail("GREE needs spp budgets".into()));
     };
     let bank = rt_denoise::Bank::from_specs(&m.plan.bank).map_err(|e| fail(e.to_string()))?;
-    let Some(integrator) = technique.camera_integrator() else {
-        return Err(fail(format!(
-            "GREE renders filter caches pixel by pixel, which the {} technique cannot",
-            technique.name()
-        )));
-    };
     let dir: PathBuf = ["images", m.scene].iter().collect();
     let slash = |p: &Path| p.to_string_lossy().replace('\\', "/");
     let measure = |image: &RgbImage| {
@@ -465,12 +462,9 @@ fn run_gree(
     };
     let mut last = None;
     for &b in budgets {
-        let params = m
-            .plan
-            .options
-            .params(b, seed)
-            .map_err(|e| fail(format!("gree: {e}")))?;
-        let run = rt_session::render_gree(ctx, integrator, &bank, &params, seed, &|_| {})
+        let job = job_at(b);
+        let run = job
+            .gree_run(ctx, technique, &bank, job.settings.seed, &())
             .map_err(|e| fail(e.to_string()))?;
         let label = format!("{b}spp");
         let rel = dir.join(format!("{}-{label}.exr", m.method));

@@ -3,15 +3,16 @@
 //! part`, `--resume` and the references run.
 
 use crate::config::{MethodPlan, Pair, ScenePlan};
-use rt_session::{Budgets, ImageSize, RenderJob, Settings, StopRule, Stream};
+use rt_session::{Budgets, GreeJob, ImageSize, RenderJob, Settings, StopRule, Stream};
 use rt_temporal::TemporalSpec;
 
 impl Pair {
     /// The job of this pair's `method` on `scene`: its estimator, structure and seed, the
     /// scene's camera at the plan's size, the normal streams, and the method's denoiser (the
     /// film then keeps what it reads; the grid denoises each stop itself, to time and measure
-    /// it apart). Without `stop` the job renders `budgets` progressively
-    /// ([`RenderJob::render_stops`]); with it, one adaptive render capped at its `max_spp`.
+    /// it apart) or its GREE options. Without `stop` the job renders `budgets` progressively
+    /// ([`RenderJob::render_stops`]), or for GREE the one budget in `budgets`
+    /// ([`RenderJob::gree_run`]); with it, one adaptive render capped at its `max_spp`.
     pub fn job(
         &self,
         scene: &ScenePlan,
@@ -39,6 +40,13 @@ impl Pair {
         job.size = ImageSize::Pixels(scene.camera.width, scene.camera.height);
         job.stream = Stream::Render;
         job.stop = stop;
+        job.gree = method.gree.as_ref().map(|g| GreeJob {
+            options: g.options,
+            // The plan's bank, which the grid hands to `RenderJob::gree_run`.
+            bank: None,
+            labels: None,
+            error_maps: None,
+        });
         job
     }
 }

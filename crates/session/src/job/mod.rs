@@ -18,6 +18,7 @@
 //! of one pass, and the film's sums are exact, so a part, a checkpoint or a resumed render
 //! merges to the very bytes of the whole render.
 
+mod gree;
 mod parts;
 mod report;
 mod run;

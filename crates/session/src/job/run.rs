@@ -614,33 +614,12 @@ impl RenderJob {
         sink: &dyn JobSink,
     ) -> Result<(RenderStats, Rendered), JobError> {
         let g = self.gree.as_ref().expect("a GREE job");
-        let scene = self.scene.display();
-        let Some(integrator) = technique.camera_integrator() else {
-            return refuse(format!(
-                "{scene}: --gree renders filter caches pixel by pixel, which the {} technique cannot (use wavefront, path, path-bsdf, direct or ao)",
-                technique.name()
-            ));
-        };
-        if self.stop.is_some() {
-            return refuse("--gree spends a fixed budget (--spp); it cannot be combined with --error or --time-limit".into());
-        }
-        if self.settings.aovs != AovSet::default() {
-            return refuse("--gree writes the composite only; save a noisy frame's AOVs with a render without --gree".into());
-        }
-        let params = g
-            .options
-            .params(self.settings.spp, self.settings.seed)
-            .map_err(|e| JobError::Refused(format!("--gree {}: {e}", g.options)))?;
         let bank = match &g.bank {
             Some(p) => rt_denoise::Bank::from_file(p),
             None => rt_denoise::Bank::default_gree(),
         }
         .map_err(|e| JobError::Refused(e.to_string()))?;
-        let rows = f64::from(ctx.camera.height.max(1));
-        let run = crate::render_gree(ctx, integrator, &bank, &params, env.seed, &|r| {
-            sink.progress(f64::from(r) / rows)
-        })
-        .map_err(|e| JobError::Failed(format!("{scene}: {e}")))?;
+        let run = self.gree_run(ctx, technique, &bank, env.seed, sink)?;
         let failed = |e: rt_film::FilmError| JobError::Failed(e.to_string());
         let opts = OutputOptions {
             exposure: self.exposure,
