@@ -8,7 +8,7 @@ use rt_integrators::PathIntegrator;
 use rt_testkit::{shipped_scene, Renderer, SceneExt};
 
 fn render(scene: &rt_core::Scene, integrator: &PathIntegrator, spp: u32, seed: u32) -> Film {
-    let buffers = FilmBuffers::for_outputs(AovSet::DENOISE);
+    let buffers = FilmBuffers::for_outputs(AovSet::denoise());
     Renderer::new(scene)
         .threads(2)
         .render(integrator, buffers, spp, seed)

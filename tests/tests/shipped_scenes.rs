@@ -14,7 +14,7 @@
 //! broken scene file must fail to load.
 
 use rt_core::SampleStream;
-use rt_film::{AovSet, Film};
+use rt_film::{Film, FilmBuffers};
 use rt_integrators::{Ctx, IntegratorSpec};
 use rt_session::{pick_camera, Budgets, ImageSize, Overrides, Session};
 use rt_testkit::workspace_root;
@@ -81,7 +81,7 @@ fn render(path: &Path, technique: &str, camera: Option<&str>) -> Result<Film, St
         integrator: integrator.as_ref(),
         seed: settings.seed,
         stream: SampleStream::Render,
-        aovs: AovSet::default(),
+        buffers: FilmBuffers::default(),
     };
     session.render(&Budgets::Spp(vec![SPP]), &|_| {}, &mut |_, _| {
         Ok::<(), String>(())

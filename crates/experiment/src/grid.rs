@@ -1,11 +1,13 @@
 //! Running the grid: references first (from the cache or rendered into it), then every method
 //! on every scene, each as one progressive render stopped at its budgets, or, for an adaptive
 //! method (`error`, `time_limit`), one render per stopping rule, stopped the way `render --error
-//! --time-limit` stops ([`rt_session::render_adaptive`]). Every stop writes its image and is
-//! measured against the scene's reference.
+//! --time-limit` stops. Each is a [`rt_session::RenderJob`] of the method on the scene
+//! ([`crate::config::Pair::job`]) that hands the grid its film at every stop
+//! ([`rt_session::RenderJob::render_stops`]); every stop writes its image and is measured
+//! against the scene's reference.
 //!
 //! A method with a denoiser renders the channels the denoiser reads
-//! ([`AovSet::for_channels`] of [`Denoiser::needs`]), denoises every stop's frame (timed
+//! ([`AovSet::for_channels`] of [`rt_denoise::Denoiser::needs`]), denoises every stop's frame (timed
 //! apart from the render) and is measured by the denoised image; the noisy image's error is
 //! kept beside it.
 
@@ -13,12 +15,13 @@ use crate::cache::Cache;
 use crate::config::{Plan, ReferencePlan, Runs};
 use crate::error::{io, ExperimentError, Result};
 use crate::Progress;
-use rt_core::{Accel, Rgb, RgbImage, SampleStream};
-use rt_denoise::{Denoiser, NoisyFrame};
-use rt_film::{read_rgb, AovSet, Film, FilmBuffers};
-use rt_integrators::Ctx;
+use crate::ProgressSink;
+use rt_core::{Accel, Rgb, RgbImage};
+use rt_denoise::NoisyFrame;
+use rt_film::{read_rgb, AovSet};
+use rt_integrators::{Ctx, Technique};
 use rt_metrics::{compare, CompareOptions, Metrics};
-use rt_session::{render_adaptive, Budgets, Session, StopReason, StopRule};
+use rt_session::{Budgets, FilmStop, RenderJob, StopReason, StopRule};
 use std::collections::hash_map::Entry;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -238,33 +241,11 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
                 })?)
             }
         };
-        let integrator = pair.estimator.build();
-        let denoiser: Option<Box<dyn Denoiser>> = method
-            .denoiser
-            .as_ref()
-            .map(|d| d.build())
-            .transpose()
-            .map_err(|e| ExperimentError::Run(format!("{}: {e}", method.name)))?;
-        let aovs = denoiser
-            .as_ref()
-            .map_or(AovSet::default(), |d| AovSet::for_channels(d.needs()));
-        if aovs.any_split() && !integrator.writes_split() {
-            return Err(ExperimentError::Run(format!(
-                "{}: its denoiser reads the lighting split, which the {} technique does not write",
-                method.name,
-                integrator.name()
-            )));
-        }
-        let session = Session {
-            ctx: Ctx {
-                scene: &scene.loaded.scene,
-                accel: accel.as_ref(),
-                camera: &scene.camera,
-            },
-            integrator: integrator.as_ref(),
-            seed: pair.seed,
-            stream: SampleStream::Render,
-            aovs,
+        let technique = pair.estimator.build();
+        let ctx = Ctx {
+            scene: &scene.loaded.scene,
+            accel: accel.as_ref(),
+            camera: &scene.camera,
         };
         bar.set_message(format!("{}: {}", scene.name, method.name));
         let runs = method.runs.len() as u64;
@@ -280,7 +261,8 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
                     opts: &opts,
                     out,
                 },
-                &session,
+                (&ctx, technique.as_ref()),
+                &|b| pair.job(scene, method, Some(&Budgets::Spp(vec![b])), None),
                 &method.runs,
                 &mut rows,
                 progress,
@@ -291,79 +273,116 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
             bar.set_position(done_runs * UNITS);
             continue;
         }
+        // The grid denoises each stop itself, to time and measure it apart from the render.
+        let denoiser = pair
+            .job(scene, method, None, None)
+            .frame_denoiser()
+            .map_err(|e| ExperimentError::Run(format!("{}: {e}", method.name)))?;
+        let aovs = denoiser
+            .as_ref()
+            .map_or(AovSet::default(), |d| AovSet::for_channels(d.needs()));
+        if aovs.any_split() && !technique.writes_split() {
+            return Err(ExperimentError::Run(format!(
+                "{}: its denoiser reads the lighting split, which the {} technique does not write",
+                method.name,
+                technique.name()
+            )));
+        }
+        let pixels = (scene.camera.width as f64 * scene.camera.height as f64).max(1.0);
         let mut last_image = None;
         let mut last_noisy = None;
-        // Writes the image of one stop, denoises it if the method says so, measures it and
-        // records its row.
-        let mut record =
-            |film: &Film, label: String, row: &dyn Fn(Metrics, String) -> Row| -> Result<()> {
-                let dir: PathBuf = ["images", &scene.name].iter().collect();
-                let rel = dir.join(format!("{}-{label}.exr", method.name));
-                rt_film::write_image(&out.join(&rel), film, &Default::default())?;
-                let measure = |image: &RgbImage, rel: &Path| {
-                    compare(image, &reference.image, &opts).map_err(|e| {
-                        ExperimentError::Run(format!(
-                            "{} against the reference of {}: {e}",
-                            rel.display(),
-                            scene.name
-                        ))
-                    })
-                };
-                let slash = |p: &Path| p.to_string_lossy().replace('\\', "/");
-                let noisy = RgbImage::new(
-                    film.width() as usize,
-                    film.height() as usize,
-                    film.mean_image(),
-                )?;
-                let raw = measure(&noisy, &rel)?;
-                let Some(d) = &denoiser else {
-                    rows.push(row(raw, slash(&rel)));
-                    last_image = Some(noisy);
-                    return Ok(());
-                };
-                let t0 = Instant::now();
-                let denoised = d
-                    .denoise(&NoisyFrame::from_film(film, aovs))
-                    .map_err(|e| ExperimentError::Run(format!("{}: {e}", method.name)))?;
-                let denoise_seconds = t0.elapsed().as_secs_f64();
-                let drel = dir.join(format!("{}-{label}-denoised.exr", method.name));
-                rt_film::write_rgb(&out.join(&drel), &denoised, &Default::default())?;
-                let mut r = row(measure(&denoised, &drel)?, slash(&rel));
-                r.raw = Some(raw);
-                r.denoise_seconds = denoise_seconds;
-                r.denoised_image = Some(slash(&drel));
-                rows.push(r);
-                last_image = Some(denoised);
-                last_noisy = Some(noisy);
-                Ok(())
+        // Writes the image of one stop (the `budget` asked for, or the adaptive `rule`), denoises
+        // it if the method says so, measures it and records its row.
+        let mut record = |stop: &FilmStop<'_>,
+                          budget: f64,
+                          label: String,
+                          rule: Option<&StopRule>|
+         -> Result<()> {
+            let film = stop.film;
+            let at = stop.at;
+            let dir: PathBuf = ["images", &scene.name].iter().collect();
+            let rel = dir.join(format!("{}-{label}.exr", method.name));
+            rt_film::write_image(&out.join(&rel), film, &Default::default())?;
+            let measure = |image: &RgbImage, rel: &Path| {
+                compare(image, &reference.image, &opts).map_err(|e| {
+                    ExperimentError::Run(format!(
+                        "{} against the reference of {}: {e}",
+                        rel.display(),
+                        scene.name
+                    ))
+                })
             };
+            let slash = |p: &Path| p.to_string_lossy().replace('\\', "/");
+            let noisy = RgbImage::new(
+                film.width() as usize,
+                film.height() as usize,
+                film.mean_image(),
+            )?;
+            let raw = measure(&noisy, &rel)?;
+            let mut row = Row {
+                pair: pi,
+                budget,
+                spp: at.spp,
+                samples: at.samples,
+                // An adaptive run's pixels took different counts.
+                mean_spp: match rule {
+                    Some(_) => at.samples as f64 / pixels,
+                    None => f64::from(at.spp),
+                },
+                stop: rule
+                    .zip(stop.adaptive.as_ref())
+                    .map(|(rule, a)| AdaptiveRun {
+                        rule: *rule,
+                        reason: a.reason,
+                        decide_seconds: a.decisions.as_secs_f64(),
+                        blocks_left: a.blocks_left,
+                    }),
+                seconds: at.seconds,
+                denoise_seconds: 0.0,
+                rays: at.rays,
+                samples_per_second: at.samples as f64 / at.seconds.max(1e-9),
+                metrics: raw,
+                raw: None,
+                image: slash(&rel),
+                denoised_image: None,
+            };
+            let Some(d) = &denoiser else {
+                rows.push(row);
+                last_image = Some(noisy);
+                return Ok(());
+            };
+            let t0 = Instant::now();
+            let denoised = d
+                .denoise(&NoisyFrame::from_film(film, aovs))
+                .map_err(|e| ExperimentError::Run(format!("{}: {e}", method.name)))?;
+            row.denoise_seconds = t0.elapsed().as_secs_f64();
+            let drel = dir.join(format!("{}-{label}-denoised.exr", method.name));
+            rt_film::write_rgb(&out.join(&drel), &denoised, &Default::default())?;
+            row.metrics = measure(&denoised, &drel)?;
+            row.raw = Some(raw);
+            row.denoised_image = Some(slash(&drel));
+            rows.push(row);
+            last_image = Some(denoised);
+            last_noisy = Some(noisy);
+            Ok(())
+        };
         match &method.runs {
             Runs::Progressive(budgets) => {
                 let values: Vec<f64> = match budgets {
                     Budgets::Spp(v) => v.iter().map(|&n| f64::from(n)).collect(),
                     Budgets::Seconds(v) => v.clone(),
                 };
-                session.render(
-                    budgets,
-                    &|f| bar.set_position(base + (f * (runs * UNITS) as f64) as u64),
-                    &mut |film, at| {
-                        let budget = values[at.budget];
-                        record(film, budget_label(budgets, budget), &|metrics, image| Row {
-                            pair: pi,
-                            budget,
-                            spp: at.spp,
-                            samples: at.samples,
-                            mean_spp: f64::from(at.spp),
-                            stop: None,
-                            seconds: at.seconds,
-                            denoise_seconds: 0.0,
-                            rays: at.rays,
-                            samples_per_second: at.samples as f64 / at.seconds.max(1e-9),
-                            metrics,
-                            raw: None,
-                            image,
-                            denoised_image: None,
-                        })
+                let job = pair.job(scene, method, Some(budgets), None);
+                let progress = |f: f64| bar.set_position(base + (f * (runs * UNITS) as f64) as u64);
+                let sink = ProgressSink(&progress);
+                job.render_stops(
+                    &ctx,
+                    technique.as_ref(),
+                    Some(budgets),
+                    &sink,
+                    &mut |stop| {
+                        let budget = values[stop.at.budget];
+                        record(stop, budget, budget_label(budgets, budget), None)
                     },
                 )?;
             }
@@ -374,51 +393,20 @@ pub fn run(plan: &Plan, out: &Path, cache: &Cache, progress: &dyn Progress) -> R
                 )))
             }
             Runs::Adaptive(rules) => {
-                let pixels = (scene.camera.width as f64 * scene.camera.height as f64).max(1.0);
                 for (i, rule) in rules.iter().enumerate() {
-                    // The criterion reads the even samples' half-buffer.
-                    let mut buffers = FilmBuffers::for_outputs(aovs);
-                    if rule.error.is_some() {
-                        buffers = buffers.with_halves();
-                    }
-                    let mut film = Film::new(scene.camera.width, scene.camera.height, buffers);
                     let run_base = base + i as u64 * UNITS;
-                    let a = render_adaptive(
-                        &session.ctx,
-                        session.integrator,
-                        &mut film,
-                        session.seed,
-                        rule,
-                        &|f| bar.set_position(run_base + (f.min(1.0) * UNITS as f64) as u64),
-                    )
-                    .map_err(|e| ExperimentError::Run(format!("{}: {e}", method.name)))?;
-                    let seconds = a.stats.elapsed.as_secs_f64();
                     let budget = match (rule.error, rule.time_limit) {
                         // As written (0.05, not the f32's 0.0500000007).
                         (Some(e), _) => e.to_string().parse().unwrap_or(f64::from(e)),
                         (None, Some(t)) => t.as_secs_f64(),
                         (None, None) => f64::from(rule.max_spp),
                     };
-                    record(&film, rule_label(rule), &|metrics, image| Row {
-                        pair: pi,
-                        budget,
-                        spp: a.spp,
-                        samples: a.stats.samples,
-                        mean_spp: a.stats.samples as f64 / pixels,
-                        stop: Some(AdaptiveRun {
-                            rule: *rule,
-                            reason: a.reason,
-                            decide_seconds: a.decisions.as_secs_f64(),
-                            blocks_left: a.active_blocks.len(),
-                        }),
-                        seconds,
-                        denoise_seconds: 0.0,
-                        rays: a.stats.rays.rays + a.stats.rays.shadow_rays,
-                        samples_per_second: a.stats.samples as f64 / seconds.max(1e-9),
-                        metrics,
-                        raw: None,
-                        image,
-                        denoised_image: None,
+                    let job = pair.job(scene, method, None, Some(*rule));
+                    let progress =
+                        |f: f64| bar.set_position(run_base + (f.min(1.0) * UNITS as f64) as u64);
+                    let sink = ProgressSink(&progress);
+                    job.render_stops(&ctx, technique.as_ref(), None, &sink, &mut |stop| {
+                        record(stop, budget, rule_label(rule), Some(rule))
                     })?;
                 }
             }
@@ -447,14 +435,16 @@ struct GreeMethod<'a> {
     out: &'a Path,
 }
 
-/// Renders a GREE method at each of its budgets (each from scratch: GREE's split of a budget
-/// is not a prefix of a larger one's), measures the composite and its noisy image, and
+/// Renders a GREE method at each of its budgets, each the job `job_at(b)` run from scratch
+/// ([`RenderJob::gree_run`] with the plan's bank; GREE's split of a budget is not a prefix of
+/// a larger one's), measures the composite and its noisy image, and
 /// records the rows; returns the last composite and noisy image. The row's `samples` are every
 /// sample traced (noisy image and caches), its `seconds` the render of both, its
 /// `denoise_seconds` the bank plus GREE's own stages.
 fn run_gree(
     m: GreeMethod<'_>,
-    session: &Session<'_>,
+    (ctx, technique): (&Ctx<'_>, &dyn Technique),
+    job_at: &dyn Fn(u32) -> RenderJob,
     runs: &Runs,
     rows: &mut Vec<Row>,
     progress: &dyn Progress,
@@ -464,12 +454,6 @@ fn run_gree(
         return Err(fail("GREE needs spp budgets".into()));
     };
     let bank = rt_denoise::Bank::from_specs(&m.plan.bank).map_err(|e| fail(e.to_string()))?;
-    let Some(integrator) = session.integrator.camera_integrator() else {
-        return Err(fail(format!(
-            "GREE renders filter caches pixel by pixel, which the {} technique cannot",
-            session.integrator.name()
-        )));
-    };
     let dir: PathBuf = ["images", m.scene].iter().collect();
     let slash = |p: &Path| p.to_string_lossy().replace('\\', "/");
     let measure = |image: &RgbImage| {
@@ -478,20 +462,10 @@ fn run_gree(
     };
     let mut last = None;
     for &b in budgets {
-        let params = m
-            .plan
-            .options
-            .params(b, session.seed)
-            .map_err(|e| fail(format!("gree: {e}")))?;
-        let run = rt_session::render_gree(
-            &session.ctx,
-            integrator,
-            &bank,
-            &params,
-            session.seed,
-            &|_| {},
-        )
-        .map_err(|e| fail(e.to_string()))?;
+        let job = job_at(b);
+        let run = job
+            .gree_run(ctx, technique, &bank, job.settings.seed, &())
+            .map_err(|e| fail(e.to_string()))?;
         let label = format!("{b}spp");
         let rel = dir.join(format!("{}-{label}.exr", m.method));
         run.frame.write_exr(&m.out.join(&rel), &[])?;

@@ -7,8 +7,9 @@
 //!   on disk under a key that changes with anything that changes the image.
 //! - [`grid`]: every method on every scene, rendered progressively to its budgets (`spp`,
 //!   `seconds`) or, for an adaptive method, once per stopping rule (`error` and `time_limit`
-//!   with `spp` as the cap, as `render --error --time-limit --spp` stop:
-//!   [`rt_session::render_adaptive`]), and measured against the reference.
+//!   with `spp` as the cap, as `render --error --time-limit --spp` stop), each a
+//!   [`rt_session::RenderJob`] that hands the grid its film at every stop, and measured
+//!   against the reference.
 //! - [`fit`]: log-log slopes and interpolation; [`report`]: results.csv, slopes.csv, equal-time
 //!   and equal-samples comparisons (the samples adaptive runs actually took), crops and
 //!   report.md; [`plot`]: the log-log error plots.
@@ -54,6 +55,7 @@ pub mod fit;
 pub mod grid;
 pub mod html;
 pub mod merge;
+mod method_job;
 pub mod plot;
 pub mod reference;
 pub mod report;
@@ -80,6 +82,16 @@ pub trait Progress: Sync {
     fn set_message(&self, _text: String) {}
     /// One line of information for the user.
     fn message(&self, _line: &str) {}
+}
+
+/// A job's progress ([`rt_session::JobSink::progress`]) handed to a closure, e.g. one that
+/// moves a [`Progress`] bar.
+pub(crate) struct ProgressSink<'a>(pub &'a (dyn Fn(f64) + Sync));
+
+impl rt_session::JobSink for ProgressSink<'_> {
+    fn progress(&self, done: f64) {
+        (self.0)(done)
+    }
 }
 
 /// A [`Progress`] that reports nothing.

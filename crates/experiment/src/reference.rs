@@ -7,11 +7,12 @@
 
 use crate::cache::{Cache, Key, ReferenceRequest, Sidecar};
 use crate::error::{ExperimentError, Result};
+use crate::ProgressSink;
 use rt_accel::AccelSpec;
 use rt_core::Accel;
 use rt_film::{AovSet, Film};
-use rt_integrators::{Ctx, RenderStats};
-use rt_session::{RenderJob, Settings, Stream};
+use rt_integrators::Ctx;
+use rt_session::{Checkpoint, RenderJob, Settings, Stream};
 use std::path::{Path, PathBuf};
 
 /// A reference ready to use.
@@ -241,8 +242,8 @@ pub fn obtain(
     }
     let out = write_to.unwrap_or(Path::new("reference.exr"));
     let job = job(req, *accel_spec, &key, out);
-    let (film, stats) = render(&job, req, accel, progress)?;
-    let seconds = stats.elapsed.as_secs_f64();
+    let (film, done) = render(&job, req, accel, progress)?;
+    let seconds = done.seconds;
     let sidecar = Sidecar {
         key: key.hex.clone(),
         description: key.description.clone(),
@@ -251,7 +252,7 @@ pub fn obtain(
         height: req.camera.height,
         spp: req.spp,
         seconds,
-        samples_per_second: stats.samples as f64 / seconds.max(1e-9),
+        samples_per_second: done.samples as f64 / seconds.max(1e-9),
     };
     let path = match (cache, write_to) {
         (Some(cache), _) => cache.store(req.scene_path, &key, &film, &sidecar)?,
@@ -272,28 +273,29 @@ pub fn obtain(
     })
 }
 
-/// Reports a job's progress to a closure.
-struct Progress<'a>(&'a (dyn Fn(f64) + Sync));
-
-impl rt_session::JobSink for Progress<'_> {
-    fn progress(&self, done: f64) {
-        (self.0)(done)
-    }
-}
-
-/// Renders the reference job over the request's scene and camera.
+/// Renders the reference job over the request's scene and camera: the film and what it took.
 fn render(
     job: &RenderJob,
     req: &ReferenceRequest<'_>,
     accel: &dyn Accel,
     progress: &(dyn Fn(f64) + Sync),
-) -> Result<(Film, RenderStats)> {
+) -> Result<(Film, Checkpoint)> {
     let ctx = Ctx {
         scene: req.scene,
         accel,
         camera: req.camera,
     };
     let technique = job.settings.integrator.build();
-    job.render_film(&ctx, technique.as_ref(), &Progress(progress))
-        .map_err(|e| ExperimentError::Run(e.to_string()))
+    let mut done = Checkpoint::default();
+    let film = job.render_stops(
+        &ctx,
+        technique.as_ref(),
+        None,
+        &ProgressSink(progress),
+        &mut |stop| -> Result<()> {
+            done = stop.at;
+            Ok(())
+        },
+    )?;
+    Ok((film, done))
 }

@@ -186,7 +186,7 @@ pub const AOV_FLAGS: [AovFlag; 15] = [
 ];
 
 /// The names [`AovSet::parse_list`] knows, in the order help texts list them: every named
-/// flag of [`AOV_FLAGS`], then `denoise` ([`AovSet::DENOISE`]).
+/// flag of [`AOV_FLAGS`], then `denoise` ([`AovSet::denoise`]).
 pub const AOV_NAMES: [&str; 15] = {
     let mut names = [""; 15];
     let (mut i, mut n) = (0, 0);
@@ -203,25 +203,20 @@ pub const AOV_NAMES: [&str; 15] = {
 };
 
 impl AovSet {
-    /// Everything a denoiser of `rt-denoise` reads: the features with their variances, the
-    /// variance and half-buffers of the pixel estimate, and the whole lighting split.
-    pub const DENOISE: AovSet = AovSet {
-        albedo: true,
-        normal: true,
-        depth: true,
-        position: true,
-        variance: true,
-        halves: true,
-        feature_variance: true,
-        emission: true,
-        direct: true,
-        indirect: true,
-        diffuse: true,
-        glossy: true,
-        irradiance: true,
-        blocks: false,
-        samples: false,
-    };
+    /// Everything a denoiser of `rt-denoise` reads: every named flag that fills frame
+    /// channels (the features with their variances, the variance and half-buffers of the
+    /// pixel estimate, and the whole lighting split), so not `blocks` (no frame channel) nor
+    /// the per-sample records (no name). `--aov denoise` stands for it.
+    pub fn denoise() -> AovSet {
+        let mut s = AovSet::default();
+        for f in AOV_FLAGS
+            .iter()
+            .filter(|f| f.name.is_some() && !f.channels.is_empty())
+        {
+            f.add_to(&mut s);
+        }
+        s
+    }
 
     /// True if any first-hit quantity is wanted (variance is not a first-hit quantity).
     pub fn any_first_hit(&self) -> bool {
@@ -258,13 +253,13 @@ impl AovSet {
     }
 
     /// Parses a comma-separated list such as `albedo,normal,variance`; `denoise` stands for
-    /// [`AovSet::DENOISE`].
+    /// [`AovSet::denoise`].
     pub fn parse_list<'a>(names: impl IntoIterator<Item = &'a str>) -> Result<Self, UnknownAov> {
         let mut s = Self::default();
         for n in names {
             match n.trim() {
                 "" => {}
-                "denoise" => s = s.union(Self::DENOISE),
+                "denoise" => s = s.union(Self::denoise()),
                 name => AOV_FLAGS
                     .iter()
                     .find(|f| f.name == Some(name))
@@ -301,15 +296,27 @@ mod tests {
     use super::*;
 
     #[test]
-    fn denoise_is_every_named_output_but_blocks() {
-        let mut want = AovSet::default();
-        for f in AOV_FLAGS
-            .iter()
-            .filter(|f| f.name.is_some_and(|n| n != "blocks"))
-        {
-            f.add_to(&mut want);
-        }
-        assert_eq!(AovSet::DENOISE, want);
+    fn denoise_is_every_frame_output_and_no_more() {
+        // Written out so that a new flag has to be placed in or out of `--aov denoise` here.
+        let every_frame_output = AovSet {
+            albedo: true,
+            normal: true,
+            depth: true,
+            position: true,
+            variance: true,
+            halves: true,
+            feature_variance: true,
+            emission: true,
+            direct: true,
+            indirect: true,
+            diffuse: true,
+            glossy: true,
+            irradiance: true,
+            blocks: false,
+            samples: false,
+        };
+        assert_eq!(AovSet::denoise(), every_frame_output);
+        assert_eq!(AovSet::parse_list(["denoise"]), Ok(every_frame_output));
     }
 
     #[test]

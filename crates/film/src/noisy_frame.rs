@@ -525,7 +525,7 @@ mod tests {
 
     /// A film with every channel, filled with distinct, awkward values.
     fn full_film() -> Film {
-        film_with(AovSet::DENOISE)
+        film_with(AovSet::denoise())
     }
 
     /// A film keeping the buffers of `aovs`, filled like [`full_film`].
@@ -565,7 +565,7 @@ mod tests {
 
     #[test]
     fn exr_round_trip_is_bit_exact_for_every_channel() {
-        let frame = NoisyFrame::from_film(&full_film(), AovSet::DENOISE);
+        let frame = NoisyFrame::from_film(&full_film(), AovSet::denoise());
         // Every channel a file can hold (sample records stay in memory).
         let saved: Vec<Channel> = Channel::ALL
             .into_iter()
@@ -629,7 +629,7 @@ mod tests {
             all,
             AovSet {
                 samples: true,
-                ..AovSet::DENOISE
+                ..AovSet::denoise()
             }
         );
         for c in Channel::ALL {

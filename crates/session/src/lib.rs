@@ -4,14 +4,17 @@
 //! - [`job`]: [`RenderJob`], a render as one typed, serialisable value (scene, settings,
 //!   frames, slice, stop rule, checkpointing, outputs, denoiser, cache), with one
 //!   [`RenderJob::run`] that takes a progress sink and a stop flag; plans and checkpoints store
-//!   it; [`job::merge`] merges its parts.
+//!   it; [`job::merge`] merges its parts. [`RenderJob::render_stops`] renders a job into a film
+//!   the caller keeps and hands it over at every stop ([`FilmStop`]), as experiments record
+//!   their budgets.
 //! - [`settings`]: the one place settings are resolved (given values, then the scene's
 //!   `[render]` table, then defaults), with their limits ([`rt_core::limits`]) and the
 //!   combinations they cannot honour.
 //! - [`camera`]: which camera renders ([`pick_camera`]) and at what size ([`ImageSize`]).
 //! - [`adaptive`]: rendering until a [`StopRule`] says stop.
 //! - [`progressive`]: a list of budgets, samples per pixel or seconds, rendered pass after pass
-//!   into one film ([`Session`], [`Budgets`], [`Checkpoint`]), as experiments measure them.
+//!   into one film ([`Session`], [`Budgets`], [`Checkpoint`]), what a job's
+//!   [`RenderJob::render_stops`] runs for an experiment's budgets.
 //! - [`sequence`]: an animation rendered frame after frame, denoised by a denoiser that may
 //!   remember earlier frames (SVGF), with the guide pass in between ([`SequenceRenderer`]);
 //!   [`viewer`]: the same frame after frame under a user's hand ([`viewer::LiveView`], the
@@ -67,8 +70,8 @@ pub use adaptive::{
 pub use camera::{parse_resolution, pick_camera, split_size, ImageSize, MAX_SIDE};
 pub use gree::{gree_aovs, render_gree, GreeRun, GreeRunError, GreeSpec};
 pub use job::{
-    load_scene, Checkpointing, FrameReport, Frames, GreeJob, JobError, JobReport, JobScene,
-    JobSink, RenderJob, Rendered, Slice, Stream,
+    load_scene, Checkpointing, FilmStop, FrameReport, Frames, GreeJob, JobError, JobReport,
+    JobScene, JobSink, RenderJob, Rendered, Slice, Stream,
 };
 pub use progressive::{Budgets, Checkpoint, Session};
 pub use report::{RenderReport, ReportInputs, Stage, Status};

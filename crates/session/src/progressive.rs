@@ -5,7 +5,7 @@
 
 use crate::MAX_SPP;
 use rt_core::SampleStream;
-use rt_film::{AovSet, Film};
+use rt_film::{Film, FilmBuffers};
 use rt_integrators::{Ctx, SamplePass, Technique};
 
 /// How much to render: samples per pixel, or a time.
@@ -60,8 +60,9 @@ pub struct Session<'a> {
     pub seed: u32,
     /// Normal or reference streams.
     pub stream: SampleStream,
-    /// AOVs the film keeps (references keep `variance`).
-    pub aovs: AovSet,
+    /// The buffers the film keeps besides the mean ([`FilmBuffers::for_outputs`] of the AOVs
+    /// written, and what a denoiser reads).
+    pub buffers: FilmBuffers,
 }
 
 impl Session<'_> {
@@ -83,7 +84,7 @@ impl Session<'_> {
         checkpoint: &mut dyn FnMut(&Film, &Checkpoint) -> Result<(), E>,
     ) -> Result<Film, E> {
         let camera = self.ctx.camera;
-        let mut film = Film::new(camera.width, camera.height, self.aovs);
+        let mut film = Film::new(camera.width, camera.height, self.buffers);
         let mut at = Checkpoint::default();
         let rows = camera.height.max(1) as f64;
         let pass = |film: &mut Film,

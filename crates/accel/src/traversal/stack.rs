@@ -63,7 +63,10 @@ impl<const CAP: usize, const TSTACK: bool> Stack<CAP, TSTACK> {
 /// Inserts child `code`, entered at distance `t`, into the `n` hit children `hits[..n]` of one
 /// node kept sorted by entry distance (insertion sort; equal distances keep the order they
 /// were offered in). Returns the new count. (A free function over the caller's array and count
-/// rather than a type holding both: the count then stays in a register.)
+/// rather than a type holding both: the count then stays in a register.) The loop over a
+/// node's hit lanes that calls it stays in each caller: one helper taking the child's code as
+/// a closure cost IOSP-2 up to 1.5 % more instructions (docs/benchmarks.md, "Issue 29: one
+/// loop over a top node's hit children?").
 #[inline(always)]
 pub(crate) fn insert_by_distance(hits: &mut [(f32, u32)], n: usize, t: f32, code: u32) -> usize {
     let mut k = n;

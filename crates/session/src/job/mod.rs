@@ -6,7 +6,8 @@
 //!
 //! `render` builds a job from its flags and runs it; `render part` runs a job from a plan with
 //! the part's slice; `render --resume` runs the job a checkpoint holds; `render reference` and
-//! an experiment's references run reference jobs ([`Stream::Reference`]). Plans and
+//! an experiment's references run reference jobs ([`Stream::Reference`]), and an experiment's
+//! methods run jobs that hand it the film at each budget ([`RenderJob::render_stops`]). Plans and
 //! checkpoints store the job as JSON with a format version ([`RenderJob::to_json`],
 //! [`RenderJob::from_json`]); a file written by another format is refused with one line.
 //!
@@ -17,13 +18,16 @@
 //! of one pass, and the film's sums are exact, so a part, a checkpoint or a resumed render
 //! merges to the very bytes of the whole render.
 
+mod gree;
 mod parts;
 mod report;
 mod run;
+mod stops;
 
 pub use parts::{merge, read_parts, MergeReport};
 pub use report::{AdaptiveSummary, FrameReport, GreeSummary, JobReport, JobSink, Rendered};
 pub use run::{thread_pool, INTERRUPTIBLE_PASS};
+pub use stops::FilmStop;
 
 use crate::text;
 use crate::{ImageSize, SessionError, Settings, SettingsError, StopRule};

@@ -8,8 +8,8 @@ use super::{load_scene, refuse, Frames, JobError, JobScene, RenderJob};
 use crate::frames::frame_path;
 use crate::memory::Estimate;
 use crate::{
-    frame_seed, pick_camera, render_adaptive, render_adaptive_until, Adaptive, RenderReport,
-    ReportInputs, SequenceRenderer,
+    frame_seed, pick_camera, render_adaptive_until, Adaptive, RenderReport, ReportInputs,
+    SequenceRenderer,
 };
 use rt_core::{Accel, Camera, Scene};
 use rt_film::{AovSet, Film, FilmBuffers, OutputOptions};
@@ -175,7 +175,7 @@ impl RenderJob {
     }
 
     /// The single-frame denoiser, built (`None` without one, or with a temporal one).
-    fn frame_denoiser(&self) -> Result<Option<Box<dyn rt_denoise::Denoiser>>, JobError> {
+    pub fn frame_denoiser(&self) -> Result<Option<Box<dyn rt_denoise::Denoiser>>, JobError> {
         match &self.settings.denoiser {
             Some(rt_temporal::TemporalSpec::PerFrame(spec)) => spec
                 .build()
@@ -280,46 +280,8 @@ impl RenderJob {
         Ok(())
     }
 
-    /// Renders this job's samples (or its slice's) of one image of `ctx` with `technique`
-    /// into a new film and returns it: no file is written. For callers that hold their own
-    /// scene, structure and camera (an experiment's references). Fixed and adaptive jobs
-    /// only.
-    pub fn render_film(
-        &self,
-        ctx: &Ctx<'_>,
-        technique: &dyn Technique,
-        sink: &dyn JobSink,
-    ) -> Result<(Film, RenderStats), JobError> {
-        let camera = ctx.camera;
-        let denoiser = self.frame_denoiser()?;
-        let mut film = Film::new(
-            camera.width,
-            camera.height,
-            self.film_buffers(denoiser.as_deref()),
-        );
-        let stats = match &self.stop {
-            Some(rule) => {
-                render_adaptive(ctx, technique, &mut film, self.settings.seed, rule, &|f| {
-                    sink.progress(f)
-                })
-                .map_err(|e| JobError::Refused(format!("--error {}", e.0)))?
-                .stats
-            }
-            None => {
-                let cut = Cut {
-                    samples: self.slice.samples.clone().unwrap_or(0..self.settings.spp),
-                    region: self
-                        .slice
-                        .rect()
-                        .unwrap_or(rt_film::Rect::full(camera.width, camera.height)),
-                };
-                self.fixed_pass(ctx, technique, &mut film, self.settings.seed, &cut, sink)
-            }
-        };
-        Ok((film, stats))
-    }
-
-    fn fixed_pass(
+    /// Renders the samples and pixels of `cut` into `film` in one pass.
+    pub(super) fn fixed_pass(
         &self,
         ctx: &Ctx<'_>,
         technique: &dyn Technique,
@@ -652,33 +614,12 @@ impl RenderJob {
         sink: &dyn JobSink,
     ) -> Result<(RenderStats, Rendered), JobError> {
         let g = self.gree.as_ref().expect("a GREE job");
-        let scene = self.scene.display();
-        let Some(integrator) = technique.camera_integrator() else {
-            return refuse(format!(
-                "{scene}: --gree renders filter caches pixel by pixel, which the {} technique cannot (use wavefront, path, path-bsdf, direct or ao)",
-                technique.name()
-            ));
-        };
-        if self.stop.is_some() {
-            return refuse("--gree spends a fixed budget (--spp); it cannot be combined with --error or --time-limit".into());
-        }
-        if self.settings.aovs != AovSet::default() {
-            return refuse("--gree writes the composite only; save a noisy frame's AOVs with a render without --gree".into());
-        }
-        let params = g
-            .options
-            .params(self.settings.spp, self.settings.seed)
-            .map_err(|e| JobError::Refused(format!("--gree {}: {e}", g.options)))?;
         let bank = match &g.bank {
             Some(p) => rt_denoise::Bank::from_file(p),
             None => rt_denoise::Bank::default_gree(),
         }
         .map_err(|e| JobError::Refused(e.to_string()))?;
-        let rows = f64::from(ctx.camera.height.max(1));
-        let run = crate::render_gree(ctx, integrator, &bank, &params, env.seed, &|r| {
-            sink.progress(f64::from(r) / rows)
-        })
-        .map_err(|e| JobError::Failed(format!("{scene}: {e}")))?;
+        let run = self.gree_run(ctx, technique, &bank, env.seed, sink)?;
         let failed = |e: rt_film::FilmError| JobError::Failed(e.to_string());
         let opts = OutputOptions {
             exposure: self.exposure,

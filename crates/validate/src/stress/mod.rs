@@ -370,7 +370,7 @@ pub fn render_film(
     spp: u32,
     seed: u32,
 ) -> (Film, rt_integrators::RenderStats) {
-    let aovs = AovSet::DENOISE;
+    let aovs = AovSet::denoise();
     // Every buffer a film can keep, so that every one is checked for invalid values.
     let buffers = FilmBuffers::for_outputs(aovs).with_variance().with_halves();
     crate::Renderer::new(scene)
