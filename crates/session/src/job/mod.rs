@@ -681,6 +681,8 @@ mod run_tests {
         let d = tempfile::tempdir().unwrap();
         let dir = d.path();
         let mut j = job(dir, 3);
+        // A temporally denoised sequence renders at the camera's own size.
+        j.size = ImageSize::Native;
         for denoiser in [None, Some("nlm"), Some("svgf")] {
             j.settings.denoiser = denoiser.map(|d| d.parse().unwrap());
             j.frames = Frames::Range(1..3);
