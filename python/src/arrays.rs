@@ -32,7 +32,7 @@ fn components(group: &str) -> [&'static str; 3] {
 }
 
 /// `exr`'s channels as a frame dict (see the module doc).
-pub fn frame_to_dict<'py>(py: Python<'py>, exr: &ExrImage) -> PyResult<Bound<'py, PyDict>> {
+pub fn frame_to_dict<'py>(py: Python<'py>, mut exr: ExrImage) -> PyResult<Bound<'py, PyDict>> {
     let (w, h) = (exr.width, exr.height);
     let dict = PyDict::new(py);
     let mut used = vec![false; exr.channels.len()];
@@ -68,12 +68,12 @@ pub fn frame_to_dict<'py>(py: Python<'py>, exr: &ExrImage) -> PyResult<Bound<'py
             }
         }
     }
-    for ((name, values), used) in exr.channels.iter().zip(used) {
+    for ((name, values), used) in exr.channels.iter_mut().zip(used) {
         if used {
             continue;
         }
         let key = name.strip_suffix(".Z").filter(|g| Z_CHANNELS.contains(g));
-        let array = PyArray1::from_vec(py, values.clone()).reshape([h, w])?;
+        let array = PyArray1::from_vec(py, std::mem::take(values)).reshape([h, w])?;
         dict.set_item(key.unwrap_or(name), array)?;
     }
     Ok(dict)

@@ -75,7 +75,7 @@ pub fn compare<'py>(
 #[pyfunction]
 pub fn read_exr<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyDict>> {
     let exr = py.detach(|| rt_film::read_exr(&path)).map_err(rt_err)?;
-    frame_to_dict(py, &exr)
+    frame_to_dict(py, exr)
 }
 
 /// Runs the experiment `config` as `render experiment` does, writing into `out` (default: the

@@ -1,9 +1,11 @@
 //! `Scene.render`: the keyword arguments become an `rt_session::RenderJob` (as `render`'s flags
 //! do in cli/src/render.rs), which runs over the scene in memory on a thread of its own while
 //! the calling thread, without the GIL held most of the time, reports progress to the callback
-//! and checks for signals. The job writes its EXR to a temporary directory and the arrays are
-//! read back from it: the image and AOVs are the CLI's, bit for bit, whatever the job's output
-//! path (plain film, denoiser, GREE composite, the stopping criterion's block map) made of them.
+//! and checks for signals. The job hands its images to the sink instead of writing files
+//! (`rt_session::Delivery::Sink`): each is the channels the CLI's EXR holds, made by the same
+//! code that the EXR writer consumes, so the image and AOVs are the CLI's, bit for bit,
+//! whatever the job's output path (plain film, denoiser, GREE composite, a temporally denoised
+//! sequence, the stopping criterion's block map) made of them.
 //!
 //! Ctrl-C: Python's handler only runs when the main thread asks (`check_signals`); when it
 //! raises, the job's stop flag is set and the render, made interruptible, ends after the pass
@@ -14,7 +16,8 @@ use crate::arrays::frame_to_dict;
 use crate::scene::Scene;
 use crate::{rt_err, value_err};
 use pyo3::prelude::*;
-use rt_session::{JobScene, JobSink, Overrides, RenderJob, StopRule, MAX_SPP};
+use rt_film::ExrImage;
+use rt_session::{Delivery, JobScene, JobSink, Overrides, RenderJob, StopRule, MAX_SPP};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{mpsc, Mutex};
 use std::time::Duration;
@@ -46,8 +49,8 @@ pub struct RenderArgs {
     pub bank: Option<std::path::PathBuf>,
 }
 
-/// The job `args` describe over `scene`, writing `output`.
-fn job(scene: &Scene, args: &RenderArgs, output: std::path::PathBuf) -> PyResult<RenderJob> {
+/// The job `args` describe over `scene`, handing its images to the sink.
+fn job(scene: &Scene, args: &RenderArgs) -> PyResult<RenderJob> {
     let path = scene.job_path();
     let integrator = args
         .integrator
@@ -71,7 +74,7 @@ fn job(scene: &Scene, args: &RenderArgs, output: std::path::PathBuf) -> PyResult
         seed: args.seed,
         accel,
         aovs: args.aovs.clone(),
-        output: Some(output),
+        output: None,
         // GREE chooses among its own bank, as `render --gree` does.
         denoiser: if args.gree.is_some() {
             if args.denoiser.is_some() {
@@ -114,6 +117,7 @@ fn job(scene: &Scene, args: &RenderArgs, output: std::path::PathBuf) -> PyResult
         job.stop = Some(rule);
     }
     job.interruptible = true;
+    job.delivery = Delivery::Sink;
     job.check().map_err(rt_err)?;
     Ok(job)
 }
@@ -124,6 +128,8 @@ struct Sink {
     /// The fraction done, as `f64` bits.
     done: AtomicU64,
     warnings: Mutex<Vec<String>>,
+    /// The frames' images, in the order rendered.
+    images: Mutex<Vec<(Option<u32>, ExrImage)>>,
 }
 
 impl JobSink for Sink {
@@ -134,6 +140,12 @@ impl JobSink for Sink {
     fn warning(&self, text: &str) {
         if let Ok(mut w) = self.warnings.lock() {
             w.push(text.to_string());
+        }
+    }
+
+    fn image(&self, frame: Option<u32>, image: ExrImage) {
+        if let Ok(mut i) = self.images.lock() {
+            i.push((frame, image));
         }
     }
 }
@@ -151,12 +163,7 @@ pub fn render<'py>(
             "progress: expected a callable taking the fraction done",
         ));
     }
-    let dir = tempfile::Builder::new()
-        .prefix("rt-renderer-")
-        .tempdir()
-        .map_err(|e| rt_err(format!("cannot create a temporary directory: {e}")))?;
-    let output = dir.path().join("render-{frame}.exr");
-    let job = job(scene, args, output.clone())?;
+    let job = job(scene, args)?;
     let loaded = JobScene {
         loaded: rt_scene::LoadedScene {
             scene: scene.loaded.scene.clone(),
@@ -223,19 +230,26 @@ pub fn render<'py>(
     if let Some(cb) = &progress {
         cb.call1(py, (1.0,))?;
     }
-    let read = |path: std::path::PathBuf| {
-        let exr = py.detach(|| rt_film::read_exr(&path)).map_err(rt_err)?;
-        frame_to_dict(py, &exr)
+    let images = sink.images.into_inner().unwrap_or_default();
+    let rendered: Vec<Option<u32>> = images.iter().map(|(f, _)| *f).collect();
+    let expected: Vec<Option<u32>> = match (&args.frames, args.frame) {
+        (Some(r), _) => r.clone().map(Some).collect(),
+        (None, f) => vec![f],
     };
-    match (&args.frames, args.frame) {
-        (Some(r), _) => {
-            let frames = r
-                .clone()
-                .map(|f| read(rt_session::frames::frame_path(&output, f)))
-                .collect::<PyResult<Vec<_>>>()?;
-            Ok(pyo3::types::PyList::new(py, frames)?.into_any())
+    if rendered != expected {
+        return Err(rt_err(format!(
+            "the render handed over frames {rendered:?}, not {expected:?}"
+        )));
+    }
+    let mut dicts = images
+        .into_iter()
+        .map(|(_, exr)| frame_to_dict(py, exr))
+        .collect::<PyResult<Vec<_>>>()?;
+    match dicts.pop() {
+        Some(one) if args.frames.is_none() => Ok(one.into_any()),
+        last => {
+            dicts.extend(last);
+            Ok(pyo3::types::PyList::new(py, dicts)?.into_any())
         }
-        (None, Some(f)) => Ok(read(rt_session::frames::frame_path(&output, f))?.into_any()),
-        (None, None) => Ok(read(output)?.into_any()),
     }
 }

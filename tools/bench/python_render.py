@@ -6,12 +6,14 @@
 
 Each round runs `render SCENE -q -o OUT.exr FLAGS` (wall time of the whole process: load,
 build, render, denoise, write) and, in this process, `rt_renderer.Scene.load(SCENE)` followed
-by `scene.render(**flags)` (wall time of both calls: the same work, plus reading the EXR back
-into arrays), alternating which goes first. Prints every round, the median of each and their
-ratio; a CPU-time ratio too (the child's user+system time against this process's), which a
+by `scene.render(**flags)` (wall time of both calls: the same work, with the image handed over
+as arrays instead of written; in passes, as renders from Python are interruptible),
+alternating which goes first. Prints every round, the median of each and their ratio; a
+CPU-time ratio too (the child's user+system time against this process's), which a
 machine shared with other jobs disturbs less. --spp, --denoiser and --threads go to both;
 --passes-control adds a CLI run in passes of one sample per pixel (`--checkpoint` with no
 checkpoint written), to see what passes cost. Needs the module and target/release/render.
+Instruction counts, which the machine's load does not disturb: python_render_instructions.py.
 """
 
 import argparse

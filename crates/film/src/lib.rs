@@ -68,7 +68,7 @@ pub use input::{decode_raw, decode_srgb, read_rgb};
 pub use noisy_frame::{Channel, FrameError, NoisyFrame};
 pub use output::{
     copy_atomic, read_exr, srgb8, write_bytes_atomic, write_image, write_image_with, write_rgb,
-    FilmError, OutputOptions,
+    ExrImage, FilmError, OutputOptions,
 };
 pub use pixel::{accepts_sample, FirstHit, HalfSums, LightSplit, PixelStats};
 pub use raw::{RawError, Rect};

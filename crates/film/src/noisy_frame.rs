@@ -16,7 +16,7 @@
 //! | depth, its variance | `depth.Z`, `depth_variance.Z` |
 //! | lighting split | `emission.`, `direct.`, `indirect.`, `diffuse.`, `glossy.`, `irradiance.{R,G,B}` |
 
-use crate::output::{read_exr, write_exr_file, ExrImage};
+use crate::output::{read_exr, ExrImage};
 use crate::{AovSet, Film, FilmError, LightSplit, SampleRecords};
 use rt_core::glam::Vec3;
 use rt_core::{Image, Rgb};
@@ -439,9 +439,19 @@ impl NoisyFrame {
     /// Writes the frame to `path` (EXR, atomically), with further per-pixel channels `extra`
     /// (such as the stopping criterion's block map).
     pub fn write_exr(&self, path: &Path, extra: &[(&str, Vec<f32>)]) -> Result<(), FilmError> {
+        self.exr_image(extra)
+            .map_err(|message| FilmError::Codec {
+                path: path.to_path_buf(),
+                message,
+            })?
+            .write(path)
+    }
+
+    /// What [`NoisyFrame::write_exr`] writes, in memory.
+    pub fn exr_image(&self, extra: &[(&str, Vec<f32>)]) -> Result<ExrImage, String> {
         let mut chans = self.exr_channels();
         chans.extend(extra.iter().map(|(n, v)| (n.to_string(), v.clone())));
-        write_exr_file(path, self.colour.size(), chans)
+        ExrImage::from_channels(self.colour.size(), chans)
     }
 
     /// Reads a frame written by [`NoisyFrame::write_exr`] (or `render --aov ... -o F.exr`):
@@ -674,7 +684,10 @@ mod tests {
         let p = dir.path().join("partial.exr");
         let mut chans = NoisyFrame::new(Image::filled(2, 2, Rgb::ONE)).exr_channels();
         chans.push(("albedo.R".into(), vec![0.5; 4]));
-        write_exr_file(&p, (2, 2), chans).unwrap();
+        ExrImage::from_channels((2, 2), chans)
+            .unwrap()
+            .write(&p)
+            .unwrap();
         let e = NoisyFrame::from_exr(&p).unwrap_err().to_string();
         assert!(e.contains("partial.exr") && e.contains("albedo"), "{e}");
     }

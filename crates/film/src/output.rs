@@ -66,24 +66,19 @@ pub fn write_image_with(
 ) -> Result<(), FilmError> {
     let pixels = film.width() as usize * film.height() as usize;
     if let Some((name, _)) = extra.iter().find(|(_, v)| v.len() != pixels) {
-        return Err(FilmError::Codec {
-            path: path.to_path_buf(),
-            message: format!("channel {name} does not have one value per pixel"),
-        });
+        return Err(codec(
+            path,
+            format!("channel {name} does not have one value per pixel"),
+        ));
     }
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     match ext.as_deref() {
-        Some("exr") => {
-            // Sample records are never written: do not copy them into the frame.
-            let aovs = crate::AovSet {
-                samples: false,
-                ..film.aovs()
-            };
-            NoisyFrame::from_film(film, aovs).write_exr(path, extra)
-        }
+        Some("exr") => ExrImage::of_film(film, extra)
+            .map_err(|message| codec(path, message))?
+            .write(path),
         Some("png") if !extra.is_empty() => Err(FilmError::Codec {
             path: path.to_path_buf(),
             message: "a PNG holds only the beauty image; write an .exr for extra channels".into(),
@@ -114,11 +109,7 @@ pub fn write_rgb(path: &Path, image: &RgbImage, opts: &OutputOptions) -> Result<
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     match ext.as_deref() {
-        Some("exr") => write_atomic(path, |w| {
-            let mut chans = Vec::new();
-            rgb_channels(&mut chans, "", ["R", "G", "B"], pixels);
-            write_exr_channels(w, (width, height), chans)
-        }),
+        Some("exr") => ExrImage::of_rgb(image).write(path),
         Some("png") => write_atomic(path, |w| write_png(w, size.0, size.1, pixels, opts)),
         _ => Err(FilmError::Format(path.to_path_buf())),
     }
@@ -176,50 +167,26 @@ fn write_atomic(
     result
 }
 
-fn channel(name: &str, values: Vec<f32>) -> AnyChannel<FlatSamples> {
-    // No NaN or Inf may reach a file: the film rejects them on entry, this is the last guard.
-    let values = values
-        .into_iter()
-        .map(|v| if v.is_finite() { v } else { 0.0 })
-        .collect();
-    AnyChannel::new(name, FlatSamples::F32(values))
-}
-
-fn rgb_channels(
-    out: &mut Vec<AnyChannel<FlatSamples>>,
-    prefix: &str,
-    names: [&str; 3],
-    img: &[Rgb],
-) {
-    for (c, n) in names.iter().enumerate() {
-        out.push(channel(
-            &format!("{prefix}{n}"),
-            img.iter().map(|p| p[c]).collect(),
-        ));
+/// A codec error about `path`.
+fn codec(path: &Path, message: String) -> FilmError {
+    FilmError::Codec {
+        path: path.to_path_buf(),
+        message,
     }
 }
 
-/// Writes named float channels of one `size` image to `path` as an EXR, atomically.
-pub(crate) fn write_exr_file(
-    path: &Path,
-    size: (usize, usize),
-    chans: Vec<(String, Vec<f32>)>,
-) -> Result<(), FilmError> {
-    let pixels = size.0 * size.1;
-    if let Some((name, _)) = chans.iter().find(|(_, v)| v.len() != pixels) {
-        return Err(FilmError::Codec {
-            path: path.to_path_buf(),
-            message: format!("channel {name} does not have one value per pixel"),
-        });
+/// No NaN or Inf may reach a file (the film rejects them on entry; this is the last guard):
+/// such values become 0.
+fn finite(values: &mut [f32]) {
+    for v in values.iter_mut().filter(|v| !v.is_finite()) {
+        *v = 0.0;
     }
-    let chans = chans.into_iter().map(|(n, v)| channel(&n, v)).collect();
-    write_atomic(path, |w| write_exr_channels(w, size, chans))
 }
 
 fn write_exr_channels(
     w: &mut BufWriter<File>,
     size: (usize, usize),
-    chans: Vec<AnyChannel<FlatSamples>>,
+    chans: SmallVec<[AnyChannel<FlatSamples>; 4]>,
 ) -> Result<(), String> {
     let layer = Layer::new(
         size,
@@ -230,7 +197,7 @@ fn write_exr_channels(
             line_order: LineOrder::Increasing,
             ..Encoding::FAST_LOSSLESS
         },
-        AnyChannels::sort(SmallVec::from_vec(chans)),
+        AnyChannels::sort(chans),
     );
     Image::from_layer(layer)
         .write()
@@ -269,8 +236,11 @@ fn write_png(
     w.flush().map_err(|e| e.to_string())
 }
 
-/// An image read back from an EXR: named float channels of equal size.
-#[derive(Clone, Debug)]
+/// An EXR's image in memory: named float channels of equal size. What a render's EXR output
+/// holds is made as one ([`ExrImage::of_film`], [`ExrImage::of_rgb`]) and then written
+/// ([`ExrImage::write`]) or handed over as it is (the Python module's arrays), so the two are
+/// the same bits; [`read_exr`] reads a file back as one.
+#[derive(Clone, Debug, PartialEq)]
 pub struct ExrImage {
     /// Width.
     pub width: usize,
@@ -281,6 +251,70 @@ pub struct ExrImage {
 }
 
 impl ExrImage {
+    /// The image an EXR of `chans` (name, one value per pixel of `size`, row-major) holds:
+    /// non-finite values are 0 and the channels are in the file's order (by name), as
+    /// [`read_exr`] would read the file back. Refuses a channel without one value per pixel.
+    pub fn from_channels(
+        size: (usize, usize),
+        mut chans: Vec<(String, Vec<f32>)>,
+    ) -> Result<ExrImage, String> {
+        let pixels = size.0 * size.1;
+        if let Some((name, _)) = chans.iter().find(|(_, v)| v.len() != pixels) {
+            return Err(format!("channel {name} does not have one value per pixel"));
+        }
+        for (_, values) in &mut chans {
+            finite(values);
+        }
+        // The order `AnyChannels::sort` gives the file: by name, byte by byte.
+        chans.sort_by(|a, b| a.0.cmp(&b.0));
+        Ok(ExrImage {
+            width: size.0,
+            height: size.1,
+            channels: chans,
+        })
+    }
+
+    /// What an EXR output of `film` holds ([`write_image_with`]): the beauty image and the
+    /// film's AOVs as [`NoisyFrame`] lays them out, then the `extra` channels.
+    pub fn of_film(film: &Film, extra: &[(&str, Vec<f32>)]) -> Result<ExrImage, String> {
+        // Sample records are never written: do not copy them into the frame.
+        let aovs = crate::AovSet {
+            samples: false,
+            ..film.aovs()
+        };
+        NoisyFrame::from_film(film, aovs).exr_image(extra)
+    }
+
+    /// What an EXR output of a plain RGB image holds ([`write_rgb`]): channels `R`, `G`, `B`.
+    pub fn of_rgb(image: &RgbImage) -> ExrImage {
+        let pixels = image.pixels();
+        let chans = ["R", "G", "B"]
+            .iter()
+            .enumerate()
+            .map(|(c, n)| (n.to_string(), pixels.iter().map(|p| p[c]).collect()))
+            .collect();
+        Self::from_channels((image.width(), image.height()), chans).expect("one value per pixel")
+    }
+
+    /// Writes the image to `path` as an EXR (float32, lossless), atomically.
+    pub fn write(self, path: &Path) -> Result<(), FilmError> {
+        let size = (self.width, self.height);
+        let pixels = size.0 * size.1;
+        if let Some((name, _)) = self.channels.iter().find(|(_, v)| v.len() != pixels) {
+            let message = format!("channel {name} does not have one value per pixel");
+            return Err(codec(path, message));
+        }
+        let chans = self
+            .channels
+            .into_iter()
+            .map(|(name, mut values)| {
+                finite(&mut values);
+                AnyChannel::new(name.as_str(), FlatSamples::F32(values))
+            })
+            .collect();
+        write_atomic(path, |w| write_exr_channels(w, size, chans))
+    }
+
     /// A channel by name.
     pub fn channel(&self, name: &str) -> Option<&[f32]> {
         self.channels
@@ -439,6 +473,26 @@ mod tests {
         assert!(img.channel("normal.X").is_none());
         // No temporary file is left behind.
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn the_image_in_memory_is_the_one_the_exr_reads_back() {
+        // Extra channels out of name order, one of them not finite: the file holds them
+        // sorted, the NaN as 0; the image in memory must say the same.
+        let film = small_film();
+        let extra = [
+            ("zeta", (0..12).map(|i| i as f32).collect()),
+            ("blocks.spp", vec![f32::NAN; 12]),
+        ];
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("a.exr");
+        write_image_with(&p, &film, &OutputOptions::default(), &extra).unwrap();
+        let memory = ExrImage::of_film(&film, &extra).unwrap();
+        assert_eq!(memory, read_exr(&p).unwrap());
+        assert_eq!(memory.channel("blocks.spp"), Some(&[0.0; 12][..]));
+        let image = RgbImage::new(4, 3, film.mean_image()).unwrap();
+        write_rgb(&p, &image, &OutputOptions::default()).unwrap();
+        assert_eq!(ExrImage::of_rgb(&image), read_exr(&p).unwrap());
     }
 
     #[test]

@@ -14,7 +14,8 @@
 //! The render loop: per frame the scene moves to the frame's time and the structure follows
 //! (updated in place when it can, rebuilt otherwise); the image is rendered in one pass, in
 //! passes of one sample per pixel (checkpointing), or until the stop rule says (adaptive);
-//! then it is written as an image, a denoised image or a part file. Passes add up to the bits
+//! then it is written as an image, a denoised image or a part file, or handed to the sink
+//! as the channels its EXR would hold ([`Delivery::Sink`]). Passes add up to the bits
 //! of one pass, and the film's sums are exact, so a part, a checkpoint or a resumed render
 //! merges to the very bytes of the whole render.
 
@@ -80,6 +81,20 @@ impl Stream {
             Stream::Reference => rt_core::SampleStream::Reference,
         }
     }
+}
+
+/// Where a job's images go.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Delivery {
+    /// To the job's output: image files (a pattern naming the frame for a sequence) or part
+    /// files.
+    #[default]
+    Files,
+    /// To the sink ([`JobSink::image`]), each the channels an EXR output would hold
+    /// ([`rt_film::ExrImage`]), bit for bit, and no file written: for callers that want the
+    /// images in memory (the Python module). The job's output path is then not used; parts
+    /// and checkpoints, which are files, are refused.
+    Sink,
 }
 
 /// The part of a render a part file holds (a job whose output ends in `.rpart`).
@@ -210,6 +225,9 @@ pub struct RenderJob {
     /// Python module's Ctrl-C); not part of the job's file.
     #[serde(skip)]
     pub interruptible: bool,
+    /// Where the images go (files by default); not part of the job's file.
+    #[serde(skip)]
+    pub delivery: Delivery,
 }
 
 /// Why a job could not run, or stopped. Each is one line naming what it is about.
@@ -323,12 +341,13 @@ impl RenderJob {
             defines: Vec::new(),
             resume: None,
             interruptible: false,
+            delivery: Delivery::Files,
         }
     }
 
     /// True if the job writes a part file (its output ends in `.rpart`).
     pub fn writes_part(&self) -> bool {
-        extension(&self.output).as_deref() == Some("rpart")
+        self.delivery == Delivery::Files && extension(&self.output).as_deref() == Some("rpart")
     }
 
     /// The job as JSON, with its format: what plans and checkpoints store.
@@ -373,34 +392,23 @@ impl RenderJob {
     /// shutter. [`RenderJob::run`] makes them first; a caller building a job may make them
     /// earlier.
     pub fn check(&self) -> Result<(), JobError> {
-        let out = self.output.display();
-        let ext = extension(&self.output);
-        match ext.as_deref() {
-            Some("exr" | "png" | "rpart") => {}
-            _ => {
-                return refuse(format!(
-                    "{out}: output must end in .exr or .png (or .rpart for a part file)"
-                ))
+        match self.delivery {
+            Delivery::Files => self.check_files()?,
+            Delivery::Sink => {
+                if !self.slice.is_whole() || self.checkpoint.is_some() {
+                    return refuse(
+                        "a job whose images go to its caller renders whole images: parts and checkpoints are files".into(),
+                    );
+                }
             }
-        }
-        let aovs = self.settings.aovs;
-        if aovs != rt_film::AovSet::default() && ext.as_deref() == Some("png") {
-            return refuse(format!(
-                "{out}: AOVs need an .exr output (PNG holds only the beauty image)"
-            ));
         }
         if !self.exposure.is_finite() {
             return refuse("--exposure must be a finite number".into());
         }
-        if aovs.blocks && self.stop.is_none_or(|s| s.error.is_none()) {
+        if self.settings.aovs.blocks && self.stop.is_none_or(|s| s.error.is_none()) {
             return refuse(
                 "--aov blocks writes the stopping criterion's blocks: it needs --error".into(),
             );
-        }
-        if !self.slice.is_whole() && !self.writes_part() {
-            return refuse(format!(
-                "{out}: --sample-range and --region write a part file: -o must end in .rpart"
-            ));
         }
         if let Some(c) = &self.checkpoint {
             let p = c.path.display();
@@ -430,7 +438,6 @@ impl RenderJob {
             check_fps(self.fps)?;
         }
         if let Frames::Range(r) = &self.frames {
-            check_frame_pattern(&self.output)?;
             if r.is_empty() {
                 return refuse(format!("frames {}..{}: no frame", r.start, r.end));
             }
@@ -442,6 +449,35 @@ impl RenderJob {
             ));
         }
         self.size.validate("--resolution")?;
+        Ok(())
+    }
+
+    /// The checks of a job that writes files: its output's format, a part's file, a
+    /// sequence's file names.
+    fn check_files(&self) -> Result<(), JobError> {
+        let out = self.output.display();
+        let ext = extension(&self.output);
+        match ext.as_deref() {
+            Some("exr" | "png" | "rpart") => {}
+            _ => {
+                return refuse(format!(
+                    "{out}: output must end in .exr or .png (or .rpart for a part file)"
+                ))
+            }
+        }
+        if self.settings.aovs != rt_film::AovSet::default() && ext.as_deref() == Some("png") {
+            return refuse(format!(
+                "{out}: AOVs need an .exr output (PNG holds only the beauty image)"
+            ));
+        }
+        if !self.slice.is_whole() && !self.writes_part() {
+            return refuse(format!(
+                "{out}: --sample-range and --region write a part file: -o must end in .rpart"
+            ));
+        }
+        if matches!(self.frames, Frames::Range(_)) {
+            check_frame_pattern(&self.output)?;
+        }
         Ok(())
     }
 
@@ -632,6 +668,50 @@ mod run_tests {
         j.interruptible = false;
         j.run(&(), &AtomicBool::new(true)).unwrap();
         assert!(j.output.exists());
+    }
+
+    /// Keeps the images a job hands over.
+    #[derive(Default)]
+    struct Images(std::sync::Mutex<Vec<(Option<u32>, rt_film::ExrImage)>>);
+
+    impl JobSink for Images {
+        fn image(&self, frame: Option<u32>, image: rt_film::ExrImage) {
+            self.0.lock().unwrap().push((frame, image));
+        }
+    }
+
+    #[test]
+    fn a_job_delivering_to_its_sink_hands_over_what_its_files_hold_and_writes_nothing() {
+        let d = tempfile::tempdir().unwrap();
+        let dir = d.path();
+        let mut j = job(dir, 3);
+        // A temporally denoised sequence renders at the camera's own size.
+        j.size = ImageSize::Native;
+        for denoiser in [None, Some("nlm"), Some("svgf")] {
+            j.settings.denoiser = denoiser.map(|d| d.parse().unwrap());
+            j.frames = Frames::Range(1..3);
+            j.delivery = Delivery::Files;
+            j.output = dir.join("f_{frame}.exr");
+            j.run(&(), &AtomicBool::new(false)).unwrap();
+            j.delivery = Delivery::Sink;
+            j.output = dir.join("not-written_{frame}.exr");
+            let images = Images::default();
+            j.run(&images, &AtomicBool::new(false)).unwrap();
+            let images = images.0.into_inner().unwrap();
+            assert_eq!(images.len(), 2, "{denoiser:?}");
+            for (f, (frame, image)) in (1..3).zip(images) {
+                assert_eq!(frame, Some(f));
+                let file = rt_film::read_exr(&dir.join(format!("f_{f}.exr"))).unwrap();
+                assert!(image == file, "{denoiser:?}, frame {f}");
+            }
+            assert!(!dir.join("not-written_1.exr").exists());
+        }
+        j.slice.samples = Some(0..1);
+        assert!(j
+            .check()
+            .unwrap_err()
+            .to_string()
+            .contains("parts and checkpoints"));
     }
 
     #[test]

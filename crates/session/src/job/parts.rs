@@ -246,13 +246,12 @@ pub fn merge(
             let built = spec
                 .build()
                 .map_err(|e| JobError::Refused(format!("--denoiser {spec}: {e}")))?;
-            write_denoised(
-                &mut merged.film,
-                built.as_ref(),
-                output,
-                job.exposure,
-                &job.scene,
-            )?;
+            let image = denoise_film(&mut merged.film, built.as_ref(), &job.scene)?;
+            let opts = OutputOptions {
+                exposure: job.exposure,
+            };
+            rt_film::write_rgb(output, &image, &opts)
+                .map_err(|e| JobError::Failed(e.to_string()))?;
         }
         _ => {
             if extension(output).as_deref() == Some("png") && !h.aovs.is_empty() {
@@ -282,22 +281,17 @@ pub fn merge(
     })
 }
 
-/// Denoises the film with `d` and writes the image: the end of a job with a denoiser, and of
-/// a merge of one.
-pub(crate) fn write_denoised(
+/// The film denoised by `d` (taking its sample records): the end of a job with a denoiser,
+/// and of a merge of one.
+pub(crate) fn denoise_film(
     film: &mut Film,
     d: &dyn rt_denoise::Denoiser,
-    output: &Path,
-    exposure: f32,
     scene: &Path,
-) -> Result<(), JobError> {
+) -> Result<rt_core::RgbImage, JobError> {
     let frame =
         rt_film::NoisyFrame::from_film_taking_samples(film, AovSet::for_channels(d.needs()));
-    let image = d
-        .denoise(&frame)
-        .map_err(|e| JobError::Failed(format!("{}: {e}", scene.display())))?;
-    rt_film::write_rgb(output, &image, &OutputOptions { exposure })
-        .map_err(|e| JobError::Failed(e.to_string()))
+    d.denoise(&frame)
+        .map_err(|e| JobError::Failed(format!("{}: {e}", scene.display())))
 }
 
 impl RenderJob {

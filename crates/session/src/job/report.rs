@@ -15,7 +15,12 @@ pub trait JobSink: Sync {
     fn progress(&self, _done: f64) {}
     /// A remark of the scene loader (a zero-area triangle, an unused material, ...).
     fn warning(&self, _text: &str) {}
-    /// An image (or a part, or a frame of a sequence) was written.
+    /// The image of `frame` (`None`: a still) of a job whose images go to the sink
+    /// ([`super::Delivery::Sink`]): the channels its EXR output would hold. Called before
+    /// the frame's [`JobSink::frame`].
+    fn image(&self, _frame: Option<u32>, _image: rt_film::ExrImage) {}
+    /// An image (or a part, or a frame of a sequence) was written, or handed to
+    /// [`JobSink::image`].
     fn frame(&self, _report: &FrameReport) {}
 }
 

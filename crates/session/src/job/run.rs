@@ -2,19 +2,19 @@
 //! its outputs (image, denoised image, part file, GREE composite); temporally denoised
 //! sequences through [`SequenceRenderer`].
 
-use super::parts::{write_denoised, Checkpointer, Cut};
+use super::parts::{denoise_film, Checkpointer, Cut};
 use super::report::{AdaptiveSummary, FrameReport, GreeSummary, JobReport, JobSink, Rendered};
-use super::{load_scene, refuse, Frames, JobError, JobScene, RenderJob};
+use super::{load_scene, refuse, Delivery, Frames, JobError, JobScene, RenderJob};
 use crate::frames::frame_path;
 use crate::memory::Estimate;
 use crate::{
     frame_seed, pick_camera, render_adaptive_until, Adaptive, RenderReport, ReportInputs,
     SequenceRenderer,
 };
-use rt_core::{Accel, Camera, Scene};
-use rt_film::{AovSet, Film, FilmBuffers, OutputOptions};
+use rt_core::{Accel, Camera, RgbImage, Scene};
+use rt_film::{AovSet, ExrImage, Film, FilmBuffers, OutputOptions};
 use rt_integrators::{Ctx, RadianceCache, RenderStats, SamplePass, Technique};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -474,13 +474,8 @@ impl RenderJob {
         };
         let (rendered, write_time) = if let Some(d) = &denoiser {
             let t = Instant::now();
-            write_denoised(
-                &mut film,
-                d.as_ref(),
-                &env.output,
-                self.exposure,
-                &self.scene,
-            )?;
+            let image = denoise_film(&mut film, d.as_ref(), &self.scene)?;
+            self.deliver(&env.output, env.frame, FrameImage::Rgb(&image), sink)?;
             let time = t.elapsed();
             let rendered = Rendered::Denoised {
                 denoiser: d.name().to_string(),
@@ -494,15 +489,12 @@ impl RenderJob {
                 Some(a) if self.settings.aovs.blocks => block_channels(a, &film),
                 _ => Vec::new(),
             };
-            rt_film::write_image_with(
+            self.deliver(
                 &env.output,
-                &film,
-                &OutputOptions {
-                    exposure: self.exposure,
-                },
-                &extra,
-            )
-            .map_err(|e| JobError::Failed(e.to_string()))?;
+                env.frame,
+                FrameImage::Film(&film, &extra),
+                sink,
+            )?;
             let rendered = Rendered::Image {
                 adaptive: adaptive.as_ref().map(AdaptiveSummary::from),
             };
@@ -621,10 +613,8 @@ impl RenderJob {
         .map_err(|e| JobError::Refused(e.to_string()))?;
         let run = self.gree_run(ctx, technique, &bank, env.seed, sink)?;
         let failed = |e: rt_film::FilmError| JobError::Failed(e.to_string());
-        let opts = OutputOptions {
-            exposure: self.exposure,
-        };
-        rt_film::write_rgb(&env.output, &run.composite.image, &opts).map_err(failed)?;
+        let composite = FrameImage::Rgb(&run.composite.image);
+        self.deliver(&env.output, env.frame, composite, sink)?;
         let names: Vec<&str> = bank.members().iter().map(|m| m.name()).collect();
         if let Some(p) = &g.labels {
             run.write_labels(p).map_err(failed)?;
@@ -684,14 +674,7 @@ impl RenderJob {
                 Some(f) => frame_path(&self.output, *f),
                 None => self.output.clone(),
             };
-            rt_film::write_rgb(
-                &output,
-                &out.image,
-                &OutputOptions {
-                    exposure: self.exposure,
-                },
-            )
-            .map_err(|e| JobError::Failed(e.to_string()))?;
+            self.deliver(&output, *f, FrameImage::Rgb(&out.image), sink)?;
             sink.frame(&FrameReport {
                 scene: self.scene.clone(),
                 frame: Some(frame),
@@ -719,6 +702,49 @@ impl RenderJob {
             elapsed: started.elapsed(),
             temporal: true,
         })
+    }
+}
+
+/// What a frame's output holds.
+enum FrameImage<'a> {
+    /// The film: its beauty image and AOVs, with further channels (the `blocks` AOV).
+    Film(&'a Film, &'a [(&'static str, Vec<f32>)]),
+    /// A finished image: denoised, GREE's composite, a frame of a temporally denoised sequence.
+    Rgb(&'a RgbImage),
+}
+
+impl RenderJob {
+    /// Hands the image of `frame` to where the job's images go ([`Delivery`]): the file
+    /// `output` (EXR or PNG by its extension) or the sink, as the channels the EXR would hold.
+    /// Both go through [`ExrImage`], so the sink's channels are the file's bits.
+    fn deliver(
+        &self,
+        output: &Path,
+        frame: Option<u32>,
+        image: FrameImage<'_>,
+        sink: &dyn JobSink,
+    ) -> Result<(), JobError> {
+        let opts = OutputOptions {
+            exposure: self.exposure,
+        };
+        let written = match (self.delivery, image) {
+            (Delivery::Files, FrameImage::Film(film, extra)) => {
+                rt_film::write_image_with(output, film, &opts, extra)
+            }
+            (Delivery::Files, FrameImage::Rgb(image)) => rt_film::write_rgb(output, image, &opts),
+            (Delivery::Sink, FrameImage::Film(film, extra)) => {
+                sink.image(
+                    frame,
+                    ExrImage::of_film(film, extra).map_err(JobError::Failed)?,
+                );
+                Ok(())
+            }
+            (Delivery::Sink, FrameImage::Rgb(image)) => {
+                sink.image(frame, ExrImage::of_rgb(image));
+                Ok(())
+            }
+        };
+        written.map_err(|e| JobError::Failed(e.to_string()))
     }
 }
 
