@@ -598,9 +598,19 @@ impl Scene {
             Some(t) => self.textures[t as usize].lookup(uv),
             None => Rgb::ONE,
         };
+        let mut blend = [crate::microfacet::PartTint::NONE; 2];
+        if let Some(b) = &m.blend {
+            for (t, p) in blend.iter_mut().zip(&b.parts) {
+                if let Some(c) = p.texture {
+                    t.color = self.textures[c as usize].lookup(uv);
+                }
+                t.params = p.textures.lookup(&self.textures, uv);
+            }
+        }
         crate::tint::Tint {
             color,
             params: m.param_textures.lookup(&self.textures, uv),
+            blend,
         }
     }
 }
