@@ -1328,4 +1328,69 @@ mod tests {
             "{e}"
         );
     }
+
+    /// A blend material's `Bsdf` is the local blend of its BSDFs in the shading frame: value,
+    /// pdf and samples; its adjoint scales only the dielectric's refraction by η².
+    #[test]
+    fn a_blend_material_shades_as_its_local_blend() {
+        use crate::microfacet::{
+            BlendPart, Diffuse, Distribution, DistributionKind, LocalBsdf, RoughDielectric,
+        };
+        let glass = Microfacet::Dielectric(RoughDielectric {
+            distribution: Some(Distribution::new(DistributionKind::Ggx, 0.3, 0.3)),
+            eta: 1.5,
+            reflectance: Rgb::ONE,
+            transmittance: Rgb::ONE,
+        });
+        let diffuse = Microfacet::Diffuse(Diffuse {
+            reflectance: Rgb::new(0.2, 0.5, 0.7),
+        });
+        let blend = Blend {
+            weight: 0.35,
+            parts: [BlendPart::new(glass), BlendPart::new(diffuse)],
+        };
+        let m = Material::blend("b", blend.clone());
+        assert_eq!(m.validate(), Ok(()));
+        let local = blend.at(None, &[crate::microfacet::PartTint::NONE; 2]);
+        let wo = Vec3::new(0.3, -0.2, 0.9).normalize();
+        let b = Bsdf::new(&m, Rgb::ONE, Vec3::Z, Vec3::Z, wo);
+        let adjoint = Bsdf::new(&m, Rgb::ONE, Vec3::Z, Vec3::Z, wo).adjoint();
+        let mut refracted = 0;
+        for i in 0..64 {
+            let (u0, u) = (
+                (i as f32 + 0.5) / 64.0,
+                Vec2::new(0.37, (i % 8) as f32 / 8.0 + 0.05),
+            );
+            let (want, got) = (local.sample(wo, u0, u), b.sample(u0, u));
+            assert_eq!(want.is_some(), got.is_some());
+            let (Some(w), Some(s)) = (want, got) else {
+                continue;
+            };
+            // The frame of +z is the identity; normalising may move the last bit.
+            assert!((w.wi - s.wi).length() < 1e-6 && w.pdf == s.pdf && w.delta == s.delta);
+            let (f, pdf) = local.eval_pdf(wo, s.wi);
+            let (fb, pb) = b.eval_pdf(s.wi);
+            assert!((f - fb).length() <= 1e-5 * f.length() && (pdf - pb).abs() <= 1e-5 * pdf);
+            if s.wi.z < 0.0 {
+                refracted += 1;
+                let (fa, _) = adjoint.eval_pdf(s.wi);
+                assert!(
+                    (fa - f * 2.25).length() < 1e-5 * fa.length(),
+                    "{fa:?} vs {f:?}"
+                );
+            }
+        }
+        assert!(refracted > 5, "{refracted}");
+        let bad = Blend {
+            weight: 1.5,
+            ..blend
+        };
+        assert_eq!(
+            Material::blend("b", bad)
+                .validate()
+                .unwrap_err()
+                .to_string(),
+            "blendbsdf weight must be in [0, 1], got 1.5"
+        );
+    }
 }

@@ -29,8 +29,9 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, mats: &mut MaterialTable) -
     ]
     .into_iter()
     .filter_map(|(k, s)| Some((k, s?)))
-    .chain(crate::microfacet::stray_key(d));
-    for (key, span) in stray {
+    .chain(crate::microfacet::stray_key(d))
+    .next();
+    if let Some((key, span)) = stray {
         return Err(err(
             span,
             format!(
