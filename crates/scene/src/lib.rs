@@ -53,7 +53,6 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
-mod blend;
 mod desc;
 mod error;
 mod files;
