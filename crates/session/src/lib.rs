@@ -71,8 +71,7 @@ pub use camera::{parse_resolution, pick_camera, split_size, ImageSize, MAX_SIDE}
 pub use gree::{gree_aovs, render_gree, GreeRun, GreeRunError, GreeSpec};
 pub use job::{
     load_scene, Checkpointing, Delivery, FilmStop, FrameReport, Frames, GreeJob, JobError,
-    JobReport,
-    JobScene, JobSink, RenderJob, Rendered, Slice, Stream,
+    JobReport, JobScene, JobSink, RenderJob, Rendered, Slice, Stream,
 };
 pub use progressive::{Budgets, Checkpoint, Session};
 pub use report::{RenderReport, ReportInputs, Stage, Status};
