@@ -51,6 +51,14 @@ impl Avx2 {
         self.avx512vl
     }
 
+    /// Whether a query of this kind runs in the AVX-512VL compilation: closest-hit queries
+    /// where the CPU has it; any-hit queries never, as they measured 2–9 % slower there
+    /// (`docs/benchmarks.md`, "AVX-512VL registers"). The one rule for single rays and streams.
+    #[inline(always)]
+    pub fn evex_for(self, any_hit: bool) -> bool {
+        !any_hit && self.avx512vl
+    }
+
     /// The same proof with AVX-512VL left unused (tests compare the two compilations).
     #[cfg(test)]
     pub(crate) fn without_avx512vl(self) -> Self {

@@ -304,9 +304,7 @@ impl<N: WideNode> WideBvh<N> {
         self.query_baseline::<ANY_HIT, C>(start, ray, t_max, c)
     }
 
-    /// [`WideBvh::query`] for a CPU with AVX2: closest-hit queries in the AVX-512VL
-    /// compilation where the CPU has it. Any-hit queries stay in the AVX2 one, which measured
-    /// 2–9 % faster for them (`docs/benchmarks.md`, "AVX-512VL registers").
+    /// [`WideBvh::query`] for a CPU with AVX2, in the compilation [`Avx2::evex_for`] picks.
     #[cfg(target_arch = "x86_64")]
     #[inline(always)]
     fn query_isa<const ANY_HIT: bool, C: Counter>(
@@ -318,10 +316,10 @@ impl<N: WideNode> WideBvh<N> {
         c: &mut C,
     ) -> Option<Hit> {
         // SAFETY: `Avx2::detect` made `avx2`, so the CPU has AVX2, and AVX-512F and
-        // AVX-512VL where `avx512vl()` says so.
+        // AVX-512VL where `evex_for` says so.
         #[allow(unsafe_code)]
         unsafe {
-            if !ANY_HIT && avx2.avx512vl() {
+            if avx2.evex_for(ANY_HIT) {
                 self.query_avx512::<ANY_HIT, C>(start, ray, t_max, avx2, c)
             } else {
                 self.query_avx2::<ANY_HIT, C>(start, ray, t_max, avx2, c)

@@ -247,11 +247,10 @@ impl WideBvh<Node8> {
         emit: impl FnMut(usize, Option<Hit>),
         avx2: Avx2,
     ) {
-        // SAFETY: the caller guarantees AVX2; `avx512vl()` says whether the CPU has AVX-512F
-        // and AVX-512VL. Any-hit streams stay in the AVX2 compilation, as single any-hit
-        // queries do (`WideBvh::query_isa`).
+        // SAFETY: the caller guarantees AVX2; `evex_for` is true only where the CPU also has
+        // AVX-512F and AVX-512VL.
         unsafe {
-            if !ANY_HIT && avx2.avx512vl() {
+            if avx2.evex_for(ANY_HIT) {
                 self.packets_evex::<ANY_HIT>(rays, t_max, emit, avx2)
             } else {
                 self.packets_vex::<ANY_HIT>(rays, t_max, emit, avx2)
