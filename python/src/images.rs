@@ -24,12 +24,7 @@ pub fn denoise<'py>(
     frame: &Bound<'py, PyAny>,
     denoiser: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let spec: DenoiserSpec = denoiser
-        .parse()
-        .map_err(|e| rt_err(format!("denoiser={denoiser}: {e}")))?;
-    let built = spec
-        .build()
-        .map_err(|e| rt_err(format!("denoiser={denoiser}: {e}")))?;
+    let built = built(denoiser, DenoiserSpec::build)?;
     let input = dict_to_input(frame, "frame")?;
     let image = py
         .detach(|| built.denoise(&input.frame))
@@ -50,12 +45,7 @@ pub fn denoise_sequence<'py>(
     frames: &Bound<'py, PyAny>,
     denoiser: &str,
 ) -> PyResult<Bound<'py, PyList>> {
-    let spec: TemporalSpec = denoiser
-        .parse()
-        .map_err(|e| rt_err(format!("denoiser={denoiser}: {e}")))?;
-    let mut built = spec
-        .build()
-        .map_err(|e| rt_err(format!("denoiser={denoiser}: {e}")))?;
+    let mut built = built(denoiser, TemporalSpec::build)?;
     let iter = frames
         .try_iter()
         .map_err(|_| value_err("frames: expected a list (or any iterable) of frame dicts"))?;
@@ -74,6 +64,18 @@ pub fn denoise_sequence<'py>(
         out.append(rgb_to_array(py, &image)?)?;
     }
     Ok(out)
+}
+
+/// `denoiser` parsed as a spec `S` and built by `build`; errors name the argument.
+fn built<S, T, E>(denoiser: &str, build: impl FnOnce(&S) -> Result<T, E>) -> PyResult<T>
+where
+    S: std::str::FromStr,
+    S::Err: std::fmt::Display,
+    E: std::fmt::Display,
+{
+    let named = |e: &dyn std::fmt::Display| rt_err(format!("denoiser={denoiser}: {e}"));
+    let spec: S = denoiser.parse().map_err(|e| named(&e))?;
+    build(&spec).map_err(|e| named(&e))
 }
 
 /// The denoisers `denoise` and `Scene.render(denoiser=...)` take.
