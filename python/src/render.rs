@@ -137,10 +137,13 @@ struct Sink {
     done: AtomicU64,
     warnings: Mutex<Vec<String>>,
     /// The frames' images, in the order rendered.
-    images: Mutex<Vec<(Option<u32>, ExrImage)>>,
+    images: PerFrame<ExrImage>,
     /// What the denoiser read for each frame, when asked for (`inputs=True`).
-    inputs: Option<Mutex<Vec<(Option<u32>, Input)>>>,
+    inputs: Option<PerFrame<Input>>,
 }
+
+/// What the job hands over for each frame (`None`: a still), in the order rendered.
+type PerFrame<T> = Mutex<Vec<(Option<u32>, T)>>;
 
 impl JobSink for Sink {
     fn progress(&self, done: f64) {
