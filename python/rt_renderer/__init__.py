@@ -11,6 +11,8 @@ Render a scene (the same bits as ``render SCENE -o OUT.exr``)::
 Denoise, compare, run an experiment, trace rays::
 
     clean = rt.denoise(frame, "atrous")
+    seq = scene.render(frames=range(3), denoiser="svgf", inputs=True)   # + what SVGF read
+    again = rt.denoise_sequence([f["input"] for f in seq], "svgf")     # the same bits
     rt.compare(clean, reference)                  # mse, relmse, rmse, psnr, ssim
     rows = rt.run_experiment("configs/convergence.toml")   # a DataFrame with pandas
     accel = rt.Accel(triangles, "bvh8")           # (n, 3, 3) float32
@@ -35,6 +37,7 @@ from ._native import (  # noqa: F401  (re-exported)
     accel_kinds,
     compare,
     denoise,
+    denoise_sequence,
     denoisers,
     read_exr,
     uniform_rays,
@@ -52,6 +55,7 @@ __all__ = [
     "accel_kinds",
     "compare",
     "denoise",
+    "denoise_sequence",
     "denoisers",
     "load_scene",
     "read_exr",

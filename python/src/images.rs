@@ -1,38 +1,81 @@
-//! Images as NumPy arrays: denoising a frame with any `rt_denoise::DenoiserSpec`, comparing
-//! two images with `render compare`'s metrics (`rt_metrics::compare`), reading an EXR as the
-//! renderer reads it, and running a TOML experiment (`render experiment`).
+//! Images as NumPy arrays: denoising a frame with any `rt_denoise::DenoiserSpec` or a
+//! sequence of frames with any `rt_temporal::TemporalSpec` (SVGF), comparing two images with
+//! `render compare`'s metrics (`rt_metrics::compare`), reading an EXR as the renderer reads it,
+//! and running a TOML experiment (`render experiment`).
 
-use crate::arrays::{dict_to_frame, f32_array, frame_to_dict};
+use crate::arrays::{f32_array, frame_to_dict};
+use crate::input::dict_to_input;
 use crate::{rt_err, value_err};
 use numpy::{PyArray1, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyList};
 use rt_core::{Rgb, RgbImage};
 use rt_denoise::DenoiserSpec;
-use rt_film::NoisyFrame;
+use rt_temporal::TemporalSpec;
 use std::path::PathBuf;
 
 /// Denoises `frame` (a dict as `Scene.render` returns: `"image"` and the AOVs the denoiser
-/// reads) with `denoiser` (`"atrous"`, `"nlm:radius=5"`, ...), as `render denoise` does, and
-/// returns the image as a `(height, width, 3)` float32 array.
+/// reads, `"samples"` for SBMF; `input.rs`) with `denoiser` (`"atrous"`, `"nlm:radius=5"`,
+/// ...), as `render denoise` does, and returns the image as a `(height, width, 3)` float32
+/// array.
 #[pyfunction]
 pub fn denoise<'py>(
     py: Python<'py>,
-    frame: &Bound<'py, PyDict>,
+    frame: &Bound<'py, PyAny>,
     denoiser: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let spec: DenoiserSpec = denoiser
-        .parse()
-        .map_err(|e| rt_err(format!("denoiser={denoiser}: {e}")))?;
-    let built = spec
-        .build()
-        .map_err(|e| rt_err(format!("denoiser={denoiser}: {e}")))?;
-    let exr = dict_to_frame(frame, "frame")?;
-    let frame = NoisyFrame::from_exr_image(&exr).map_err(|e| rt_err(format!("frame: {e}")))?;
+    let built = built(denoiser, DenoiserSpec::build)?;
+    let input = dict_to_input(frame, "frame")?;
     let image = py
-        .detach(|| built.denoise(&frame))
+        .detach(|| built.denoise(&input.frame))
         .map_err(|e| rt_err(format!("denoiser={denoiser}: {e}")))?;
     rgb_to_array(py, &image)
+}
+
+/// Denoises the frames of a sequence in order with `denoiser` (`"svgf"`, `"svgf:alpha=0.1"`,
+/// or any single-frame spec, run on each frame alone), carrying a temporal denoiser's history
+/// from frame to frame as `Scene.render(frames=..., denoiser=...)` does, and returns one
+/// `(height, width, 3)` float32 array per frame. `frames` is any iterable of frame dicts
+/// (`input.rs`: SVGF reads `"direct"`, `"indirect"`, `"emission"`, `"guides"` and, above one
+/// sample per pixel, `"extra"`), taken one at a time.
+#[pyfunction]
+#[pyo3(signature = (frames, denoiser="svgf"))]
+pub fn denoise_sequence<'py>(
+    py: Python<'py>,
+    frames: &Bound<'py, PyAny>,
+    denoiser: &str,
+) -> PyResult<Bound<'py, PyList>> {
+    let mut built = built(denoiser, TemporalSpec::build)?;
+    let iter = frames
+        .try_iter()
+        .map_err(|_| value_err("frames: expected a list (or any iterable) of frame dicts"))?;
+    let out = PyList::empty(py);
+    for (k, frame) in iter.enumerate() {
+        let what = format!("frames[{k}]");
+        let input = dict_to_input(&frame?, &what)?;
+        // `push` checks these too; here the message can name the sample.
+        for (j, e) in input.extra.iter().enumerate() {
+            e.require(built.name(), &rt_temporal::EXTRA_SAMPLE_CHANNELS)
+                .map_err(|e| rt_err(format!("{what}[\"extra\"][{j}]: {e}")))?;
+        }
+        let image = py
+            .detach(|| built.push(&input.as_frame()))
+            .map_err(|e| rt_err(format!("{what}: denoiser={denoiser}: {e}")))?;
+        out.append(rgb_to_array(py, &image)?)?;
+    }
+    Ok(out)
+}
+
+/// `denoiser` parsed as a spec `S` and built by `build`; errors name the argument.
+fn built<S, T, E>(denoiser: &str, build: impl FnOnce(&S) -> Result<T, E>) -> PyResult<T>
+where
+    S: std::str::FromStr,
+    S::Err: std::fmt::Display,
+    E: std::fmt::Display,
+{
+    let named = |e: &dyn std::fmt::Display| rt_err(format!("denoiser={denoiser}: {e}"));
+    let spec: S = denoiser.parse().map_err(|e| named(&e))?;
+    build(&spec).map_err(|e| named(&e))
 }
 
 /// The denoisers `denoise` and `Scene.render(denoiser=...)` take.

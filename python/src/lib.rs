@@ -7,8 +7,11 @@
 //!   it (`render`) with the GIL released, a progress callback and Ctrl-C at the next pass.
 //! - `rays`: `Accel`, any `rt_accel::AccelSpec` built over NumPy triangles, tracing
 //!   NumPy rays on all cores; the `render bench-accel` uniform rays.
-//! - `images`: denoising NumPy frames with any `rt_denoise::DenoiserSpec`, the CLI's metrics
-//!   (`rt_metrics::compare`), EXR reading and experiments.
+//! - `images`: denoising NumPy frames with any `rt_denoise::DenoiserSpec` and sequences with
+//!   any `rt_temporal::TemporalSpec` (SVGF), the CLI's metrics (`rt_metrics::compare`), EXR
+//!   reading and experiments.
+//! - `input`: a denoiser's input (channels, sample records, guide buffers, further samples)
+//!   as a dict of arrays and back.
 //!
 //! Errors raise `rt_renderer.RtError` with the library's one-line message; arguments of the
 //! wrong type or shape raise `TypeError` or `ValueError`.
@@ -18,6 +21,7 @@
 
 mod arrays;
 mod images;
+mod input;
 mod rays;
 mod render;
 mod scene;
@@ -50,6 +54,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rays::uniform_rays, m)?)?;
     m.add_function(wrap_pyfunction!(rays::accel_kinds, m)?)?;
     m.add_function(wrap_pyfunction!(images::denoise, m)?)?;
+    m.add_function(wrap_pyfunction!(images::denoise_sequence, m)?)?;
     m.add_function(wrap_pyfunction!(images::denoisers, m)?)?;
     m.add_function(wrap_pyfunction!(images::compare, m)?)?;
     m.add_function(wrap_pyfunction!(images::read_exr, m)?)?;

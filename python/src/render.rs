@@ -13,6 +13,7 @@
 //! propagates.
 
 use crate::arrays::frame_to_dict;
+use crate::input::{input_to_dict, Input};
 use crate::scene::Scene;
 use crate::{rt_err, value_err};
 use pyo3::prelude::*;
@@ -47,6 +48,8 @@ pub struct RenderArgs {
     /// GREE's options (`""`: the defaults) instead of a denoiser, with its bank file.
     pub gree: Option<String>,
     pub bank: Option<std::path::PathBuf>,
+    /// Hand over what the denoiser read with each frame (`"input"`, `input.rs`).
+    pub inputs: bool,
 }
 
 /// The job `args` describe over `scene`, handing its images to the sink.
@@ -119,6 +122,11 @@ fn job(scene: &Scene, args: &RenderArgs) -> PyResult<RenderJob> {
     job.interruptible = true;
     job.delivery = Delivery::Sink;
     job.check().map_err(rt_err)?;
+    if args.inputs && (job.settings.denoiser.is_none() || job.gree.is_some()) {
+        return Err(value_err(
+            "inputs=True hands over what the denoiser read, and this render has no denoiser (GREE's input is its own bank's renders)",
+        ));
+    }
     Ok(job)
 }
 
@@ -129,8 +137,13 @@ struct Sink {
     done: AtomicU64,
     warnings: Mutex<Vec<String>>,
     /// The frames' images, in the order rendered.
-    images: Mutex<Vec<(Option<u32>, ExrImage)>>,
+    images: PerFrame<ExrImage>,
+    /// What the denoiser read for each frame, when asked for (`inputs=True`).
+    inputs: Option<PerFrame<Input>>,
 }
+
+/// What the job hands over for each frame (`None`: a still), in the order rendered.
+type PerFrame<T> = Mutex<Vec<(Option<u32>, T)>>;
 
 impl JobSink for Sink {
     fn progress(&self, done: f64) {
@@ -146,6 +159,12 @@ impl JobSink for Sink {
     fn image(&self, frame: Option<u32>, image: ExrImage) {
         if let Ok(mut i) = self.images.lock() {
             i.push((frame, image));
+        }
+    }
+
+    fn denoiser_input(&self, frame: Option<u32>, input: &rt_temporal::TemporalFrame<'_>) {
+        if let Some(Ok(mut i)) = self.inputs.as_ref().map(Mutex::lock) {
+            i.push((frame, Input::of(input)));
         }
     }
 }
@@ -172,7 +191,10 @@ pub fn render<'py>(
         },
         access: scene.access.clone(),
     };
-    let sink = Sink::default();
+    let sink = Sink {
+        inputs: args.inputs.then(Mutex::default),
+        ..Sink::default()
+    };
     let stop = AtomicBool::new(false);
     let progress = progress.map(Bound::unbind);
     // The first Python error raised while waiting (KeyboardInterrupt, the callback's).
@@ -245,6 +267,18 @@ pub fn render<'py>(
         .into_iter()
         .map(|(_, exr)| frame_to_dict(py, exr))
         .collect::<PyResult<Vec<_>>>()?;
+    if let Some(inputs) = sink.inputs {
+        let inputs = inputs.into_inner().unwrap_or_default();
+        let handed: Vec<Option<u32>> = inputs.iter().map(|(f, _)| *f).collect();
+        if handed != expected {
+            return Err(rt_err(format!(
+                "the render handed over denoiser inputs of frames {handed:?}, not {expected:?}"
+            )));
+        }
+        for (d, (_, input)) in dicts.iter().zip(&inputs) {
+            d.set_item("input", input_to_dict(py, input)?)?;
+        }
+    }
     match dicts.pop() {
         Some(one) if args.frames.is_none() => Ok(one.into_any()),
         last => {

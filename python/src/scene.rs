@@ -286,8 +286,11 @@ impl Scene {
     /// `KeyboardInterrupt`. `frames=range(a, b)` renders frames of the animation and returns
     /// a list of frame dicts (a temporal `denoiser`, `"svgf"`, carries its history across
     /// them); `frame=F` renders one; `gree="fraction=0.875"` (`""`: the defaults) denoises by
-    /// GREE with the filter bank file `bank`, as `render --gree` does.
-    #[pyo3(signature = (spp=None, integrator=None, accel=None, seed=None, error=None, time_limit=None, aovs=None, threads=None, denoiser=None, camera=None, max_depth=None, size=None, frames=None, frame=None, gree=None, bank=None, progress=None))]
+    /// GREE with the filter bank file `bank`, as `render --gree` does. `inputs=True` adds to
+    /// each frame dict, under `"input"`, what the denoiser read (the noisy channels, sample
+    /// records, guide buffers and further samples): `denoise(input, denoiser)`, or
+    /// `denoise_sequence` over the frames' inputs, gives the frame's image again.
+    #[pyo3(signature = (spp=None, integrator=None, accel=None, seed=None, error=None, time_limit=None, aovs=None, threads=None, denoiser=None, camera=None, max_depth=None, size=None, frames=None, frame=None, gree=None, bank=None, inputs=false, progress=None))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
@@ -308,6 +311,7 @@ impl Scene {
         frame: Option<u32>,
         gree: Option<String>,
         bank: Option<PathBuf>,
+        inputs: bool,
         progress: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let frames = frames.map(|f| frame_range(&f)).transpose()?;
@@ -328,6 +332,7 @@ impl Scene {
             frame,
             gree,
             bank,
+            inputs,
         };
         crate::render::render(py, self, &args, progress)
     }

@@ -88,6 +88,9 @@ pub struct SequenceFrame {
     /// The guide buffers, if the denoiser reads them or [`SequenceRenderer::set_guides`] asked
     /// for them.
     pub guides: Option<GuideBuffers>,
+    /// Samples 1, 2, ... of every pixel as one-sample frames, when the denoiser samples with
+    /// guide rays at several samples per pixel ([`TemporalFrame::extra`]); empty otherwise.
+    pub extra: Vec<NoisyFrame>,
     /// Samples and rays of the render.
     pub stats: RenderStats,
     /// Stage times.
@@ -369,6 +372,7 @@ impl SequenceRenderer {
             image,
             noisy,
             guides,
+            extra,
             stats,
             times,
             spp,

@@ -246,7 +246,7 @@ pub fn merge(
             let built = spec
                 .build()
                 .map_err(|e| JobError::Refused(format!("--denoiser {spec}: {e}")))?;
-            let image = denoise_film(&mut merged.film, built.as_ref(), &job.scene)?;
+            let image = denoise_film(&mut merged.film, built.as_ref(), &job.scene, &(), None)?;
             let opts = OutputOptions {
                 exposure: job.exposure,
             };
@@ -282,15 +282,23 @@ pub fn merge(
 }
 
 /// The film denoised by `d` (taking its sample records): the end of a job with a denoiser,
-/// and of a merge of one.
+/// and of a merge of one. `sink` sees the denoiser's input first, as that of `frame`.
 pub(crate) fn denoise_film(
     film: &mut Film,
     d: &dyn rt_denoise::Denoiser,
     scene: &Path,
+    sink: &dyn super::JobSink,
+    frame: Option<u32>,
 ) -> Result<rt_core::RgbImage, JobError> {
-    let frame =
+    let noisy =
         rt_film::NoisyFrame::from_film_taking_samples(film, AovSet::for_channels(d.needs()));
-    d.denoise(&frame)
+    let input = rt_temporal::TemporalFrame {
+        frame: &noisy,
+        guides: None,
+        extra: &[],
+    };
+    sink.denoiser_input(frame, &input);
+    d.denoise(&noisy)
         .map_err(|e| JobError::Failed(format!("{}: {e}", scene.display())))
 }
 

@@ -19,6 +19,12 @@ pub trait JobSink: Sync {
     /// ([`super::Delivery::Sink`]): the channels its EXR output would hold. Called before
     /// the frame's [`JobSink::frame`].
     fn image(&self, _frame: Option<u32>, _image: rt_film::ExrImage) {}
+    /// What the denoiser of `frame` read, in a job with a denoiser (not GREE): the noisy
+    /// frame (with its sample records for SBMF) and, for a temporal one, its guide buffers and
+    /// further samples. Called before the frame's [`JobSink::image`]; a sink that keeps a copy
+    /// can denoise it again elsewhere (the Python module's `inputs=True`), and only such a
+    /// sink pays for the copy.
+    fn denoiser_input(&self, _frame: Option<u32>, _input: &rt_temporal::TemporalFrame<'_>) {}
     /// An image (or a part, or a frame of a sequence) was written, or handed to
     /// [`JobSink::image`].
     fn frame(&self, _report: &FrameReport) {}

@@ -474,7 +474,7 @@ impl RenderJob {
         };
         let (rendered, write_time) = if let Some(d) = &denoiser {
             let t = Instant::now();
-            let image = denoise_film(&mut film, d.as_ref(), &self.scene)?;
+            let image = denoise_film(&mut film, d.as_ref(), &self.scene, sink, env.frame)?;
             self.deliver(&env.output, env.frame, FrameImage::Rgb(&image), sink)?;
             let time = t.elapsed();
             let rendered = Rendered::Denoised {
@@ -670,6 +670,12 @@ impl RenderJob {
             let out = pool
                 .install(|| renderer.render(scene, frame))
                 .map_err(|e| JobError::Failed(format!("{path}: frame {frame}: {e}")))?;
+            let input = rt_temporal::TemporalFrame {
+                frame: &out.noisy,
+                guides: out.guides.as_ref(),
+                extra: &out.extra,
+            };
+            sink.denoiser_input(*f, &input);
             let output = match f {
                 Some(f) => frame_path(&self.output, *f),
                 None => self.output.clone(),
