@@ -49,6 +49,7 @@
 mod aov_set;
 mod buffers;
 mod film;
+mod filtered;
 mod fixed;
 mod guides;
 pub mod input;
