@@ -86,6 +86,16 @@ fn bad_input_is_one_line() {
         line.contains("pixel filter gaussian:stddev=0.5:splat"),
         "{line}"
     );
+    // Its Gaussian is splatted, as Mitsuba does: the film keeps no per-pixel AOVs.
+    let line = one_error_line(&render(
+        dir,
+        &["s.xml", "--aov", "albedo", "-q", "-o", "x.exr"],
+    ));
+    assert!(
+        line.contains("splats its pixel filter (gaussian:stddev=0.5:splat)")
+            && line.contains("--aov albedo"),
+        "{line}"
+    );
     let line = one_error_line(&render(dir, &["convert", "s.toml", "-o", "x.toml"]));
     assert!(line.contains("not a Mitsuba scene file"), "{line}");
 }
