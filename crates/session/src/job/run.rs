@@ -218,16 +218,15 @@ impl RenderJob {
             } else {
                 None
             };
-            return match what {
-                None => Ok(()),
-                Some(what) => Err(JobError::Refused(format!(
+            if let Some(what) = what {
+                return Err(JobError::Refused(format!(
                     "{}: camera \"{}\" splats its pixel filter ({}), which keeps only the image \
                      and its half-images; {what} needs the filter importance-sampled (drop `:splat`)",
                     self.scene.display(),
                     camera.name,
                     camera.filter,
-                ))),
-            };
+                )));
+            }
         }
         if camera.filter == rt_core::pixel_filter::PixelFilter::Box
             || !self.settings.integrator.build().splats()
