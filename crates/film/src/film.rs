@@ -68,7 +68,7 @@ pub(crate) struct EvenSums {
 /// exact integer sum (see the crate doc), so the order samples arrive in never changes a bit.
 ///
 /// A film whose camera splats its pixel filter ([`FilmStripe::add_filtered`]) keeps the
-/// filter-weighted sums instead ([`crate::filtered`]), allocated with the first splat: its
+/// filter-weighted sums instead (`crates/film/src/filtered.rs`), allocated with the first splat: its
 /// image and half-images are the filtered ones; it keeps no per-pixel variance (a pixel's
 /// samples are shared with its neighbours), and its sample counts are those taken in each
 /// pixel.
@@ -126,7 +126,7 @@ fn lock(m: &Mutex<FilterSums>) -> MutexGuard<'_, FilterSums> {
 impl FilmStripe<'_> {
     /// Adds radiance sample `index` of pixel `(x, y)`, taken at film position `pos` (uniform in
     /// the pixel), splatted through `filter` into every pixel within its radius
-    /// ([`crate::filtered`]); counted as a sample of `(x, y)`. Non-finite or negative samples
+    /// (`crates/film/src/filtered.rs`); counted as a sample of `(x, y)`. Non-finite or negative samples
     /// are dropped and counted; returns whether it was kept. First-hit AOVs, the lighting
     /// split and the variance are not kept for splatted samples (callers refuse them).
     #[inline]

@@ -5,7 +5,7 @@
 //! the thread count or scheduling. A sample counts only in the pixel it was taken in (the box,
 //! or a filter applied by importance sampling), which keeps pixel noise independent for the
 //! denoisers downstream; a camera whose filter splats ([`rt_core::pixel_filter`]) has the
-//! film add it to every pixel under the filter instead ([`CameraSampling::add_to_film`]).
+//! film add it to every pixel under the filter instead (`CameraSampling::add_to_film`).
 //!
 //! Dimension layout of one sample: the film position (one 2D draw), the lens position (one 2D
 //! draw, only for a thin-lens camera: a pinhole ignores it, so it is not drawn), then whatever
