@@ -40,7 +40,7 @@ fn xml_and_its_conversion_render_the_same_bytes() {
     let out = render(dir, &["convert", "s.xml", "-o", "s.toml"]);
     assert!(out.status.success(), "{out:?}");
     let toml = std::fs::read_to_string(dir.join("s.toml")).unwrap();
-    assert!(toml.contains("pixel_filter = \"gaussian\""), "{toml}");
+    assert!(toml.contains("pixel_filter = \"gaussian:splat\""), "{toml}");
     let out = render(dir, &["s.toml", "-q", "-o", "toml.exr"]);
     assert!(out.status.success(), "{out:?}");
     let (a, b) = (
@@ -82,7 +82,20 @@ fn bad_input_is_one_line() {
         dir,
         &["s.xml", "--integrator", "light", "-q", "-o", "x.exr"],
     ));
-    assert!(line.contains("pixel filter gaussian:stddev=0.5"), "{line}");
+    assert!(
+        line.contains("pixel filter gaussian:stddev=0.5:splat"),
+        "{line}"
+    );
+    // Its Gaussian is splatted, as Mitsuba does: the film keeps no per-pixel AOVs.
+    let line = one_error_line(&render(
+        dir,
+        &["s.xml", "--aov", "albedo", "-q", "-o", "x.exr"],
+    ));
+    assert!(
+        line.contains("splats its pixel filter (gaussian:stddev=0.5:splat)")
+            && line.contains("--aov albedo"),
+        "{line}"
+    );
     let line = one_error_line(&render(dir, &["convert", "s.toml", "-o", "x.toml"]));
     assert!(line.contains("not a Mitsuba scene file"), "{line}");
 }

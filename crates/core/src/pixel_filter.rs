@@ -1,9 +1,24 @@
-//! Pixel reconstruction filters, applied by filter importance sampling: each camera sample's
-//! position in its pixel is drawn from the filter's profile instead of uniformly, and the
-//! sample counts with weight 1 (Ernst et al., "Filter importance sampling", RT 2006). The
-//! image converges to the same filtered image as Mitsuba's weighted splatting (each pixel
-//! the filter-weighted mean of the radiance around its centre), while every sample still
-//! lands in one pixel, so films, parts and checkpoints stay as they are.
+//! Pixel reconstruction filters, applied in one of two ways.
+//!
+//! - Filter importance sampling (the default): each camera sample's position in its pixel is
+//!   drawn from the filter's profile instead of uniformly, and the sample counts with weight 1
+//!   in that pixel alone (Ernst et al., "Filter importance sampling", RT 2006). Pixel noise
+//!   stays independent (denoisers, per-pixel variances and every film buffer work as with the
+//!   box).
+//! - Splatting (`:splat`, what Mitsuba 3 does): the position is uniform in the pixel, and the
+//!   film adds the sample to every pixel whose centre lies within the filter's radius, weighted
+//!   by [`PixelFilter::eval`], each pixel divided by its sum of weights (`rt_film`'s filtered
+//!   sums, after Mitsuba 3's `ImageBlock::put`). Each sample reaches several pixels, so a
+//!   pixel averages more samples: for noise independent between samples its variance is the
+//!   box's times `∫w²/(∫w)²` per axis (0.318 in two dimensions for the Gaussian of σ = ½),
+//!   where filter importance sampling keeps the box's. The price: neighbouring pixels' noise
+//!   is correlated.
+//!
+//! Both converge to an image filtered by the same profile, but not to the same image: the
+//! importance-sampled pixel is `∫f(x)L(x)dx / ∫f` over its footprint, the splatted one a ratio
+//! of two such sums, which equals it in expectation only where the radiance is constant over
+//! the footprint (and at image borders, where Mitsuba's pixels lose the weights outside the
+//! image, differs even then only in how the border is treated).
 //!
 //! Filters are separable, as Mitsuba's: `box` (radius ½, the plain jitter), `tent:radius=R`
 //! (Mitsuba's default R = 1) and `gaussian:stddev=S` (Mitsuba's: `exp(−x²/2S²)` less its value
@@ -28,6 +43,8 @@ pub enum PixelFilter {
     Tent {
         /// Support radius in pixels.
         radius: f32,
+        /// Applied by splatting rather than by importance sampling (see the module doc).
+        splat: bool,
     },
     /// Mitsuba's truncated Gaussian per axis.
     Gaussian {
@@ -35,13 +52,18 @@ pub enum PixelFilter {
         stddev: f32,
         /// The inverse distribution: offsets at `TABLE_SIZE` evenly spaced probabilities.
         inverse: Vec<f32>,
+        /// Applied by splatting rather than by importance sampling (see the module doc).
+        splat: bool,
     },
 }
 
 impl PixelFilter {
     /// Mitsuba's tent (radius 1).
     pub fn tent(radius: f32) -> Self {
-        Self::Tent { radius }
+        Self::Tent {
+            radius,
+            splat: false,
+        }
     }
 
     /// Mitsuba's Gaussian with standard deviation `stddev` pixels.
@@ -49,10 +71,30 @@ impl PixelFilter {
         Self::Gaussian {
             stddev,
             inverse: gaussian_inverse(stddev as f64),
+            splat: false,
         }
     }
 
-    /// Parses `box`, `tent[:radius=R]` or `gaussian[:stddev=S]` (the option grammar).
+    /// The same filter applied by splatting (the box has nothing to splat: it stays the box).
+    pub fn splatted(mut self) -> Self {
+        match &mut self {
+            Self::Box => {}
+            Self::Tent { splat, .. } | Self::Gaussian { splat, .. } => *splat = true,
+        }
+        self
+    }
+
+    /// True if the film splats samples with this filter's weights (see the module doc).
+    #[inline]
+    pub fn splats(&self) -> bool {
+        match self {
+            Self::Box => false,
+            Self::Tent { splat, .. } | Self::Gaussian { splat, .. } => *splat,
+        }
+    }
+
+    /// Parses `box`, `tent[:radius=R][:splat]` or `gaussian[:stddev=S][:splat]` (the option
+    /// grammar).
     pub fn parse(text: &str) -> Result<Self, OptionsError> {
         let mut o = Options::parse(text)?;
         let positive = |v: &f32| v.is_finite() && *v > 0.0 && *v <= 16.0;
@@ -73,18 +115,26 @@ impl PixelFilter {
                 return Err(o.bad("filter", &kind, "one of box, tent, gaussian"));
             }
         };
+        let filter = if filter != Self::Box && o.flag("splat")? {
+            filter.splatted()
+        } else {
+            filter
+        };
         o.finish()?;
         Ok(filter)
     }
 
     /// The film position of a sample of pixel `(x, y)` drawn with the uniform `jitter` in
-    /// [0, 1)²; the box filter gives exactly `(x, y) + jitter`.
+    /// [0, 1)²; the box filter and every splatted filter give exactly `(x, y) + jitter`.
     #[inline]
     pub fn film_position(&self, x: u32, y: u32, jitter: Vec2) -> Vec2 {
         let corner = Vec2::new(x as f32, y as f32);
+        if self.splats() {
+            return corner + jitter;
+        }
         match self {
             Self::Box => corner + jitter,
-            Self::Tent { radius } => {
+            Self::Tent { radius, .. } => {
                 corner + Vec2::splat(0.5) + Vec2::new(tent(jitter.x), tent(jitter.y)) * *radius
             }
             Self::Gaussian { inverse, .. } => {
@@ -99,8 +149,25 @@ impl PixelFilter {
     pub fn radius(&self) -> f32 {
         match self {
             Self::Box => 0.5,
-            Self::Tent { radius } => *radius,
+            Self::Tent { radius, .. } => *radius,
             Self::Gaussian { stddev, .. } => 4.0 * stddev,
+        }
+    }
+
+    /// The filter's weight at offset `x` pixels from a pixel's centre along one axis, as
+    /// Mitsuba 3 evaluates it in single precision: the tent `max(0, 1 − |x · (1/radius)|)`,
+    /// the Gaussian `max(0, exp(α x²) − exp(α r²))` with `α = −1/(2σ²)` and `r = 4σ`, the box
+    /// 1 inside `|x| ≤ ½` (and 0 outside).
+    #[inline]
+    pub fn eval(&self, x: f32) -> f32 {
+        match self {
+            Self::Box => f32::from(u8::from(x.abs() <= 0.5)),
+            Self::Tent { radius, .. } => (1.0 - (x * (1.0 / radius)).abs()).max(0.0),
+            Self::Gaussian { stddev, .. } => {
+                let alpha = -1.0 / (2.0 * stddev * stddev);
+                let r = 4.0 * stddev;
+                ((alpha * x * x).exp() - (alpha * r * r).exp()).max(0.0)
+            }
         }
     }
 }
@@ -108,10 +175,14 @@ impl PixelFilter {
 impl std::fmt::Display for PixelFilter {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            Self::Box => write!(f, "box"),
-            Self::Tent { radius } => write!(f, "tent:radius={radius}"),
-            Self::Gaussian { stddev, .. } => write!(f, "gaussian:stddev={stddev}"),
+            Self::Box => write!(f, "box")?,
+            Self::Tent { radius, .. } => write!(f, "tent:radius={radius}")?,
+            Self::Gaussian { stddev, .. } => write!(f, "gaussian:stddev={stddev}")?,
         }
+        if self.splats() {
+            write!(f, ":splat")?;
+        }
+        Ok(())
     }
 }
 
@@ -250,7 +321,13 @@ mod tests {
 
     #[test]
     fn specs_parse_print_and_refuse() {
-        for text in ["box", "tent:radius=1.5", "gaussian:stddev=0.25"] {
+        for text in [
+            "box",
+            "tent:radius=1.5",
+            "gaussian:stddev=0.25",
+            "tent:radius=1:splat",
+            "gaussian:stddev=0.5:splat",
+        ] {
             let f = PixelFilter::parse(text).unwrap();
             assert_eq!(f.to_string(), text);
             assert_eq!(PixelFilter::parse(&f.to_string()).unwrap(), f);
@@ -266,5 +343,16 @@ mod tests {
             "gaussian: stddev: `0` is not a number of pixels in (0, 4]"
         );
         assert_eq!(e("box:radius=1"), "box: unknown option `radius`");
+        assert_eq!(e("box:splat"), "box: unknown option `splat`");
+        let g = PixelFilter::parse("gaussian:splat").unwrap();
+        assert!(g.splats() && !PixelFilter::gaussian(0.5).splats());
+        assert_ne!(
+            g,
+            PixelFilter::gaussian(0.5),
+            "the method is part of the filter"
+        );
+        // Splatted filters place samples uniformly in the pixel, as the box does.
+        let j = Vec2::new(0.25, 0.75);
+        assert_eq!(g.film_position(3, 4, j), Vec2::new(3.25, 4.75));
     }
 }

@@ -139,7 +139,8 @@ impl Order {
 /// carry so that the merged parts are stored under it), over `accel`, written to `output`:
 /// the reference stream, the camera at the request's size, the variance AOV kept where the
 /// film knows it. A technique that splats (bdpt, light; the reference for caustics that
-/// camera paths rarely find) has no per-pixel variance, so its reference has no noise floor.
+/// camera paths rarely find) has no per-pixel variance, so its reference has no noise floor;
+/// nor has a camera that splats its pixel filter (Mitsuba scene files' Gaussian).
 pub fn job(req: &ReferenceRequest<'_>, accel: AccelSpec, key: &Key, output: &Path) -> RenderJob {
     let settings = Settings {
         integrator: req.estimator,
@@ -148,7 +149,8 @@ pub fn job(req: &ReferenceRequest<'_>, accel: AccelSpec, key: &Key, output: &Pat
         threads: None,
         seed: req.seed,
         aovs: AovSet {
-            variance: !req.estimator.build().splats(),
+            // Neither light-path nor filter splats leave a pixel its own samples.
+            variance: !req.estimator.build().splats() && !req.camera.filter.splats(),
             ..AovSet::default()
         },
         output: Some(output.to_path_buf()),

@@ -90,6 +90,9 @@ pub struct FilmMemory {
     pub split: Option<usize>,
     /// Light-path splat sums (allocated by the first splat).
     pub splats: Option<usize>,
+    /// Filter-weighted sums of a splatted pixel filter (allocated by the first band that
+    /// splats; 64 bytes per pixel, twice that with half-buffers).
+    pub filtered: Option<usize>,
     /// Per-sample records and their per-pixel offsets.
     pub samples: Option<usize>,
 }
@@ -131,6 +134,8 @@ impl FilmMemory {
                 splats,
                 (1 + usize::from(buffers.halves)) * size_of::<Sum3>(),
             ),
+            // Not estimated: a film learns that its camera splats with the first splat.
+            filtered: None,
             samples: buffers.samples.then(|| {
                 (n as u64)
                     .saturating_mul(samples_per_pixel)
@@ -155,6 +160,7 @@ impl FilmMemory {
                 self.feature_variance,
                 self.split,
                 self.splats,
+                self.filtered,
                 self.samples,
             ]
             .iter()

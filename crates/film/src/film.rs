@@ -1,14 +1,17 @@
 //! The film: a grid of pixel statistics plus the optional buffers a caller asked for
 //! ([`FilmBuffers`]): variance, half-buffers, first-hit AOVs, the lighting split, samples.
 
+use crate::filtered::{FilterSums, Window};
 use crate::fixed::{sample_variance, sample_variance3, Squares3, Sum1, Sum3};
 use crate::pixel::{FeatureSquares, FirstHit, HalfSums, LightSplit, PixelStats, SplitSums};
 use crate::samples::SampleRecords;
 use crate::splat::{Splat, SplatSums};
 use crate::{AovSet, FilmBuffers, FilmMemory};
-use rt_core::glam::Vec3;
+use rt_core::glam::{Vec2, Vec3};
+use rt_core::pixel_filter::PixelFilter;
 use rt_core::Rgb;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{Mutex, MutexGuard};
 
 /// The variance of each pixel's mean feature ([`Film::feature_variance_images`]); `None` for a
 /// feature the film does not keep. Albedo is RGB, stored like the normal and position as three
@@ -63,6 +66,12 @@ pub(crate) struct EvenSums {
 /// Per-pixel accumulation for a `width × height` image, row 0 at the top. Only the buffers
 /// named by its [`FilmBuffers`] exist; the others have length zero. Every statistic is an
 /// exact integer sum (see the crate doc), so the order samples arrive in never changes a bit.
+///
+/// A film whose camera splats its pixel filter ([`FilmStripe::add_filtered`]) keeps the
+/// filter-weighted sums instead (`crates/film/src/filtered.rs`), allocated with the first splat: its
+/// image and half-images are the filtered ones; it keeps no per-pixel variance (a pixel's
+/// samples are shared with its neighbours), and its sample counts are those taken in each
+/// pixel.
 #[derive(Debug)]
 pub struct Film {
     width: u32,
@@ -74,6 +83,8 @@ pub struct Film {
     pub(crate) even: Vec<EvenSums>,
     pub(crate) aov: AovBuffers,
     pub(crate) splats: SplatSums,
+    /// Filter-weighted sums; behind a lock only for the stripes that add their windows.
+    pub(crate) filtered: Mutex<FilterSums>,
     samples: Option<SampleRecords>,
     discarded: AtomicU64,
 }
@@ -91,9 +102,60 @@ pub struct FilmStripe<'a> {
     even: &'a mut [EvenSums],
     aov: AovSlices<'a>,
     discarded: &'a AtomicU64,
+    height: u32,
+    /// This band's filtered splats, made at its first one and added to `filtered` on drop.
+    window: Option<Window>,
+    filtered: &'a Mutex<FilterSums>,
+}
+
+impl Drop for FilmStripe<'_> {
+    fn drop(&mut self) {
+        if let Some(w) = self.window.take() {
+            let pixels = self.width as usize * self.height as usize;
+            w.add_into(&mut lock(self.filtered), self.width, pixels);
+        }
+    }
+}
+
+/// The filtered sums, whether or not a panicking thread poisoned the lock (the sums of a
+/// finished window are whole: it is added in one call).
+fn lock(m: &Mutex<FilterSums>) -> MutexGuard<'_, FilterSums> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 impl FilmStripe<'_> {
+    /// Adds radiance sample `index` of pixel `(x, y)`, taken at film position `pos` (uniform in
+    /// the pixel), splatted through `filter` into every pixel within its radius
+    /// (`crates/film/src/filtered.rs`); counted as a sample of `(x, y)`. Non-finite or negative samples
+    /// are dropped and counted; returns whether it was kept. First-hit AOVs, the lighting
+    /// split and the variance are not kept for splatted samples (callers refuse them).
+    #[inline]
+    pub fn add_filtered(
+        &mut self,
+        filter: &PixelFilter,
+        pos: Vec2,
+        (x, y): (u32, u32),
+        index: u32,
+        radiance: Rgb,
+    ) -> bool {
+        let i = ((y - self.y0) * self.width + x) as usize;
+        if !crate::accepts_sample(radiance) {
+            self.discarded.fetch_add(1, Ordering::Relaxed);
+            return false;
+        }
+        self.counts[i] += 1;
+        let even = index.is_multiple_of(2);
+        if let (Some(e), true) = (self.even.get_mut(i), even) {
+            e.n += 1;
+        }
+        let (w, h, y0, rows) = (self.width, self.height, self.y0, self.rows());
+        let halves = !self.even.is_empty();
+        self.window
+            .get_or_insert_with(|| Window::new(y0..y0 + rows, w, h, filter, halves))
+            .splat(filter, (pos.x, pos.y), (w, h), even, radiance);
+        true
+    }
+
     /// Number of rows in this band.
     pub fn rows(&self) -> u32 {
         (self.counts.len() / self.width as usize) as u32
@@ -232,6 +294,7 @@ impl Film {
                 split: buffer(a.any_split(), n),
             },
             splats: SplatSums::default(),
+            filtered: Mutex::default(),
             samples: buffers.samples.then(|| SampleRecords::empty(width, height)),
             discarded: AtomicU64::new(0),
         }
@@ -272,6 +335,7 @@ impl Film {
             feature_variance: bytes(&self.aov.squares),
             split: bytes(&self.aov.split),
             splats: self.splats.bytes(),
+            filtered: lock(&self.filtered).bytes(),
             samples: self.samples.as_ref().map(SampleRecords::memory_bytes),
         }
     }
@@ -293,6 +357,13 @@ impl Film {
 
     fn stats_at(&self, i: usize) -> PixelStats {
         let (sum, n) = (&self.sums[i], self.counts[i]);
+        let f = lock(&self.filtered);
+        if f.is_some() {
+            let halves = self.even.get(i).map(|e| {
+                HalfSums::from_means([f.half_mean(i, 0), f.half_mean(i, 1)], [e.n, n - e.n])
+            });
+            return PixelStats::filtered(f.all[i].mean(), n, halves);
+        }
         let halves = self
             .even
             .get(i)
@@ -333,6 +404,8 @@ impl Film {
         let rows = rows.max(1);
         let chunk = (rows as usize * w as usize).max(1);
         let discarded = &self.discarded;
+        let filtered = &self.filtered;
+        let height = self.height;
         let mut sums = chunks(&mut self.sums, chunk);
         let mut squares = chunks(&mut self.squares, chunk);
         let mut even = chunks(&mut self.even, chunk);
@@ -363,6 +436,9 @@ impl Film {
                     split: split.next().unwrap_or_default(),
                 },
                 discarded,
+                height,
+                window: None,
+                filtered,
             })
     }
 
@@ -417,9 +493,20 @@ impl Film {
         self.splats.paths() > 0
     }
 
+    /// True if the film holds samples splatted through a pixel filter
+    /// ([`FilmStripe::add_filtered`]), whose per-pixel variance it does not know.
+    pub fn has_filtered(&self) -> bool {
+        lock(&self.filtered).is_some()
+    }
+
     /// The pixel estimates, row-major: the mean of the camera samples plus the light paths'
-    /// splats over the number of light paths.
+    /// splats over the number of light paths; for a film of filtered samples, each pixel's
+    /// weighted sum over its sum of weights.
     pub fn mean_image(&self) -> Vec<Rgb> {
+        let f = lock(&self.filtered);
+        if f.is_some() {
+            return f.all.iter().map(|p| p.mean()).collect();
+        }
         self.sums
             .iter()
             .zip(&self.counts)
@@ -430,7 +517,7 @@ impl Film {
 
     /// Variance of each pixel estimate, row-major; `None` without a variance buffer.
     pub fn variance_image(&self) -> Option<Vec<Rgb>> {
-        if self.squares.is_empty() {
+        if self.squares.is_empty() || self.has_filtered() {
             return None;
         }
         Some(
@@ -444,6 +531,10 @@ impl Film {
     pub fn half_image(&self, half: usize) -> Option<Vec<Rgb>> {
         if self.even.is_empty() {
             return None;
+        }
+        let f = lock(&self.filtered);
+        if f.is_some() {
+            return Some((0..self.even.len()).map(|i| f.half_mean(i, half)).collect());
         }
         Some(
             self.even

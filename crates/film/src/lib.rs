@@ -16,7 +16,7 @@
 //! sums of a rectangle ([`Rect`]) between machines, and the film that adds up the parts of a
 //! render (sample ranges, regions, a checkpoint and what came after it) is the film of the
 //! whole render, bit for bit (`rt-parts` builds part files and plans on this). The encoding
-//! is a flags byte (bit 0: splats present), the discarded-sample count (`u64`), with splats
+//! is a flags byte (bit 0: splats present; bit 1: filtered sums present), the discarded-sample count (`u64`), with splats
 //! the light paths and even-index light paths taken (two `u64`), then each kept buffer in a
 //! fixed order, one element per pixel of the rectangle, row-major, little-endian; the reader
 //! derives every length from its own buffers and the rectangle and checks the total first.
@@ -24,6 +24,12 @@
 //! Light paths land on any pixel: their [`Splat`]s are summed apart (exactly, allocated at the
 //! first splat) and divided by the number of light paths taken; the image is the camera
 //! samples' mean plus that ([`Film::mean_image`]).
+//!
+//! A camera whose pixel filter splats (`rt_core::pixel_filter`, Mitsuba's way) adds each sample
+//! to every pixel under the filter ([`FilmStripe::add_filtered`]): the film then keeps
+//! filter-weighted sums and sums of weights (exact, allocated with the first such sample; each
+//! band of rows collects what crosses its border and adds it when the band ends), and its image
+//! and half-images are their ratios.
 //!
 //! [`input`] reads any image (EXR, PNG, JPEG) as a linear [`rt_core::RgbImage`]. [`output`]
 //! writes EXR (linear float, AOVs as extra channel groups) and PNG (tone mapped
@@ -49,6 +55,7 @@
 mod aov_set;
 mod buffers;
 mod film;
+mod filtered;
 mod fixed;
 mod guides;
 pub mod input;

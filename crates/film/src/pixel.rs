@@ -27,6 +27,11 @@ impl HalfSums {
         }
     }
 
+    /// From the two halves' estimates and sample counts.
+    pub(crate) fn from_means(mean: [Rgb; 2], n: [u32; 2]) -> Self {
+        Self { mean, n }
+    }
+
     /// Mean of the even-numbered (`half = 0`) or odd-numbered (`half = 1`) samples; zero
     /// without samples.
     #[inline]
@@ -62,6 +67,16 @@ impl PixelStats {
             mean: sum.mean(n.into()),
             n,
             sample_variance: squares.map(|q| q.variance(n.into(), sum)),
+            halves,
+        }
+    }
+
+    /// A pixel of filtered sums: its estimate, the samples taken in it, no variance.
+    pub(crate) fn filtered(mean: Rgb, n: u32, halves: Option<HalfSums>) -> Self {
+        Self {
+            mean,
+            n,
+            sample_variance: None,
             halves,
         }
     }

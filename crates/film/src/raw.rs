@@ -4,15 +4,17 @@
 //! parts of a render (sample ranges, regions, or the state before a checkpoint) holds the very
 //! bits of the film that rendered everything itself.
 //!
-//! Layout (little-endian): a flags byte (bit 0: light-path splats present), the discarded
-//! sample count (`u64`), with splats the light paths and even-index light paths taken (two
-//! `u64`); then, for each buffer the film keeps, in a fixed order, one element per pixel of the
-//! rectangle in row-major order. Nothing in the bytes says how long anything is: the reader
+//! Layout (little-endian): a flags byte (bit 0: light-path splats present; bit 1: filtered
+//! sums of a splatted pixel filter present), the discarded sample count (`u64`), with splats
+//! the light paths and even-index light paths taken (two `u64`); then, for each buffer the
+//! film keeps, in a fixed order, one element per pixel of the rectangle in row-major order,
+//! the filtered sums last. Nothing in the bytes says how long anything is: the reader
 //! computes every length from its own buffers and the rectangle, and checks the total first,
 //! so a corrupt or hostile input can neither make it allocate nor read out of bounds.
 //! Per-sample records ([`FilmBuffers::samples`]) are not encoded.
 
 use crate::film::{EvenSums, Film};
+use crate::filtered::Weighted;
 use crate::fixed::{Squares3, Sum1, Sum3};
 use crate::pixel::{FeatureSquares, SplitSums};
 use crate::FilmBuffers;
@@ -259,6 +261,26 @@ impl Sums for SplitSums {
     }
 }
 
+impl Sums for Weighted {
+    const N: usize = 4;
+    fn values(&self) -> impl Iterator<Item = i128> {
+        self.sum.0.into_iter().chain([self.weight.0])
+    }
+    fn from_values(mut v: impl FnMut(usize) -> i128) -> Self {
+        Weighted {
+            sum: Sum3([v(0), v(1), v(2)]),
+            weight: Sum1(v(3)),
+        }
+    }
+    fn add_values(&mut self, o: &Self) {
+        self.merge(o);
+    }
+}
+
+/// Flag bits of the encoding's first byte.
+const LIGHT_SPLATS: u8 = 1;
+const FILTERED: u8 = 2;
+
 impl Raw for EvenSums {
     const BYTES: usize = 16 * 3 + 4;
     fn put(&self, out: &mut Vec<u8>) {
@@ -334,8 +356,11 @@ impl Film {
     pub fn encode_sums(&self, rect: Rect) -> Vec<u8> {
         let w = self.width();
         let splats = self.splats.parts();
-        let mut out = Vec::with_capacity(self.encoded_len(rect, splats.is_some()) as usize);
-        out.push(u8::from(splats.is_some()));
+        let filtered = self.filtered.lock().unwrap_or_else(|e| e.into_inner());
+        let flags = if splats.is_some() { LIGHT_SPLATS } else { 0 }
+            | if filtered.is_some() { FILTERED } else { 0 };
+        let mut out = Vec::with_capacity(self.encoded_len(rect, flags) as usize);
+        out.push(flags);
         out.extend_from_slice(&self.discarded().to_le_bytes());
         if let Some((_, _, paths, even_paths)) = splats {
             out.extend_from_slice(&paths.to_le_bytes());
@@ -357,15 +382,21 @@ impl Film {
             put_all(all, rect, w, &mut out);
             put_all(even, rect, w, &mut out);
         }
+        put_all(&filtered.all, rect, w, &mut out);
+        put_all(&filtered.even, rect, w, &mut out);
         out
     }
 
-    /// Bytes [`Film::encode_sums`] writes for `rect`, with or without splats.
-    pub fn encoded_len(&self, rect: Rect, splats: bool) -> u64 {
+    /// Bytes [`Film::encode_sums`] writes for `rect` with the given flags (with or without
+    /// light-path splats and filtered sums).
+    fn encoded_len(&self, rect: Rect, flags: u8) -> u64 {
         let mut n = 1 + 8 + rect.area() * pixel_bytes(&self.buffers()) as u64;
-        if splats {
-            let sets = 1 + u64::from(self.buffers().halves);
+        let sets = 1 + u64::from(self.buffers().halves);
+        if flags & LIGHT_SPLATS != 0 {
             n += 16 + rect.area() * sets * Sum3::BYTES as u64;
+        }
+        if flags & FILTERED != 0 {
+            n += rect.area() * sets * Weighted::BYTES as u64;
         }
         n
     }
@@ -389,9 +420,10 @@ impl Film {
                 height: h,
             });
         }
-        let splats = bytes.first() == Some(&1);
-        let want = self.encoded_len(rect, splats);
-        if bytes.len() as u64 != want || bytes.first().is_some_and(|&f| f > 1) {
+        let flags = bytes.first().copied().unwrap_or(0);
+        let splats = flags & LIGHT_SPLATS != 0;
+        let want = self.encoded_len(rect, flags);
+        if bytes.len() as u64 != want || flags > (LIGHT_SPLATS | FILTERED) {
             return Err(RawError::Length {
                 got: bytes.len(),
                 want,
@@ -434,6 +466,13 @@ impl Film {
             if add_light_paths {
                 self.splats.add_paths(paths, even_paths);
             }
+        }
+        if flags & FILTERED != 0 {
+            let halves = self.buffers().halves;
+            let filtered = self.filtered.get_mut().unwrap_or_else(|e| e.into_inner());
+            let (all, even) = filtered.parts_mut((w * h) as usize, halves);
+            r.add(all);
+            r.add(even);
         }
         self.add_discarded(discarded);
         if r.overflow {

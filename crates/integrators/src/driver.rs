@@ -2,8 +2,10 @@
 //!
 //! Each pixel's samples are taken in index order by one worker, and every random number is a
 //! function of (seed, pixel, sample index, dimension), so the image is bit-identical whatever
-//! the thread count or scheduling. The pixel filter is a box: a sample counts only in the pixel
-//! it was taken in, which keeps pixel noise independent for the denoisers downstream.
+//! the thread count or scheduling. A sample counts only in the pixel it was taken in (the box,
+//! or a filter applied by importance sampling), which keeps pixel noise independent for the
+//! denoisers downstream; a camera whose filter splats ([`rt_core::pixel_filter`]) has the
+//! film add it to every pixel under the filter instead (`CameraSampling::add_to_film`).
 //!
 //! Dimension layout of one sample: the film position (one 2D draw), the lens position (one 2D
 //! draw, only for a thin-lens camera: a pinhole ignores it, so it is not drawn), then whatever
@@ -15,7 +17,7 @@
 use crate::{Ctx, Integrator, RayCounters, SampleAux};
 use rayon::prelude::*;
 use rt_core::{glam::Vec2, SampleStream, Sampler};
-use rt_film::{Film, SampleRecords};
+use rt_film::{Film, FilmStripe, SampleRecords};
 use std::ops::Range;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
@@ -164,8 +166,9 @@ pub fn render_samples(
                             &mut counters,
                         );
                         let split = want_split.then_some(&aux.split);
+                        let hit = aux.first_hit.as_ref();
                         let kept =
-                            stripe.add_sample_split(x, y, i, l, aux.first_hit.as_ref(), split);
+                            camera.add_to_film(&mut stripe, &mut sampler, (x, y, i), l, hit, split);
                         if let (true, Some(r)) = (kept, &mut record) {
                             let hit = aux.first_hit.as_ref();
                             let coc = hit.map_or(ctx.camera.coc_at_infinity(), |h| {
@@ -254,10 +257,10 @@ impl<'a> CameraSampling<'a> {
         integrator.li(ctx, ray, sampler, aux, counters)
     }
 
-    /// The camera ray of sample `i` of pixel `(x, y)`, leaving `sampler` at the integrator's
-    /// first dimension.
+    /// The film position of sample `i` of pixel `(x, y)`: the first draw of its stream,
+    /// placed by the pixel filter. Leaves `sampler` after that draw.
     #[inline]
-    pub(crate) fn ray(&self, sampler: &mut Sampler, (x, y, i): (u32, u32, u32)) -> rt_core::Ray {
+    fn film_position(&self, sampler: &mut Sampler, (x, y, i): (u32, u32, u32)) -> Vec2 {
         sampler.start(x, y, i);
         let jitter = sampler.next_2d();
         let jitter = if self.centre_first && i == 0 {
@@ -265,7 +268,36 @@ impl<'a> CameraSampling<'a> {
         } else {
             jitter
         };
-        let film_pos = self.camera.filter.film_position(x, y, jitter);
+        self.camera.filter.film_position(x, y, jitter)
+    }
+
+    /// Adds sample `i` of pixel `(x, y)`, of radiance `l`, to `stripe`: in its pixel, or, when
+    /// the camera's filter splats, through the filter around the sample's film position
+    /// (drawn again from `sampler`, which is restarted: one hash per sample, and no place
+    /// in a path's state to keep it). Returns whether the film kept it.
+    #[inline]
+    pub(crate) fn add_to_film(
+        &self,
+        stripe: &mut FilmStripe<'_>,
+        sampler: &mut Sampler,
+        (x, y, i): (u32, u32, u32),
+        l: rt_core::Rgb,
+        hit: Option<&rt_film::FirstHit>,
+        split: Option<&rt_film::LightSplit>,
+    ) -> bool {
+        if self.camera.filter.splats() {
+            let pos = self.film_position(sampler, (x, y, i));
+            stripe.add_filtered(&self.camera.filter, pos, (x, y), i, l)
+        } else {
+            stripe.add_sample_split(x, y, i, l, hit, split)
+        }
+    }
+
+    /// The camera ray of sample `i` of pixel `(x, y)`, leaving `sampler` at the integrator's
+    /// first dimension.
+    #[inline]
+    pub(crate) fn ray(&self, sampler: &mut Sampler, (x, y, i): (u32, u32, u32)) -> rt_core::Ray {
+        let film_pos = self.film_position(sampler, (x, y, i));
         let lens = if self.thin_lens {
             sampler.next_2d()
         } else {

@@ -287,7 +287,7 @@ fn the_cornell_box_from_the_shared_data_loads_and_converts_to_the_same_scene() {
     assert_eq!(xml.render.max_depth, Some(9));
     assert_eq!(
         xml.scene.cameras[0].filter.to_string(),
-        "gaussian:stddev=0.5"
+        "gaussian:stddev=0.5:splat"
     );
     let dir = tempfile::tempdir().unwrap();
     let c = mitsuba::to_toml(&p, Some(dir.path()), &FileAccess::open(), &[]).unwrap();

@@ -285,7 +285,8 @@ fn render_stripe(
         // Finished paths go to the film; the rest move up.
         batch.paths.retain(|p| {
             if p.done {
-                stripe.add_sample_split(p.x, p.y, p.index, p.l, p.first_hit.as_ref(), None);
+                let (xyi, hit) = ((p.x, p.y, p.index), p.first_hit.as_ref());
+                camera.add_to_film(stripe, &mut sampler, xyi, p.l, hit, None);
             }
             !p.done
         });

@@ -308,8 +308,8 @@ impl<'a> Builder<'a, '_> {
         }
         let filters = p.objects("rfilter");
         let filter = match filters.as_slice() {
-            // Mitsuba's default reconstruction filter.
-            [] => "gaussian".to_string(),
+            // Mitsuba's default reconstruction filter, splatted as Mitsuba applies it.
+            [] => "gaussian:splat".to_string(),
             [r] => pixel_filter(r, self.warnings)?,
             _ => return Err(p.error("has more than one <rfilter>")),
         };
@@ -808,18 +808,20 @@ fn focal_length_fov(p: &Props, text: &str) -> Result<f64, SceneError> {
     Ok((2.0 * (18.0 / mm).atan()).to_degrees())
 }
 
-/// An `<rfilter>` as our `pixel_filter` option string.
+/// An `<rfilter>` as our `pixel_filter` option string: the tent and the Gaussian splatted
+/// into the pixels under them, as Mitsuba's `ImageBlock` does (so the noise, not only the
+/// image, is Mitsuba's).
 fn pixel_filter(r: &Node, warnings: &mut Vec<String>) -> Result<String, SceneError> {
     let p = Props::new(r);
     let spec = match r.plugin()? {
         "box" => "box".to_string(),
         "tent" => match p.float("radius")? {
-            Some(radius) => format!("tent:radius={radius}"),
-            None => "tent".into(),
+            Some(radius) => format!("tent:radius={radius}:splat"),
+            None => "tent:splat".into(),
         },
         "gaussian" => match p.float("stddev")? {
-            Some(s) => format!("gaussian:stddev={s}"),
-            None => "gaussian".into(),
+            Some(s) => format!("gaussian:stddev={s}:splat"),
+            None => "gaussian:splat".into(),
         },
         other => {
             return Err(r.at.error(format!(

@@ -199,9 +199,35 @@ impl RenderJob {
     }
 
     /// Refuses a pixel filter wider than the box with a technique that splats: its light
-    /// paths land where they land, so only camera samples can be placed by the filter.
+    /// paths land where they land, so only camera samples can be placed by the filter. A
+    /// filter the film splats ([`rt_core::pixel_filter`]) keeps only the image and its
+    /// half-images, whose pixels share samples: it refuses what needs more (the other
+    /// buffers, a denoiser, which assumes independent pixel noise) or a region, whose samples
+    /// would splat past its border.
     fn check_filter(&self, scene: &Scene) -> Result<(), JobError> {
         let camera = self.camera_in(scene)?;
+        if camera.filter.splats() {
+            let b = self.film_buffers(None);
+            let a = b.aovs;
+            let what = if self.settings.denoiser.is_some() {
+                Some("a denoiser (it assumes independent pixel noise)".to_string())
+            } else if b.variance || a.any_first_hit() || a.any_split() || b.samples {
+                Some(format!("--aov {}", a.names().join(",")))
+            } else if self.slice.region.is_some() {
+                Some("--region (its samples would splat past its border)".to_string())
+            } else {
+                None
+            };
+            if let Some(what) = what {
+                return Err(JobError::Refused(format!(
+                    "{}: camera \"{}\" splats its pixel filter ({}), which keeps only the image \
+                     and its half-images; {what} needs the filter importance-sampled (drop `:splat`)",
+                    self.scene.display(),
+                    camera.name,
+                    camera.filter,
+                )));
+            }
+        }
         if camera.filter == rt_core::pixel_filter::PixelFilter::Box
             || !self.settings.integrator.build().splats()
         {
