@@ -248,11 +248,6 @@ impl SequencePlan {
     pub fn is_empty(&self) -> bool {
         self.frames.is_empty()
     }
-
-    /// The camera of frame `f` (the scene already moved to the frame's time), resized.
-    pub fn camera_of(&self, scene: &rt_core::Scene) -> Option<Camera> {
-        Some(self.size.apply(scene.camera(self.camera.as_deref())?))
-    }
 }
 
 /// A scene's reference.
@@ -315,7 +310,7 @@ pub enum Runs {
     /// (sorted: the largest error first, then the shortest time).
     Adaptive(Vec<StopRule>),
     /// A sequence experiment's method: every frame rendered at `spp` samples per pixel
-    /// ([`rt_session::SequenceRenderer`]).
+    /// ([`Pair::sequence_job`]).
     Sequence {
         /// Samples per pixel per frame.
         spp: u32,
@@ -1274,8 +1269,7 @@ spp = 1
             .collect();
         assert_eq!(temporal, [Some(true), Some(false), None]);
         assert!(p.methods.iter().all(|m| m.denoiser.is_none()));
-        let camera = seq.camera_of(&p.scenes[0].loaded.scene).unwrap();
-        assert_eq!((camera.width, camera.height), (16, 12));
+        assert_eq!(seq.size, ImageSize::Pixels(16, 12));
         assert!(!plan(GOOD).unwrap().is_sequence());
     }
 

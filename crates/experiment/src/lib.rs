@@ -19,8 +19,9 @@
 //! - A method may name a denoiser (`rt-denoise`); its images are denoised after each budget
 //!   and measured as denoised, with the noisy error and the denoising time kept beside.
 //! - [`sequence`] and [`seqreport`]: sequence experiments (scenes with `frames = [A, B]`):
-//!   every method renders the frames in order (`rt_session::SequenceRenderer`, denoised by
-//!   SVGF or a per-frame denoiser), each frame measured against its own reference frame, with
+//!   every method runs a job whose frames render in order
+//!   (`rt_session::RenderJob::render_sequence`, denoised by SVGF or a per-frame denoiser),
+//!   each frame measured against its own reference frame, with
 //!   the temporal metrics of `rt_metrics::temporal`; frames.csv, sequences.csv, plots over
 //!   frames, stills.
 //!

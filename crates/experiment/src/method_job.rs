@@ -1,9 +1,10 @@
 //! The render job of a method on a scene ([`Pair::job`]): what the grid runs for each of a
 //! method's progressive budgets or adaptive rules, the same [`RenderJob`] `render`, `render
-//! part`, `--resume` and the references run.
+//! part`, `--resume` and the references run; and of a sequence method on a sequence scene
+//! ([`Pair::sequence_job`]), the frames `render --frames A..B --denoiser ...` renders.
 
-use crate::config::{MethodPlan, Pair, ScenePlan};
-use rt_session::{Budgets, GreeJob, ImageSize, RenderJob, Settings, StopRule, Stream};
+use crate::config::{MethodPlan, Pair, ScenePlan, SequencePlan};
+use rt_session::{Budgets, Frames, GreeJob, ImageSize, RenderJob, Settings, StopRule, Stream};
 use rt_temporal::TemporalSpec;
 
 impl Pair {
@@ -25,17 +26,8 @@ impl Pair {
             (None, Some(Budgets::Spp(list))) => list.last().copied().unwrap_or(0),
             (None, _) => 0,
         };
-        let settings = Settings {
-            integrator: self.estimator,
-            accel: self.accel,
-            spp,
-            threads: None,
-            seed: self.seed,
-            aovs: Default::default(),
-            output: None,
-            denoiser: method.denoiser.clone().map(TemporalSpec::PerFrame),
-        };
-        let mut job = RenderJob::new(&scene.path, settings);
+        let denoiser = method.denoiser.clone().map(TemporalSpec::PerFrame);
+        let mut job = RenderJob::new(&scene.path, self.settings(spp, denoiser));
         job.camera = Some(scene.camera.name.clone());
         job.size = ImageSize::Pixels(scene.camera.width, scene.camera.height);
         job.stream = Stream::Render;
@@ -47,6 +39,47 @@ impl Pair {
             labels: None,
             error_maps: None,
         });
+        job
+    }
+
+    /// The job of this pair's sequence `method` on the frames `seq` of `scene`
+    /// ([`SequencePlan::job`]) at `spp` samples per pixel per frame: its estimator, structure
+    /// and seed, and the method's denoiser, temporal or run on each frame alone
+    /// ([`RenderJob::sequence_renderer`]).
+    pub fn sequence_job(
+        &self,
+        scene: &ScenePlan,
+        method: &MethodPlan,
+        seq: &SequencePlan,
+        spp: u32,
+    ) -> RenderJob {
+        seq.job(scene, self.settings(spp, method.temporal.clone()))
+    }
+
+    /// This pair's estimator, structure and seed at `spp` with `denoiser`.
+    fn settings(&self, spp: u32, denoiser: Option<TemporalSpec>) -> Settings {
+        Settings {
+            integrator: self.estimator,
+            accel: self.accel,
+            spp,
+            threads: None,
+            seed: self.seed,
+            aovs: Default::default(),
+            output: None,
+            denoiser,
+        }
+    }
+}
+
+impl SequencePlan {
+    /// A job over these frames of `scene` with `settings`: the sequence's camera (looked up
+    /// again at every frame's time, as cameras move) at its size, its frames and rate.
+    pub fn job(&self, scene: &ScenePlan, settings: Settings) -> RenderJob {
+        let mut job = RenderJob::new(&scene.path, settings);
+        job.camera = self.camera.clone();
+        job.size = self.size;
+        job.frames = Frames::Range(self.frames.clone());
+        job.fps = self.fps;
         job
     }
 }

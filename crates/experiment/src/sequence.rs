@@ -1,27 +1,31 @@
-//! Sequence experiments: every scene is an animation (`frames = [A, B]`), every method renders
-//! its frames in order through one [`SequenceRenderer`] per (scene, method), so a temporal
-//! denoiser (SVGF) keeps its history, and each frame is measured against its own reference
-//! frame. The temporal metrics (temporal error, temporal relMSE, lag after an event) are
-//! `rt_metrics::temporal`'s, streamed through [`SequenceComparison`].
+//! Sequence experiments: every scene is an animation (`frames = [A, B]`), every method runs
+//! one job per scene ([`crate::config::Pair::sequence_job`]) whose frames render in order
+//! through one [`rt_session::SequenceRenderer`] ([`rt_session::RenderJob::render_sequence`]),
+//! so a temporal denoiser (SVGF) keeps its history, and each frame is measured against its
+//! own reference frame. The temporal metrics (temporal error, temporal relMSE, lag after an
+//! event) are `rt_metrics::temporal`'s, streamed through [`SequenceComparison`].
 //!
-//! References: frame `f` of a scene is rendered at the reference's spp in the reference stream
-//! through the [`Cache`], keyed like any reference by the scene's content and the camera,
-//! which both change with the frame's time ([`rt_core::Scene::set_time`] writes the time
-//! into the scene), so every frame is its own entry. Every frame's reference uses the same
-//! seed: where nothing moved between two frames their references have the same noise, so the
-//! reference's frame differences are nearly noise-free there.
+//! References: a job over the scene's frames in the reference stream walks them
+//! ([`rt_session::RenderJob::each_frame`]: the scene, its structure and the camera at each
+//! frame's time), and frame `f`'s reference is a still reference job of the scene at that
+//! time ([`crate::reference::obtain`]), at the reference's spp, through the [`Cache`], keyed
+//! like any reference by the scene's content and the camera, which both change with the
+//! frame's time ([`rt_core::Scene::set_time`] writes the time into the scene), so every frame
+//! is its own entry. Every frame's reference uses the same seed: where nothing moved between
+//! two frames their references have the same noise, so the reference's frame differences are
+//! nearly noise-free there.
 
 use crate::cache::{Cache, ReferenceRequest};
 use crate::config::{Plan, ReferencePlan, Runs, SequencePlan};
 use crate::error::{io, ExperimentError, Result};
 use crate::Progress;
-use rt_core::{Accel, RgbImage, Scene};
+use rt_core::RgbImage;
 use rt_integrators::GuideOptions;
 use rt_metrics::temporal::{
     lag, luminance_change_in, LagOptions, SequenceComparison, TemporalError,
 };
 use rt_metrics::{CompareOptions, Metrics};
-use rt_session::{FrameTimes, SequenceFrame, SequenceRenderer};
+use rt_session::{FrameTimes, SequenceFrame, Settings, Stream};
 use std::path::{Path, PathBuf};
 
 /// The lag's steady state is the median of at most this many frames before the event.
@@ -115,27 +119,12 @@ pub fn still_frames(seq: &SequencePlan) -> Vec<u32> {
     v
 }
 
-/// The time of frame `f`, as [`SequenceRenderer::time_of`] computes it.
-fn time_of(seq: &SequencePlan, f: u32) -> f32 {
-    (f64::from(f) / seq.fps) as f32
-}
-
 fn slash(p: &Path) -> String {
     p.to_string_lossy().replace('\\', "/")
 }
 
 fn run_error(what: impl std::fmt::Display) -> ExperimentError {
     ExperimentError::Run(what.to_string())
-}
-
-/// The camera of the scene at its current time, or an error naming the scene.
-fn camera_at(seq: &SequencePlan, scene: &Scene, name: &str, f: u32) -> Result<rt_core::Camera> {
-    seq.camera_of(scene).ok_or_else(|| {
-        run_error(format!(
-            "{name}: frame {f}: no camera named \"{}\"",
-            seq.camera.as_deref().unwrap_or("(first)")
-        ))
-    })
 }
 
 /// Writes frame `f` of `method` as `<dir>/<method>-f<frame>.png` (tone mapped like `render -o
@@ -227,44 +216,28 @@ pub fn run(
                 run_error(format!("{}: {}: {e}", scene.name, method.name))
             };
             progress.set_message(format!("{}: {}", scene.name, method.name));
-            let denoiser = method
-                .temporal
-                .as_ref()
-                .map(|t| t.build())
-                .transpose()
+            let job = pair.sequence_job(scene, method, seq, spp);
+            let mut renderer = job
+                .sequence_renderer(&scene.loaded.scene)
                 .map_err(|e| at(&e))?;
-            let mut renderer = SequenceRenderer::new(
-                pair.estimator.build(),
-                pair.accel,
-                denoiser,
-                seq.camera.clone(),
-                spp,
-                pair.seed,
-                seq.fps,
-            )
-            .map_err(|e| at(&e))?;
             renderer.set_guides(true);
             let mut moving = scene.loaded.scene.clone();
             let mut specular = SpecularFlicker::default();
             let mut comparison = SequenceComparison::new(opts).map_err(|e| at(&e))?;
             let mut total_ms = 0.0;
-            for f in seq.frames.clone() {
-                moving.set_time(renderer.time_of(f));
-                let camera = camera_at(seq, &moving, &scene.name, f)?;
-                let frame = renderer
-                    .render_with(&mut moving, f, Some(&camera))
-                    .map_err(|e| at(&format!("frame {f}: {e}")))?;
+            job.render_sequence(&mut renderer, &mut moving, &mut |frame| -> Result<()> {
+                let f = frame.frame;
                 if stills.contains(&f) {
                     results
                         .stills
                         .push(write_still(out, &dir, si, &method.name, f, &frame.image)?);
                 }
                 specular
-                    .push(&frame)
+                    .push(frame)
                     .map_err(|e| at(&format!("frame {f}: {e}")))?;
                 let reference = references[(f - seq.frames.start) as usize].clone();
                 let measured = comparison
-                    .push(frame.image, reference)
+                    .push(frame.image.clone(), reference)
                     .map_err(|e| at(&format!("frame {f}: {e}")))?;
                 total_ms += frame.times.total().as_secs_f64() * 1e3;
                 results.frames.push(FrameRow {
@@ -275,7 +248,8 @@ pub fn run(
                 });
                 done += 1;
                 progress.set_position(done);
-            }
+                Ok(())
+            })?;
             let m = comparison.finish().map_err(|e| at(&e))?;
             let relmse = m.per_frame(|m| m.relmse);
             let (lag_frames, steady) = match seq.event {
@@ -356,7 +330,7 @@ fn references(
         spp,
         estimator,
         seed,
-        accel: accel_spec,
+        accel,
     } = &scene.reference
     else {
         return Err(run_error(format!(
@@ -364,42 +338,49 @@ fn references(
             scene.name
         )));
     };
+    // Only the walk over the frames: each frame's reference is a still job of its own, every
+    // frame's from the same seed.
+    let mut walk = seq.job(
+        scene,
+        Settings {
+            integrator: *estimator,
+            accel: *accel,
+            spp: *spp,
+            threads: None,
+            seed: *seed,
+            aovs: Default::default(),
+            output: None,
+            denoiser: None,
+        },
+    );
+    walk.stream = Stream::Reference;
     let mut moving = scene.loaded.scene.clone();
-    let mut accel: Option<Box<dyn Accel>> = None;
     let mut images = Vec::with_capacity(seq.len());
     let (mut cached, mut rendered, mut seconds) = (0usize, 0usize, 0.0f64);
-    for f in seq.frames.clone() {
-        moving.set_time(time_of(seq, f));
-        let camera = camera_at(seq, &moving, &scene.name, f)?;
-        let req = ReferenceRequest {
-            scene_path: &scene.path,
-            scene: &moving,
-            camera: &camera,
-            estimator: *estimator,
-            spp: *spp,
-            seed: *seed,
-        };
-        let hit = cache.lookup(&scene.path, &req.key()?);
-        let path = match hit {
+    walk.each_frame(&mut moving, &mut |at| -> Result<()> {
+        let key = ReferenceRequest {
+            scene: at.scene(),
+            camera: &at.camera,
+            ..scene.reference_request(*estimator, *spp, *seed)
+        }
+        .key()?;
+        let path = match cache.lookup(&scene.path, &key) {
             Some((path, sidecar)) => {
                 cached += 1;
                 seconds += sidecar.seconds;
                 path
             }
             None => {
-                // Follow the scene as a sequence does: update in place when the structure can.
-                let updated = accel.as_mut().is_some_and(|a| a.update(req.scene));
-                if !updated {
-                    accel =
-                        Some(accel_spec.build(req.scene).map_err(|e| {
-                            run_error(format!("{}: {accel_spec}: {e}", scene.name))
-                        })?);
-                }
-                let built = accel.as_deref().expect("built above");
+                // Built in the scene's order: the next frame's key hashes the scene again.
+                let ctx = at.ctx_in_order()?;
                 let base = *done;
                 let got = crate::reference::obtain(
-                    &req,
-                    (accel_spec, built),
+                    &ReferenceRequest {
+                        scene: ctx.scene,
+                        camera: ctx.camera,
+                        ..scene.reference_request(*estimator, *spp, *seed)
+                    },
+                    (accel, ctx.accel),
                     Some(cache),
                     None,
                     &|_| progress.set_position(base),
@@ -412,7 +393,8 @@ fn references(
         images.push(rt_film::read_rgb(&path)?);
         *done += 1;
         progress.set_position(*done);
-    }
+        Ok(())
+    })?;
     let origin = format!(
         "{} frames at {spp} spp: {rendered} rendered, {cached} from the cache ({seconds:.1} s of rendering)",
         seq.len()

@@ -6,7 +6,10 @@
 //!   [`RenderJob::run`] that takes a progress sink and a stop flag; plans and checkpoints store
 //!   it; [`job::merge`] merges its parts. [`RenderJob::render_stops`] renders a job into a film
 //!   the caller keeps and hands it over at every stop ([`FilmStop`]), as experiments record
-//!   their budgets.
+//!   their budgets; [`RenderJob::render_sequence`] renders its frames over a scene the caller
+//!   holds and hands each over with its guide buffers, as sequence experiments record them;
+//!   [`RenderJob::each_frame`] is the frame loop they all walk, with [`following`]: the
+//!   structure that follows a moving scene.
 //! - [`settings`]: the one place settings are resolved (given values, then the scene's
 //!   `[render]` table, then defaults), with their limits ([`rt_core::limits`]) and the
 //!   combinations they cannot honour.
@@ -50,6 +53,7 @@
 
 pub mod adaptive;
 pub mod camera;
+pub mod following;
 pub mod frames;
 pub mod gree;
 pub mod job;
@@ -71,7 +75,7 @@ pub use camera::{parse_resolution, pick_camera, split_size, ImageSize, MAX_SIDE}
 pub use gree::{gree_aovs, render_gree, GreeRun, GreeRunError, GreeSpec};
 pub use job::{
     load_scene, Checkpointing, Delivery, FilmStop, FrameReport, Frames, GreeJob, JobError,
-    JobReport, JobScene, JobSink, RenderJob, Rendered, Slice, Stream,
+    JobFrame, JobReport, JobScene, JobSink, RenderJob, Rendered, Slice, Stream,
 };
 pub use progressive::{Budgets, Checkpoint, Session};
 pub use report::{RenderReport, ReportInputs, Stage, Status};

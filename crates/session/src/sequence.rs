@@ -17,9 +17,10 @@
 //! the first frame), and never beyond `spp` passes. How many passes fit depends on the clock,
 //! so budgeted frames are not deterministic; without a budget they are.
 
+use crate::following::FollowingAccel;
 use crate::settings::frame_seed;
 use rt_accel::AccelSpec;
-use rt_core::{Accel, Camera, RgbImage, SampleStream, Scene};
+use rt_core::{Camera, RgbImage, SampleStream, Scene};
 use rt_film::{AovSet, Film, FilmBuffers, GuideBuffers, NoisyFrame};
 use rt_integrators::{
     render_guides, Ctx, GuideOptions, PreviousView, RenderStats, SamplePass, Technique,
@@ -153,8 +154,7 @@ impl std::fmt::Display for RunSummary {
 /// from frame to frame.
 pub struct SequenceRenderer {
     technique: Box<dyn Technique>,
-    accel_spec: AccelSpec,
-    accel: Option<Box<dyn Accel>>,
+    structure: FollowingAccel,
     denoiser: Option<Box<dyn TemporalDenoiser>>,
     aovs: AovSet,
     guide_options: GuideOptions,
@@ -197,8 +197,7 @@ impl SequenceRenderer {
         }
         Ok(Self {
             technique,
-            accel_spec: accel,
-            accel: None,
+            structure: FollowingAccel::new(accel),
             denoiser,
             aovs,
             guide_options: GuideOptions::default(),
@@ -295,17 +294,12 @@ impl SequenceRenderer {
         let t = frame_start;
         let time = self.time_of(f);
         scene.set_time(time);
-        let updated = self.accel.as_mut().is_some_and(|a| a.update(scene));
-        if !updated {
-            let built = self
-                .accel_spec
-                .build(rt_accel::BuildInput::SceneToReorder(scene))
-                .map_err(|e| SequenceError::Accel {
-                    accel: self.accel_spec.to_string(),
-                    message: e.to_string(),
-                })?;
-            self.accel = Some(built);
-        }
+        self.structure
+            .follow(rt_accel::BuildInput::SceneToReorder(scene))
+            .map_err(|e| SequenceError::Accel {
+                accel: self.structure.spec().to_string(),
+                message: e.to_string(),
+            })?;
         times.update = t.elapsed();
         let camera = match camera {
             Some(c) => c.clone(),
@@ -316,7 +310,7 @@ impl SequenceRenderer {
                     SequenceError::NoCamera(self.camera.clone().unwrap_or_else(|| "(none)".into()))
                 })?,
         };
-        let accel = self.accel.as_deref().expect("built above");
+        let accel = self.structure.current().expect("followed above");
         let ctx = Ctx {
             scene,
             accel,

@@ -19,12 +19,15 @@
 //! of one pass, and the film's sums are exact, so a part, a checkpoint or a resumed render
 //! merges to the very bytes of the whole render.
 
+mod each_frame;
 mod gree;
 mod parts;
 mod report;
 mod run;
+mod sequence;
 mod stops;
 
+pub use each_frame::JobFrame;
 pub use parts::{merge, read_parts, MergeReport};
 pub use report::{AdaptiveSummary, FrameReport, GreeSummary, JobReport, JobSink, Rendered};
 pub use run::{thread_pool, INTERRUPTIBLE_PASS};
@@ -684,9 +687,8 @@ mod run_tests {
     fn a_job_delivering_to_its_sink_hands_over_what_its_files_hold_and_writes_nothing() {
         let d = tempfile::tempdir().unwrap();
         let dir = d.path();
+        // At the job's size (24x16), a temporally denoised sequence too.
         let mut j = job(dir, 3);
-        // A temporally denoised sequence renders at the camera's own size.
-        j.size = ImageSize::Native;
         for denoiser in [None, Some("nlm"), Some("svgf")] {
             j.settings.denoiser = denoiser.map(|d| d.parse().unwrap());
             j.frames = Frames::Range(1..3);
@@ -701,6 +703,7 @@ mod run_tests {
             assert_eq!(images.len(), 2, "{denoiser:?}");
             for (f, (frame, image)) in (1..3).zip(images) {
                 assert_eq!(frame, Some(f));
+                assert_eq!((image.width, image.height), (24, 16), "{denoiser:?}");
                 let file = rt_film::read_exr(&dir.join(format!("f_{f}.exr"))).unwrap();
                 assert!(image == file, "{denoiser:?}, frame {f}");
             }

@@ -1,16 +1,13 @@
-//! Running a job: the frame loop, one image per frame (fixed, adaptive or checkpointed), and
-//! its outputs (image, denoised image, part file, GREE composite); temporally denoised
-//! sequences through [`SequenceRenderer`].
+//! Running a job: one image per frame of its frame loop ([`RenderJob::each_frame`]), fixed,
+//! adaptive or checkpointed, and its outputs (image, denoised image, part file, GREE
+//! composite); temporally denoised sequences go to `sequence.rs`.
 
 use super::parts::{denoise_film, Checkpointer, Cut};
 use super::report::{AdaptiveSummary, FrameReport, GreeSummary, JobReport, JobSink, Rendered};
 use super::{load_scene, refuse, Delivery, Frames, JobError, JobScene, RenderJob};
 use crate::frames::frame_path;
 use crate::memory::Estimate;
-use crate::{
-    frame_seed, pick_camera, render_adaptive_until, Adaptive, RenderReport, ReportInputs,
-    SequenceRenderer,
-};
+use crate::{pick_camera, render_adaptive_until, Adaptive, RenderReport, ReportInputs};
 use rt_core::{Accel, Camera, RgbImage, Scene};
 use rt_film::{AovSet, ExrImage, Film, FilmBuffers, OutputOptions};
 use rt_integrators::{Ctx, RadianceCache, RenderStats, SamplePass, Technique};
@@ -88,79 +85,53 @@ impl RenderJob {
         self.check_filter(&scene)?;
         self.check_lights(&scene)?;
         self.check_memory(&scene)?;
-        if let Some(spec) = self.temporal() {
+        if self.temporal().is_some() {
             if self.writes_part() {
                 return refuse(format!(
                     "{}: a part file cannot hold a temporally denoised sequence: its history carries from frame to frame; render the frames' parts without it",
                     self.output.display()
                 ));
             }
-            return self.run_sequence(spec, &mut scene, sink);
+            return self.run_sequence(&mut scene, sink);
         }
         let pool = thread_pool(self.settings.threads)?;
         // One cache for the whole job: it persists across passes and frames.
         let cache =
             crate::worldcache::for_job(self.cache.as_ref(), &self.settings.integrator, &scene)?;
         let started = Instant::now();
-        let frames = self.frame_list();
-        let mut accel: Option<Box<dyn Accel>> = None;
-        for frame in &frames {
-            let frame = *frame;
-            let (output, seed) = match frame {
-                Some(f) => {
-                    scene.set_time((f64::from(f) / self.fps) as f32);
-                    (
-                        frame_path(&self.output, f),
-                        frame_seed(self.settings.seed, f),
-                    )
-                }
-                None => (self.output.clone(), self.settings.seed),
-            };
-            if let Some(e) = scene.motion_blur_error() {
+        let threads = pool.current_num_threads();
+        let mut frames = 0;
+        self.each_frame(&mut scene, &mut |at| {
+            if let Some(e) = at.scene().motion_blur_error() {
                 return refuse(format!("{}: --shutter: {e}", self.scene.display()));
             }
-            // Two-level structures follow rigid motion in place; flat ones are rebuilt.
+            let (frame, seed) = (at.frame, at.seed);
+            let output = frame.map_or_else(|| self.output.clone(), |f| frame_path(&self.output, f));
             let t_build = Instant::now();
-            let updated = accel
-                .as_mut()
-                .is_some_and(|a| pool.install(|| a.update(&scene)));
-            if !updated {
-                // IOSP reorders the scene's triangles to store nothing beyond them.
-                let built = pool.install(|| {
-                    self.settings
-                        .accel
-                        .build(rt_accel::BuildInput::SceneToReorder(&mut scene))
-                });
-                accel = Some(built.map_err(|e| {
-                    JobError::Refused(format!(
-                        "{}: --accel {}: {e}",
-                        self.scene.display(),
-                        self.settings.accel
-                    ))
-                })?);
-            }
+            let ctx = pool.install(|| at.ctx())?;
             let env = FrameEnv {
-                scene: &scene,
-                accel: accel.as_deref().expect("built above"),
+                scene: ctx.scene,
+                accel: ctx.accel,
                 frame,
                 output,
                 seed,
                 load,
                 build: t_build.elapsed(),
-                threads: pool.current_num_threads(),
+                threads,
                 scene_hash: scene_hash.as_deref(),
             };
-            pool.install(|| self.render_frame(&env, cache.clone(), sink, stop))?;
-        }
+            frames += 1;
+            pool.install(|| self.render_frame(&env, cache.clone(), sink, stop))
+        })?;
         Ok(JobReport {
-            frames: frames.len(),
+            frames,
             elapsed: started.elapsed(),
             temporal: false,
         })
     }
 
     /// The frames to render: `None` for a still (the scene at time 0).
-    fn frame_list(&self) -> Vec<Option<u32>> {
+    pub(super) fn frame_list(&self) -> Vec<Option<u32>> {
         match &self.frames {
             Frames::Still => vec![None],
             Frames::One(f) => vec![Some(*f)],
@@ -169,7 +140,7 @@ impl RenderJob {
     }
 
     /// The camera of the job (resized), in `scene` as it is now.
-    fn camera_in(&self, scene: &Scene) -> Result<Camera, JobError> {
+    pub(super) fn camera_in(&self, scene: &Scene) -> Result<Camera, JobError> {
         let c = pick_camera(scene, &self.scene, self.camera.as_deref())?;
         Ok(self.size.apply(c))
     }
@@ -651,94 +622,10 @@ impl RenderJob {
         let summary = GreeSummary::of(&run, &names, g.labels.is_some());
         Ok((run.render, Rendered::Gree(Box::new(summary))))
     }
-
-    /// The frames of a temporally denoised job, rendered in order through
-    /// [`SequenceRenderer`] so that the denoiser carries its history.
-    fn run_sequence(
-        &self,
-        spec: &rt_temporal::TemporalSpec,
-        scene: &mut Scene,
-        sink: &dyn JobSink,
-    ) -> Result<JobReport, JobError> {
-        let path = self.scene.display();
-        if self.stop.is_some() {
-            return refuse(format!("--denoiser {spec}: a sequence renders a fixed number of samples per frame (--spp); --error and --time-limit do not apply"));
-        }
-        if self.shutter != 0.0 {
-            return refuse(format!("--denoiser {spec}: its guide buffers describe one instant; motion blur (--shutter) would not match them"));
-        }
-        if self.size != crate::ImageSize::Native {
-            return refuse(format!(
-                "--denoiser {spec}: a sequence renders at the camera's resolution"
-            ));
-        }
-        let denoiser = spec
-            .build()
-            .map_err(|e| JobError::Refused(format!("--denoiser {spec}: {e}")))?;
-        let pool = thread_pool(self.settings.threads)?;
-        // One cache for the sequence, as for a plain job: it carries over from frame to frame.
-        let cache =
-            crate::worldcache::for_job(self.cache.as_ref(), &self.settings.integrator, scene)?;
-        let mut renderer = SequenceRenderer::new(
-            crate::worldcache::technique(&self.settings.integrator, cache)?,
-            self.settings.accel,
-            Some(denoiser),
-            self.camera.clone(),
-            self.settings.spp,
-            self.settings.seed,
-            self.fps,
-        )
-        .map_err(|e| JobError::Refused(format!("{path}: --denoiser {spec}: {e}")))?;
-        let started = Instant::now();
-        let frames = self.frame_list();
-        for f in &frames {
-            let frame = f.unwrap_or(0);
-            let out = pool
-                .install(|| renderer.render(scene, frame))
-                .map_err(|e| JobError::Failed(format!("{path}: frame {frame}: {e}")))?;
-            let input = rt_temporal::TemporalFrame {
-                frame: &out.noisy,
-                guides: out.guides.as_ref(),
-                extra: &out.extra,
-            };
-            sink.denoiser_input(*f, &input);
-            let output = match f {
-                Some(f) => frame_path(&self.output, *f),
-                None => self.output.clone(),
-            };
-            self.deliver(&output, *f, FrameImage::Rgb(&out.image), sink)?;
-            sink.frame(&FrameReport {
-                scene: self.scene.clone(),
-                frame: Some(frame),
-                output,
-                width: out.image.width() as u32,
-                height: out.image.height() as u32,
-                spp: self.settings.spp,
-                technique: self.settings.integrator.to_string(),
-                accel: self.settings.accel.to_string(),
-                accel_name: String::new(),
-                triangles: scene.triangle_count(),
-                threads: pool.current_num_threads(),
-                load: Duration::ZERO,
-                build: out.times.update,
-                stats: out.stats,
-                rendered: Rendered::Sequence {
-                    denoiser: renderer.denoiser_name().unwrap_or_default().to_string(),
-                    times: out.times,
-                },
-                stages: None,
-            });
-        }
-        Ok(JobReport {
-            frames: frames.len(),
-            elapsed: started.elapsed(),
-            temporal: true,
-        })
-    }
 }
 
 /// What a frame's output holds.
-enum FrameImage<'a> {
+pub(super) enum FrameImage<'a> {
     /// The film: its beauty image and AOVs, with further channels (the `blocks` AOV).
     Film(&'a Film, &'a [(&'static str, Vec<f32>)]),
     /// A finished image: denoised, GREE's composite, a frame of a temporally denoised sequence.
@@ -749,7 +636,7 @@ impl RenderJob {
     /// Hands the image of `frame` to where the job's images go ([`Delivery`]): the file
     /// `output` (EXR or PNG by its extension) or the sink, as the channels the EXR would hold.
     /// Both go through [`ExrImage`], so the sink's channels are the file's bits.
-    fn deliver(
+    pub(super) fn deliver(
         &self,
         output: &Path,
         frame: Option<u32>,
