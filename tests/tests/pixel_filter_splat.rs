@@ -22,7 +22,7 @@
 //! carried as part bytes.
 
 use rt_core::pixel_filter::PixelFilter;
-use rt_core::{Rgb, SampleStream, Scene};
+use rt_core::{Rgb, Scene};
 use rt_film::{AovSet, Film, FilmBuffers, Rect};
 use rt_integrators::{CameraRays, PathIntegrator, SamplePass, Technique, Wavefront};
 use rt_testkit::{shipped_scene, Renderer, SceneExt};
@@ -36,12 +36,7 @@ fn scene_with(filter: &PixelFilter) -> Scene {
 }
 
 fn pass(indices: std::ops::Range<u32>) -> SamplePass {
-    SamplePass {
-        indices,
-        stream: SampleStream::Render,
-        pixels: None,
-        centre_first: false,
-    }
+    SamplePass::render(indices)
 }
 
 /// Renders `passes` of `technique` on `threads` threads into a film keeping `buffers`.

@@ -40,12 +40,7 @@ fn buffers() -> FilmBuffers {
 }
 
 fn pass(indices: std::ops::Range<u32>) -> SamplePass {
-    SamplePass {
-        indices,
-        stream: SampleStream::Render,
-        pixels: None,
-        centre_first: false,
-    }
+    SamplePass::render(indices)
 }
 
 /// Renders `passes` of `technique` one after another on `threads` threads.

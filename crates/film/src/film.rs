@@ -138,12 +138,9 @@ impl FilmStripe<'_> {
         index: u32,
         radiance: Rgb,
     ) -> bool {
-        let i = ((y - self.y0) * self.width + x) as usize;
-        if !crate::accepts_sample(radiance) {
-            self.discarded.fetch_add(1, Ordering::Relaxed);
+        let Some(i) = self.count(x, y, radiance) else {
             return false;
-        }
-        self.counts[i] += 1;
+        };
         let even = index.is_multiple_of(2);
         if let (Some(e), true) = (self.even.get_mut(i), even) {
             e.n += 1;
@@ -154,6 +151,19 @@ impl FilmStripe<'_> {
             .get_or_insert_with(|| Window::new(y0..y0 + rows, w, h, filter, halves))
             .splat(filter, (pos.x, pos.y), (w, h), even, radiance);
         true
+    }
+
+    /// Counts a sample of pixel `(x, y)` (image coordinates) and returns the pixel's index in
+    /// this band, or drops and counts it as discarded when it is non-finite or negative.
+    #[inline]
+    fn count(&mut self, x: u32, y: u32, radiance: Rgb) -> Option<usize> {
+        if !crate::accepts_sample(radiance) {
+            self.discarded.fetch_add(1, Ordering::Relaxed);
+            return None;
+        }
+        let i = ((y - self.y0) * self.width + x) as usize;
+        self.counts[i] += 1;
+        Some(i)
     }
 
     /// Number of rows in this band.
@@ -187,14 +197,11 @@ impl FilmStripe<'_> {
         hit: Option<&FirstHit>,
         split: Option<&LightSplit>,
     ) -> bool {
-        let i = ((y - self.y0) * self.width + x) as usize;
-        if !crate::accepts_sample(radiance) {
-            self.discarded.fetch_add(1, Ordering::Relaxed);
+        let Some(i) = self.count(x, y, radiance) else {
             return false;
-        }
+        };
         // Optional buffers are empty slices when not kept, so `get_mut` is the "is it kept"
         // test: one predictable branch per buffer, no per-sample flags to consult.
-        self.counts[i] += 1;
         self.sums[i].add(radiance);
         if let Some(q) = self.squares.get_mut(i) {
             q.add(radiance);

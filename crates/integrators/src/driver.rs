@@ -89,6 +89,19 @@ pub struct SamplePass {
     pub centre_first: bool,
 }
 
+impl SamplePass {
+    /// Samples `indices` of every pixel from the render streams, jittered: a plain render's
+    /// pass.
+    pub fn render(indices: Range<u32>) -> Self {
+        Self {
+            indices,
+            stream: SampleStream::Render,
+            pixels: None,
+            centre_first: false,
+        }
+    }
+}
+
 /// Renders `opts.spp` samples into every pixel of `film`. `progress` is called with the number
 /// of rows finished so far (from worker threads).
 pub fn render(
@@ -98,12 +111,7 @@ pub fn render(
     opts: &RenderOptions,
     progress: &(dyn Fn(u32) + Sync),
 ) -> RenderStats {
-    let pass = SamplePass {
-        indices: 0..opts.spp,
-        stream: SampleStream::Render,
-        pixels: None,
-        centre_first: false,
-    };
+    let pass = SamplePass::render(0..opts.spp);
     render_samples(ctx, integrator, film, opts.seed, &pass, progress)
 }
 
