@@ -41,7 +41,9 @@
 //! connections never need a wavelength the path does not have yet.
 
 use crate::bump::NormalPerturbation;
-use crate::microfacet::{Microfacet, ParamTextures, ParamValues};
+use crate::microfacet::{
+    AlphaTables, Blend, Blended, LocalSample, Microfacet, ParamTextures, ParamValues,
+};
 use crate::tint::Tint;
 use crate::{
     frame::Frame,
@@ -154,6 +156,11 @@ pub struct Material {
     pub perturbation: Option<NormalPerturbation>,
     /// Textures on the microfacet BSDF's parameters ([`crate::microfacet::ParamTextures`]).
     pub param_textures: ParamTextures,
+    /// A rough plastic's coating tables over the range of its textured `alpha`.
+    pub alpha_tables: Option<AlphaTables>,
+    /// Mitsuba's `blendbsdf` in place of the layer stack and of `microfacet` (both then
+    /// empty): [`crate::microfacet::Blend`]. Its textured weight is `param_textures.weight`.
+    pub blend: Option<Box<Blend>>,
     /// Mitsuba's `mask`: the probability in [0, 1] that light meets the surface (`None`:
     /// opaque); otherwise it passes straight through ([`Bsdf`]). Its texture is
     /// `param_textures.opacity`.
@@ -215,6 +222,8 @@ impl Material {
             microfacet: None,
             perturbation: None,
             param_textures: ParamTextures::default(),
+            alpha_tables: None,
+            blend: None,
             opacity: None,
         }
     }
@@ -223,6 +232,14 @@ impl Material {
     pub fn microfacet(name: &str, bsdf: Microfacet) -> Self {
         let mut m = Self::with_layers(name, Vec::new());
         m.microfacet = Some(bsdf);
+        m
+    }
+
+    /// Mitsuba's `blendbsdf` of two BSDFs of the microfacet family
+    /// ([`crate::microfacet::Blend`]).
+    pub fn blend(name: &str, blend: Blend) -> Self {
+        let mut m = Self::with_layers(name, Vec::new());
+        m.blend = Some(Box::new(blend));
         m
     }
 
@@ -276,6 +293,9 @@ impl Material {
         }
         if let Some(m) = &self.microfacet {
             m.validate().map_err(MaterialError::Microfacet)?;
+        }
+        if let Some(b) = &self.blend {
+            b.validate().map_err(MaterialError::Microfacet)?;
         }
         if let Some(o) = self.opacity {
             if !(0.0..=1.0).contains(&o) {
@@ -427,6 +447,10 @@ pub struct Bsdf<'a> {
     /// tint applies through [`Microfacet::eval_pdf_tinted`] and [`Microfacet::sample_tinted`],
     /// the textured parameters `params` through [`Bsdf::with_micro`].
     micro: Option<&'a Microfacet>,
+    /// A rough plastic's tables for its textured roughness.
+    alpha_tables: Option<&'a AlphaTables>,
+    /// The material's blend at this point, which replaces the layers when present.
+    blended: Option<Blended>,
     /// The textured parameters' values at this point (all `None` for most materials).
     params: ParamValues,
     /// The path's wavelength, nm (`None`: an RGB path).
@@ -461,6 +485,7 @@ impl<'a> Bsdf<'a> {
         let Tint {
             color: tint,
             params,
+            blend,
         } = tint.into();
         let frame = Frame::from_normal(ns);
         let wo_local = frame.to_local(wo);
@@ -480,13 +505,18 @@ impl<'a> Bsdf<'a> {
             has_non_delta |= *w > 0.0 && !l.is_delta();
         }
         let micro = material.microfacet.as_ref();
-        let total = match micro {
+        let blended = material.blend.as_ref().map(|b| b.at(params.weight, &blend));
+        let total = match (micro, &blended) {
             // One "layer" of weight one: the checks of `total` below hold as for layers.
-            Some(m) => {
+            (Some(m), _) => {
                 has_non_delta = m.has_non_delta();
                 1.0
             }
-            None => weights.iter().sum(),
+            (None, Some(b)) => {
+                has_non_delta = b.has_non_delta();
+                1.0
+            }
+            (None, None) => weights.iter().sum(),
         };
         // `color_at` of a plain Lambertian layer is `color · tint` at every angle, and its
         // one weight is `1 · weight`.
@@ -506,6 +536,8 @@ impl<'a> Bsdf<'a> {
             total,
             lambert,
             micro,
+            alpha_tables: material.alpha_tables.as_ref(),
+            blended,
             params,
             wavelength: None,
             opacity,
@@ -576,8 +608,9 @@ impl<'a> Bsdf<'a> {
         if self.total <= 0.0 {
             return 0.0;
         }
-        if self.micro.is_some() {
-            // The microfacet family is glossy or specular throughout.
+        if self.micro.is_some() || self.blended.is_some() {
+            // The microfacet family counts as glossy or specular throughout (its diffuse, in
+            // a blend, too: it is then path traced, which is unbiased).
             return (class == LayerClass::Specular) as u8 as f32;
         }
         let kept: f32 = self
@@ -603,9 +636,10 @@ impl<'a> Bsdf<'a> {
     /// [`Bsdf::restricted`] of the layers (or the microfacet BSDF).
     fn restricted_layers(&self, class: LayerClass) -> Self {
         let mut b = self.clone();
-        if b.micro.is_some() {
+        if b.micro.is_some() || b.blended.is_some() {
             if class != LayerClass::Specular {
                 b.micro = None;
+                b.blended = None;
                 b.total = 0.0;
                 b.has_non_delta = false;
             }
@@ -634,6 +668,9 @@ impl<'a> Bsdf<'a> {
     fn albedo_opaque(&self) -> Rgb {
         if let Some(a) = self.with_micro(|m| m.albedo_tinted(self.tint)) {
             return a;
+        }
+        if let Some(b) = &self.blended {
+            return b.albedo();
         }
         self.layers
             .iter()
@@ -698,15 +735,11 @@ impl<'a> Bsdf<'a> {
         if let Some(f) = self.lambert {
             return lambert_eval_pdf(f, wi_local, reflect);
         }
-        if let Some(r) = self.with_micro(|m| {
-            let (f, pdf) = m.eval_pdf_tinted(self.tint, self.wo_local, wi_local);
-            if self.adjoint && !reflect {
-                (f * m.adjoint_scale(self.wo_local), pdf)
-            } else {
-                (f, pdf)
-            }
-        }) {
+        if let Some(r) = self.with_micro(|m| self.micro_eval_pdf(m, self.tint, wi_local, reflect)) {
             return r;
+        }
+        if let Some(b) = &self.blended {
+            return b.mix(|m| self.micro_eval_pdf(m, Rgb::ONE, wi_local, reflect));
         }
         let mut f = Rgb::ZERO;
         let mut pdf = 0.0;
@@ -761,6 +794,9 @@ impl<'a> Bsdf<'a> {
         }
         if let Some(s) = self.with_micro(|m| self.sample_microfacet(m, u_layer, u)) {
             return s;
+        }
+        if let Some(b) = &self.blended {
+            return self.sample_blend(b, u_layer, u);
         }
         // Pick a layer in proportion to its weight; rounding past the end lands on the last
         // layer with weight.
@@ -846,7 +882,7 @@ impl Bsdf<'_> {
     #[inline]
     fn with_micro<R>(&self, f: impl FnOnce(&Microfacet) -> R) -> Option<R> {
         let m = self.micro?;
-        Some(match m.with_params(&self.params) {
+        Some(match m.with_params(&self.params, self.alpha_tables) {
             Some(textured) => f(&textured),
             None => f(m),
         })
@@ -856,6 +892,43 @@ impl Bsdf<'_> {
     /// where it is consistent with the geometric normal too.
     fn sample_microfacet(&self, m: &Microfacet, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
         let s = m.sample_tinted(self.tint, self.wo_local, u_lobe, u)?;
+        self.world_sample(s, m)
+    }
+
+    /// `(f, pdf)` of microfacet BSDF `m` under a texture's `tint`, `f` the adjoint's in
+    /// importance transport.
+    #[inline]
+    fn micro_eval_pdf(
+        &self,
+        m: &Microfacet,
+        tint: Rgb,
+        wi_local: Vec3,
+        reflect: bool,
+    ) -> (Rgb, f32) {
+        let (f, pdf) = m.eval_pdf_tinted(tint, self.wo_local, wi_local);
+        if self.adjoint && !reflect {
+            (f * m.adjoint_scale(self.wo_local), pdf)
+        } else {
+            (f, pdf)
+        }
+    }
+
+    /// [`Bsdf::sample`] for a blend: its local sample in world space. Importance transported
+    /// through a non-delta refraction gets the value of the blend's adjoint, whose two BSDFs
+    /// may scale it differently.
+    fn sample_blend(&self, b: &Blended, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        let (i, s) = b.sample_part(self.wo_local, u_lobe, u)?;
+        let mut out = self.world_sample(s, &b.bsdfs[i])?;
+        if self.adjoint && out.transmitted && !out.delta {
+            let (f, _) = self.eval_pdf_opaque(out.wi);
+            out.weight = f * (s.wi.z.abs() / s.pdf);
+        }
+        Some(out)
+    }
+
+    /// Local sample `s` of microfacet BSDF `m` in world space, kept only where it is
+    /// consistent with the geometric normal too.
+    fn world_sample(&self, s: LocalSample, m: &Microfacet) -> Option<BsdfSample> {
         let wi = self.frame.to_world(s.wi).normalize();
         let reflect = self.sides(wi, s.wi)?;
         let weight = if self.adjoint && !reflect {
@@ -1073,6 +1146,8 @@ impl crate::content_hash::ContentHash for Material {
             microfacet,
             perturbation,
             param_textures,
+            alpha_tables,
+            blend,
             opacity,
         } = self;
         name.content_hash(out);
@@ -1092,6 +1167,20 @@ impl crate::content_hash::ContentHash for Material {
         }
         if let Some(o) = opacity {
             o.content_hash(out);
+        }
+        // The tables follow from the BSDF and the roughnesses they are computed at.
+        if let Some(t) = alpha_tables {
+            format!("{:?}", t.alphas()).content_hash(out);
+        }
+        if let Some(b) = blend {
+            b.weight.content_hash(out);
+            for p in &b.parts {
+                p.bsdf.content_hash(out);
+                format!("{:?} {:?}", p.textures, p.texture).content_hash(out);
+                if let Some(t) = &p.alpha_tables {
+                    format!("{:?}", t.alphas()).content_hash(out);
+                }
+            }
         }
     }
 }
@@ -1237,6 +1326,71 @@ mod tests {
         assert!(
             e.contains("layer 0: dispersion: index of refraction must be in (1, 4]"),
             "{e}"
+        );
+    }
+
+    /// A blend material's `Bsdf` is the local blend of its BSDFs in the shading frame: value,
+    /// pdf and samples; its adjoint scales only the dielectric's refraction by η².
+    #[test]
+    fn a_blend_material_shades_as_its_local_blend() {
+        use crate::microfacet::{
+            BlendPart, Diffuse, Distribution, DistributionKind, LocalBsdf, RoughDielectric,
+        };
+        let glass = Microfacet::Dielectric(RoughDielectric {
+            distribution: Some(Distribution::new(DistributionKind::Ggx, 0.3, 0.3)),
+            eta: 1.5,
+            reflectance: Rgb::ONE,
+            transmittance: Rgb::ONE,
+        });
+        let diffuse = Microfacet::Diffuse(Diffuse {
+            reflectance: Rgb::new(0.2, 0.5, 0.7),
+        });
+        let blend = Blend {
+            weight: 0.35,
+            parts: [BlendPart::new(glass), BlendPart::new(diffuse)],
+        };
+        let m = Material::blend("b", blend.clone());
+        assert_eq!(m.validate(), Ok(()));
+        let local = blend.at(None, &[crate::microfacet::PartTint::NONE; 2]);
+        let wo = Vec3::new(0.3, -0.2, 0.9).normalize();
+        let b = Bsdf::new(&m, Rgb::ONE, Vec3::Z, Vec3::Z, wo);
+        let adjoint = Bsdf::new(&m, Rgb::ONE, Vec3::Z, Vec3::Z, wo).adjoint();
+        let mut refracted = 0;
+        for i in 0..64 {
+            let (u0, u) = (
+                (i as f32 + 0.5) / 64.0,
+                Vec2::new(0.37, (i % 8) as f32 / 8.0 + 0.05),
+            );
+            let (want, got) = (local.sample(wo, u0, u), b.sample(u0, u));
+            assert_eq!(want.is_some(), got.is_some());
+            let (Some(w), Some(s)) = (want, got) else {
+                continue;
+            };
+            // The frame of +z is the identity; normalising may move the last bit.
+            assert!((w.wi - s.wi).length() < 1e-6 && w.pdf == s.pdf && w.delta == s.delta);
+            let (f, pdf) = local.eval_pdf(wo, s.wi);
+            let (fb, pb) = b.eval_pdf(s.wi);
+            assert!((f - fb).length() <= 1e-5 * f.length() && (pdf - pb).abs() <= 1e-5 * pdf);
+            if s.wi.z < 0.0 {
+                refracted += 1;
+                let (fa, _) = adjoint.eval_pdf(s.wi);
+                assert!(
+                    (fa - f * 2.25).length() < 1e-5 * fa.length(),
+                    "{fa:?} vs {f:?}"
+                );
+            }
+        }
+        assert!(refracted > 5, "{refracted}");
+        let bad = Blend {
+            weight: 1.5,
+            ..blend
+        };
+        assert_eq!(
+            Material::blend("b", bad)
+                .validate()
+                .unwrap_err()
+                .to_string(),
+            "blendbsdf weight must be in [0, 1], got 1.5"
         );
     }
 }

@@ -594,9 +594,19 @@ impl Scene {
     /// and its textured parameters.
     #[inline]
     pub fn tint(&self, m: &Material, uv: Vec2) -> crate::tint::Tint {
+        let mut blend = [crate::microfacet::PartTint::NONE; 2];
+        if let Some(b) = &m.blend {
+            for (t, p) in blend.iter_mut().zip(&b.parts) {
+                if let Some(c) = p.texture {
+                    t.color = self.textures[c as usize].lookup(uv);
+                }
+                t.params = p.textures.lookup(&self.textures, uv);
+            }
+        }
         crate::tint::Tint {
             color: self.texture_color(m, uv),
             params: m.param_textures.lookup(&self.textures, uv),
+            blend,
         }
     }
 

@@ -3,7 +3,7 @@
 //! ([`crate::microfacet::ParamValues`]). [`crate::Scene::tint`] looks them up; a
 //! [`crate::material::Bsdf`] is built from them.
 
-use crate::microfacet::ParamValues;
+use crate::microfacet::{ParamValues, PartTint};
 use crate::Rgb;
 
 /// A material's texture values at one point.
@@ -13,19 +13,17 @@ pub struct Tint {
     pub color: Rgb,
     /// The textured parameters (all `None` without textured parameters).
     pub params: ParamValues,
+    /// A blend's two BSDFs' texture values ([`crate::microfacet::Blend`]; its weight is
+    /// `params.weight`).
+    pub blend: [PartTint; 2],
 }
 
 impl Tint {
     /// No texture: white, every parameter its constant.
     pub const NONE: Tint = Tint {
         color: Rgb::ONE,
-        params: ParamValues {
-            alpha_u: None,
-            alpha_v: None,
-            specular_reflectance: None,
-            specular_transmittance: None,
-            opacity: None,
-        },
+        params: ParamValues::NONE,
+        blend: [PartTint::NONE; 2],
     };
 }
 

@@ -10,10 +10,10 @@
 //! [`crate::texture::Texture::lookup`]; a roughness texel of 0 becomes
 //! [`super::MIN_ALPHA`], as a constant 0 does.
 //!
-//! Deviation: `roughplastic`'s `alpha` takes no texture, as in Mitsuba 3 (its coating's
-//! transmittance is tabulated for one roughness).
+//! `roughplastic`'s `alpha` takes a texture too, which Mitsuba 3 refuses: its coating's
+//! tables come from [`AlphaTables`], computed over the texture's range when the scene loads.
 
-use super::{Distribution, Microfacet};
+use super::{AlphaTables, Distribution, Microfacet};
 use crate::texture::{luminance, Texture};
 use crate::Rgb;
 use glam::Vec2;
@@ -32,6 +32,8 @@ pub struct ParamTextures {
     pub specular_transmittance: Option<u32>,
     /// A mask's opacity ([`crate::Material::opacity`]; any material type).
     pub opacity: Option<u32>,
+    /// A blend's weight ([`super::Blend::weight`]).
+    pub weight: Option<u32>,
 }
 
 /// The textured parameters' values at one surface point (`None`: the material's constant).
@@ -47,6 +49,8 @@ pub struct ParamValues {
     pub specular_transmittance: Option<Rgb>,
     /// See [`ParamTextures::opacity`].
     pub opacity: Option<f32>,
+    /// See [`ParamTextures::weight`].
+    pub weight: Option<f32>,
 }
 
 impl ParamTextures {
@@ -70,11 +74,22 @@ impl ParamTextures {
             specular_reflectance: colour(self.specular_reflectance),
             specular_transmittance: colour(self.specular_transmittance),
             opacity: scalar(self.opacity),
+            weight: scalar(self.weight),
         }
     }
 }
 
 impl ParamValues {
+    /// Every parameter its constant.
+    pub const NONE: ParamValues = ParamValues {
+        alpha_u: None,
+        alpha_v: None,
+        specular_reflectance: None,
+        specular_transmittance: None,
+        opacity: None,
+        weight: None,
+    };
+
     /// True when every parameter keeps its constant.
     #[inline]
     pub fn is_empty(&self) -> bool {
@@ -94,10 +109,12 @@ impl ParamValues {
 impl Microfacet {
     /// The BSDF with the textured parameters `v` in place of its constants; `None` when `v`
     /// changes nothing. A parameter the type does not have is ignored (the loaders refuse
-    /// such textures).
-    pub fn with_params(&self, v: &ParamValues) -> Option<Self> {
+    /// such textures). A rough plastic's textured roughness takes its coating's tables from
+    /// `tables` (without them, only its distribution changes).
+    pub fn with_params(&self, v: &ParamValues, tables: Option<&AlphaTables>) -> Option<Self> {
         let v = ParamValues {
             opacity: None,
+            weight: None,
             ..*v
         };
         if v.is_empty() {
@@ -134,10 +151,21 @@ impl Microfacet {
                 }
             }
             Microfacet::RoughPlastic(p) => {
+                if let Some(a) = v.alpha_u {
+                    *p = match tables {
+                        Some(t) => p.with_alpha(a, t),
+                        None => {
+                            let mut q = *p;
+                            q.distribution = v.distribution(p.distribution);
+                            q
+                        }
+                    };
+                }
                 if let Some(r) = v.specular_reflectance {
                     p.specular = r;
                 }
             }
+            Microfacet::Diffuse(_) => {}
         }
         Some(out)
     }
