@@ -77,8 +77,7 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, mats: &mut MaterialTable) -
         blend_part(m).map_err(|e| err(n.span(), format!("\"{}\" {e}", n.get_ref())))
     };
     let parts = [part(first)?, part(second)?];
-    let mut blend = Blend { weight: 0.5, parts };
-    let mut textures = rt_core::microfacet::ParamTextures::default();
+    let mut blend = Blend::new(0.5, parts);
     match param_desc::scalar(ctx, name, "weight", w)? {
         Param::Const(x) if !(0.0..=1.0).contains(&x) => {
             return Err(err(
@@ -87,10 +86,9 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, mats: &mut MaterialTable) -
             ))
         }
         Param::Const(x) => blend.weight = x,
-        Param::Texture(t) => textures.weight = Some(t),
+        Param::Texture(t) => blend.weight_texture = Some(t),
     }
     let mut m = Material::blend(name, blend);
-    m.param_textures = textures;
     if let Some(e) = &d.emission {
         m.emission = finite3(ctx, e, "emission")?;
     }

@@ -391,13 +391,7 @@ pub(crate) fn metallic_roughness(
                 texture,
                 ..BlendPart::new(bsdf)
             };
-            Material::blend(
-                name,
-                Blend {
-                    weight: metallic,
-                    parts: [part(plastic), part(metal)],
-                },
-            )
+            Material::blend(name, Blend::new(metallic, [part(plastic), part(metal)]))
         }
     };
     if out.blend.is_none() {

@@ -422,13 +422,21 @@ mod tests {
 
     /// Builds the materials of `text` and returns the last, or the error message.
     fn mat(text: &str) -> std::result::Result<(Material, usize), String> {
+        mat_in(Path::new("."), text).map(|(m, t)| (m, t.len()))
+    }
+
+    /// [`mat`] with texture files read from `base`; the scene's textures too.
+    fn mat_in(
+        base: &Path,
+        text: &str,
+    ) -> std::result::Result<(Material, Vec<rt_core::texture::Texture>), String> {
         let d: SceneDesc = toml::from_str(text).map_err(|e| e.to_string())?;
         let mut ctx = Ctx {
             src: Source {
                 name: Path::new("m.toml"),
                 text,
             },
-            base: Path::new("."),
+            base,
             textures: Textures::default(),
             warnings: vec![],
         };
@@ -440,7 +448,7 @@ mod tests {
             mats.insert(built);
         }
         let m = m.expect("a material");
-        Ok((m, ctx.textures.into_vec().len()))
+        Ok((m, ctx.textures.into_vec()))
     }
 
     fn ok(body: &str) -> Material {
@@ -720,28 +728,7 @@ mod tests {
         image::RgbImage::from_pixel(2, 2, image::Rgb([128, 128, 255]))
             .save(dir.path().join("t.png"))
             .unwrap();
-        let load = |body: &str| {
-            let text = format!("[[material]]\nname = \"m\"\n{body}");
-            let d: SceneDesc = toml::from_str(&text).map_err(|e| e.to_string())?;
-            let mut ctx = Ctx {
-                src: Source {
-                    name: Path::new("m.toml"),
-                    text: &text,
-                },
-                base: dir.path(),
-                textures: Textures::default(),
-                warnings: vec![],
-            };
-            let mut mats = MaterialTable::default();
-            let mut m = None;
-            for d in &d.material {
-                let built = build(&mut ctx, d, &mut mats).map_err(|e| e.to_string())?;
-                m = Some(built.clone());
-                mats.insert(built);
-            }
-            let m = m.expect("a material");
-            Ok::<_, String>((m, ctx.textures.into_vec()))
-        };
+        let load = |body: &str| mat_in(dir.path(), &format!("[[material]]\nname = \"m\"\n{body}"));
         let (m, t) = load(
             "texture = { file = \"t.png\", filter = \"nearest\", wrap = \"clamp\" }\n\
              bump_map = \"t.png\"\nbump_scale = 0.5",

@@ -259,7 +259,7 @@ fn a_blend_loads_with_its_two_bsdfs() {
         .iter()
         .find(|m| m.blend.is_some())
         .unwrap();
-    assert!(m.param_textures.weight.is_some());
+    assert!(m.blend.as_ref().unwrap().weight_texture.is_some());
     // Weights 0 and 1 render as the BSDF they keep, bit for bit; 0.5 as neither.
     let gold = r#"<bsdf type="roughconductor"><string name="material" value="Au"/></bsdf>"#;
     let white = r#"<bsdf type="roughplastic"><rgb name="diffuse_reflectance" value="0.8, 0.8, 0.8"/></bsdf>"#;

@@ -1,5 +1,5 @@
 //! Mitsuba 3's `blendbsdf`: `(1 − w)·f₀ + w·f₁` for a weight `w` in [0, 1] (a constant, or a
-//! texture's luminance, [`super::ParamTextures::weight`]) and two BSDFs of the family.
+//! texture's luminance, [`Blend::weight_texture`]) and two BSDFs of the family.
 //!
 //! Sampling picks BSDF 1 with probability `w` and BSDF 0 otherwise, as Mitsuba does. A
 //! non-delta sample then carries the blend's value and the blend of both pdfs (the mixture's
@@ -7,11 +7,15 @@
 //! value and pdf: the same expectation, and MIS sees the density the sampler really has. A
 //! delta sample keeps its weight and has its probability scaled by the pick's.
 //!
-//! Each BSDF keeps its own textured parameters and colour texture ([`BlendPart`]). A blend
-//! inside a blend is not represented: the loaders refuse it.
+//! Each BSDF keeps its own textured parameters and colour texture ([`BlendPart`]). They are
+//! read where the blend is evaluated ([`BlendAt::blended`]), not when its
+//! [`crate::material::Bsdf`] is built, so that a `Bsdf` holds no blend by value (see
+//! [`crate::tint`]). A blend inside a blend is not represented: the loaders refuse it.
 
 use super::rough_plastic::AlphaTables;
 use super::{LocalBsdf, LocalSample, Microfacet, ParamTextures, ParamValues};
+use crate::texture::luminance;
+use crate::tint::TexturesAt;
 use crate::Rgb;
 use glam::{Vec2, Vec3};
 
@@ -20,7 +24,7 @@ use glam::{Vec2, Vec3};
 pub struct BlendPart {
     /// The BSDF (any type of the family; not a blend).
     pub bsdf: Microfacet,
-    /// Textures on its parameters (their `opacity` and `weight` are not used).
+    /// Textures on its parameters (their `opacity` is not used).
     pub textures: ParamTextures,
     /// A colour texture multiplying its diffuse colour (a diffuse's or a plastic's base).
     pub texture: Option<u32>,
@@ -41,17 +45,16 @@ impl BlendPart {
 }
 
 /// What one BSDF of a blend reads from its textures at a point.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PartTint {
+struct PartTint {
     /// Its colour texture's value (white without one).
-    pub color: Rgb,
+    color: Rgb,
     /// Its textured parameters.
-    pub params: ParamValues,
+    params: ParamValues,
 }
 
 impl PartTint {
     /// No texture.
-    pub const NONE: PartTint = PartTint {
+    const NONE: PartTint = PartTint {
         color: Rgb::ONE,
         params: ParamValues::NONE,
     };
@@ -60,10 +63,43 @@ impl PartTint {
 /// Mitsuba's `blendbsdf`, as a material holds it.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Blend {
-    /// `w`, the weight of `parts[1]`, in [0, 1] (a textured weight replaces it).
+    /// `w`, the weight of `parts[1]`, in [0, 1] (`weight_texture` replaces it).
     pub weight: f32,
+    /// A texture whose luminance is the weight (an index into the scene's textures).
+    pub weight_texture: Option<u32>,
     /// BSDF 0 (weight `1 − w`) and BSDF 1 (weight `w`).
     pub parts: [BlendPart; 2],
+}
+
+/// A material's blend at one surface point, its textures not read yet.
+#[derive(Clone, Copy, Debug)]
+pub struct BlendAt<'a> {
+    /// The material's blend.
+    pub blend: &'a Blend,
+    /// Where its textures are read (`None`: each reads as its constant).
+    pub at: Option<TexturesAt<'a>>,
+}
+
+impl BlendAt<'_> {
+    /// The blend with its textures' values at this point in place.
+    pub fn blended(&self) -> Blended {
+        let b = self.blend;
+        let Some(at) = self.at else {
+            return b.at(None, &[PartTint::NONE, PartTint::NONE]);
+        };
+        let tint = |p: &BlendPart| PartTint {
+            color: p.texture.map_or(Rgb::ONE, |i| at.color(i)),
+            params: p.textures.lookup(&at.scene.textures, at.uv),
+        };
+        let weight = b.weight_texture.map(|i| luminance(at.color(i)));
+        b.at(weight, &[tint(&b.parts[0]), tint(&b.parts[1])])
+    }
+
+    /// True if some BSDF of positive weight here has a non-delta lobe.
+    #[inline(never)]
+    pub fn has_non_delta(&self) -> bool {
+        self.blended().has_non_delta()
+    }
 }
 
 /// A blend at one point: its weight and both BSDFs with their textures' values in place.
@@ -76,6 +112,15 @@ pub struct Blended {
 }
 
 impl Blend {
+    /// A blend of constant weight `weight` of `parts`.
+    pub fn new(weight: f32, parts: [BlendPart; 2]) -> Self {
+        Self {
+            weight,
+            weight_texture: None,
+            parts,
+        }
+    }
+
     /// Checks the weight and both BSDFs; the message names what is wrong.
     pub fn validate(&self) -> Result<(), String> {
         if !(0.0..=1.0).contains(&self.weight) {
@@ -93,7 +138,7 @@ impl Blend {
     }
 
     /// The blend with the texture values `weight` (its textured weight) and `tints` in place.
-    pub fn at(&self, weight: Option<f32>, tints: &[PartTint; 2]) -> Blended {
+    fn at(&self, weight: Option<f32>, tints: &[PartTint; 2]) -> Blended {
         let part = |p: &BlendPart, t: &PartTint| {
             let m = p.bsdf.with_params(&t.params, p.alpha_tables.as_ref());
             let m = m.unwrap_or(p.bsdf);

@@ -24,14 +24,14 @@ mod rough_plastic;
 mod textured;
 mod thin;
 
-pub use blend::{Blend, BlendPart, Blended, PartTint};
+pub use blend::{Blend, BlendAt, BlendPart, Blended};
 pub use conductor::RoughConductor;
 pub use dielectric::RoughDielectric;
 pub use diffuse::Diffuse;
 pub use distribution::{Distribution, DistributionKind, MIN_ALPHA};
 pub use fresnel::fresnel_conductor;
 pub use plastic::{fresnel_diffuse_reflectance, Plastic};
-pub use rough_plastic::{AlphaTables, RoughPlastic};
+pub use rough_plastic::{AlphaTables, RoughPlastic, ALPHA_NODES};
 pub use textured::{ParamTextures, ParamValues};
 pub use thin::ThinDielectric;
 

@@ -32,8 +32,6 @@ pub struct ParamTextures {
     pub specular_transmittance: Option<u32>,
     /// A mask's opacity ([`crate::Material::opacity`]; any material type).
     pub opacity: Option<u32>,
-    /// A blend's weight ([`super::Blend::weight`]).
-    pub weight: Option<u32>,
 }
 
 /// The textured parameters' values at one surface point (`None`: the material's constant).
@@ -49,8 +47,6 @@ pub struct ParamValues {
     pub specular_transmittance: Option<Rgb>,
     /// See [`ParamTextures::opacity`].
     pub opacity: Option<f32>,
-    /// See [`ParamTextures::weight`].
-    pub weight: Option<f32>,
 }
 
 impl ParamTextures {
@@ -74,7 +70,6 @@ impl ParamTextures {
             specular_reflectance: colour(self.specular_reflectance),
             specular_transmittance: colour(self.specular_transmittance),
             opacity: scalar(self.opacity),
-            weight: scalar(self.weight),
         }
     }
 }
@@ -87,7 +82,6 @@ impl ParamValues {
         specular_reflectance: None,
         specular_transmittance: None,
         opacity: None,
-        weight: None,
     };
 
     /// True when every parameter keeps its constant.
@@ -114,7 +108,6 @@ impl Microfacet {
     pub fn with_params(&self, v: &ParamValues, tables: Option<&AlphaTables>) -> Option<Self> {
         let v = ParamValues {
             opacity: None,
-            weight: None,
             ..*v
         };
         if v.is_empty() {
