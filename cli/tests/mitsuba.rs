@@ -63,13 +63,13 @@ fn bad_input_is_one_line() {
     let dir = d.path();
     std::fs::write(
         dir.join("s.xml"),
-        SCENE.replace("roughconductor", "blendbsdf"),
+        SCENE.replace("roughconductor", "principled"),
     )
     .unwrap();
     let out = render(dir, &["s.xml", "-q", "-o", "x.exr"]);
     let line = one_error_line(&out);
     assert!(
-        line.contains("s.xml:17:9:") && line.contains("bsdf \"blendbsdf\" is not supported"),
+        line.contains("s.xml:17:9:") && line.contains("bsdf \"principled\" is not supported"),
         "{line}"
     );
     std::fs::write(dir.join("s.xml"), SCENE).unwrap();

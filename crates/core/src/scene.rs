@@ -591,12 +591,17 @@ impl Scene {
     }
 
     /// What material `m`'s textures read at `uv`: its texture's colour (white without one)
-    /// and its textured parameters.
+    /// and its textured parameters; for a blend, where its BSDF will read its textures.
     #[inline]
-    pub fn tint(&self, m: &Material, uv: Vec2) -> crate::tint::Tint {
+    pub fn tint(&self, m: &Material, uv: Vec2) -> crate::tint::Tint<'_> {
         crate::tint::Tint {
             color: self.texture_color(m, uv),
             params: m.param_textures.lookup(&self.textures, uv),
+            // A blend's textures are read where its BSDF is evaluated (`crate::tint`).
+            at: m
+                .blend
+                .as_ref()
+                .map(|_| crate::tint::TexturesAt { scene: self, uv }),
         }
     }
 

@@ -184,6 +184,20 @@ impl Texture {
         }
     }
 
+    /// The least and greatest luminance a lookup can return (lookups interpolate between
+    /// texels, and luminance is linear); 1 for an empty image, which reads white.
+    pub fn luminance_range(&self) -> (f32, f32) {
+        if self.texels.is_empty() {
+            return (1.0, 1.0);
+        }
+        self.texels
+            .iter()
+            .map(|&t| luminance(sanitize(t)))
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), l| {
+                (lo.min(l), hi.max(l))
+            })
+    }
+
     /// Colour at `uv` (white for an empty image or a non-finite `uv`). `v = 0` is the bottom
     /// row of the image (the OBJ and .ruv convention; glTF's top-left origin is converted at
     /// load time).

@@ -3,12 +3,13 @@
 //! than it receives and nearly smooth ones lose almost none (white furnace), and reciprocity
 //! holds (for refraction in its generalised form `f(wo, wi)/ηo² = f(wi, wo)/ηi²`). Each check
 //! has a control that it must reject: a pdf of the wrong roughness, a reflectance of 1.05, a
-//! refraction compared without the η² factor.
+//! refraction compared without the η² factor. Blends (Mitsuba's `blendbsdf`) pass the χ²
+//! and furnace checks too, with their own controls.
 
 use rt_core::glam::{Vec2, Vec3};
 use rt_core::microfacet::{
-    Distribution, DistributionKind, LocalBsdf, LocalSample, Plastic, RoughConductor,
-    RoughDielectric, RoughPlastic,
+    Blended, Diffuse, Distribution, DistributionKind, LocalBsdf, LocalSample, Microfacet, Plastic,
+    RoughConductor, RoughDielectric, RoughPlastic,
 };
 use rt_core::Rgb;
 use rt_testkit::{chi2, Rng};
@@ -442,7 +443,6 @@ fn two_sided_conductors_mirror_the_front() {
 /// ones reflect nothing from below (control).
 #[test]
 fn two_sided_plastics_mirror_the_front() {
-    use rt_core::microfacet::Microfacet;
     let mut smooth = plastic(0.6, 1.5);
     let mut rough = rough_plastic(Ggx, 0.1, 0.6, 1.5);
     let one_sided = [Microfacet::Plastic(smooth), Microfacet::RoughPlastic(rough)];
@@ -474,4 +474,165 @@ fn two_sided_plastics_mirror_the_front() {
         }
         assert!(seen > 900, "{seen}");
     }
+}
+
+/// Mitsuba's `blendbsdf` of `a` (weight `1 − w`) and `b` (weight `w`).
+fn blend(w: f32, a: impl Into<Microfacet>, b: impl Into<Microfacet>) -> Blended {
+    Blended {
+        weight: w,
+        bsdfs: [a.into(), b.into()],
+    }
+}
+
+fn white_diffuse(r: f32) -> Diffuse {
+    Diffuse {
+        reflectance: Rgb::splat(r),
+    }
+}
+
+/// Blends sample the mixture their `eval_pdf` describes, whatever their BSDFs' lobes: rough
+/// ones, a delta coating (plastic) and refraction. Control: the same samples judged against
+/// the pdf of a weight 0.1 off.
+#[test]
+fn blend_sampling_matches_the_pdf_chi_square() {
+    let n = 200_000;
+    let mut rng = Rng::new(0x5eed_b1e2d);
+    let mut cases: Vec<(&str, Blended, Vec3)> = Vec::new();
+    for w in [0.3, 0.8] {
+        for cos in [0.9, 0.4] {
+            let wo = wo_at(cos, 1.0);
+            cases.push((
+                "gold + roughplastic",
+                blend(w, gold(Ggx, 0.2, 0.2), rough_plastic(Ggx, 0.3, 0.5, 1.49)),
+                wo,
+            ));
+            cases.push((
+                "diffuse + plastic",
+                blend(w, white_diffuse(0.7), plastic(0.5, 1.49)),
+                wo,
+            ));
+            cases.push((
+                "anisotropic beckmann gold + diffuse",
+                blend(w, gold(Beckmann, 0.5, 0.15), white_diffuse(0.4)),
+                wo,
+            ));
+            for side in [1.0, -1.0] {
+                cases.push((
+                    "glass + diffuse",
+                    blend(w, glass(Ggx, 0.3, 1.5), white_diffuse(0.6)),
+                    wo_at(cos, side),
+                ));
+            }
+        }
+    }
+    let alpha = chi2::sidak(0.01, cases.len());
+    let mut failures = Vec::new();
+    for (name, b, wo) in &cases {
+        let r = chi_square(b, b, *wo, n, &mut rng);
+        if !r.passes(alpha) {
+            failures.push(format!("{name} w={} wo={wo}: {r:?}", b.weight));
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "χ² failures at α = {alpha:.2e}:\n{}",
+        failures.join("\n")
+    );
+    let sampler = blend(0.3, gold(Ggx, 0.2, 0.2), white_diffuse(0.5));
+    let off = Blended {
+        weight: 0.4,
+        ..sampler
+    };
+    let r = chi_square(&sampler, &off, wo_at(0.7, 1.0), n, &mut rng);
+    assert!(
+        !r.passes(alpha),
+        "the χ² test missed a weight 0.1 off: {r:?}"
+    );
+}
+
+/// A blend of two lossless BSDFs is lossless, and a blend's albedo is the blend of its BSDFs'
+/// albedos. Control: a blend with a BSDF of reflectance 1.05 is seen to create energy.
+#[test]
+fn blend_white_furnace() {
+    let mut rng = Rng::new(17);
+    let n = 40_000;
+    // Two-sided, so that it is lossless from below too.
+    let smooth_white = RoughConductor {
+        distribution: None,
+        two_sided: true,
+        ..white_conductor(Ggx, 0.1, 0.1, 1.0)
+    };
+    let smooth_glass = RoughDielectric {
+        distribution: None,
+        ..glass(Ggx, 0.1, 1.5)
+    };
+    for w in [0.0, 0.25, 0.6, 1.0] {
+        for cos in [1.0, 0.6, 0.2] {
+            for side in [1.0, -1.0] {
+                let wo = wo_at(cos, side);
+                let lossless: [(&str, Blended); 3] = [
+                    (
+                        "diffuse + mirror",
+                        blend(w, white_diffuse(1.0), smooth_white),
+                    ),
+                    (
+                        "glass + diffuse",
+                        blend(w, smooth_glass, white_diffuse(1.0)),
+                    ),
+                    ("glass + mirror", blend(w, smooth_glass, smooth_white)),
+                ];
+                for (name, b) in &lossless {
+                    let (a, se) = albedo(b, wo, glass_eta(1.5), n, &mut rng);
+                    assert!(
+                        (a - 1.0).abs() < 4.0 * se + 1e-4,
+                        "{name} w={w} wo={wo}: {a} ± {se}"
+                    );
+                }
+            }
+            let wo = wo_at(cos, 1.0);
+            let (p0, p1) = (gold(Ggx, 0.3, 0.3), rough_plastic(Beckmann, 0.2, 0.8, 1.49));
+            let (a, se) = albedo(&blend(w, p0, p1), wo, no_eta, n, &mut rng);
+            let (a0, se0) = albedo(&p0, wo, no_eta, n, &mut rng);
+            let (a1, se1) = albedo(&p1, wo, no_eta, n, &mut rng);
+            let want = (1.0 - w as f64) * a0 + w as f64 * a1;
+            let se_all = (se * se + se0 * se0 + se1 * se1).sqrt();
+            assert!(
+                (a - want).abs() < 4.0 * se_all + 1e-4,
+                "gold + roughplastic w={w} cos={cos}: {a} ± {se} against {want} ± {se_all}"
+            );
+        }
+    }
+    let hot = blend(
+        0.5,
+        white_diffuse(1.0),
+        RoughConductor {
+            distribution: None,
+            ..white_conductor(Ggx, 0.1, 0.1, 1.05)
+        },
+    );
+    let (a, se) = albedo(&hot, wo_at(0.7, 1.0), no_eta, n, &mut rng);
+    assert!(
+        a > 1.0 + 4.0 * se + 1e-3,
+        "the furnace missed 2.5 % of created energy: {a} ± {se}"
+    );
+}
+
+/// A delta lobe of a blend keeps its weight and has its probability scaled by the pick's.
+#[test]
+fn blend_delta_samples_carry_the_pick_probability() {
+    let mirror = RoughConductor {
+        distribution: None,
+        ..gold(Ggx, 0.1, 0.1)
+    };
+    let b = blend(0.25, white_diffuse(0.5), mirror);
+    let wo = wo_at(0.6, 1.0);
+    let alone = mirror
+        .sample(wo, 0.5, Vec2::splat(0.3))
+        .expect("a reflection");
+    let s = b.sample(wo, 0.1, Vec2::splat(0.3)).expect("the mirror");
+    assert!(s.delta);
+    assert_eq!((s.wi, s.weight), (alone.wi, alone.weight));
+    assert!((s.pdf - 0.25 * alone.pdf).abs() < 1e-7, "{}", s.pdf);
+    let d = b.sample(wo, 0.9, Vec2::splat(0.3)).expect("the diffuse");
+    assert!(!d.delta && (d.pdf - 0.75 * d.wi.z / std::f32::consts::PI).abs() < 1e-6);
 }

@@ -232,6 +232,10 @@ pub(crate) struct MaterialDesc {
     pub nonlinear: Option<Spanned<bool>>,
     /// Mitsuba's `mask`: a number in [0, 1] or a texture (`param_desc.rs`); any type.
     pub opacity: Option<Spanned<toml::Value>>,
+    /// `blendbsdf`: the weight of its second BSDF, a number in [0, 1] or a texture.
+    pub weight: Option<Spanned<toml::Value>>,
+    /// `blendbsdf`: the names of the two materials it blends.
+    pub bsdfs: Option<Spanned<Vec<Spanned<String>>>>,
 }
 
 /// One entry of a material's `layers` array.

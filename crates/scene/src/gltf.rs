@@ -8,23 +8,34 @@
 //! flipped to our bottom-up convention (`v' = 1 − v`). Point and line primitives are skipped
 //! with a warning.
 //!
-//! Material mapping onto the layered model (documented in `docs/scene-format.md`), with
-//! `C = baseColorFactor.rgb` (times `baseColorTexture`, which becomes the texture) and
-//! `κ = 1 − roughnessFactor`:
-//! - `KHR_materials_transmission` factor > 0.5: glass, colour C, hardness κ, ior from
-//!   `KHR_materials_ior` (default 1.5);
-//! - else `metallicFactor` > 0.5: metal, colour C, hardness κ;
-//! - else roughness 1: diffuse C; otherwise plastic, base C under a clear coat of hardness κ
-//!   and ior 1.5 (or `KHR_materials_ior`).
-//! - Emission: `emissiveFactor × KHR_materials_emissive_strength` (default 1); `doubleSided`
-//!   makes emission two-sided. Metallic-roughness, normal, occlusion and emissive textures
-//!   are ignored.
+//! Materials: glTF 2.0's metallic-roughness BRDF (the specification's Appendix B) on GGX, with
+//! `C = baseColorFactor.rgb` (times `baseColorTexture`) and `α = roughnessFactor²`: a blend
+//! (`rt_core::microfacet::Blend`) of weight `metallicFactor` of
+//! - the dielectric: a rough plastic (`roughplastic`, GGX α, coating ior 1.5 or
+//!   `KHR_materials_ior`) over a Lambertian base C, the specification's `fresnel_mix` of a
+//!   specular layer over `diffuse_brdf(C)`;
+//! - the metal: a rough conductor (GGX α) that reflects everything (Mitsuba's `none`) times
+//!   C, the specification's `conductor_fresnel(f0 = C)`.
+//!
+//! A metallic factor of 0 or 1 is the one BSDF. Both reflect from either face (glTF culls or
+//! shades back faces; neither is black). Deviations: the plastic's coating uses the exact
+//! dielectric Fresnel term and Mitsuba's internal-reflection model where the specification
+//! uses Schlick's approximation and no inter-reflection; the metal is `F = 1` tinted by C where
+//! the specification has Schlick's `C + (1 − C)(1 − cos)⁵`, which brightens toward white at
+//! grazing angles only. `KHR_materials_transmission` factor > 0.5 is still the layered model's
+//! glass (colour C, hardness `1 − roughness`, ior from `KHR_materials_ior`, default 1.5).
+//! Emission: `emissiveFactor × KHR_materials_emissive_strength` (default 1); `doubleSided`
+//! makes emission two-sided. Metallic-roughness, normal, occlusion and emissive textures are
+//! ignored.
 
 use crate::error::{Result, SceneError};
 use crate::geometry::Mesh;
 use crate::image_io::{texture_from_bytes, Textures};
 use ::gltf::mesh::Mode;
 use glam::{Mat4, Vec2, Vec3};
+use rt_core::microfacet::{
+    Blend, BlendPart, Distribution, DistributionKind, Microfacet, RoughConductor, RoughPlastic,
+};
 use rt_core::transform::Transform;
 use rt_core::{Material, Rgb};
 use std::collections::HashMap;
@@ -270,40 +281,37 @@ impl Loader<'_> {
         Ok(slot)
     }
 
-    /// Maps a glTF material onto the layered model (see the module docs).
+    /// Maps a glTF material onto GGX (see the module docs).
     fn convert(&mut self, m: &::gltf::Material, name: &str) -> Result<Material> {
         let pbr = m.pbr_metallic_roughness();
         let [r, g, b, _] = pbr.base_color_factor();
         let fix = |c: Rgb| if c.is_finite() { c } else { Rgb::ZERO };
         let color = fix(Rgb::new(r, g, b)).clamp(Rgb::ZERO, Rgb::ONE);
-        let roughness = pbr.roughness_factor();
-        let roughness = if roughness.is_finite() {
-            roughness.clamp(0.0, 1.0)
-        } else {
-            1.0
+        let unit = |x: f32, default: f32| {
+            if x.is_finite() {
+                x.clamp(0.0, 1.0)
+            } else {
+                default
+            }
         };
-        let hardness = 1.0 - roughness;
-        let ior = m
-            .ior()
-            .filter(|i| i.is_finite() && *i >= 1.0)
-            .unwrap_or(1.5);
+        let roughness = unit(pbr.roughness_factor(), 1.0);
+        let metallic = unit(pbr.metallic_factor(), 1.0);
+        let ior = m.ior().filter(|i| i.is_finite() && *i > 1.0).unwrap_or(1.5);
+        let texture = match pbr.base_color_texture() {
+            Some(info) => Some(self.image(&info.texture().source())?),
+            None => None,
+        };
         let transmission = m.transmission().map_or(0.0, |t| t.transmission_factor());
         let mut out = if transmission > 0.5 {
-            Material::glass(name, color, ior, hardness)
-        } else if pbr.metallic_factor() > 0.5 {
-            Material::metal(name, color, hardness)
-        } else if roughness >= 1.0 {
-            Material::diffuse(name, color)
+            let mut glass = Material::glass(name, color, ior, 1.0 - roughness);
+            glass.texture = texture;
+            glass
         } else {
-            Material::plastic(name, color, hardness, ior)
+            metallic_roughness(name, color, texture, roughness, metallic, ior)
         };
         let strength = m.emissive_strength().unwrap_or(1.0);
         out.emission = fix(Rgb::from(m.emissive_factor()) * strength).max(Rgb::ZERO);
         out.two_sided = m.double_sided();
-        if let Some(info) = pbr.base_color_texture() {
-            let image = info.texture().source();
-            out.texture = Some(self.image(&image)?);
-        }
         Ok(out)
     }
 
@@ -348,6 +356,48 @@ impl Loader<'_> {
         self.images.insert(index, t);
         Ok(t)
     }
+}
+
+/// glTF's metallic-roughness material on GGX (see the module docs): base colour `color`
+/// (times the texture `texture`), `roughness` and `metallic` in [0, 1], the dielectric's `ior`.
+pub(crate) fn metallic_roughness(
+    name: &str,
+    color: Rgb,
+    texture: Option<u32>,
+    roughness: f32,
+    metallic: f32,
+    ior: f32,
+) -> Material {
+    let ggx = Distribution::new(
+        DistributionKind::Ggx,
+        roughness * roughness,
+        roughness * roughness,
+    );
+    let mut plastic = RoughPlastic::new(ggx, color, Rgb::ONE, ior, false);
+    plastic.two_sided = true;
+    let metal = Microfacet::Conductor(RoughConductor {
+        distribution: Some(ggx),
+        eta: Rgb::ZERO,
+        k: Rgb::ONE,
+        specular_reflectance: color,
+        two_sided: true,
+    });
+    let plastic = Microfacet::RoughPlastic(plastic);
+    let mut out = match metallic {
+        0.0 => Material::microfacet(name, plastic),
+        1.0 => Material::microfacet(name, metal),
+        _ => {
+            let part = |bsdf| BlendPart {
+                texture,
+                ..BlendPart::new(bsdf)
+            };
+            Material::blend(name, Blend::new(metallic, [part(plastic), part(metal)]))
+        }
+    };
+    if out.blend.is_none() {
+        out.texture = texture;
+    }
+    out
 }
 
 /// Decodes `%XX` escapes of a relative URI.

@@ -65,6 +65,11 @@ impl Textures {
         (self.list.len() - 1) as u32
     }
 
+    /// Texture `i`.
+    pub fn get(&self, i: u32) -> &Texture {
+        &self.list[i as usize]
+    }
+
     /// The textures, in index order.
     pub fn into_vec(self) -> Vec<Texture> {
         self.list

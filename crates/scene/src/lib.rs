@@ -53,6 +53,7 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+mod blend;
 mod desc;
 mod error;
 mod files;

@@ -69,7 +69,7 @@ pub(crate) fn load(
     scene.cameras = cameras(&ctx, &d.camera)?;
     let mut mats = MaterialTable::default();
     for m in &d.material {
-        let built = material::build(&mut ctx, m)?;
+        let built = material::build(&mut ctx, m, &mut mats)?;
         if mats.insert(built).is_none() {
             return Err(ctx.src.error_at(
                 m.get_ref().name.span(),

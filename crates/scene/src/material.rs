@@ -17,6 +17,9 @@ pub(crate) const TYPES: [&str; 7] = [
     "diffuse", "mirror", "glass", "glossy", "plastic", "metal", "layered",
 ];
 
+/// Mitsuba's `blendbsdf` (`blend.rs`).
+pub(crate) const BLEND: &str = "blendbsdf";
+
 /// Colour when `color` is not given.
 pub(crate) const DEFAULT_COLOR: Rgb = Rgb::splat(0.8);
 /// Index of refraction when `ior` is not given.
@@ -61,6 +64,11 @@ impl MaterialTable {
         Some(id)
     }
 
+    /// Material `id`.
+    pub fn get(&self, id: u32) -> &Material {
+        &self.list[id as usize]
+    }
+
     /// Index of the material called `name`, without marking it used (an animation of a
     /// material does not make it appear in the image).
     pub fn find(&self, name: &str) -> Option<u32> {
@@ -82,9 +90,14 @@ impl MaterialTable {
     }
 }
 
-/// Builds the material of one `[[material]]` table and checks it with `Material::validate`.
-pub(crate) fn build(ctx: &mut Ctx, d: &Spanned<MaterialDesc>) -> Result<Material> {
-    let mut m = build_bsdf(ctx, d.get_ref())?;
+/// Builds the material of one `[[material]]` table and checks it with `Material::validate`;
+/// a blend finds the materials it blends in `mats`.
+pub(crate) fn build(
+    ctx: &mut Ctx,
+    d: &Spanned<MaterialDesc>,
+    mats: &mut MaterialTable,
+) -> Result<Material> {
+    let mut m = build_bsdf(ctx, d.get_ref(), mats)?;
     m.perturbation = crate::texture_desc::perturbation(ctx, d.get_ref())?;
     if let Some(v) = &d.get_ref().opacity {
         let name = d.get_ref().name.get_ref();
@@ -103,7 +116,7 @@ pub(crate) fn build(ctx: &mut Ctx, d: &Spanned<MaterialDesc>) -> Result<Material
 }
 
 /// [`build`] without the bump or normal map.
-fn build_bsdf(ctx: &mut Ctx, d: &MaterialDesc) -> Result<Material> {
+fn build_bsdf(ctx: &mut Ctx, d: &MaterialDesc, mats: &mut MaterialTable) -> Result<Material> {
     let name = d.name.get_ref();
     let src = ctx.src;
     let err =
@@ -120,11 +133,11 @@ fn build_bsdf(ctx: &mut Ctx, d: &MaterialDesc) -> Result<Material> {
     let kind = match (&d.kind, &d.layers) {
         (Some(k), _) => {
             let k_str = k.get_ref().as_str();
-            if !TYPES.contains(&k_str) && !microfacet::TYPES.contains(&k_str) {
+            if !TYPES.contains(&k_str) && !microfacet::TYPES.contains(&k_str) && k_str != BLEND {
                 return Err(err(
                     k.span(),
                     format!(
-                        "unknown material type \"{}\"; valid types are {}, {}",
+                        "unknown material type \"{}\"; valid types are {}, {}, {BLEND}",
                         k.get_ref(),
                         TYPES.join(", "),
                         microfacet::TYPES.join(", ")
@@ -136,6 +149,19 @@ fn build_bsdf(ctx: &mut Ctx, d: &MaterialDesc) -> Result<Material> {
         (None, Some(_)) => "layered",
         (None, None) => "diffuse",
     };
+    if kind == BLEND {
+        return crate::blend::build(ctx, d, mats);
+    }
+    let blend_keys = [
+        ("weight", d.weight.as_ref().map(|v| v.span())),
+        ("bsdfs", d.bsdfs.as_ref().map(|v| v.span())),
+    ];
+    if let Some((key, Some(span))) = blend_keys.into_iter().find(|(_, s)| s.is_some()) {
+        return Err(err(
+            span,
+            format!("`{key}` does not apply to type \"{kind}\" (it applies to {BLEND})"),
+        ));
+    }
     if microfacet::TYPES.contains(&kind) {
         return microfacet::build(ctx, d, kind);
     }
@@ -394,20 +420,35 @@ mod tests {
     use crate::image_io::Textures;
     use std::path::Path;
 
-    /// Builds the first material of `text`, or returns the error message.
+    /// Builds the materials of `text` and returns the last, or the error message.
     fn mat(text: &str) -> std::result::Result<(Material, usize), String> {
+        mat_in(Path::new("."), text).map(|(m, t)| (m, t.len()))
+    }
+
+    /// [`mat`] with texture files read from `base`; the scene's textures too.
+    fn mat_in(
+        base: &Path,
+        text: &str,
+    ) -> std::result::Result<(Material, Vec<rt_core::texture::Texture>), String> {
         let d: SceneDesc = toml::from_str(text).map_err(|e| e.to_string())?;
         let mut ctx = Ctx {
             src: Source {
                 name: Path::new("m.toml"),
                 text,
             },
-            base: Path::new("."),
+            base,
             textures: Textures::default(),
             warnings: vec![],
         };
-        let m = build(&mut ctx, &d.material[0]).map_err(|e| e.to_string())?;
-        Ok((m, ctx.textures.into_vec().len()))
+        let mut mats = MaterialTable::default();
+        let mut m = None;
+        for d in &d.material {
+            let built = build(&mut ctx, d, &mut mats).map_err(|e| e.to_string())?;
+            m = Some(built.clone());
+            mats.insert(built);
+        }
+        let m = m.expect("a material");
+        Ok((m, ctx.textures.into_vec()))
     }
 
     fn ok(body: &str) -> Material {
@@ -665,7 +706,7 @@ mod tests {
             textures: Textures::default(),
             warnings: vec![],
         };
-        let m = build(&mut ctx, &d.material[0]).unwrap();
+        let m = build(&mut ctx, &d.material[0], &mut MaterialTable::default()).unwrap();
         assert_eq!(m.texture, Some(0));
         let t = ctx.textures.into_vec();
         assert_eq!(
@@ -687,21 +728,7 @@ mod tests {
         image::RgbImage::from_pixel(2, 2, image::Rgb([128, 128, 255]))
             .save(dir.path().join("t.png"))
             .unwrap();
-        let load = |body: &str| {
-            let text = format!("[[material]]\nname = \"m\"\n{body}");
-            let d: SceneDesc = toml::from_str(&text).map_err(|e| e.to_string())?;
-            let mut ctx = Ctx {
-                src: Source {
-                    name: Path::new("m.toml"),
-                    text: &text,
-                },
-                base: dir.path(),
-                textures: Textures::default(),
-                warnings: vec![],
-            };
-            let m = build(&mut ctx, &d.material[0]).map_err(|e| e.to_string())?;
-            Ok::<_, String>((m, ctx.textures.into_vec()))
-        };
+        let load = |body: &str| mat_in(dir.path(), &format!("[[material]]\nname = \"m\"\n{body}"));
         let (m, t) = load(
             "texture = { file = \"t.png\", filter = \"nearest\", wrap = \"clamp\" }\n\
              bump_map = \"t.png\"\nbump_scale = 0.5",
@@ -894,5 +921,81 @@ mod tests {
             assert!(e.contains(says), "{body}: {e}");
             assert!(e.contains("m.toml"), "{e}");
         }
+    }
+
+    const PARTS: &str =
+        "[[material]]\nname = \"gold\"\ntype = \"roughconductor\"\nmaterial = \"Au\"\n\
+                         [[material]]\nname = \"base\"\ncolor = [0.2, 0.4, 0.6]\n";
+
+    fn blend(body: &str) -> std::result::Result<Material, String> {
+        mat(&format!(
+            "{PARTS}[[material]]\nname = \"m\"\ntype = \"blendbsdf\"\n{body}"
+        ))
+        .map(|(m, _)| m)
+    }
+
+    #[test]
+    fn a_blend_names_two_materials_defined_before_it() {
+        use rt_core::microfacet::{Diffuse, Microfacet};
+        let m = blend("weight = 0.25\nbsdfs = [\"gold\", \"base\"]").unwrap();
+        let b = m.blend.as_ref().expect("a blend");
+        assert_eq!(b.weight, 0.25);
+        assert!(matches!(b.parts[0].bsdf, Microfacet::Conductor(_)));
+        assert_eq!(
+            b.parts[1].bsdf,
+            Microfacet::Diffuse(Diffuse {
+                reflectance: Rgb::new(0.2, 0.4, 0.6)
+            })
+        );
+        let cases = [
+            (
+                "weight = 1.5\nbsdfs = [\"gold\", \"base\"]",
+                "m.toml:11:10: material \"m\": blendbsdf weight must be in [0, 1], got 1.5",
+            ),
+            (
+                "weight = -0.1\nbsdfs = [\"gold\", \"base\"]",
+                "blendbsdf weight must be in [0, 1], got -0.1",
+            ),
+            (
+                "bsdfs = [\"gold\", \"base\"]",
+                "type \"blendbsdf\" needs `weight`",
+            ),
+            (
+                "weight = 0.5\nbsdfs = [\"gold\"]",
+                "`bsdfs` names 1 materials; a blend takes two",
+            ),
+            (
+                "weight = 0.5\nbsdfs = [\"gold\", \"later\"]",
+                "no material \"later\" is defined before this one",
+            ),
+            (
+                "weight = 0.5\nbsdfs = [\"gold\", \"base\"]\nalpha = 0.2",
+                "`alpha` does not apply to type \"blendbsdf\"",
+            ),
+        ];
+        for (body, want) in cases {
+            let e = blend(body).unwrap_err();
+            assert!(e.contains(want), "{body}: {e}");
+            assert_eq!(e.lines().count(), 1, "{e}");
+        }
+        // What cannot be blended: a layered material, a blend, an emitter.
+        let e = mat(&format!(
+            "{PARTS}[[material]]\nname = \"g\"\ntype = \"glossy\"\n\
+             [[material]]\nname = \"m\"\ntype = \"blendbsdf\"\nweight = 0.5\nbsdfs = [\"gold\", \"g\"]"
+        ))
+        .unwrap_err();
+        assert!(e.contains("\"g\" is a layered material"), "{e}");
+        let e = mat(&format!(
+            "{PARTS}[[material]]\nname = \"b\"\ntype = \"blendbsdf\"\nweight = 0.5\nbsdfs = [\"gold\", \"base\"]\n\
+             [[material]]\nname = \"m\"\ntype = \"blendbsdf\"\nweight = 0.5\nbsdfs = [\"gold\", \"b\"]"
+        ))
+        .unwrap_err();
+        assert!(e.contains("a blend inside a blend is not supported"), "{e}");
+        // The blend's keys on another type.
+        let e = bad("type = \"diffuse\"\nweight = 0.5");
+        assert!(
+            e.contains("`weight` does not apply to type \"diffuse\" (it applies to blendbsdf)"),
+            "{e}"
+        );
     }
 }

@@ -10,8 +10,8 @@ use crate::load::{finite3, Ctx};
 use crate::param_desc::{self, Param};
 use rt_core::microfacet::named::{CONDUCTORS, DIELECTRICS};
 use rt_core::microfacet::{
-    named_conductor, named_ior, Distribution, DistributionKind, Microfacet, ParamTextures, Plastic,
-    RoughConductor, RoughDielectric, RoughPlastic, ThinDielectric,
+    named_conductor, named_ior, AlphaTables, Distribution, DistributionKind, Microfacet,
+    ParamTextures, Plastic, RoughConductor, RoughDielectric, RoughPlastic, ThinDielectric,
 };
 use rt_core::{Material, Rgb};
 use std::ops::Range;
@@ -192,6 +192,7 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
     // Reflection from both faces (Mitsuba's `twosided`) for the reflecting types; for every
     // type it also makes an emitter emit from both.
     let two_sided = d.two_sided.unwrap_or(false);
+    let mut alpha_tables = None;
     let bsdf = if conductor {
         let (eta, k) = match &d.material {
             Some(named) => {
@@ -246,16 +247,13 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
                             .into(),
                     ));
                 }
-                if let (Some(_), Some(a)) = (textures.alpha_u, &d.alpha) {
-                    return Err(err(
-                        a.span(),
-                        "roughplastic's `alpha` takes no texture (Mitsuba 3 tabulates its \
-                         coating for one roughness)"
-                            .into(),
-                    ));
-                }
                 let mut p = RoughPlastic::new(dist, diffuse, reflectance, eta, nonlinear);
                 p.two_sided = two_sided;
+                // A textured roughness: the coating's tables over the texture's range.
+                if let Some(t) = textures.alpha_u {
+                    let (lo, hi) = ctx.textures.get(t).luminance_range();
+                    alpha_tables = Some(AlphaTables::new(&p, lo, hi));
+                }
                 Microfacet::RoughPlastic(p)
             }
             None => Microfacet::Plastic(Plastic {
@@ -276,6 +274,7 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
     };
     let mut m = Material::microfacet(name, bsdf);
     m.param_textures = textures;
+    m.alpha_tables = alpha_tables;
     if let Some(e) = &d.emission {
         m.emission = finite3(ctx, e, "emission")?;
     }

@@ -159,7 +159,7 @@ fn test_document() -> String {
               "extensions": { "KHR_materials_transmission": { "transmissionFactor": 1.0 }, "KHR_materials_ior": { "ior": 1.33 } } },
             { "pbrMetallicRoughness": { "metallicFactor": 0.0, "roughnessFactor": 1.0 }, "emissiveFactor": [1.0, 0.5, 0.25],
               "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": 4.0 } }, "doubleSided": true },
-            { "name": "painted", "pbrMetallicRoughness": { "baseColorFactor": [0.8, 0.8, 0.8, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.5,
+            { "name": "painted", "pbrMetallicRoughness": { "baseColorFactor": [0.8, 0.8, 0.8, 1.0], "metallicFactor": 0.3, "roughnessFactor": 0.5,
               "baseColorTexture": { "index": 0 } } },
         ],
         "textures": [{ "source": 0 }],
@@ -224,7 +224,8 @@ fn gltf_hierarchy_indices_modes_and_sparse_accessors() {
 }
 
 #[test]
-fn gltf_materials_map_onto_the_layered_model() {
+fn gltf_materials_map_onto_ggx() {
+    use rt_core::microfacet::{Microfacet, RoughConductor, RoughPlastic};
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("t.gltf"), test_document()).unwrap();
     let s = load_in(
@@ -248,11 +249,38 @@ fn gltf_materials_map_onto_the_layered_model() {
                 )
             })
     };
+    // GGX with α = roughness², the metal reflecting everything tinted by the base colour.
+    let conductor = |m: &Microfacet| -> RoughConductor {
+        match m {
+            Microfacet::Conductor(c) => *c,
+            other => panic!("{other:?}"),
+        }
+    };
+    let plastic = |m: &Microfacet| -> RoughPlastic {
+        match m {
+            Microfacet::RoughPlastic(p) => *p,
+            other => panic!("{other:?}"),
+        }
+    };
+    let ggx = |d: Option<rt_core::microfacet::Distribution>, alpha: f32| {
+        let d = d.expect("rough");
+        assert_eq!(d.kind, rt_core::microfacet::DistributionKind::Ggx);
+        assert!(
+            (d.alpha_x - alpha).abs() < 1e-6 && d.alpha_x == d.alpha_y,
+            "{d:?}"
+        );
+    };
     let steel = by_name("t/steel");
-    assert_eq!(
-        steel,
-        &Material::metal("t/steel", Rgb::new(0.5, 0.6, 0.7), 0.8)
+    let c = conductor(
+        steel
+            .microfacet
+            .as_ref()
+            .expect("metallic 1: the conductor alone"),
     );
+    ggx(c.distribution, 0.04);
+    assert_eq!((c.eta, c.k), (Rgb::ZERO, Rgb::ONE), "F = 1");
+    assert_eq!(c.specular_reflectance, Rgb::new(0.5, 0.6, 0.7));
+    assert!(c.two_sided && steel.blend.is_none() && steel.layers.is_empty());
     assert_eq!(
         by_name("t/glass"),
         &Material::glass("t/glass", Rgb::ONE, 1.33, 1.0)
@@ -260,18 +288,37 @@ fn gltf_materials_map_onto_the_layered_model() {
     let lamp = by_name("t/material2");
     assert_eq!(lamp.emission, Rgb::new(4.0, 2.0, 1.0));
     assert!(lamp.two_sided);
-    assert_eq!(
-        lamp.layers,
-        Material::diffuse("x", Rgb::ONE).layers,
-        "roughness 1, not metallic: diffuse"
+    let p = plastic(
+        lamp.microfacet
+            .as_ref()
+            .expect("metallic 0: the plastic alone"),
     );
+    ggx(Some(p.distribution), 1.0);
+    assert_eq!((p.diffuse, p.specular, p.eta), (Rgb::ONE, Rgb::ONE, 1.5));
+    // Metallic 0.3: a blend of weight 0.3 of the plastic and the metal, both textured.
     let painted = by_name("t/painted");
-    assert_eq!(
-        painted.layers,
-        Material::plastic("x", Rgb::splat(0.8), 0.5, 1.5).layers
-    );
-    let tex = painted.texture.unwrap() as usize;
+    let b = painted.blend.as_ref().expect("a blend");
+    assert_eq!(b.weight, 0.3);
+    let (p, c) = (plastic(&b.parts[0].bsdf), conductor(&b.parts[1].bsdf));
+    ggx(Some(p.distribution), 0.25);
+    ggx(c.distribution, 0.25);
+    assert_eq!((p.diffuse, p.eta), (Rgb::splat(0.8), 1.5));
+    assert_eq!(c.specular_reflectance, Rgb::splat(0.8));
+    assert_eq!(b.parts[0].texture, b.parts[1].texture);
+    let tex = b.parts[0].texture.unwrap() as usize;
     assert_eq!(s.scene.textures[tex].texels[0], Rgb::new(1.0, 0.0, 0.0));
+    // The texture multiplies the metal's colour as the plastic's base.
+    let tint = s.scene.tint(painted, rt_core::glam::Vec2::splat(0.5));
+    let wo = rt_core::glam::Vec3::new(0.3, 0.0, 0.9).normalize();
+    let bsdf = rt_core::material::Bsdf::new(
+        painted,
+        tint,
+        rt_core::glam::Vec3::Z,
+        rt_core::glam::Vec3::Z,
+        wo,
+    );
+    let a = bsdf.albedo();
+    assert!(a.y == 0.0 && a.z == 0.0 && a.x > 0.0, "red texture: {a:?}");
     // Triangle materials in order: steel, glass, emissive, painted, steel...
     let names: Vec<&str> = s.scene.material_ids[2..7]
         .iter()

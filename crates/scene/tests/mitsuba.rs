@@ -174,8 +174,8 @@ fn transforms_apply_in_order() {
 fn unsupported_elements_and_parameters_are_one_line_at_their_position() {
     let cases = [
         (
-            r#"<shape type="cube"><bsdf type="blendbsdf"/></shape>"#,
-            "s.xml:8:20: bsdf \"blendbsdf\" is not supported",
+            r#"<shape type="cube"><bsdf type="principled"/></shape>"#,
+            "s.xml:8:20: bsdf \"principled\" is not supported",
         ),
         (
             r#"<shape type="cube"><bsdf type="diffuse"><float name="roughness" value="1"/></bsdf></shape>"#,

@@ -113,6 +113,20 @@ fn a_textured_parameter_renders_as_its_constant() {
             r#"<ref name="specular_reflectance" id="magenta"/>"#.into(),
             r#"<rgb name="specular_reflectance" value="1, 0, 1"/>"#.into(),
         ),
+        // A blend's weight (the control: another weight).
+        (
+            "blendbsdf",
+            format!(r#"<bsdf type="diffuse"/><bsdf type="roughconductor">{gold}</bsdf>"#),
+            constant_checkerboard("weight", a),
+            format!(r#"<float name="weight" value="{la:?}"/>"#),
+        ),
+        // A rough plastic's roughness (its coating's tables follow it).
+        (
+            "roughplastic",
+            ggx.to_string(),
+            constant_checkerboard("alpha", a),
+            format!(r#"<float name="alpha" value="{la:?}"/>"#),
+        ),
         // A mask's opacity (its default is 0.5).
         (
             "mask",
@@ -127,6 +141,8 @@ fn a_textured_parameter_renders_as_its_constant() {
         let c = render(dir.path(), &bsdf(constant));
         let control = if textured.contains("alpha_u") {
             r#"<float name="alpha_u" value="0.1"/>"#
+        } else if textured.contains("weight") {
+            r#"<float name="weight" value="0.9"/>"#
         } else {
             ""
         };
@@ -141,8 +157,24 @@ fn bad_textures_are_one_error_line_naming_the_file() {
     let dir = tempfile::tempdir().unwrap();
     let cases = [
         (
-            r#"<bsdf type="roughplastic"><texture type="checkerboard" name="alpha"/></bsdf>"#,
-            "roughplastic's `alpha` takes no texture",
+            r#"<bsdf type="blendbsdf"><float name="weight" value="1.5"/>
+                <bsdf type="diffuse"/><bsdf type="conductor"/></bsdf>"#,
+            "weight must be in [0, 1], got 1.5",
+        ),
+        (
+            r#"<bsdf type="blendbsdf"><float name="weight" value="0.5"/><bsdf type="diffuse"/>
+                <bsdf type="blendbsdf"><float name="weight" value="0.5"/>
+                <bsdf type="diffuse"/><bsdf type="conductor"/></bsdf></bsdf>"#,
+            "a blendbsdf inside a blendbsdf is not supported",
+        ),
+        (
+            r#"<bsdf type="blendbsdf"><float name="weight" value="0.5"/><bsdf type="diffuse"/>
+                </bsdf>"#,
+            "blends 1 BSDFs, expected two",
+        ),
+        (
+            r#"<bsdf type="blendbsdf"><bsdf type="diffuse"/><bsdf type="conductor"/></bsdf>"#,
+            "needs a `weight`",
         ),
         (
             r#"<bsdf type="roughconductor"><texture type="wood" name="alpha"/></bsdf>"#,
@@ -173,4 +205,123 @@ fn bad_textures_are_one_error_line_naming_the_file() {
         assert!(e.contains("s.xml") && e.contains(want), "{bsdf}: {e}");
         assert_eq!(e.lines().count(), 1, "{e}");
     }
+}
+
+/// Mitsuba's `blendbsdf`: its two BSDFs (nested, or `<ref>`, in the order they appear) become
+/// the blend's parts with their own parameters and textures; a textured weight is the
+/// material's.
+#[test]
+fn a_blend_loads_with_its_two_bsdfs() {
+    use rt_core::microfacet::Microfacet;
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbImage::from_pixel(2, 2, image::Rgb([255, 0, 255]))
+        .save(dir.path().join("magenta.png"))
+        .unwrap();
+    let bsdf = r#"<bsdf type="twosided"><bsdf type="blendbsdf">
+        <float name="weight" value="0.3"/>
+        <bsdf type="roughconductor"><string name="material" value="Au"/>
+            <ref name="specular_reflectance" id="magenta"/></bsdf>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.2, 0.4, 0.6"/></bsdf>
+    </bsdf></bsdf>"#;
+    let s = load(dir.path(), bsdf).unwrap();
+    let m = s
+        .scene
+        .materials
+        .iter()
+        .find(|m| m.blend.is_some())
+        .expect("a blend");
+    let b = m.blend.as_ref().unwrap();
+    assert_eq!(b.weight, 0.3);
+    let Microfacet::Conductor(c) = b.parts[0].bsdf else {
+        panic!("{:?}", b.parts[0].bsdf);
+    };
+    assert!(
+        c.two_sided,
+        "the twosided around the blend reaches its conductor"
+    );
+    assert!(b.parts[0].textures.specular_reflectance.is_some());
+    assert_eq!(
+        b.parts[1].bsdf,
+        Microfacet::Diffuse(rt_core::microfacet::Diffuse {
+            reflectance: Rgb::new(0.2, 0.4, 0.6)
+        })
+    );
+    assert!(m.microfacet.is_none() && m.layers.is_empty());
+    // A textured weight.
+    let textured = bsdf.replace(
+        r#"<float name="weight" value="0.3"/>"#,
+        r#"<texture type="checkerboard" name="weight"/>"#,
+    );
+    let s = load(dir.path(), &textured).unwrap();
+    let m = s
+        .scene
+        .materials
+        .iter()
+        .find(|m| m.blend.is_some())
+        .unwrap();
+    assert!(m.blend.as_ref().unwrap().weight_texture.is_some());
+    // Weights 0 and 1 render as the BSDF they keep, bit for bit; 0.5 as neither.
+    let gold = r#"<bsdf type="roughconductor"><string name="material" value="Au"/></bsdf>"#;
+    let white = r#"<bsdf type="roughplastic"><rgb name="diffuse_reflectance" value="0.8, 0.8, 0.8"/></bsdf>"#;
+    let blend = |w: f32| {
+        format!(
+            r#"<bsdf type="blendbsdf"><float name="weight" value="{w:?}"/>{gold}{white}</bsdf>"#
+        )
+    };
+    let (g, p) = (render(dir.path(), gold), render(dir.path(), white));
+    assert!(render(dir.path(), &blend(0.0)) == g);
+    assert!(render(dir.path(), &blend(1.0)) == p);
+    let half = render(dir.path(), &blend(0.5));
+    assert!(half != g && half != p && g != p);
+}
+
+/// A checkerboard roughness on `roughplastic` (which Mitsuba 3 refuses): every pixel whose
+/// footprint lies in one square renders the bits of the constant roughness of that square
+/// (the two values are the ends of the texture's range, where the coating's tables are
+/// computed exactly); only pixels on the squares' edges are neither. Control: the two
+/// constants render differently.
+#[test]
+fn a_checkerboard_roughness_on_rough_plastic_renders_each_square_as_its_constant() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a0, a1) = (0.05f32, 0.6f32);
+    let (l0, l1) = (luminance(Rgb::splat(a0)), luminance(Rgb::splat(a1)));
+    let plastic = |alpha: &str| {
+        format!(
+            r#"<bsdf type="roughplastic"><string name="distribution" value="ggx"/>
+            <rgb name="diffuse_reflectance" value="0.2, 0.5, 0.3"/>{alpha}</bsdf>"#
+        )
+    };
+    let textured = render(
+        dir.path(),
+        &plastic(&format!(
+            r#"<texture type="checkerboard" name="alpha"><rgb name="color0" value="{a0:?}"/>
+            <rgb name="color1" value="{a1:?}"/></texture>"#
+        )),
+    );
+    let constant = |l: f32| {
+        render(
+            dir.path(),
+            &plastic(&format!(r#"<float name="alpha" value="{l:?}"/>"#)),
+        )
+    };
+    let (c0, c1) = (constant(l0), constant(l1));
+    assert!(c0 != c1, "the control must differ");
+    let (mut n0, mut n1, mut neither, mut seen) = (0, 0, 0, 0);
+    for ((t, x), y) in textured.chunks(3).zip(c0.chunks(3)).zip(c1.chunks(3)) {
+        // Pixels that miss the rectangle see the sky in all three renders.
+        if x == y {
+            continue;
+        }
+        seen += 1;
+        match (t == x, t == y) {
+            (true, _) => n0 += 1,
+            (_, true) => n1 += 1,
+            _ => neither += 1,
+        }
+    }
+    assert!(n0 > seen / 5 && n1 > seen / 5, "{n0} and {n1} of {seen}");
+    assert!(
+        neither * 5 < seen,
+        "{neither} of {seen} pixels match no constant"
+    );
 }

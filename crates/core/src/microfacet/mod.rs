@@ -12,8 +12,10 @@
 //! Walter 2007) instead of its visible normals, which changes the variance, not the image;
 //! masking-shadowing is Mitsuba's separable Smith form `G1(wo)·G1(wi)`.
 
+mod blend;
 mod conductor;
 mod dielectric;
+mod diffuse;
 mod distribution;
 mod fresnel;
 pub mod named;
@@ -22,12 +24,14 @@ mod rough_plastic;
 mod textured;
 mod thin;
 
+pub use blend::{Blend, BlendAt, BlendPart, Blended};
 pub use conductor::RoughConductor;
 pub use dielectric::RoughDielectric;
+pub use diffuse::Diffuse;
 pub use distribution::{Distribution, DistributionKind, MIN_ALPHA};
 pub use fresnel::fresnel_conductor;
 pub use plastic::{fresnel_diffuse_reflectance, Plastic};
-pub use rough_plastic::RoughPlastic;
+pub use rough_plastic::{AlphaTables, RoughPlastic, ALPHA_NODES};
 pub use textured::{ParamTextures, ParamValues};
 pub use thin::ThinDielectric;
 
@@ -112,7 +116,28 @@ pub enum Microfacet {
     RoughPlastic(RoughPlastic),
     /// `thindielectric`.
     ThinDielectric(ThinDielectric),
+    /// `diffuse`, as one of a blend's BSDFs ([`Blend`]).
+    Diffuse(Diffuse),
 }
+
+macro_rules! from_bsdf {
+    ($($ty:ident => $variant:ident),*) => {$(
+        impl From<$ty> for Microfacet {
+            fn from(b: $ty) -> Self {
+                Microfacet::$variant(b)
+            }
+        }
+    )*};
+}
+
+from_bsdf!(
+    RoughConductor => Conductor,
+    RoughDielectric => Dielectric,
+    Plastic => Plastic,
+    RoughPlastic => RoughPlastic,
+    ThinDielectric => ThinDielectric,
+    Diffuse => Diffuse
+);
 
 impl Microfacet {
     /// The surface's normal distribution (`None`: smooth, every lobe a delta).
@@ -121,13 +146,14 @@ impl Microfacet {
             Microfacet::Conductor(c) => c.distribution,
             Microfacet::Dielectric(d) => d.distribution,
             Microfacet::RoughPlastic(p) => Some(p.distribution),
-            Microfacet::Plastic(_) | Microfacet::ThinDielectric(_) => None,
+            Microfacet::Plastic(_) | Microfacet::ThinDielectric(_) | Microfacet::Diffuse(_) => None,
         }
     }
 
     /// True if some lobe is not a delta (light sampling can contribute).
     pub fn has_non_delta(&self) -> bool {
-        matches!(self, Microfacet::Plastic(_)) || self.distribution().is_some()
+        matches!(self, Microfacet::Plastic(_) | Microfacet::Diffuse(_))
+            || self.distribution().is_some()
     }
 
     /// Reflectance at normal incidence, for the albedo AOV.
@@ -138,11 +164,14 @@ impl Microfacet {
             Microfacet::Plastic(p) => p.diffuse,
             Microfacet::RoughPlastic(p) => p.diffuse,
             Microfacet::ThinDielectric(t) => t.transmittance,
+            Microfacet::Diffuse(d) => d.reflectance,
         }
     }
 
-    /// The BSDF with a texture's `tint` multiplying the diffuse base of the plastics (the
-    /// other types take no texture); `None` when the tint changes nothing.
+    /// The BSDF with a texture's `tint` multiplying the diffuse base of the plastics, the
+    /// diffuse's reflectance and a conductor's `specular_reflectance` (glTF's base colour
+    /// texture on its metal; Mitsuba's loader gives conductors no such texture); the
+    /// dielectrics take none. `None` when the tint changes nothing.
     fn tinted(&self, tint: Rgb) -> Option<Self> {
         if tint == Rgb::ONE {
             return None;
@@ -155,6 +184,14 @@ impl Microfacet {
             Microfacet::RoughPlastic(mut p) => {
                 p.diffuse *= tint;
                 Some(Microfacet::RoughPlastic(p))
+            }
+            Microfacet::Diffuse(mut d) => {
+                d.reflectance *= tint;
+                Some(Microfacet::Diffuse(d))
+            }
+            Microfacet::Conductor(mut c) => {
+                c.specular_reflectance *= tint;
+                Some(Microfacet::Conductor(c))
             }
             _ => None,
         }
@@ -266,6 +303,7 @@ impl Microfacet {
                 colour(t.reflectance, "specular_reflectance")?;
                 colour(t.transmittance, "specular_transmittance")
             }
+            Microfacet::Diffuse(d) => colour(d.reflectance, "reflectance"),
         }
     }
 }
@@ -296,6 +334,7 @@ impl Microfacet {
             Microfacet::Plastic(p) => p.eval_pdf(wo, wi),
             Microfacet::RoughPlastic(p) => p.eval_pdf(wo, wi),
             Microfacet::ThinDielectric(t) => t.eval_pdf(wo, wi),
+            Microfacet::Diffuse(d) => d.eval_pdf(wo, wi),
         }
     }
 
@@ -306,6 +345,7 @@ impl Microfacet {
             Microfacet::Plastic(p) => p.sample(wo, u_lobe, u),
             Microfacet::RoughPlastic(p) => p.sample(wo, u_lobe, u),
             Microfacet::ThinDielectric(t) => t.sample(wo, u_lobe, u),
+            Microfacet::Diffuse(d) => d.sample(wo, u_lobe, u),
         }
     }
 }

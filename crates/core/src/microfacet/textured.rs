@@ -10,10 +10,10 @@
 //! [`crate::texture::Texture::lookup`]; a roughness texel of 0 becomes
 //! [`super::MIN_ALPHA`], as a constant 0 does.
 //!
-//! Deviation: `roughplastic`'s `alpha` takes no texture, as in Mitsuba 3 (its coating's
-//! transmittance is tabulated for one roughness).
+//! `roughplastic`'s `alpha` takes a texture too, which Mitsuba 3 refuses: its coating's
+//! tables come from [`AlphaTables`], computed over the texture's range when the scene loads.
 
-use super::{Distribution, Microfacet};
+use super::{AlphaTables, Distribution, Microfacet};
 use crate::texture::{luminance, Texture};
 use crate::Rgb;
 use glam::Vec2;
@@ -75,6 +75,15 @@ impl ParamTextures {
 }
 
 impl ParamValues {
+    /// Every parameter its constant.
+    pub const NONE: ParamValues = ParamValues {
+        alpha_u: None,
+        alpha_v: None,
+        specular_reflectance: None,
+        specular_transmittance: None,
+        opacity: None,
+    };
+
     /// True when every parameter keeps its constant.
     #[inline]
     pub fn is_empty(&self) -> bool {
@@ -94,8 +103,9 @@ impl ParamValues {
 impl Microfacet {
     /// The BSDF with the textured parameters `v` in place of its constants; `None` when `v`
     /// changes nothing. A parameter the type does not have is ignored (the loaders refuse
-    /// such textures).
-    pub fn with_params(&self, v: &ParamValues) -> Option<Self> {
+    /// such textures). A rough plastic's textured roughness takes its coating's tables from
+    /// `tables` (without them, only its distribution changes).
+    pub fn with_params(&self, v: &ParamValues, tables: Option<&AlphaTables>) -> Option<Self> {
         let v = ParamValues {
             opacity: None,
             ..*v
@@ -134,10 +144,21 @@ impl Microfacet {
                 }
             }
             Microfacet::RoughPlastic(p) => {
+                if let Some(a) = v.alpha_u {
+                    *p = match tables {
+                        Some(t) => p.with_alpha(a, t),
+                        None => {
+                            let mut q = *p;
+                            q.distribution = v.distribution(p.distribution);
+                            q
+                        }
+                    };
+                }
                 if let Some(r) = v.specular_reflectance {
                     p.specular = r;
                 }
             }
+            Microfacet::Diffuse(_) => {}
         }
         Some(out)
     }

@@ -48,7 +48,7 @@ pub(super) struct Vertex<'a> {
     /// The BSDF for `wo` (surfaces).
     pub bsdf: Option<Bsdf<'a>>,
     pub material: Option<&'a Material>,
-    pub tint: rt_core::tint::Tint,
+    pub tint: rt_core::tint::Tint<'a>,
     /// Triangle index (surfaces and emitters), for the light sampler's pdf.
     pub prim: u32,
     /// Radiance the emitter leaves (light vertices).

@@ -19,7 +19,7 @@ const CHUNK: usize = 1024;
 /// Where an eye path stopped: the first vertex whose sampled layer is diffuse. Holds what
 /// rebuilding its BSDF needs rather than the BSDF, which is twice the size.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct EyeVertex {
+pub(super) struct EyeVertex<'a> {
     pub p: Vec3,
     pub p_error: Vec3,
     pub ng: Vec3,
@@ -29,7 +29,7 @@ pub(super) struct EyeVertex {
     /// Throughput from the camera, the choice of the diffuse part included (`1 / p_D`).
     pub beta: Rgb,
     pub material: u32,
-    pub tint: rt_core::tint::Tint,
+    pub tint: rt_core::tint::Tint<'a>,
     /// Radius of its caustic-histogram bin: half the pixel footprint at this distance.
     pub radius: f32,
     /// Scattering vertices of the eye path, this one included.
@@ -38,9 +38,9 @@ pub(super) struct EyeVertex {
     pub pixel: u32,
 }
 
-impl EyeVertex {
+impl<'a> EyeVertex<'a> {
     /// The diffuse part of the BSDF, through which VPLs and photons reach the eye.
-    pub fn diffuse_bsdf<'a>(&self, ctx: &Ctx<'a>) -> Bsdf<'a> {
+    pub fn diffuse_bsdf(&self, ctx: &Ctx<'a>) -> Bsdf<'a> {
         let m = &ctx.scene.materials[self.material as usize];
         Bsdf::new(m, self.tint, self.ns, self.ng, self.wo).restricted(LayerClass::Diffuse)
     }
@@ -48,23 +48,23 @@ impl EyeVertex {
 
 /// One pixel's eye path.
 #[derive(Clone, Copy, Debug, Default)]
-pub(super) struct EyeSample {
+pub(super) struct EyeSample<'a> {
     /// Emission found along the path (`ES*L`).
     pub emitted: Rgb,
-    pub vertex: Option<EyeVertex>,
+    pub vertex: Option<EyeVertex<'a>>,
     pub first_hit: Option<FirstHit>,
 }
 
 impl Partitioned {
     /// Every pixel's eye path of sample index `index`, in pixel order.
-    pub(super) fn eye_paths(
+    pub(super) fn eye_paths<'a>(
         &self,
-        ctx: &Ctx<'_>,
+        ctx: &Ctx<'a>,
         seed: u32,
         stream: SampleStream,
         index: u32,
         want_first_hit: bool,
-    ) -> Vec<EyeSample> {
+    ) -> Vec<EyeSample<'a>> {
         let cam = ctx.camera;
         let pixels = (cam.width * cam.height) as usize;
         // Angle subtended by a pixel at the centre of the image.
@@ -85,15 +85,15 @@ impl Partitioned {
         chunks.into_iter().flatten().collect()
     }
 
-    fn eye_path(
+    fn eye_path<'a>(
         &self,
-        ctx: &Ctx<'_>,
+        ctx: &Ctx<'a>,
         sampler: &mut Sampler,
         x: u32,
         y: u32,
         pixel_angle: f32,
         want_first_hit: bool,
-    ) -> EyeSample {
+    ) -> EyeSample<'a> {
         let (scene, cam) = (ctx.scene, ctx.camera);
         let film_pos = cam.filter.film_position(x, y, sampler.next_2d());
         let lens = if cam.is_pinhole() {

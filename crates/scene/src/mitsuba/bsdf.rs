@@ -2,7 +2,8 @@
 //! keep their names and parameters (docs/scene-format.md, "The microfacet family"),
 //! `plastic` becomes our `smoothplastic`, `twosided` a flag on what it wraps, `mask` the key
 //! `opacity` on what it wraps, `bumpmap` and `normalmap` the keys `bump_map` (with
-//! `bump_scale`) and `normal_map` on what they wrap.
+//! `bump_scale`) and `normal_map` on what they wrap, `blendbsdf` a `blendbsdf` table whose
+//! two BSDFs become materials of their own ([`Converted::parts`]).
 
 use toml::{Table, Value};
 
@@ -16,6 +17,9 @@ pub(super) struct Converted {
     pub table: Table,
     /// The table's texture keys, whose file names are relative to the scene file.
     pub textures: Vec<TextureKey>,
+    /// A `blendbsdf`'s two BSDFs, which the caller names and lists before the blend's table
+    /// and names in its `bsdfs` key; empty for every other BSDF.
+    pub parts: Vec<Converted>,
 }
 
 /// A texture key of a material table: a `bitmap`'s file and its options, or a
@@ -49,6 +53,8 @@ struct Wrapped {
     two_sided: bool,
     /// A `bumpmap` or `normalmap`.
     perturbed: bool,
+    /// A `blendbsdf`: what its BSDFs cannot be.
+    blended: bool,
 }
 
 /// Converts `node` (a `<bsdf>`).
@@ -119,6 +125,43 @@ fn convert_in<'a>(
                 ..wrapped
             };
             return convert_in(one, resolve, inner, warnings);
+        }
+        "mask" | "bumpmap" | "normalmap" | "blendbsdf" if wrapped.blended => {
+            return Err(node.at.error(format!(
+                "a {ty} inside a blendbsdf is not supported (wrap the blendbsdf instead)"
+            )));
+        }
+        "blendbsdf" => {
+            let (weight_texture, weight) = match p.named_texture("weight", resolve)? {
+                Some(tex) => (Some(texture(tex, "weight", warnings)?), None),
+                None => (None, p.float("weight")?),
+            };
+            let inner = blended_two(node, &p, resolve)?;
+            t.insert("type".into(), "blendbsdf".into());
+            match (weight_texture, weight) {
+                (Some(tex), _) => textures.push(tex),
+                (None, Some(w)) if !(0.0..=1.0).contains(&w) => {
+                    return Err(p.error(format!("weight must be in [0, 1], got {w}")));
+                }
+                (None, Some(w)) => {
+                    t.insert("weight".into(), w.into());
+                }
+                (None, None) => return Err(p.error("needs a `weight`")),
+            }
+            p.finish(warnings)?;
+            let in_blend = Wrapped {
+                blended: true,
+                ..wrapped
+            };
+            let parts = inner
+                .into_iter()
+                .map(|n| convert_in(n, resolve, in_blend, warnings))
+                .collect::<Result<Vec<_>, _>>()?;
+            return Ok(Converted {
+                table: t,
+                textures,
+                parts,
+            });
         }
         "mask" => {
             // Mitsuba's default opacity is 0.5.
@@ -286,12 +329,44 @@ fn convert_in<'a>(
             return Err(node.at.error(format!(
             "bsdf \"{other}\" is not supported (supported: diffuse, dielectric, thindielectric, \
                  roughdielectric, conductor, roughconductor, plastic, roughplastic, twosided, \
-                 mask, bumpmap, normalmap)"
+                 mask, bumpmap, normalmap, blendbsdf)"
         )))
         }
     }
     p.finish(warnings)?;
-    Ok(Converted { table: t, textures })
+    Ok(Converted {
+        table: t,
+        textures,
+        parts: Vec::new(),
+    })
+}
+
+/// The two BSDFs a `blendbsdf` blends, nested or referenced, in the order they appear.
+fn blended_two<'a>(
+    node: &'a Node,
+    p: &Props<'a>,
+    resolve: &dyn Fn(&'a Node) -> Result<&'a Node, SceneError>,
+) -> Result<[&'a Node; 2], SceneError> {
+    // Marks them read.
+    p.objects("bsdf");
+    p.refs();
+    let mut inner = Vec::new();
+    for c in &node.children {
+        match c.tag.as_str() {
+            "bsdf" => inner.push(c),
+            "ref" => {
+                let n = resolve(c)?;
+                if n.tag == "bsdf" {
+                    inner.push(n);
+                }
+            }
+            _ => {}
+        }
+    }
+    match inner.as_slice() {
+        [a, b] => Ok([a, b]),
+        _ => Err(p.error(format!("blends {} BSDFs, expected two", inner.len()))),
+    }
 }
 
 /// A colour parameter: a constant, a nested texture or a `<ref>` to one.

@@ -593,13 +593,29 @@ impl<'a> Builder<'a, '_> {
         let name = b
             .attr("id")
             .map_or_else(|| format!("bsdf{}", self.by_node.len()), str::to_string);
-        let mut t = converted.table;
-        for tex in &converted.textures {
-            t.insert(tex.key.into(), tex.value(self.file_name));
+        let mut t = self.table_of(&converted);
+        if !converted.parts.is_empty() {
+            // A blend's BSDFs: materials of their own, listed before it.
+            let mut names = Vec::new();
+            for (i, part) in converted.parts.iter().enumerate() {
+                let part_name = format!("{name}.{i}");
+                let table = self.table_of(part);
+                names.push(toml::Value::from(self.use_material(part_name, table)));
+            }
+            t.insert("bsdfs".into(), toml::Value::Array(names));
         }
         let done = (name, t);
         self.by_node.insert(b as *const Node, done.clone());
         Ok(done)
+    }
+
+    /// The material table of a converted BSDF, its textures' file names mapped.
+    fn table_of(&self, c: &bsdf::Converted) -> Table {
+        let mut t = c.table.clone();
+        for tex in &c.textures {
+            t.insert(tex.key.into(), tex.value(self.file_name));
+        }
+        t
     }
 
     /// `constant` and `envmap` light the scene from every direction; other emitters outside
