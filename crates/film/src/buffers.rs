@@ -3,6 +3,7 @@
 //! is refused before it starts.
 
 use crate::film::EvenSums;
+use crate::filtered::Weighted;
 use crate::fixed::{Squares3, Sum1, Sum3};
 use crate::pixel::{FeatureSquares, SplitSums};
 use crate::AovSet;
@@ -64,6 +65,16 @@ impl From<AovSet> for FilmBuffers {
     }
 }
 
+/// The sums a film allocates with the first sample that needs them rather than up front: what
+/// the technique and the camera will send it, known before a render starts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LateSums {
+    /// Light-path splats (a technique whose paths start at the lights: `light`, `bdpt`).
+    pub light_splats: bool,
+    /// Filter-weighted sums (a camera whose pixel filter splats, `rt_core::pixel_filter`).
+    pub filtered: bool,
+}
+
 /// Bytes held by each of a film's buffers (length × element size); `None` for a buffer the
 /// film did not allocate.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -99,15 +110,15 @@ pub struct FilmMemory {
 
 impl FilmMemory {
     /// What `Film::new(width, height, buffers)` holds once every pixel has
-    /// `samples_per_pixel` samples (per-sample records grow with them) and, with `splats`,
-    /// after the first light-path splat: the sizes [`Film::memory`](crate::Film::memory) reports, computed without
-    /// allocating, so that a render that cannot fit is refused before it starts.
+    /// `samples_per_pixel` samples (per-sample records grow with them) and the `late` sums
+    /// have been made: the sizes [`Film::memory`](crate::Film::memory) reports, computed
+    /// without allocating, so that a render that cannot fit is refused before it starts.
     pub fn estimate(
         width: u32,
         height: u32,
         buffers: impl Into<FilmBuffers>,
         samples_per_pixel: u64,
-        splats: bool,
+        late: LateSums,
     ) -> FilmMemory {
         let mut buffers = buffers.into();
         buffers.variance |= buffers.aovs.variance;
@@ -131,11 +142,14 @@ impl FilmMemory {
             split: of(a.any_split(), size_of::<SplitSums>()),
             // The even samples' splats only with half-buffers (`SplatSums::add`).
             splats: of(
-                splats,
+                late.light_splats,
                 (1 + usize::from(buffers.halves)) * size_of::<Sum3>(),
             ),
-            // Not estimated: a film learns that its camera splats with the first splat.
-            filtered: None,
+            // The even samples' filtered sums only with half-buffers (`FilterSums::parts_mut`).
+            filtered: of(
+                late.filtered,
+                (1 + usize::from(buffers.halves)) * size_of::<Weighted>(),
+            ),
             samples: buffers.samples.then(|| {
                 (n as u64)
                     .saturating_mul(samples_per_pixel)

@@ -643,7 +643,13 @@ impl Film {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::AOV_NAMES;
+    use crate::{LateSums, AOV_NAMES};
+
+    /// A technique whose paths start at the lights.
+    const LIGHT: LateSums = LateSums {
+        light_splats: true,
+        filtered: false,
+    };
 
     #[test]
     fn the_estimate_is_what_a_film_allocates() {
@@ -661,7 +667,7 @@ mod tests {
             ] {
                 let film = Film::new(7, 5, buffers);
                 assert_eq!(
-                    FilmMemory::estimate(7, 5, buffers, 0, false),
+                    FilmMemory::estimate(7, 5, buffers, 0, LateSums::default()),
                     film.memory(),
                     "{buffers:?}"
                 );
@@ -677,7 +683,7 @@ mod tests {
                 value: Rgb::ONE,
             }],
         );
-        let e = FilmMemory::estimate(7, 5, FilmBuffers::default(), 0, true);
+        let e = FilmMemory::estimate(7, 5, FilmBuffers::default(), 0, LIGHT);
         assert_eq!(e.splats, film.memory().splats);
         let halves = FilmBuffers::default().with_halves();
         let mut film = Film::new(7, 5, halves);
@@ -689,16 +695,31 @@ mod tests {
                 value: Rgb::ONE,
             }],
         );
-        let e = FilmMemory::estimate(7, 5, halves, 0, true);
+        let e = FilmMemory::estimate(7, 5, halves, 0, LIGHT);
         assert_eq!(e.splats, film.memory().splats);
+        // Filtered sums appear with the first splatted camera sample, doubled by half-buffers.
+        let filter = PixelFilter::parse("gaussian:splat").unwrap();
+        for buffers in [FilmBuffers::default(), halves] {
+            let mut film = Film::new(7, 5, buffers);
+            for mut stripe in film.stripes_mut(2) {
+                let y = stripe.y0;
+                stripe.add_filtered(&filter, Vec2::new(0.5, y as f32 + 0.5), (0, y), 0, Rgb::ONE);
+            }
+            let late = LateSums {
+                filtered: true,
+                ..LateSums::default()
+            };
+            let e = FilmMemory::estimate(7, 5, buffers, 0, late);
+            assert_eq!(e, film.memory(), "{buffers:?}");
+        }
         let records = FilmBuffers {
             samples: true,
             ..FilmBuffers::default()
         };
-        let e = FilmMemory::estimate(7, 5, records, 16, false);
+        let e = FilmMemory::estimate(7, 5, records, 16, LateSums::default());
         assert_eq!(e.samples, Some(35 * 16 * 56 + 36 * 8));
         // A 16384² film with every sample kept at 1024 spp: about 15 TB, without overflow.
-        let huge = FilmMemory::estimate(16384, 16384, records, 1024, false);
+        let huge = FilmMemory::estimate(16384, 16384, records, 1024, LateSums::default());
         assert!(huge.total() > 15_000_000_000_000, "{huge:?}");
     }
 

@@ -68,7 +68,7 @@ mod splat;
 pub mod stopping;
 
 pub use aov_set::{AovFlag, AovSet, UnknownAov, AOV_FLAGS, AOV_NAMES};
-pub use buffers::{FilmBuffers, FilmMemory};
+pub use buffers::{FilmBuffers, FilmMemory, LateSums};
 pub use film::{FeatureVariances, Film, FilmStripe};
 pub use guides::{GuideBuffers, GuideError, ReflectedGuides, NO_ID};
 pub use input::{decode_raw, decode_srgb, read_rgb};

@@ -17,7 +17,7 @@ use crate::film::{EvenSums, Film};
 use crate::filtered::Weighted;
 use crate::fixed::{Squares3, Sum1, Sum3};
 use crate::pixel::{FeatureSquares, SplitSums};
-use crate::FilmBuffers;
+use crate::{FilmBuffers, LateSums};
 
 /// A rectangle of pixels: columns `x0..x1`, rows `y0..y1`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -399,6 +399,16 @@ impl Film {
             n += rect.area() * sets * Weighted::BYTES as u64;
         }
         n
+    }
+
+    /// The late sums ([`LateSums`]) that bytes [`Film::encode_sums`] wrote carry, read from
+    /// their flags byte (unchecked: [`Film::add_encoded`] checks the rest).
+    pub fn encoded_late_sums(bytes: &[u8]) -> LateSums {
+        let flags = bytes.first().copied().unwrap_or(0);
+        LateSums {
+            light_splats: flags & LIGHT_SPLATS != 0,
+            filtered: flags & FILTERED != 0,
+        }
     }
 
     /// Adds sums that [`Film::encode_sums`] wrote for `rect` from a film with the same

@@ -7,7 +7,7 @@
 //! the splats that landed inside) are counted once.
 
 use crate::file::{Part, PartHeader};
-use rt_film::{Film, FilmMemory, Rect};
+use rt_film::{Film, FilmMemory, LateSums, Rect};
 use std::collections::BTreeMap;
 use std::ops::Range;
 
@@ -195,7 +195,15 @@ pub fn merge(parts: &[(String, Part)], memory_limit: Option<u64>) -> Result<Merg
         file: first_name.clone(),
         message: e.to_string(),
     })?;
-    let need = FilmMemory::estimate(w, hgt, buffers, 0, true).total() as u64;
+    // The sums a part made late (light-path splats, filtered sums) the merged film makes too.
+    let late = parts.iter().fold(LateSums::default(), |l, (_, p)| {
+        let f = Film::encoded_late_sums(&p.sums);
+        LateSums {
+            light_splats: l.light_splats | f.light_splats,
+            filtered: l.filtered | f.filtered,
+        }
+    });
+    let need = FilmMemory::estimate(w, hgt, buffers, 0, late).total() as u64;
     if let Some(limit) = memory_limit {
         if need > limit {
             return Err(MergeError::Memory { need, limit });

@@ -7,7 +7,7 @@
 //! counted again.
 
 use rt_accel::AccelSpec;
-use rt_film::{FilmBuffers, FilmMemory};
+use rt_film::{FilmBuffers, FilmMemory, LateSums};
 
 /// A size that does not parse, or a render that would not fit.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
@@ -85,19 +85,19 @@ pub struct Estimate {
 }
 
 impl Estimate {
-    /// Film of `width × height` keeping `buffers` after `spp` samples per pixel (`splats`:
-    /// a light-path technique), and `accel` over `triangles`.
+    /// Film of `width × height` keeping `buffers` after `spp` samples per pixel, with the
+    /// `late` sums its technique and camera will make, and `accel` over `triangles`.
     pub fn new(
         width: u32,
         height: u32,
         buffers: FilmBuffers,
         spp: u32,
-        splats: bool,
+        late: LateSums,
         accel: &AccelSpec,
         triangles: usize,
     ) -> Self {
         Self {
-            film: FilmMemory::estimate(width, height, buffers, u64::from(spp), splats),
+            film: FilmMemory::estimate(width, height, buffers, u64::from(spp), late),
             structure: accel.kind.memory_bound(triangles),
         }
     }

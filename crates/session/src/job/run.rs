@@ -9,7 +9,7 @@ use crate::frames::frame_path;
 use crate::memory::Estimate;
 use crate::{pick_camera, render_adaptive_until, Adaptive, RenderReport, ReportInputs};
 use rt_core::{Accel, Camera, RgbImage, Scene};
-use rt_film::{AovSet, ExrImage, Film, FilmBuffers, OutputOptions};
+use rt_film::{AovSet, ExrImage, Film, FilmBuffers, LateSums, OutputOptions};
 use rt_integrators::{Ctx, RadianceCache, RenderStats, SamplePass, Technique};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -234,13 +234,16 @@ impl RenderJob {
         let camera = self.camera_in(scene)?;
         // A temporal denoiser's needs are its own; the plain film is still the floor.
         let denoiser = self.frame_denoiser()?;
-        let splats = self.settings.integrator.build().splats();
+        let late = LateSums {
+            light_splats: self.settings.integrator.build().splats(),
+            filtered: camera.filter.splats(),
+        };
         Estimate::new(
             camera.width,
             camera.height,
             self.film_buffers(denoiser.as_deref()),
             self.settings.spp,
-            splats,
+            late,
             &self.settings.accel,
             scene.triangle_count(),
         )
