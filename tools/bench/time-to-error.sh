@@ -29,6 +29,8 @@
 #   MI_SEED, REF_SEED, VARIANT                         [1, 7, llvm_ad_rgb]
 #   INTEGRATOR   our integrator                        [wavefront]
 #   COMMIT       commit RENDER was built from          [git rev-parse --short HEAD]
+#   REF_ONLY     1: render (or find) the references and stop, so that a later timed run
+#                can start on a quiet machine                           [unset]
 #
 # A cold reference takes long (16384 spp at 256x256: about 10 min for the box, more for the
 # dragon, on 2 cores); it is rendered once per scene and Mitsuba version and then cached.

@@ -353,6 +353,10 @@ def main() -> int:
             ref_info["cached"] = False
         refs[scene] = (toml, ref, ref_var, ref_info)
 
+    if env("REF_ONLY", "") == "1":
+        log("REF_ONLY=1: the references are in the cache; no timed renders")
+        return 0
+
     # Phase 2: the timed renders.
     meta["date"] = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     meta["uptime_start"] = sh("uptime")
