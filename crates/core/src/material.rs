@@ -42,7 +42,7 @@
 
 use crate::bump::NormalPerturbation;
 use crate::microfacet::{
-    AlphaTables, Blend, BlendAt, LocalSample, Microfacet, ParamTextures, ParamValues,
+    AlphaTables, Blend, BlendAt, IorValues, LocalSample, Microfacet, ParamTextures, ParamValues,
 };
 use crate::tint::{TexturesAt, Tint};
 use crate::{
@@ -447,9 +447,10 @@ pub struct Bsdf<'a> {
     /// [`Bsdf::sample`], need no layer loop. The arithmetic is the general path's, operation
     /// for operation, so both give the same bits.
     lambert: Option<Rgb>,
-    /// Where a blend's textures are read ([`Tint::at`]). They are read each time the blend is
-    /// evaluated ([`BlendAt::blended`]): their values, or the blended BSDFs (650 bytes), held
-    /// here would make every `Bsdf` that much larger to build and copy.
+    /// Where a blend's textures and a textured index of refraction are read ([`Tint::at`]).
+    /// They are read each time the BSDF is evaluated ([`BlendAt::blended`],
+    /// [`ParamTextures::ior_at`]): their values, or the blended BSDFs (650 bytes), held here
+    /// would make every `Bsdf` that much larger to build and copy.
     at: Option<TexturesAt<'a>>,
     /// The textured parameters' values at this point (all `None` for most materials).
     params: ParamValues,
@@ -897,7 +898,14 @@ impl<'a> Bsdf<'a> {
     fn with_micro<R>(&self, f: impl FnOnce(&Microfacet) -> R) -> Option<R> {
         let m = self.material.microfacet.as_ref()?;
         let tables = self.material.alpha_tables.as_ref();
-        Some(match m.with_params(&self.params, tables) {
+        // A textured index of refraction is read here, not carried (`crate::tint`).
+        let ior = match &self.at {
+            Some(at) if self.material.param_textures.has_ior() => {
+                self.material.param_textures.ior_at(at)
+            }
+            _ => IorValues::NONE,
+        };
+        Some(match m.with_params(&self.params, &ior, tables) {
             Some(textured) => f(&textured),
             None => f(m),
         })
@@ -1188,7 +1196,7 @@ impl crate::content_hash::ContentHash for Material {
             format!("{p:?}").content_hash(out);
         }
         if !param_textures.is_empty() {
-            format!("{param_textures:?}").content_hash(out);
+            param_textures.hash_text().content_hash(out);
         }
         if let Some(o) = opacity {
             o.content_hash(out);
@@ -1202,7 +1210,7 @@ impl crate::content_hash::ContentHash for Material {
             format!("{:?}", b.weight_texture).content_hash(out);
             for p in &b.parts {
                 p.bsdf.content_hash(out);
-                format!("{:?} {:?}", p.textures, p.texture).content_hash(out);
+                format!("{} {:?}", p.textures.hash_text(), p.texture).content_hash(out);
                 if let Some(t) = &p.alpha_tables {
                     format!("{:?}", t.alphas()).content_hash(out);
                 }

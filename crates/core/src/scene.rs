@@ -597,11 +597,10 @@ impl Scene {
         crate::tint::Tint {
             color: self.texture_color(m, uv),
             params: m.param_textures.lookup(&self.textures, uv),
-            // A blend's textures are read where its BSDF is evaluated (`crate::tint`).
-            at: m
-                .blend
-                .as_ref()
-                .map(|_| crate::tint::TexturesAt { scene: self, uv }),
+            // A blend's textures and a textured index of refraction are read where the BSDF
+            // is evaluated (`crate::tint`).
+            at: (m.blend.is_some() || m.param_textures.has_ior())
+                .then_some(crate::tint::TexturesAt { scene: self, uv }),
         }
     }
 

@@ -202,10 +202,24 @@ impl Texture {
     /// row of the image (the OBJ and .ruv convention; glTF's top-left origin is converted at
     /// load time).
     pub fn lookup(&self, uv: Vec2) -> Rgb {
+        self.interpolate(uv, sanitize)
+    }
+
+    /// [`Texture::lookup`] without the upper clamp: texels are read as they are, negative or
+    /// NaN components as 0 and infinities as the largest finite value. For parameters that are
+    /// not reflectances, such as a conductor's index of refraction (`eta` above 1, `k` often
+    /// above 3), which the loaders read from float images or checkerboard constants.
+    pub fn lookup_unbounded(&self, uv: Vec2) -> Rgb {
+        self.interpolate(uv, |c| c.max(Rgb::ZERO).min(Rgb::splat(f32::MAX)))
+    }
+
+    /// The bilinear (or nearest) combination at `uv` of texels passed through `texel`.
+    #[inline]
+    fn interpolate(&self, uv: Vec2, texel: impl Fn(Rgb) -> Rgb) -> Rgb {
         let Some(fp) = self.footprint(uv) else {
             return Rgb::ONE;
         };
-        let at = |k: usize| sanitize(self.texels[fp.at[k]]);
+        let at = |k: usize| texel(self.texels[fp.at[k]]);
         let (fx, fy) = (fp.f.x, fp.f.y);
         let top = at(0) * (1.0 - fx) + at(1) * fx;
         let bot = at(2) * (1.0 - fx) + at(3) * fx;
@@ -283,6 +297,19 @@ mod tests {
             );
         }
         assert_eq!(t.lookup(Vec2::new(0.25, 0.5)), Rgb::new(0.0, 1.0, 0.0));
+        // Unbounded: values above 1 kept, still finite and non-negative everywhere.
+        for i in 0..50 {
+            let c = t.lookup_unbounded(Vec2::new(i as f32 / 49.0, 0.5));
+            assert!(c.is_finite() && c.min_element() >= 0.0, "{c}");
+        }
+        assert_eq!(
+            t.lookup_unbounded(Vec2::new(0.75, 0.5)),
+            Rgb::new(0.5, 0.0, 3.0)
+        );
+        assert_eq!(
+            t.lookup_unbounded(Vec2::new(0.25, 0.5)),
+            Rgb::new(0.0, f32::MAX, 0.0)
+        );
     }
 
     #[test]

@@ -7,7 +7,8 @@
 //! evaluated ([`crate::microfacet::BlendAt`]): their values, two BSDFs' worth, would make every
 //! `Tint` and every [`crate::material::Bsdf`] larger, and the path tracer copies both at every
 //! vertex of every material. A `Tint` carries what that reading needs instead
-//! ([`TexturesAt`]).
+//! ([`TexturesAt`]). So does a conductor's textured index of refraction
+//! ([`crate::microfacet::ParamTextures::ior_at`]), the one other parameter read that way.
 
 use crate::microfacet::ParamValues;
 use crate::{Rgb, Scene};
@@ -20,8 +21,8 @@ pub struct Tint<'a> {
     pub color: Rgb,
     /// The textured parameters (all `None` without textured parameters).
     pub params: ParamValues,
-    /// Where a blend's textures are read (`None` for the other materials, and for a blend
-    /// whose textures read as their constants).
+    /// Where a blend's textures or a textured `eta` or `k` are read (`None` for the other
+    /// materials, and for a blend whose textures read as their constants).
     pub at: Option<TexturesAt<'a>>,
 }
 

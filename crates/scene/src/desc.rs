@@ -218,8 +218,9 @@ pub(crate) struct MaterialDesc {
     pub alpha: Option<Spanned<toml::Value>>,
     pub alpha_u: Option<Spanned<toml::Value>>,
     pub alpha_v: Option<Spanned<toml::Value>>,
-    pub eta: Option<Spanned<V3>>,
-    pub k: Option<Spanned<V3>>,
+    /// `[r, g, b]` or textures read unclamped (`param_desc::index`).
+    pub eta: Option<Spanned<toml::Value>>,
+    pub k: Option<Spanned<toml::Value>>,
     /// A number or one of Mitsuba's named indices (`"water"`, `"bk7"`, ...).
     pub int_ior: Option<Spanned<toml::Value>>,
     pub ext_ior: Option<Spanned<toml::Value>>,

@@ -1,4 +1,5 @@
-//! Image files: textures (PNG, JPEG; sRGB decoded to linear) and EXR environment maps.
+//! Image files: textures (PNG, JPEG: sRGB decoded to linear unless raw; EXR and HDR: linear
+//! floats) and environment maps (EXR, HDR).
 
 use crate::error::{Result, SceneError};
 use crate::files::FileAccess;
@@ -44,14 +45,21 @@ impl Textures {
         if let Some(&i) = self.by_path.get(&key) {
             return Ok(i);
         }
-        let bytes = self.access.read(path, "")?;
-        let decoded = if options.raw {
-            rt_film::decode_raw(&bytes)
+        let mut t = if is_float_image(path) {
+            // Linear floats (Mitsuba reads them so, `raw` or not); any non-negative value, for
+            // parameters that are not reflectances (a conductor's `eta` and `k`).
+            let (w, h, texels) = read_env_map(&self.access, path)?;
+            Texture::new(w, h, texels)
         } else {
-            rt_film::decode_srgb(&bytes)
+            let bytes = self.access.read(path, "")?;
+            let decoded = if options.raw {
+                rt_film::decode_raw(&bytes)
+            } else {
+                rt_film::decode_srgb(&bytes)
+            };
+            let img = decoded.map_err(|e| SceneError::file(path, e))?;
+            Texture::new(img.width() as u32, img.height() as u32, img.into_pixels())
         };
-        let img = decoded.map_err(|e| SceneError::file(path, e))?;
-        let mut t = Texture::new(img.width() as u32, img.height() as u32, img.into_pixels());
         t.filter = options.filter;
         t.wrap = options.wrap;
         let i = self.add(t);
@@ -95,7 +103,14 @@ pub(crate) fn texture_from_bytes(bytes: &[u8]) -> std::result::Result<Texture, S
     ))
 }
 
-/// Reads an environment map as row-major linear radiance (row 0 at the top): the first
+/// True for the float formats (OpenEXR, Radiance `.hdr`), read by [`read_env_map`].
+fn is_float_image(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr") || e.eq_ignore_ascii_case("hdr"))
+}
+
+/// Reads an environment map (or a float texture) as row-major linear radiance (row 0 at the top): the first
 /// RGB(A) layer of an OpenEXR file, or a Radiance RGBE (`.hdr`) file. Rejects empty images
 /// and NaN, infinite or negative texels, naming the first bad one.
 pub(crate) fn read_env_map(access: &FileAccess, path: &Path) -> Result<(u32, u32, Vec<Rgb>)> {

@@ -863,6 +863,18 @@ mod tests {
                 "`eta` does not apply",
             ),
             (
+                "type = \"conductor\"\nk = [-1, 0, 0]",
+                "`k` must not be negative",
+            ),
+            (
+                "type = \"conductor\"\neta = { type = \"checkerboard\", color0 = -1 }",
+                "checkerboard `color0` must be a non-negative number or [r, g, b]",
+            ),
+            (
+                "type = \"roughdielectric\"\neta = { type = \"checkerboard\" }",
+                "`eta` does not apply",
+            ),
+            (
                 "type = \"roughconductor\"\ncolor = [1, 1, 1]",
                 "use specular_reflectance",
             ),

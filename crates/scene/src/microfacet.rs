@@ -214,7 +214,16 @@ pub(crate) fn build(ctx: &mut Ctx, d: &MaterialDesc, kind: &str) -> Result<Mater
                     )
                 })?
             }
-            None => (rgb(&d.eta, "eta", Rgb::ZERO)?, rgb(&d.k, "k", Rgb::ONE)?),
+            None => {
+                let (eta, k) = (
+                    index(ctx, d, &d.eta, "eta", Rgb::ZERO)?,
+                    index(ctx, d, &d.k, "k", Rgb::ONE)?,
+                );
+                textures.eta = eta.texture();
+                textures.k = k.texture();
+                // A texture's placeholder: a valid constant, replaced at every hit.
+                (eta.constant_or(Rgb::ZERO), k.constant_or(Rgb::ONE))
+            }
         };
         Microfacet::Conductor(RoughConductor {
             distribution,
@@ -317,6 +326,20 @@ fn colour(
     match v {
         None => Ok(Param::Const(Rgb::ONE)),
         Some(v) => param_desc::colour(ctx, d.name.get_ref(), key, v),
+    }
+}
+
+/// A conductor's `eta` or `k`: a colour or a texture, `default` when absent.
+fn index(
+    ctx: &mut Ctx,
+    d: &MaterialDesc,
+    v: &Option<toml::Spanned<toml::Value>>,
+    key: &str,
+    default: Rgb,
+) -> Result<Param<Rgb>> {
+    match v {
+        None => Ok(Param::Const(default)),
+        Some(v) => param_desc::index(ctx, d.name.get_ref(), key, v),
     }
 }
 

@@ -88,6 +88,26 @@ pub(crate) fn colour(
     }
 }
 
+/// A conductor's `eta` or `k` (key `key` of material `name`): `[r, g, b]` of non-negative
+/// numbers, or a texture read unclamped.
+pub(crate) fn index(
+    ctx: &mut Ctx,
+    name: &str,
+    key: &str,
+    v: &Spanned<Value>,
+) -> Result<Param<Rgb>> {
+    if matches!(v.get_ref(), Value::String(_) | Value::Table(_)) {
+        return crate::texture_desc::load_unbounded(ctx, name, v).map(Param::Texture);
+    }
+    match colour(ctx, name, key, v)? {
+        Param::Const(c) if c.min_element() < 0.0 => Err(ctx.src.error_at(
+            v.span(),
+            format!("material \"{name}\": `{key}` must not be negative, got {c}"),
+        )),
+        p => Ok(p),
+    }
+}
+
 fn texture<T>(ctx: &mut Ctx, name: &str, v: &Spanned<Value>) -> Result<Param<T>> {
     crate::texture_desc::load(ctx, name, v, false).map(Param::Texture)
 }

@@ -23,8 +23,34 @@ use crate::load::Ctx;
 
 /// Loads the texture `v` names for material `name`; `raw` is the default of its `raw` key.
 pub(crate) fn load(ctx: &mut Ctx, name: &str, v: &Spanned<Value>, raw: bool) -> Result<u32> {
+    load_in(ctx, name, v, raw, Texels::Reflectance)
+}
+
+/// [`load`] for a parameter that is not a reflectance (a conductor's `eta` and `k`): a
+/// checkerboard's colours may exceed 1, and lookups read texels unclamped
+/// ([`rt_core::texture::Texture::lookup_unbounded`]; float images hold such values).
+pub(crate) fn load_unbounded(ctx: &mut Ctx, name: &str, v: &Spanned<Value>) -> Result<u32> {
+    load_in(ctx, name, v, false, Texels::Unbounded)
+}
+
+/// The values a texture's texels may take.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Texels {
+    /// [0, 1].
+    Reflectance,
+    /// Any non-negative number.
+    Unbounded,
+}
+
+fn load_in(
+    ctx: &mut Ctx,
+    name: &str,
+    v: &Spanned<Value>,
+    raw: bool,
+    texels: Texels,
+) -> Result<u32> {
     if let Some(t) = v.get_ref().as_table().filter(|t| t.contains_key("type")) {
-        let texture = checkerboard(t).map_err(|e| {
+        let texture = checkerboard(t, texels).map_err(|e| {
             ctx.src
                 .error_at(v.span(), format!("material \"{name}\": {e}"))
         })?;
@@ -35,7 +61,7 @@ pub(crate) fn load(ctx: &mut Ctx, name: &str, v: &Spanned<Value>, raw: bool) -> 
 }
 
 /// A `{ type = "checkerboard", ... }` table (the only texture type besides files).
-fn checkerboard(t: &toml::Table) -> std::result::Result<Texture, String> {
+fn checkerboard(t: &toml::Table, texels: Texels) -> std::result::Result<Texture, String> {
     let mut colors = [Rgb::splat(0.4), Rgb::splat(0.2)];
     let mut to_uv = Affine2::IDENTITY;
     for (key, value) in t {
@@ -51,8 +77,13 @@ fn checkerboard(t: &toml::Table) -> std::result::Result<Texture, String> {
                 None => return Err("texture `type` must be a string".into()),
             },
             "color0" | "color1" => {
-                let c = colour(value).ok_or_else(|| {
-                    format!("checkerboard `{key}` must be a number or [r, g, b] in [0, 1]")
+                let c = colour(value, texels).ok_or_else(|| match texels {
+                    Texels::Reflectance => {
+                        format!("checkerboard `{key}` must be a number or [r, g, b] in [0, 1]")
+                    }
+                    Texels::Unbounded => {
+                        format!("checkerboard `{key}` must be a non-negative number or [r, g, b]")
+                    }
                 })?;
                 colors[(key == "color1") as usize] = c;
             }
@@ -81,13 +112,17 @@ fn number(v: &Value) -> Option<f32> {
     x.is_finite().then_some(x)
 }
 
-/// A reflectance: a number or `[r, g, b]`, each in [0, 1].
-fn colour(v: &Value) -> Option<Rgb> {
+/// A number or `[r, g, b]`, each non-negative, and at most 1 for a reflectance.
+fn colour(v: &Value, texels: Texels) -> Option<Rgb> {
     let c = match v {
         Value::Array(a) if a.len() == 3 => Rgb::new(number(&a[0])?, number(&a[1])?, number(&a[2])?),
         other => Rgb::splat(number(other)?),
     };
-    (c.min_element() >= 0.0 && c.max_element() <= 1.0).then_some(c)
+    let max = match texels {
+        Texels::Reflectance => 1.0,
+        Texels::Unbounded => f32::MAX,
+    };
+    (c.min_element() >= 0.0 && c.max_element() <= max).then_some(c)
 }
 
 /// `[[a, b, c], [d, e, f]]`: `(u, v) ↦ (a·u + b·v + c, d·u + e·v + f)`.

@@ -152,6 +152,70 @@ fn a_textured_parameter_renders_as_its_constant() {
     }
 }
 
+/// A conductor's `eta` and `k` take textures read unclamped: a checkerboard of values above
+/// 1, and a float (EXR) bitmap; also inside a blend. The control: the default index (a perfect
+/// mirror) renders differently.
+#[test]
+fn a_textured_index_of_refraction_renders_as_its_constant() {
+    let dir = tempfile::tempdir().unwrap();
+    exr::prelude::write_rgb_file(dir.path().join("eta.exr"), 2, 2, |_, _| {
+        (0.2f32, 0.9f32, 1.1f32)
+    })
+    .unwrap();
+    let ggx = r#"<string name="distribution" value="ggx"/>"#;
+    let exr = r#"<texture type="bitmap" name="eta"><string name="filename" value="eta.exr"/>
+        <string name="filter_type" value="nearest"/>
+        </texture>"#;
+    let k3 = r#"<rgb name="k" value="3"/>"#;
+    let eta02 = r#"<rgb name="eta" value="0.2"/>"#;
+    let eta_exr = r#"<rgb name="eta" value="0.2, 0.9, 1.1"/>"#;
+    let blend = |inner: &str| {
+        format!(
+            r#"<bsdf type="blendbsdf"><float name="weight" value="0.5"/><bsdf type="diffuse"/>
+                <bsdf type="roughconductor">{ggx}{inner}</bsdf></bsdf>"#
+        )
+    };
+    // (the BSDF with textures, with their constants, with the default index)
+    let cases = [
+        (
+            format!(
+                r#"<bsdf type="conductor">{}{k3}</bsdf>"#,
+                constant_checkerboard("eta", 2.5)
+            ),
+            format!(r#"<bsdf type="conductor"><rgb name="eta" value="2.5"/>{k3}</bsdf>"#),
+            r#"<bsdf type="conductor"/>"#.to_string(),
+        ),
+        (
+            format!(
+                r#"<bsdf type="roughconductor">{ggx}{eta02}{}</bsdf>"#,
+                constant_checkerboard("k", 3.7)
+            ),
+            format!(
+                r#"<bsdf type="roughconductor">{ggx}{eta02}<rgb name="k" value="3.7"/></bsdf>"#
+            ),
+            // `eta` 0 reflects everything whatever `k` is: the control keeps 0.2.
+            format!(r#"<bsdf type="roughconductor">{ggx}{eta02}</bsdf>"#),
+        ),
+        (
+            format!(r#"<bsdf type="conductor">{exr}{k3}</bsdf>"#),
+            format!(r#"<bsdf type="conductor">{eta_exr}{k3}</bsdf>"#),
+            r#"<bsdf type="conductor"/>"#.to_string(),
+        ),
+        (
+            blend(&format!("{exr}{k3}")),
+            blend(&format!("{eta_exr}{k3}")),
+            blend(""),
+        ),
+    ];
+    for (textured, constant, default) in &cases {
+        let t = render(dir.path(), textured);
+        let c = render(dir.path(), constant);
+        let d = render(dir.path(), default);
+        assert!(t == c, "{textured}: differs from its constant");
+        assert!(c != d, "{constant}: the control must differ");
+    }
+}
+
 #[test]
 fn bad_textures_are_one_error_line_naming_the_file() {
     let dir = tempfile::tempdir().unwrap();

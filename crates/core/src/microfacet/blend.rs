@@ -13,7 +13,7 @@
 //! [`crate::tint`]). A blend inside a blend is not represented: the loaders refuse it.
 
 use super::rough_plastic::AlphaTables;
-use super::{LocalBsdf, LocalSample, Microfacet, ParamTextures, ParamValues};
+use super::{IorValues, LocalBsdf, LocalSample, Microfacet, ParamTextures, ParamValues};
 use crate::texture::luminance;
 use crate::tint::TexturesAt;
 use crate::Rgb;
@@ -50,6 +50,8 @@ struct PartTint {
     color: Rgb,
     /// Its textured parameters.
     params: ParamValues,
+    /// A conductor's textured index of refraction.
+    ior: IorValues,
 }
 
 impl PartTint {
@@ -57,6 +59,7 @@ impl PartTint {
     const NONE: PartTint = PartTint {
         color: Rgb::ONE,
         params: ParamValues::NONE,
+        ior: IorValues::NONE,
     };
 }
 
@@ -90,6 +93,7 @@ impl BlendAt<'_> {
         let tint = |p: &BlendPart| PartTint {
             color: p.texture.map_or(Rgb::ONE, |i| at.color(i)),
             params: p.textures.lookup(&at.scene.textures, at.uv),
+            ior: p.textures.ior_at(&at),
         };
         let weight = b.weight_texture.map(|i| luminance(at.color(i)));
         b.at(weight, &[tint(&b.parts[0]), tint(&b.parts[1])])
@@ -140,7 +144,9 @@ impl Blend {
     /// The blend with the texture values `weight` (its textured weight) and `tints` in place.
     fn at(&self, weight: Option<f32>, tints: &[PartTint; 2]) -> Blended {
         let part = |p: &BlendPart, t: &PartTint| {
-            let m = p.bsdf.with_params(&t.params, p.alpha_tables.as_ref());
+            let m = p
+                .bsdf
+                .with_params(&t.params, &t.ior, p.alpha_tables.as_ref());
             let m = m.unwrap_or(p.bsdf);
             m.tinted(t.color).unwrap_or(m)
         };

@@ -32,7 +32,7 @@ pub use distribution::{Distribution, DistributionKind, MIN_ALPHA};
 pub use fresnel::fresnel_conductor;
 pub use plastic::{fresnel_diffuse_reflectance, Plastic};
 pub use rough_plastic::{AlphaTables, RoughPlastic, ALPHA_NODES};
-pub use textured::{ParamTextures, ParamValues};
+pub use textured::{IorValues, ParamTextures, ParamValues};
 pub use thin::ThinDielectric;
 
 use crate::Rgb;

@@ -10,11 +10,17 @@
 //! [`crate::texture::Texture::lookup`]; a roughness texel of 0 becomes
 //! [`super::MIN_ALPHA`], as a constant 0 does.
 //!
+//! A conductor's `eta` and `k` take textures too. They are not reflectances: they are read
+//! unclamped ([`Texture::lookup_unbounded`]), and where the BSDF is evaluated
+//! ([`ParamTextures::ior_at`]) rather than into [`ParamValues`], which every
+//! [`crate::material::Bsdf`] carries (see [`crate::tint`]).
+//!
 //! `roughplastic`'s `alpha` takes a texture too, which Mitsuba 3 refuses: its coating's
 //! tables come from [`AlphaTables`], computed over the texture's range when the scene loads.
 
 use super::{AlphaTables, Distribution, Microfacet};
 use crate::texture::{luminance, Texture};
+use crate::tint::TexturesAt;
 use crate::Rgb;
 use glam::Vec2;
 
@@ -32,6 +38,10 @@ pub struct ParamTextures {
     pub specular_transmittance: Option<u32>,
     /// A mask's opacity ([`crate::Material::opacity`]; any material type).
     pub opacity: Option<u32>,
+    /// A conductor's `eta` (real part of its index of refraction, per channel).
+    pub eta: Option<u32>,
+    /// A conductor's `k` (imaginary part).
+    pub k: Option<u32>,
 }
 
 /// The textured parameters' values at one surface point (`None`: the material's constant).
@@ -49,11 +59,66 @@ pub struct ParamValues {
     pub opacity: Option<f32>,
 }
 
+/// A conductor's textured index of refraction at one point (`None`: the constant).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct IorValues {
+    /// See [`ParamTextures::eta`].
+    pub eta: Option<Rgb>,
+    /// See [`ParamTextures::k`].
+    pub k: Option<Rgb>,
+}
+
+impl IorValues {
+    /// Both parts their constants.
+    pub const NONE: IorValues = IorValues { eta: None, k: None };
+}
+
 impl ParamTextures {
     /// True when no parameter is textured.
     #[inline]
     pub fn is_empty(&self) -> bool {
         *self == Self::default()
+    }
+
+    /// The text a material's content hash reads: the derived `Debug` form the struct had
+    /// before `eta` and `k`, which follow only when textured, so that scenes keep their hashes.
+    pub fn hash_text(&self) -> String {
+        let ParamTextures {
+            alpha_u,
+            alpha_v,
+            specular_reflectance,
+            specular_transmittance,
+            opacity,
+            eta,
+            k,
+        } = self;
+        let mut text = format!(
+            "ParamTextures {{ alpha_u: {alpha_u:?}, alpha_v: {alpha_v:?}, \
+             specular_reflectance: {specular_reflectance:?}, \
+             specular_transmittance: {specular_transmittance:?}, opacity: {opacity:?} }}"
+        );
+        if self.has_ior() {
+            text += &format!(" eta: {eta:?}, k: {k:?}");
+        }
+        text
+    }
+
+    /// True when `eta` or `k` is textured: the BSDF reads them where it is evaluated
+    /// ([`ParamTextures::ior_at`]), so the scene hands it where to ([`crate::tint::Tint::at`]).
+    #[inline]
+    pub fn has_ior(&self) -> bool {
+        self.eta.is_some() || self.k.is_some()
+    }
+
+    /// `eta` and `k` at `at`, unclamped.
+    #[inline]
+    pub fn ior_at(&self, at: &TexturesAt) -> IorValues {
+        let read =
+            |t: Option<u32>| t.map(|i| at.scene.textures[i as usize].lookup_unbounded(at.uv));
+        IorValues {
+            eta: read(self.eta),
+            k: read(self.k),
+        }
     }
 
     /// The values at `uv` of the textures in `textures`.
@@ -101,16 +166,21 @@ impl ParamValues {
 }
 
 impl Microfacet {
-    /// The BSDF with the textured parameters `v` in place of its constants; `None` when `v`
-    /// changes nothing. A parameter the type does not have is ignored (the loaders refuse
-    /// such textures). A rough plastic's textured roughness takes its coating's tables from
-    /// `tables` (without them, only its distribution changes).
-    pub fn with_params(&self, v: &ParamValues, tables: Option<&AlphaTables>) -> Option<Self> {
+    /// The BSDF with the textured parameters `v` and index of refraction `ior` in place of
+    /// its constants; `None` when they change nothing. A parameter the type does not have is
+    /// ignored (the loaders refuse such textures). A rough plastic's textured roughness takes
+    /// its coating's tables from `tables` (without them, only its distribution changes).
+    pub fn with_params(
+        &self,
+        v: &ParamValues,
+        ior: &IorValues,
+        tables: Option<&AlphaTables>,
+    ) -> Option<Self> {
         let v = ParamValues {
             opacity: None,
             ..*v
         };
-        if v.is_empty() {
+        if v.is_empty() && *ior == IorValues::NONE {
             return None;
         }
         let mut out = *self;
@@ -119,6 +189,12 @@ impl Microfacet {
                 c.distribution = c.distribution.map(|d| v.distribution(d));
                 if let Some(r) = v.specular_reflectance {
                     c.specular_reflectance = r;
+                }
+                if let Some(eta) = ior.eta {
+                    c.eta = eta;
+                }
+                if let Some(k) = ior.k {
+                    c.k = k;
                 }
             }
             Microfacet::Dielectric(d) => {
@@ -161,5 +237,26 @@ impl Microfacet {
             Microfacet::Diffuse(_) => {}
         }
         Some(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The hash text of textures without `eta` and `k` is the derived `Debug` form the
+    /// struct had before them.
+    #[test]
+    fn hash_text_is_the_old_debug_form() {
+        let t = ParamTextures {
+            alpha_u: Some(3),
+            opacity: Some(1),
+            ..ParamTextures::default()
+        };
+        let old = "ParamTextures { alpha_u: Some(3), alpha_v: None, specular_reflectance: None, \
+                   specular_transmittance: None, opacity: Some(1) }";
+        assert_eq!(t.hash_text(), old);
+        let eta = ParamTextures { eta: Some(2), ..t };
+        assert_eq!(eta.hash_text(), format!("{old} eta: Some(2), k: None"));
     }
 }

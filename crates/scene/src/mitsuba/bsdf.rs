@@ -256,7 +256,9 @@ fn convert_in<'a>(
                 t.insert("material".into(), m.into());
             }
             for key in ["eta", "k"] {
-                if let Some(c) = p.rgb(key, Role::Unbounded)? {
+                if let Some(tex) = p.named_texture(key, resolve)? {
+                    textures.push(texture(tex, key, warnings)?);
+                } else if let Some(c) = p.rgb(key, Role::Unbounded)? {
                     t.insert(key.into(), rgb(c));
                 }
             }
@@ -472,8 +474,13 @@ fn checkerboard(
     let p = Props::new(tex);
     let mut options = Table::new();
     options.insert("type".into(), "checkerboard".into());
+    // A conductor's index of refraction is not a reflectance: its colours are not clamped.
+    let role = match key {
+        "eta" | "k" => Role::Unbounded,
+        _ => Role::Reflectance,
+    };
     for c in ["color0", "color1"] {
-        if let Some(v) = p.rgb(c, Role::Reflectance)? {
+        if let Some(v) = p.rgb(c, role)? {
             options.insert(c.into(), rgb(v));
         }
     }
