@@ -308,20 +308,28 @@ fn check_keys(ctx: &Ctx, d: &GeometryDesc, kind: &Kind) -> Result<()> {
     ];
     let (allowed, required, what): (&[&str], &[&str], String) = match kind {
         Kind::File(_) => (&["smooth", "flip_v"], &[], "a mesh file".into()),
-        Kind::Shape("quad", _) => (&["vertices"], &["vertices"], "shape \"quad\"".into()),
-        Kind::Shape("box", _) => (&["min", "max"], &["min", "max"], "shape \"box\"".into()),
+        Kind::Shape("quad", _) => (
+            &["vertices", "flip_v"],
+            &["vertices"],
+            "shape \"quad\"".into(),
+        ),
+        Kind::Shape("box", _) => (
+            &["min", "max", "flip_v"],
+            &["min", "max"],
+            "shape \"box\"".into(),
+        ),
         Kind::Shape("sphere", _) => (
             &["center", "radius", "subdivisions", "smooth"],
             &["radius"],
             "shape \"sphere\"".into(),
         ),
         Kind::Shape("cylinder", _) => (
-            &["p0", "p1", "radius", "segments", "smooth"],
+            &["p0", "p1", "radius", "segments", "smooth", "flip_v"],
             &["radius"],
             "shape \"cylinder\"".into(),
         ),
         Kind::Shape(_, _) => (
-            &["center", "normal", "radius", "segments"],
+            &["center", "normal", "radius", "segments", "flip_v"],
             &["radius"],
             "shape \"disk\"".into(),
         ),

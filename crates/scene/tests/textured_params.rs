@@ -389,3 +389,81 @@ fn a_checkerboard_roughness_on_rough_plastic_renders_each_square_as_its_constant
         "{neither} of {seen} pixels match no constant"
     );
 }
+
+/// Mitsuba reads a bitmap with v = 0 at its top row and evaluates a checkerboard on its own
+/// uvs, whose v is 1 − ours on every shape: seen face-on, the bottom of a rectangle (local
+/// y = −1, Mitsuba's v = 0) shows the bitmap's top row and the checkerboard's colour at
+/// Mitsuba's v. Control: each texture's two colours differ between the bottom and the top, so
+/// a texture read in the wrong v shows the wrong colour at both.
+#[test]
+fn textures_on_a_rectangle_and_a_mesh_read_mitsubas_v() {
+    let dir = tempfile::tempdir().unwrap();
+    // Top row red, bottom row blue.
+    image::RgbImage::from_fn(1, 2, |_, y| {
+        image::Rgb(if y == 0 { [255, 0, 0] } else { [0, 0, 255] })
+    })
+    .save(dir.path().join("rows.png"))
+    .unwrap();
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../tools/reference/bump-plane.obj"),
+        dir.path().join("plane.obj"),
+    )
+    .unwrap();
+    let bitmap = r#"<texture type="bitmap" name="reflectance"><string name="filename" value="rows.png"/>
+        <string name="filter_type" value="nearest"/></texture>"#;
+    // Mitsuba's v + 0.1: red for v < 0.4 and v > 0.9, blue between (u < ½).
+    let checker = r#"<texture type="checkerboard" name="reflectance"><rgb name="color0" value="1, 0, 0"/>
+        <rgb name="color1" value="0, 0, 1"/><transform name="to_uv"><translate y="0.1"/></transform></texture>"#;
+    // The plane mesh spans [-2, 2]² in x-z with uvs 0..2 (v = 0 at z = 2, the files'
+    // convention); stood up facing the camera and scaled to [-1, 1]², its uvs are 0..2 from
+    // the bottom up in the file's v, so Mitsuba's v (its flip) runs 1..−1: a checkerboard
+    // repeats, its colour at the bottom (Mitsuba's v ≈ 0.86 + 1) is blue, at the top
+    // (Mitsuba's v ≈ −0.86) red.
+    let cases = [
+        ("rectangle", "", bitmap, [1.0, 0.0], "the bitmap's top row"),
+        ("rectangle", "", checker, [1.0, 0.0], "the checkerboard at Mitsuba's v"),
+        (
+            "obj",
+            r#"<string name="filename" value="plane.obj"/>"#,
+            checker,
+            [0.0, 1.0],
+            "the checkerboard at Mitsuba's v on a mesh",
+        ),
+    ];
+    for (shape, file, texture, [bottom_red, top_red], what) in cases {
+        let to_world = if shape == "obj" {
+            r#"<scale value="0.5"/><rotate x="1" angle="90"/>"#
+        } else {
+            ""
+        };
+        let xml = format!(
+            r#"<scene version="3.0.0">
+    <integrator type="path"><integer name="max_depth" value="2"/></integrator>
+    <sensor type="perspective"><float name="fov" value="45"/>
+        <transform name="to_world"><lookat origin="0, 0, 2" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/>
+            <rfilter type="box"/></film>
+    </sensor>
+    <shape type="{shape}">{file}<transform name="to_world">{to_world}</transform>
+        <bsdf type="diffuse">{texture}</bsdf></shape>
+    <emitter type="constant"><rgb name="radiance" value="1, 1, 1"/></emitter>
+</scene>"#
+        );
+        std::fs::write(dir.path().join("v.xml"), xml).unwrap();
+        let s = rt_scene::load(&dir.path().join("v.xml")).unwrap_or_else(|e| panic!("{e}"));
+        let film = rt_testkit::render(&s.scene, &rt_integrators::PathIntegrator::new(2), 4, 1);
+        let image = film.mean_image();
+        // The left column's top and bottom pixels (u < ½ on both shapes).
+        let red = |row: usize| {
+            let p = image[row * 8];
+            (p.x > 0.5 && p.z < 0.1) as u8 as f32
+        };
+        assert_eq!(
+            [red(7), red(0)],
+            [bottom_red, top_red],
+            "{shape}: {what} (bottom, top: {}, {})",
+            image[56],
+            image[0]
+        );
+    }
+}

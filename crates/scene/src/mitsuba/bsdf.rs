@@ -5,6 +5,7 @@
 //! `bump_scale`) and `normal_map` on what they wrap, `blendbsdf` a `blendbsdf` table whose
 //! two BSDFs become materials of their own ([`Converted::parts`]).
 
+use rt_core::glam::DMat4;
 use toml::{Table, Value};
 
 use super::props::{Color, Props};
@@ -484,10 +485,11 @@ fn checkerboard(
             options.insert(c.into(), rgb(v));
         }
     }
-    if let Some(m) = p.transform("to_uv")? {
-        let row = |r: usize| rgb([m.col(0)[r], m.col(1)[r], m.col(3)[r]]);
-        options.insert("to_uv".into(), Value::Array(vec![row(0), row(1)]));
-    }
+    // Mitsuba's checkerboard reads Mitsuba's uv, whose v is 1 − ours on every shape (see the
+    // shapes in `scene.rs`): `to_uv` after `(u, v) ↦ (u, 1 − v)`.
+    let m = p.transform("to_uv")?.unwrap_or(DMat4::IDENTITY);
+    let row = |r: usize| rgb([m.col(0)[r], -m.col(1)[r], m.col(1)[r] + m.col(3)[r]]);
+    options.insert("to_uv".into(), Value::Array(vec![row(0), row(1)]));
     p.finish(warnings)?;
     Ok(TextureKey {
         key,

@@ -477,6 +477,8 @@ impl<'a> Builder<'a, '_> {
                 g.insert("p1".into(), arr(p1));
                 g.insert("radius".into(), r.into());
                 g.insert("segments".into(), CYLINDER_SEGMENTS.into());
+                // Mitsuba's parameterisation, in our v convention (see "rectangle").
+                g.insert("flip_v".into(), true.into());
                 self.warnings.push(n.at.warning(format!(
                     "shape \"cylinder\" tessellated into {} triangles",
                     2 * CYLINDER_SEGMENTS
@@ -487,6 +489,10 @@ impl<'a> Builder<'a, '_> {
                 let corners = [[-1, -1], [1, -1], [1, 1], [-1, 1]]
                     .map(|[x, y]| arr(DVec3::new(x as f64, y as f64, 0.0)));
                 g.insert("vertices".into(), Value::Array(corners.to_vec()));
+                // The quad's uvs are Mitsuba's `((x + 1) / 2, (y + 1) / 2)`. Mitsuba reads a
+                // bitmap with v = 0 at its top row, we at its bottom row (the OBJ files'
+                // convention, which Mitsuba flips into its own): our v is Mitsuba's 1 − v.
+                g.insert("flip_v".into(), true.into());
             }
             "cube" => {
                 g.insert("shape".into(), "box".into());
