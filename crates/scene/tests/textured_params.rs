@@ -414,14 +414,19 @@ fn textures_on_a_rectangle_and_a_mesh_read_mitsubas_v() {
     // Mitsuba's v + 0.1: red for v < 0.4 and v > 0.9, blue between (u < ½).
     let checker = r#"<texture type="checkerboard" name="reflectance"><rgb name="color0" value="1, 0, 0"/>
         <rgb name="color1" value="0, 0, 1"/><transform name="to_uv"><translate y="0.1"/></transform></texture>"#;
-    // The plane mesh spans [-2, 2]² in x-z with uvs 0..2 (v = 0 at z = 2, the files'
-    // convention); stood up facing the camera and scaled to [-1, 1]², its uvs are 0..2 from
-    // the bottom up in the file's v, so Mitsuba's v (its flip) runs 1..−1: a checkerboard
-    // repeats, its colour at the bottom (Mitsuba's v ≈ 0.86 + 1) is blue, at the top
-    // (Mitsuba's v ≈ −0.86) red.
+    // The plane mesh (x-z in [-2, 2]², uvs 0..2 with v = 0 at z = 2, the file's convention)
+    // stood up and halved: its file v runs 0..2 from the bottom up, Mitsuba's (1 − v) 1..−1.
+    // The left column's bottom pixel (file v ≈ 0.28, Mitsuba's ≈ 0.72) is blue, its top
+    // pixel (≈ 1.72, ≈ −0.72) red.
     let cases = [
         ("rectangle", "", bitmap, [1.0, 0.0], "the bitmap's top row"),
-        ("rectangle", "", checker, [1.0, 0.0], "the checkerboard at Mitsuba's v"),
+        (
+            "rectangle",
+            "",
+            checker,
+            [1.0, 0.0],
+            "the checkerboard at Mitsuba's v",
+        ),
         (
             "obj",
             r#"<string name="filename" value="plane.obj"/>"#,
