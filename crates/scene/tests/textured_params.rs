@@ -472,3 +472,38 @@ fn textures_on_a_rectangle_and_a_mesh_read_mitsubas_v() {
         );
     }
 }
+
+/// A texture on a shape whose uvs are not Mitsuba's (sphere, cube, disk) is a warning naming
+/// the shape, nested or by reference; the same shape without a texture, or a rectangle with
+/// one, is not.
+#[test]
+fn textures_on_shapes_without_mitsubas_uvs_are_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    image::RgbImage::from_pixel(2, 2, image::Rgb([255, 0, 255]))
+        .save(dir.path().join("magenta.png"))
+        .unwrap();
+    let textured = r#"<bsdf type="diffuse"><ref name="reflectance" id="magenta"/></bsdf>"#;
+    let blended = r#"<bsdf type="blendbsdf"><float name="weight" value="0.5"/><bsdf type="diffuse"/>
+        <bsdf type="diffuse"><ref name="reflectance" id="magenta"/></bsdf></bsdf>"#;
+    let plain = r#"<bsdf type="diffuse"/>"#;
+    for (shape, bsdf, warned) in [
+        ("sphere", textured, true),
+        ("cube", blended, true),
+        ("disk", textured, true),
+        ("sphere", plain, false),
+        ("rectangle", textured, false),
+    ] {
+        let xml = scene(bsdf).replace(
+            r#"<shape type="rectangle">"#,
+            &format!(r#"<shape type="{shape}">"#),
+        );
+        std::fs::write(dir.path().join("w.xml"), xml).unwrap();
+        let s = rt_scene::load(&dir.path().join("w.xml")).unwrap_or_else(|e| panic!("{e}"));
+        let said = s.warnings.iter().any(|w| {
+            w.contains(&format!(
+                "shape \"{shape}\": its texture coordinates are not Mitsuba's"
+            ))
+        });
+        assert_eq!(said, warned, "{shape} {bsdf}: {:?}", s.warnings);
+    }
+}

@@ -155,6 +155,21 @@ fn arr(v: DVec3) -> Value {
 }
 
 /// The element a `<ref id>` names.
+/// True if BSDF `b` reads a texture, nested or by reference, in it or in its nested BSDFs.
+fn reads_texture(ids: &HashMap<String, &Node>, b: &Node) -> bool {
+    b.children.iter().any(|c| {
+        let t = if c.tag == "ref" {
+            match resolve(ids, c) {
+                Ok(t) => t,
+                Err(_) => return false,
+            }
+        } else {
+            c
+        };
+        t.tag == "texture" || (t.tag == "bsdf" && reads_texture(ids, t))
+    })
+}
+
 fn resolve<'a>(ids: &HashMap<String, &'a Node>, r: &Node) -> Result<&'a Node, SceneError> {
     let id = r.attr("id").ok_or_else(|| r.at.error("<ref> has no id"))?;
     ids.get(id).copied().ok_or_else(|| {
@@ -542,6 +557,16 @@ impl<'a> Builder<'a, '_> {
                 )));
             }
             bsdfs.push(target);
+        }
+        // Our sphere has no uvs, and our cube's and disk's are not Mitsuba's: say so rather
+        // than render other texels than Mitsuba does.
+        if matches!(ty, "sphere" | "cube" | "disk")
+            && bsdfs.iter().any(|b| reads_texture(&self.ids, b))
+        {
+            self.warnings.push(n.at.warning(format!(
+                "shape \"{ty}\": its texture coordinates are not Mitsuba's, so its BSDF's \
+                 textures read other texels than in Mitsuba"
+            )));
         }
         let (base, table) = match bsdfs.as_slice() {
             [] => default_material(),
