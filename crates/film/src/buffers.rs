@@ -75,6 +75,18 @@ pub struct LateSums {
     pub filtered: bool,
 }
 
+impl std::ops::BitOr for LateSums {
+    type Output = LateSums;
+
+    /// The sums either makes (a merge of parts that made either).
+    fn bitor(self, o: LateSums) -> LateSums {
+        LateSums {
+            light_splats: self.light_splats | o.light_splats,
+            filtered: self.filtered | o.filtered,
+        }
+    }
+}
+
 /// Bytes held by each of a film's buffers (length × element size); `None` for a buffer the
 /// film did not allocate.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

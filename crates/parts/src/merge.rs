@@ -197,11 +197,7 @@ pub fn merge(parts: &[(String, Part)], memory_limit: Option<u64>) -> Result<Merg
     })?;
     // The sums a part made late (light-path splats, filtered sums) the merged film makes too.
     let late = parts.iter().fold(LateSums::default(), |l, (_, p)| {
-        let f = Film::encoded_late_sums(&p.sums);
-        LateSums {
-            light_splats: l.light_splats | f.light_splats,
-            filtered: l.filtered | f.filtered,
-        }
+        l | Film::encoded_late_sums(&p.sums)
     });
     let need = FilmMemory::estimate(w, hgt, buffers, 0, late).total() as u64;
     if let Some(limit) = memory_limit {
